@@ -1,0 +1,1 @@
+"""Pictures: floor plans, overlays on video, evaluation plots. Sinks only; no tracking state."""
