@@ -132,10 +132,9 @@ class Camera:
         K, R = scipy.linalg.rq(Pn[:, :3])
         D = np.diag(np.sign(np.diag(K)))
         K, R = K @ D, D @ R
+        # ‖P[2, :3]‖ = 1 and R orthonormal make K[2, 2] = 1 already; remove rounding only.
+        K = K / K[2, 2]
         t = np.linalg.solve(K, Pn[:, 3])
-        scale = K[2, 2]
-        K = K / scale
-        t = t / scale
         K[1, 0] = K[2, 0] = K[2, 1] = 0.0
         return cls(id, int(width), int(height), K, R, t, dist)
 
@@ -241,21 +240,36 @@ class Camera:
         yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
         return np.stack([xd, yd], axis=1)
 
-    def undistort_normalised(self, xy_distorted: np.ndarray, iterations: int = 30) -> np.ndarray:
-        """Invert :meth:`distort_normalised` by fixed-point iteration (as OpenCV does), (N, 2)."""
+    def undistort_normalised(self, xy_distorted: np.ndarray, max_iterations: int = 200,
+                             tol: float = 1e-12) -> np.ndarray:
+        """Invert :meth:`distort_normalised` by fixed-point iteration (as OpenCV does), (N, 2).
+
+        Iterates until no point moves by more than ``tol`` (normalised units) or
+        ``max_iterations``. Points with no solution (beyond the range where the distortion
+        polynomial is monotonic) come back NaN.
+        """
         if not self.has_distortion:
             return xy_distorted
         k1, k2, p1, p2, k3 = self.dist
         xd, yd = xy_distorted[:, 0], xy_distorted[:, 1]
         x, y = xd.copy(), yd.copy()
-        for _ in range(iterations):
+        for _ in range(max_iterations):
             r2 = x * x + y * y
             radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
             dx = 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
             dy = p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
-            x = (xd - dx) / radial
-            y = (yd - dy) / radial
-        return np.stack([x, y], axis=1)
+            xn = (xd - dx) / radial
+            yn = (yd - dy) / radial
+            change = np.nanmax(np.abs(np.concatenate([xn - x, yn - y]))) if len(xn) else 0.0
+            x, y = xn, yn
+            if not change > tol:
+                break
+        out = np.stack([x, y], axis=1)
+        # Pixels beyond the lens's monotonic range have no ray: the iteration then settles on
+        # a point that does not distort back to the pixel. Mark those NaN.
+        bad = np.abs(self.distort_normalised(out) - xy_distorted).max(axis=1) > 1e-7
+        out[bad] = np.nan
+        return out
 
     def _normalised_to_pixels(self, xy: np.ndarray) -> np.ndarray:
         K = self.K
