@@ -1,0 +1,550 @@
+"""Track files: what trackers write and what evaluation reads.
+
+Two headered CSV formats that open in a spreadsheet, plus MOTChallenge text for other tools.
+
+``tracks.csv`` (tracker output), one row per person per frame::
+
+    frame,time,id,x,y,height,width,score,mode,flags[,extra…]
+
+``frame`` counts from 0, ``time`` is seconds, ``id`` is an integer from 1, ``x, y, height,
+width`` are metres, ``mode`` is a word (``capture``, ``tracking``…) and ``flags`` is a
+``;``-separated list of words (``unmeasurable``), possibly empty. Trackers may append columns
+(``sx,sy,sz`` box sizes…); readers keep them.
+
+``gt.csv`` (ground truth from the synthetic-world renderer)::
+
+    frame,time,id,x,y,z_head,height,width,speed,vis_<cam>,head_<cam>,feet_<cam>,…
+
+MOTChallenge text (``frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z``, no header,
+frames and ids from 1, ``-1`` for unknown) is read when the file has no header and at least ten
+numeric columns; ``x, y, z`` (columns 8–10) are world coordinates in metres. Frames become
+0-based on reading and 1-based again on writing; ids are 1-based in both.
+
+>>> with TracksWriter("tracks.csv") as out:                         # doctest: +SKIP
+...     out.write(0, 0.0, [{"id": 1, "x": 1.2, "y": 0.4, "mode": "capture"}])
+>>> table = read_tracks("tracks.csv")                                # doctest: +SKIP
+>>> table.xy                                                         # doctest: +SKIP
+array([[1.2, 0.4]])
+"""
+
+from __future__ import annotations
+
+import csv
+import enum
+import io
+import math
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from worldtrack.errors import InputError
+
+#: Columns of ``tracks.csv``, in order; trackers may append more.
+TRACK_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "height", "width", "score",
+                                  "mode", "flags")
+#: Columns of ``gt.csv`` before the per-camera ``vis_<cam>, head_<cam>, feet_<cam>`` triples.
+GT_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "z_head", "height", "width",
+                               "speed")
+#: Columns of a MOTChallenge text file (1-based frames and ids, ``-1`` = unknown).
+MOT_COLUMNS: tuple[str, ...] = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height",
+                                "conf", "x", "y", "z")
+
+_CORE = ("frame", "time", "id", "x", "y")
+_REQUIRED = ("frame", "id", "x", "y")
+# Extra columns that must be numbers (empty cells read as NaN) and ones that are always text.
+_FLOAT_COLUMNS = frozenset({"height", "width", "score", "z_head", "speed", "sx", "sy", "sz",
+                            "bb_left", "bb_top", "bb_width", "bb_height", "conf", "z"})
+_FLOAT_PREFIXES = ("vis_", "head_", "feet_")
+_TEXT_COLUMNS = frozenset({"mode", "flags"})
+_SPLIT_MOT = re.compile(r"[,\s]+")
+
+
+# --------------------------------------------------------------------------------------------
+# The table
+# --------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class TrackTable:
+    """Rows of (frame, id) → position, as NumPy columns; one row per person per frame.
+
+    Parameters
+    ----------
+    frame : (N,) int64
+        Frame index from 0.
+    time : (N,) float64, seconds
+        Time stamp; NaN where the file had none.
+    id : (N,) int64
+        Track id from 1.
+    x, y : (N,) float64, metres
+        Position on the floor.
+    extra : dict of str → (N,) ndarray
+        Every other column, in file order: float64 for numbers, ``str`` arrays for text.
+    source : str
+        Where the rows came from (a file name), for error messages.
+    """
+
+    frame: np.ndarray
+    time: np.ndarray
+    id: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "frame", np.asarray(self.frame, dtype=np.int64).reshape(-1))
+        set_(self, "id", np.asarray(self.id, dtype=np.int64).reshape(-1))
+        for name in ("time", "x", "y"):
+            set_(self, name, np.asarray(getattr(self, name), dtype=float).reshape(-1))
+        extra = {str(k): np.asarray(v).reshape(-1) for k, v in dict(self.extra).items()}
+        set_(self, "extra", extra)
+        n = self.frame.shape[0]
+        for name in (*_CORE, *extra):
+            if self.column(name).shape[0] != n:
+                raise ValueError(f"TrackTable: column {name!r} has {self.column(name).shape[0]} "
+                                 f"rows, frame has {n}")
+        clash = set(extra) & set(_CORE)
+        if clash:
+            raise ValueError(f"TrackTable: extra columns repeat core columns: {sorted(clash)}")
+
+    @classmethod
+    def from_arrays(cls, frame: ArrayLike, id: ArrayLike, x: ArrayLike, y: ArrayLike,
+                    time: ArrayLike | None = None, extra: Mapping[str, ArrayLike] | None = None,
+                    source: str = "") -> "TrackTable":
+        """Build a table from columns; ``time`` defaults to NaN."""
+        frame = np.asarray(frame)
+        if time is None:
+            time = np.full(frame.shape, np.nan)
+        return cls(frame=frame, time=np.asarray(time), id=np.asarray(id), x=np.asarray(x),
+                   y=np.asarray(y), extra={k: np.asarray(v) for k, v in (extra or {}).items()},
+                   source=source)
+
+    def __len__(self) -> int:
+        return int(self.frame.shape[0])
+
+    @property
+    def xy(self) -> np.ndarray:
+        """(N, 2) float64, metres: ``x, y`` side by side."""
+        return np.column_stack([self.x, self.y])
+
+    @property
+    def columns(self) -> list[str]:
+        """All column names: ``frame, time, id, x, y`` then the extra columns in file order."""
+        return [*_CORE, *self.extra]
+
+    def column(self, name: str) -> np.ndarray:
+        """One column by name (core or extra); ``KeyError`` if there is none."""
+        if name in _CORE:
+            return getattr(self, name)
+        return self.extra[name]
+
+    def frames(self) -> np.ndarray:
+        """Sorted distinct frame indices."""
+        return np.unique(self.frame)
+
+    def ids(self) -> np.ndarray:
+        """Sorted distinct track ids."""
+        return np.unique(self.id)
+
+    def select(self, rows: ArrayLike) -> "TrackTable":
+        """Rows by boolean mask (N,) or integer index, as a new table."""
+        rows = np.asarray(rows)
+        return TrackTable(frame=self.frame[rows], time=self.time[rows], id=self.id[rows],
+                          x=self.x[rows], y=self.y[rows],
+                          extra={k: v[rows] for k, v in self.extra.items()}, source=self.source)
+
+    def sorted(self) -> "TrackTable":
+        """Rows ordered by frame, then id (stable)."""
+        order = np.lexsort((self.id, self.frame))
+        return self.select(order)
+
+
+# --------------------------------------------------------------------------------------------
+# Reading
+# --------------------------------------------------------------------------------------------
+
+def read_tracks(path: str | Path) -> TrackTable:
+    """Read ``tracks.csv``, ``gt.csv`` or MOTChallenge text into a :class:`TrackTable`.
+
+    A headered CSV needs at least ``frame, id, x, y``; ``time`` is optional (NaN if absent) and
+    every other column is kept in ``extra``. A file without a header whose first line has at
+    least ten numbers is read as MOTChallenge (frames made 0-based; world ``x, y`` from columns
+    8–9, ``z`` and the box kept as extras).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    TrackTable
+        Sorted by frame, then id.
+
+    Raises
+    ------
+    InputError
+        One line naming the file and, where it applies, the line and column: a missing file,
+        an empty file, missing columns, a cell that is not a number, a row with the wrong number
+        of fields, a negative frame, an id below 1, or two rows for the same (frame, id).
+    """
+    name = str(path)
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as f:
+            text = f.read()
+    except FileNotFoundError:
+        raise InputError(f"{name}: no such file") from None
+    except IsADirectoryError:
+        raise InputError(f"{name}: is a directory, expected a track file") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{name}: not a text file (expected UTF-8 CSV)") from None
+    except OSError as e:
+        raise InputError(f"{name}: cannot read: {e.strerror or e}") from None
+
+    first = next((line for line in text.splitlines() if line.strip()), None)
+    if first is None:
+        raise InputError(f"{name}: empty file")
+    tokens = [t for t in _SPLIT_MOT.split(first.strip()) if t]
+    if all(_is_number(t) for t in tokens):
+        if len(tokens) < len(MOT_COLUMNS):
+            raise InputError(f"{name}: line 1: no header and only {len(tokens)} numeric columns; "
+                             f"expected a CSV header (frame,id,x,y,…) or MOTChallenge text with "
+                             f"{len(MOT_COLUMNS)} columns")
+        return _read_mot(text, name)
+    return _read_csv(text, name)
+
+
+def _read_csv(text: str, name: str) -> TrackTable:
+    reader = csv.reader(io.StringIO(text))
+    header: list[str] | None = None
+    cells: list[list[str]] = []
+    lines: list[int] = []
+    for record in reader:
+        if not any(c.strip() for c in record):
+            continue
+        if header is None:
+            header = [c.strip() for c in record]
+            if "" in header:
+                raise InputError(f"{name}: line {reader.line_num}: empty column name in header")
+            dup = sorted({c for c in header if header.count(c) > 1})
+            if dup:
+                raise InputError(f"{name}: line {reader.line_num}: repeated columns: {', '.join(dup)}")
+            missing = [c for c in _REQUIRED if c not in header]
+            if missing:
+                hint = ""
+                if len(header) == 1 and any(sep in header[0] for sep in ";\t"):
+                    hint = " (the header is one column: columns must be separated by commas)"
+                raise InputError(f"{name}: missing columns: {', '.join(missing)}{hint}")
+            continue
+        if len(record) != len(header):
+            raise InputError(f"{name}: line {reader.line_num}: expected {len(header)} fields "
+                             f"({','.join(header)}), got {len(record)}")
+        cells.append([c.strip() for c in record])
+        lines.append(reader.line_num)
+    assert header is not None  # the caller saw a non-blank first line
+    line_no = np.asarray(lines, dtype=np.int64)
+    cols = list(zip(*cells)) if cells else [() for _ in header]
+    raw = {h: np.asarray(c, dtype=str) for h, c in zip(header, cols)}
+
+    frame = _integers(raw["frame"], "frame", line_no, name, minimum=0)
+    ids = _integers(raw["id"], "id", line_no, name, minimum=1)
+    x = _floats(raw["x"], "x", line_no, name, allow_empty=False)
+    y = _floats(raw["y"], "y", line_no, name, allow_empty=False)
+    if "time" in raw:
+        time = _floats(raw["time"], "time", line_no, name, allow_empty=True, finite=False)
+    else:
+        time = np.full(len(cells), np.nan)
+    extra: dict[str, np.ndarray] = {}
+    for h in header:
+        if h in _CORE:
+            continue
+        if h in _TEXT_COLUMNS:
+            extra[h] = raw[h]
+        elif h in _FLOAT_COLUMNS or h.startswith(_FLOAT_PREFIXES):
+            extra[h] = _floats(raw[h], h, line_no, name, allow_empty=True, finite=False)
+        else:
+            extra[h] = _guess(raw[h])
+    return _finish(TrackTable(frame=frame, time=time, id=ids, x=x, y=y, extra=extra, source=name),
+                   line_no)
+
+
+def _read_mot(text: str, name: str) -> TrackTable:
+    rows: list[list[str]] = []
+    lines: list[int] = []
+    width = None
+    for i, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        tokens = [t for t in _SPLIT_MOT.split(line.strip()) if t]
+        if width is None:
+            width = len(tokens)
+        elif len(tokens) != width:
+            raise InputError(f"{name}: line {i}: expected {width} fields (MOTChallenge), "
+                             f"got {len(tokens)}")
+        rows.append(tokens)
+        lines.append(i)
+    assert width is not None
+    line_no = np.asarray(lines, dtype=np.int64)
+    names = list(MOT_COLUMNS) + [f"col_{k + 1}" for k in range(len(MOT_COLUMNS), width)]
+    raw = np.asarray(rows, dtype=str)
+    col = {n: raw[:, k] for k, n in enumerate(names)}
+
+    frame = _integers(col["frame"], "frame", line_no, name, minimum=1) - 1
+    ids = _integers(col["id"], "id", line_no, name, minimum=1)
+    x = _floats(col["x"], "x", line_no, name, allow_empty=False)
+    y = _floats(col["y"], "y", line_no, name, allow_empty=False)
+    extra = {n: _floats(col[n], n, line_no, name, allow_empty=False, finite=False)
+             for n in names if n not in ("frame", "id", "x", "y")}
+    if np.all(x == -1) and np.all(y == -1) and np.all(extra["z"] == -1):
+        raise InputError(f"{name}: MOTChallenge file without world coordinates (columns 8-10, "
+                         f"x,y,z, are all -1); worldtrack evaluates positions in metres")
+    return _finish(TrackTable(frame=frame, time=np.full(len(rows), np.nan), id=ids, x=x, y=y,
+                              extra=extra, source=name), line_no)
+
+
+def _finish(table: TrackTable, line_no: np.ndarray) -> TrackTable:
+    """Sort by (frame, id) and reject duplicate rows, naming both lines."""
+    order = np.lexsort((table.id, table.frame))
+    table = table.select(order)
+    line_no = line_no[order]
+    same = (np.diff(table.frame) == 0) & (np.diff(table.id) == 0)
+    if np.any(same):
+        k = int(np.flatnonzero(same)[0])
+        a, b = sorted((int(line_no[k]), int(line_no[k + 1])))
+        raise InputError(f"{table.source}: line {b}: duplicate row for frame {table.frame[k]}, "
+                         f"id {table.id[k]} (first at line {a})")
+    return table
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _floats(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
+            allow_empty: bool, finite: bool = True) -> np.ndarray:
+    """Parse a column of strings to float64; the first bad cell raises with its line number."""
+    vals = np.where(values == "", "nan", values) if allow_empty else values
+    try:
+        out = vals.astype(float) if vals.size else np.zeros(0)
+    except ValueError:
+        out = None
+    bad = np.zeros(values.shape, bool)
+    if out is None:
+        bad = np.array([not _is_number(v) for v in vals], dtype=bool)
+        if not np.any(bad):  # text NumPy refuses but Python's float() accepts ("1_000")
+            out = np.array([float(v) for v in vals])
+    if finite and out is not None:
+        bad = ~np.isfinite(out)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        what = "a number" if out is None else "a finite number"
+        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected {what}, "
+                         f"got {str(values[k])!r}")
+    assert out is not None
+    return out
+
+
+def _integers(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
+              minimum: int) -> np.ndarray:
+    out = _floats(values, column, line_no, name, allow_empty=False)
+    bad = out != np.round(out)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected an integer, "
+                         f"got {str(values[k])!r}")
+    low = out < minimum
+    if np.any(low):
+        k = int(np.flatnonzero(low)[0])
+        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected an integer "
+                         f">= {minimum}, got {str(values[k])!r}")
+    return out.astype(np.int64)
+
+
+def _guess(values: np.ndarray) -> np.ndarray:
+    """An unknown extra column: float64 if every non-empty cell is a number, else text."""
+    filled = values != ""
+    if not np.any(filled):
+        return values
+    try:
+        return np.where(filled, values, "nan").astype(float)
+    except ValueError:
+        return values
+
+
+# --------------------------------------------------------------------------------------------
+# Writing
+# --------------------------------------------------------------------------------------------
+
+def _fmt_float(v: Any) -> str:
+    """Shortest text that reads back to the same float; NaN and None as an empty cell."""
+    if v is None:
+        return ""
+    f = float(v)
+    return "" if math.isnan(f) else repr(f)
+
+
+def _fmt_cell(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, enum.Enum):
+        v = v.value
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (bool, np.bool_)):
+        return str(int(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return _fmt_float(v)
+    if isinstance(v, Iterable):
+        return ";".join(_fmt_cell(w) for w in v)
+    return str(v)
+
+
+def _get(track: Any, key: str, default: Any = None) -> Any:
+    if isinstance(track, Mapping):
+        return track.get(key, default)
+    return getattr(track, key, default)
+
+
+def _open_for_writing(path: str | Path) -> TextIO:
+    try:
+        return open(path, "w", encoding="utf-8", newline="")
+    except OSError as e:
+        raise InputError(f"{path}: cannot write: {e.strerror or e}") from None
+
+
+class TracksWriter:
+    """Stream ``tracks.csv`` as a tracker runs; every :meth:`write` is flushed to disk.
+
+    The header is written when the writer is created, so an interrupted run (Ctrl-C, a crash)
+    leaves a valid file with every frame written so far.
+
+    Parameters
+    ----------
+    path : str or Path
+        Output file; replaced if it exists.
+    extra_columns : sequence of str
+        Columns after :data:`TRACK_COLUMNS` (e.g. ``("sx", "sy", "sz")``), read from each track
+        by attribute or key; missing values are left empty.
+
+    Examples
+    --------
+    >>> with TracksWriter("tracks.csv", extra_columns=("sx",)) as out:   # doctest: +SKIP
+    ...     for frame, t, tracks in run():
+    ...         out.write(frame, t, tracks)
+    """
+
+    def __init__(self, path: str | Path, extra_columns: Sequence[str] = ()):
+        self.path = Path(path)
+        self.extra_columns = tuple(str(c) for c in extra_columns)
+        clash = [c for c in self.extra_columns if c in TRACK_COLUMNS]
+        if clash or len(set(self.extra_columns)) != len(self.extra_columns):
+            raise ValueError(f"TracksWriter: extra_columns must be new, distinct names, got "
+                             f"{list(self.extra_columns)}")
+        self.columns = TRACK_COLUMNS + self.extra_columns
+        self.rows_written = 0
+        self._file: TextIO | None = _open_for_writing(self.path)
+        self._csv = csv.writer(self._file, lineterminator="\n")
+        self._csv.writerow(self.columns)
+        self._file.flush()
+
+    def write(self, frame: int, time: float, tracks: Iterable[Any]) -> None:
+        """Append one row per track for this frame and flush.
+
+        Parameters
+        ----------
+        frame : int
+            Frame index from 0.
+        time : float, seconds
+        tracks : iterable of objects or mappings
+            Each has ``id`` (int ≥ 1) and ``x, y`` (metres) — or ``xy``/``position`` (2+,) —
+            and optionally ``height, width`` (metres), ``score``, ``mode`` (str or Enum),
+            ``flags`` (str or iterable of str) and the extra columns.
+        """
+        if self._file is None:
+            raise ValueError(f"TracksWriter({self.path}): write after close")
+        frame = int(frame)
+        if frame < 0:
+            raise ValueError(f"TracksWriter: frame must be >= 0, got {frame}")
+        rows = []
+        for t in tracks:
+            tid = int(_get(t, "id"))
+            if tid < 1:
+                raise ValueError(f"TracksWriter: track ids start at 1, got {tid}")
+            x, y = _get(t, "x"), _get(t, "y")
+            if x is None or y is None:
+                xy = _get(t, "xy")
+                if xy is None:
+                    xy = _get(t, "position")
+                x, y = xy[0], xy[1]
+            flags = _get(t, "flags", "")
+            row = [str(frame), _fmt_float(time), str(tid), _fmt_float(x), _fmt_float(y),
+                   _fmt_float(_get(t, "height")), _fmt_float(_get(t, "width")),
+                   _fmt_float(_get(t, "score")), _fmt_cell(_get(t, "mode", "")),
+                   flags if isinstance(flags, str) else ";".join(map(str, flags))]
+            row += [_fmt_cell(_get(t, c)) for c in self.extra_columns]
+            rows.append(row)
+        self._csv.writerows(rows)
+        self._file.flush()
+        self.rows_written += len(rows)
+
+    def close(self) -> None:
+        """Close the file; further writes raise."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> "TracksWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def write_tracks(path: str | Path, table: TrackTable) -> None:
+    """Write a whole table as a headered CSV: ``frame,time,id,x,y`` then its extra columns.
+
+    A table read from ``tracks.csv`` or ``gt.csv`` is written back with the same columns.
+    """
+    with _open_for_writing(path) as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(table.columns)
+        cols = [table.column(c) for c in table.columns]
+        for k in range(len(table)):
+            w.writerow([_fmt_cell(c[k]) for c in cols])
+
+
+def write_mot(path: str | Path, table: TrackTable) -> None:
+    """Export MOTChallenge text: ``frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z``.
+
+    Frames are written 1-based (``frame + 1``), ids as they are (already from 1). The box and
+    ``z`` come from extra columns of those names when present, else ``-1`` (box) and ``0`` (a
+    floor position has z = 0); ``conf`` from an extra ``conf`` or ``score`` column, else 1.
+    Rows are ordered by frame, then id.
+    """
+    t = table.sorted()
+    n = len(t)
+
+    def extra(name: str, default: float) -> np.ndarray:
+        v = t.extra.get(name)
+        if v is None or v.dtype.kind not in "fiub":
+            return np.full(n, default)
+        return np.where(np.isnan(v.astype(float)), -1.0, v.astype(float))
+
+    conf = extra("conf", np.nan) if "conf" in t.extra else extra("score", 1.0)
+    cols = [extra("bb_left", -1.0), extra("bb_top", -1.0), extra("bb_width", -1.0),
+            extra("bb_height", -1.0), conf, t.x, t.y, extra("z", 0.0)]
+    with _open_for_writing(path) as f:
+        for k in range(n):
+            f.write(",".join([str(int(t.frame[k]) + 1), str(int(t.id[k]))]
+                             + [_fmt_float(c[k]) for c in cols]) + "\n")
