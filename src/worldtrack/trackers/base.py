@@ -1,0 +1,124 @@
+"""What every tracker shares: the track record, the person position map and the tracker protocol.
+
+The :class:`PositionMap` is the 1999 paper's "person position management map": every person's id,
+floor position, size, mode and score in world coordinates — including people that no camera of
+this process currently sees. It is the integration point between trackers, cameras and processes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterator, Mapping, Protocol
+
+import numpy as np
+
+#: Track modes. ``capture``: just found, matched without the −1 ring until the score passes the
+#: capture threshold (seed 000 §5.2). ``tracking``: normal. ``lost``: kept in the map, not updated.
+MODES = ("capture", "tracking", "lost")
+
+
+@dataclass
+class Track:
+    """One person in the position map.
+
+    Attributes
+    ----------
+    id : int — stable for the life of the track, from 1
+    x, y : float — floor position, metres
+    height, width : float — body size used by the model, metres
+    vx, vy : float — floor velocity, m/s
+    score : float — the tracker's match score of the last update (ellipsoid: E in [−1, 1])
+    mode : str — one of :data:`MODES`
+    flags : set of str — e.g. ``unmeasurable`` (head and feet hidden in every view)
+    sigma : float — position uncertainty (1-σ, metres)
+    born, last_seen : float — times (s) of creation and of the last update with evidence
+    frames_low : int — consecutive frames with a score under the keep threshold
+    extra : dict — method-specific values written as extra output columns (e.g. ``sx, sy, sz``)
+    """
+
+    id: int
+    x: float
+    y: float
+    height: float = 1.65
+    width: float = 0.40
+    vx: float = 0.0
+    vy: float = 0.0
+    score: float = 0.0
+    mode: str = "capture"
+    flags: set[str] = field(default_factory=set)
+    sigma: float = 0.1
+    born: float = 0.0
+    last_seen: float = 0.0
+    frames_low: int = 0
+    age_frames: int = 0
+    extra: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.array([self.x, self.y])
+
+    def copy(self) -> "Track":
+        return Track(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
+                     self.mode, set(self.flags), self.sigma, self.born, self.last_seen, self.frames_low,
+                     self.age_frames, dict(self.extra))
+
+
+class PositionMap:
+    """All people known to the system, keyed by track id.
+
+    Examples
+    --------
+    >>> m = PositionMap()
+    >>> t = m.add(1.0, 2.0, time=0.0)
+    >>> t.id, len(m)
+    (1, 1)
+    """
+
+    def __init__(self) -> None:
+        self._tracks: dict[int, Track] = {}
+        self._next_id = 1
+
+    def add(self, x: float, y: float, height: float = 1.65, width: float = 0.40, mode: str = "capture",
+            time: float = 0.0, track_id: int | None = None) -> Track:
+        """Register a new person; ids are never reused within a map."""
+        if track_id is None:
+            track_id = self._next_id
+        if track_id in self._tracks:
+            raise ValueError(f"track id {track_id} already exists")
+        self._next_id = max(self._next_id, track_id + 1)
+        t = Track(track_id, float(x), float(y), float(height), float(width), mode=mode, born=time, last_seen=time)
+        self._tracks[track_id] = t
+        return t
+
+    def remove(self, track_id: int) -> Track:
+        return self._tracks.pop(track_id)
+
+    def __getitem__(self, track_id: int) -> Track:
+        return self._tracks[track_id]
+
+    def __contains__(self, track_id: int) -> bool:
+        return track_id in self._tracks
+
+    def __iter__(self) -> Iterator[Track]:
+        return iter(list(self._tracks.values()))
+
+    def __len__(self) -> int:
+        return len(self._tracks)
+
+    def positions(self) -> np.ndarray:
+        """(N, 2) floor positions in id order."""
+        return np.array([[t.x, t.y] for t in self], dtype=float).reshape(-1, 2)
+
+    def snapshot(self) -> list[Track]:
+        """Copies of the current tracks (what sinks receive)."""
+        return [t.copy() for t in self]
+
+
+class Tracker(Protocol):
+    """The one method that matters: take a synchronised bundle of frames, return the tracks."""
+
+    position_map: PositionMap
+
+    def step(self, frames: Mapping[str, "object"], t: float) -> list[Track]:
+        """Update with ``frames`` (``{camera_id: Frame}``) taken at time ``t`` (s)."""
+        ...

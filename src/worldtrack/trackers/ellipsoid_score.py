@@ -1,0 +1,369 @@
+"""Scoring ellipsoid candidates against a ternary foreground image (seed 000 §4).
+
+The simulated image of a candidate is the union ("joint image") of every person's visible
+ellipse: 1 inside, −1 in a ring of ``ring_px`` pixels around it, 0 elsewhere. The real image is
+the same ternary coding of the foreground mask. The score is the paper's eq. 5::
+
+    E = Σ sim(x, y)·real(x, y) / Σ |sim(x, y)|        (sums where sim ≠ 0)
+
+Differences from the paper, all to make it faster or well-defined:
+
+* Only the pixels a candidate can touch are summed: the union of the candidates' bounding boxes
+  (ring included), on a grid of stride ``s`` chosen so that about ``target_pixels`` pixels are
+  visited however large the person appears (``target_pixels = 0``: every pixel, as published).
+* The ring of an ellipse with semi-axes (a, b) is the ellipse (a + r, b + r) minus the ellipse —
+  the dilation of an ellipse by r pixels up to a sliver at the ends of the major axis.
+* A pixel hidden by an obstacle nearer than the person (floor distance, the paper's §3.3) is 0 for
+  that person in both the ellipse and its ring: occluded pixels carry no evidence either way.
+* With lens distortion each real pixel is tested at its undistorted position (exact silhouette).
+
+Ellipses are passed in a normal form of 5 numbers ``(cx, cy, a11, a12, a22)``: a point (u, v) of
+the ideal image is inside when ``a11·du² + 2·a12·du·dv + a22·dv² < 1`` with ``du = u − cx``,
+``dv = v − cy``. :func:`ellipse_forms` computes them for people; :func:`score_candidates` is the
+optimised kernel and :func:`score_candidates_reference` the plain NumPy version it is tested
+against.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from worldtrack.geometry import quadric
+
+#: Samples on an ellipse's outline used to bound it after lens distortion.
+_OUTLINE_SAMPLES = 24
+
+
+@njit(cache=True)
+def _distort_ideal_pixel(u, v, K, dist):
+    """Ideal (pinhole) pixel → real pixel under OpenCV distortion k1, k2, p1, p2, k3."""
+    fx, s, cx, fy, cy = K[0, 0], K[0, 1], K[0, 2], K[1, 1], K[1, 2]
+    y = (v - cy) / fy
+    x = (u - cx - s * y) / fx
+    k1, k2, p1, p2, k3 = dist[0], dist[1], dist[2], dist[3], dist[4]
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
+    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
+    return fx * xd + s * yd + cx, fy * yd + cy
+
+
+@njit(cache=True)
+def ellipse_forms(P, K, dist, has_dist, width, height, xy, heights, widths, ring_px, min_depth):
+    """Normal forms, bounding boxes and floor distances of standing-person ellipsoids.
+
+    Parameters
+    ----------
+    P : (3, 4) float64 — camera matrix, normalised (third row = depth)
+    K : (3, 3), dist : (5,), has_dist : bool — for bounding boxes under lens distortion
+    width, height : int — image size
+    xy : (N, 2) — floor positions, metres
+    heights, widths : (N,) — ellipsoid sizes (2·Rb, 2·Ra), metres
+    ring_px : float — ring width in pixels
+    min_depth : float — an ellipsoid whose nearest point is closer than this (m) is not drawn
+
+    Returns
+    -------
+    inner : (N, 5) — normal forms of the ellipses
+    ring : (N, 5) — normal forms of the ring-expanded ellipses
+    box : (N, 4) int64 — ``u0, u1, v0, v1`` (end exclusive) of the ring ellipse in the real image,
+        clipped to the image; empty (u0 ≥ u1) when not visible
+    valid : (N,) bool — ellipsoid fully in front of the camera and outline an ellipse
+    """
+    n = xy.shape[0]
+    inner = np.zeros((n, 5))
+    ring = np.zeros((n, 5))
+    box = np.zeros((n, 4), dtype=np.int64)
+    valid = np.zeros(n, dtype=np.bool_)
+    Q = np.zeros((4, 4))
+    for i in range(n):
+        ra = 0.5 * widths[i]
+        rb = 0.5 * heights[i]
+        c0, c1, c2 = xy[i, 0], xy[i, 1], rb
+        # Nearest depth of the ellipsoid: depth(centre) − ‖diag(r)·axis‖ (axis = P[2, :3], unit).
+        dc = P[2, 0] * c0 + P[2, 1] * c1 + P[2, 2] * c2 + P[2, 3]
+        ext = math.sqrt((ra * P[2, 0]) ** 2 + (ra * P[2, 1]) ** 2 + (rb * P[2, 2]) ** 2)
+        if dc - ext < min_depth:
+            continue
+        # Dual quadric Q* = T·diag(ra², ra², rb², −1)·Tᵀ.
+        cc = (c0, c1, c2)
+        rr = (ra * ra, ra * ra, rb * rb)
+        for a in range(3):
+            for b in range(3):
+                Q[a, b] = -cc[a] * cc[b]
+            Q[a, a] += rr[a]
+            Q[a, 3] = -cc[a]
+            Q[3, a] = -cc[a]
+        Q[3, 3] = -1.0
+        # Dual conic C* = P·Q*·Pᵀ.
+        PQ = P @ Q
+        D = PQ @ P.T
+        # Point conic = adjugate of C*; only the 2×2 block and the linear terms are needed.
+        A11 = D[1, 1] * D[2, 2] - D[1, 2] * D[2, 1]
+        A12 = D[0, 2] * D[2, 1] - D[0, 1] * D[2, 2]
+        A22 = D[0, 0] * D[2, 2] - D[0, 2] * D[2, 0]
+        B1 = D[0, 1] * D[1, 2] - D[0, 2] * D[1, 1]
+        B2 = D[0, 2] * D[1, 0] - D[0, 0] * D[1, 2]
+        F = D[0, 0] * D[1, 1] - D[0, 1] * D[1, 0]
+        det = A11 * A22 - A12 * A12
+        if det <= 0.0:
+            continue
+        # Centre of the conic and its value there.
+        cu = -(A22 * B1 - A12 * B2) / det
+        cv = -(-A12 * B1 + A11 * B2) / det
+        k = F + B1 * cu + B2 * cv
+        # Inside ⇔ (x−c)ᵀA(x−c) < −k: an ellipse needs A and −k of the same sign.
+        if k * A11 >= 0.0:
+            continue
+        s = -1.0 / k
+        a11, a12, a22 = A11 * s, A12 * s, A22 * s
+        # Semi-axes from the eigenvalues of the normal form.
+        tr = a11 + a22
+        dd = math.sqrt(max((a11 - a22) ** 2 / 4.0 + a12 * a12, 0.0))
+        l1 = tr / 2.0 - dd  # smaller eigenvalue → major axis
+        l2 = tr / 2.0 + dd
+        if l1 <= 0.0:
+            continue
+        ax1 = 1.0 / math.sqrt(l1)
+        ax2 = 1.0 / math.sqrt(l2)
+        # Eigenvector of l1: (l1 − a22, a12) or (a12, l1 − a11), whichever is better conditioned.
+        e1x, e1y = l1 - a22, a12
+        f1x, f1y = a12, l1 - a11
+        if f1x * f1x + f1y * f1y > e1x * e1x + e1y * e1y:
+            e1x, e1y = f1x, f1y
+        nrm = math.sqrt(e1x * e1x + e1y * e1y)
+        if nrm == 0.0:  # a circle: any direction
+            e1x, e1y, nrm = 1.0, 0.0, 1.0
+        e1x /= nrm
+        e1y /= nrm
+        e2x, e2y = -e1y, e1x
+        bx1 = ax1 + ring_px
+        bx2 = ax2 + ring_px
+        # Ring ellipse with the same axes directions and expanded semi-axes.
+        w1 = 1.0 / (bx1 * bx1)
+        w2 = 1.0 / (bx2 * bx2)
+        inner[i, 0], inner[i, 1], inner[i, 2], inner[i, 3], inner[i, 4] = cu, cv, a11, a12, a22
+        ring[i, 0], ring[i, 1] = cu, cv
+        ring[i, 2] = w1 * e1x * e1x + w2 * e2x * e2x
+        ring[i, 3] = w1 * e1x * e1y + w2 * e2x * e2y
+        ring[i, 4] = w1 * e1y * e1y + w2 * e2y * e2y
+        # Bounding box of the ring ellipse in the real image.
+        if has_dist:
+            umin, umax, vmin, vmax = 1e300, -1e300, 1e300, -1e300
+            for j in range(_OUTLINE_SAMPLES):
+                t = 2.0 * math.pi * j / _OUTLINE_SAMPLES
+                pu = cu + bx1 * math.cos(t) * e1x + bx2 * math.sin(t) * e2x
+                pv = cv + bx1 * math.cos(t) * e1y + bx2 * math.sin(t) * e2y
+                qu, qv = _distort_ideal_pixel(pu, pv, K, dist)
+                umin, umax = min(umin, qu), max(umax, qu)
+                vmin, vmax = min(vmin, qv), max(vmax, qv)
+            umin -= 1.0
+            vmin -= 1.0
+            umax += 1.0
+            vmax += 1.0
+        else:
+            hu = math.sqrt((bx1 * e1x) ** 2 + (bx2 * e2x) ** 2)
+            hv = math.sqrt((bx1 * e1y) ** 2 + (bx2 * e2y) ** 2)
+            umin, umax, vmin, vmax = cu - hu, cu + hu, cv - hv, cv + hv
+        u0 = max(0, int(math.floor(umin)))
+        u1 = min(width, int(math.ceil(umax)) + 1)
+        v0 = max(0, int(math.floor(vmin)))
+        v1 = min(height, int(math.ceil(vmax)) + 1)
+        box[i, 0], box[i, 1], box[i, 2], box[i, 3] = u0, u1, v0, v1
+        valid[i] = True
+    return inner, ring, box, valid
+
+
+@njit(cache=True, inline="always")
+def _inside(f, u, v):
+    du = u - f[0]
+    dv = v - f[1]
+    return f[2] * du * du + 2.0 * f[3] * du * dv + f[4] * dv * dv < 1.0
+
+
+@njit(cache=True)
+def score_candidates(grid, has_dist, occ, real, use_ring,
+                     c_inner, c_ring, c_box, c_dist, c_valid,
+                     o_inner, o_ring, o_box, o_dist, o_valid, target_pixels):
+    """Numerators and denominators of E for C candidates of one person in one camera.
+
+    Parameters
+    ----------
+    grid : (H, W, 2) float32 — ideal coordinates of each real pixel (used when ``has_dist``)
+    occ : (H, W) float32 — obstacle floor distance per pixel (inf = none)
+    real : (H, W) int8 — ternary real image (1 foreground, −1 ring, 0 else)
+    use_ring : bool — False in capture mode: no −1 in either image
+    c_* : candidate forms from :func:`ellipse_forms` and their floor distances (C,)
+    o_* : the other people's forms and floor distances (M,)
+    target_pixels : int — visit about this many pixels (0 = all)
+
+    Returns
+    -------
+    num, den : (C,) float64 — E = num / den where den > 0
+    n_in : (C,) int64 — visited pixels inside the candidate's own visible ellipse
+    """
+    C = c_inner.shape[0]
+    M = o_inner.shape[0]
+    num = np.zeros(C)
+    den = np.zeros(C)
+    n_in = np.zeros(C, dtype=np.int64)
+    H, W = real.shape
+    u0, u1, v0, v1 = W, 0, H, 0
+    for c in range(C):
+        if c_valid[c] and c_box[c, 0] < c_box[c, 1] and c_box[c, 2] < c_box[c, 3]:
+            u0 = min(u0, c_box[c, 0])
+            u1 = max(u1, c_box[c, 1])
+            v0 = min(v0, c_box[c, 2])
+            v1 = max(v1, c_box[c, 3])
+    if u0 >= u1 or v0 >= v1:
+        return num, den, n_in
+    stride = 1
+    if target_pixels > 0:
+        stride = max(1, int(math.sqrt((u1 - u0) * (v1 - v0) / target_pixels)))
+    # Others whose ring box overlaps the region.
+    near = np.empty(M, dtype=np.int64)
+    n_near = 0
+    for m in range(M):
+        if (o_valid[m] and o_box[m, 0] < u1 and o_box[m, 1] > u0
+                and o_box[m, 2] < v1 and o_box[m, 3] > v0):
+            near[n_near] = m
+            n_near += 1
+    # Align the sampling grid to absolute coordinates so that every candidate sees the same pixels.
+    vs = v0 + (-v0) % stride
+    us = u0 + (-u0) % stride
+    for v in range(vs, v1, stride):
+        for uu in range(us, u1, stride):
+            if has_dist:
+                x = np.float64(grid[v, uu, 0])
+                y = np.float64(grid[v, uu, 1])
+            else:
+                x = np.float64(uu)
+                y = np.float64(v)
+            o = occ[v, uu]
+            r = real[v, uu]
+            if not use_ring and r < 0:
+                r = 0
+            # The other people's contribution to the joint image at this pixel.
+            other_in = False
+            other_ring = False
+            for j in range(n_near):
+                m = near[j]
+                if o >= o_dist[m]:
+                    if _inside(o_inner[m], x, y):
+                        other_in = True
+                        break
+                    if use_ring and not other_ring and _inside(o_ring[m], x, y):
+                        other_ring = True
+            for c in range(C):
+                if not c_valid[c]:
+                    continue
+                if uu < c_box[c, 0] or uu >= c_box[c, 1] or v < c_box[c, 2] or v >= c_box[c, 3]:
+                    s = 1 if other_in else (-1 if other_ring else 0)
+                else:
+                    vis = o >= c_dist[c]
+                    if vis and _inside(c_inner[c], x, y):
+                        s = 1
+                        n_in[c] += 1
+                    elif other_in:
+                        s = 1
+                    elif use_ring and (other_ring or (vis and _inside(c_ring[c], x, y))):
+                        s = -1
+                    else:
+                        s = 0
+                if s != 0:
+                    num[c] += s * r
+                    den[c] += 1.0
+    return num, den, n_in
+
+
+def ternary_real(mask: np.ndarray, ring_px: int) -> np.ndarray:
+    """The paper's ternary real image: 1 foreground, −1 in a ring of ``ring_px`` around it, 0 else."""
+    import cv2
+    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * ring_px + 1, 2 * ring_px + 1))
+    dil = cv2.dilate(mask, k)
+    return (mask.astype(np.int8) - (dil & ~mask.astype(bool)).astype(np.int8)).astype(np.int8)
+
+
+def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widths, ring_px,
+                               others_xy, others_h, others_w, target_pixels=0, min_depth=0.1):
+    """Plain NumPy version of :func:`ellipse_forms` + :func:`score_candidates` for tests.
+
+    Renders each candidate's joint ternary image over the whole frame with
+    :func:`worldtrack.geometry.quadric.ellipse_mask` and sums eq. 5 on the same pixel grid.
+    """
+    H, W = real.shape
+    grid = camera.ideal_pixel_grid if camera.has_distortion else None
+    centre = camera.centre
+
+    def forms(pxy, ph, pw):
+        pxy = np.asarray(pxy, float).reshape(-1, 2)
+        cen, rad = quadric.person_ellipsoid(pxy, ph, pw)
+        conics = quadric.ellipsoid_conics(P, cen, rad)
+        ctr, axes, ang = quadric.ellipse_parameters(conics)
+        dist = np.hypot(pxy[:, 0] - centre[0], pxy[:, 1] - centre[1])
+        depth_c = cen @ P[2, :3] + P[2, 3]
+        ext = np.sqrt((rad[:, 0] * P[2, 0]) ** 2 + (rad[:, 1] * P[2, 1]) ** 2 + (rad[:, 2] * P[2, 2]) ** 2)
+        ok = (depth_c - ext >= min_depth) & np.isfinite(axes).all(axis=1)
+        return ctr, axes, ang, dist, ok
+
+    def masks(ctr, axes, ang, dist, ok, r):
+        """Full-image inside/ring masks (list per person), visibility against obstacles applied."""
+        if grid is None:
+            v, u = np.mgrid[0:H, 0:W].astype(float)
+        else:
+            u, v = grid[..., 0].astype(float), grid[..., 1].astype(float)
+        ins, rng = [], []
+        for k in range(len(ctr)):
+            if not ok[k]:
+                ins.append(np.zeros((H, W), bool))
+                rng.append(np.zeros((H, W), bool))
+                continue
+            du, dv = u - ctr[k, 0], v - ctr[k, 1]
+            ca, sa = np.cos(ang[k]), np.sin(ang[k])
+            p1 = du * ca + dv * sa
+            p2 = -du * sa + dv * ca
+            vis = occ >= dist[k]
+            ins.append(vis & ((p1 / axes[k, 0]) ** 2 + (p2 / axes[k, 1]) ** 2 < 1))
+            rng.append(vis & ((p1 / (axes[k, 0] + r)) ** 2 + (p2 / (axes[k, 1] + r)) ** 2 < 1))
+        return ins, rng
+
+    cand = forms(xy, heights, widths)
+    oth = forms(others_xy, others_h, others_w)
+    c_in, c_rg = masks(*cand, ring_px)
+    o_in, o_rg = masks(*oth, ring_px)
+    other_in = np.zeros((H, W), bool)
+    other_rg = np.zeros((H, W), bool)
+    for a, b in zip(o_in, o_rg):
+        other_in |= a
+        other_rg |= b
+    # The sampled region: union of the candidates' boxes, from the optimised kernel's forms.
+    args = (P, camera.K, camera.dist, camera.has_distortion, W, H)
+    _, _, box, valid = ellipse_forms(*args, np.asarray(xy, float).reshape(-1, 2),
+                                     np.broadcast_to(np.asarray(heights, float), (len(c_in),)).copy(),
+                                     np.broadcast_to(np.asarray(widths, float), (len(c_in),)).copy(),
+                                     float(ring_px), min_depth)
+    sel = valid & (box[:, 0] < box[:, 1]) & (box[:, 2] < box[:, 3])
+    num = np.zeros(len(c_in))
+    den = np.zeros(len(c_in))
+    if not sel.any():
+        return num, den
+    u0, u1 = box[sel, 0].min(), box[sel, 1].max()
+    v0, v1 = box[sel, 2].min(), box[sel, 3].max()
+    stride = 1 if target_pixels <= 0 else max(1, int(np.sqrt((u1 - u0) * (v1 - v0) / target_pixels)))
+    vv = np.arange(v0 + (-v0) % stride, v1, stride)
+    uu = np.arange(u0 + (-u0) % stride, u1, stride)
+    R = real[np.ix_(vv, uu)].astype(float)
+    if not use_ring:
+        R = np.maximum(R, 0)
+    for c in range(len(c_in)):
+        if not valid[c]:
+            continue
+        inside = (c_in[c] | other_in)[np.ix_(vv, uu)]
+        ring = ((c_rg[c] | other_rg) if use_ring else np.zeros((H, W), bool))[np.ix_(vv, uu)] & ~inside
+        sim = inside.astype(float) - ring.astype(float)
+        num[c] = (sim * R).sum()
+        den[c] = np.abs(sim).sum()
+    return num, den

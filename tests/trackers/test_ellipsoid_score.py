@@ -1,0 +1,105 @@
+"""The candidate-scoring kernel against its plain NumPy reference, and eq. 5 on ideal images."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from worldtrack.geometry import quadric as q
+from worldtrack.scene import load_scene
+from worldtrack.trackers.ellipsoid_score import (ellipse_forms, score_candidates, score_candidates_reference,
+                                                 ternary_real)
+
+LAB = Path(__file__).parents[2] / "examples" / "scenes" / "kato_lab.yaml"
+
+
+@pytest.fixture(scope="module")
+def lab():
+    return load_scene(LAB)
+
+
+def person_mask(cam, xy, height, width):
+    cen, rad = q.person_ellipsoid([xy], height, width)
+    C = q.ellipsoid_conics(cam.P, cen, rad)[0]
+    grid = cam.ideal_pixel_grid if cam.has_distortion else None
+    return q.ellipse_mask(C, (cam.height, cam.width), ideal_grid=grid).astype(np.uint8)
+
+
+def kernel(cam, occ, real, use_ring, cand, others, ring, target):
+    args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
+    h = np.full(len(cand), 1.65)
+    w = np.full(len(cand), 0.40)
+    ci, cr, cb, cv = ellipse_forms(*args, cand, h, w, float(ring), 0.1)
+    oi, orr, ob, ov = ellipse_forms(*args, others, np.full(len(others), 1.65), np.full(len(others), 0.4),
+                                    float(ring), 0.1)
+    cd = np.hypot(*(cand - cam.centre[:2]).T)
+    od = np.hypot(*(others - cam.centre[:2]).T)
+    grid = cam.ideal_pixel_grid if cam.has_distortion else np.zeros((1, 1, 2), np.float32)
+    return score_candidates(grid, cam.has_distortion, occ, real, use_ring, ci, cr, cb, cd, cv,
+                            oi, orr, ob, od, ov, target)
+
+
+@pytest.mark.parametrize("cam_id", ["cam1", "cam2"])
+def test_kernel_equals_reference(lab, cam_id):
+    cam = lab.cameras[cam_id]
+    occ = lab.occlusion(cam_id).floor_distance
+    rng = np.random.default_rng(7)
+    for trial in range(6):
+        truth = np.array([rng.uniform(-2, 0), rng.uniform(0, 2.8)])
+        mask = person_mask(cam, truth, rng.uniform(1.5, 1.9), rng.uniform(0.35, 0.5))
+        mask[rng.random(mask.shape) < 0.05] ^= 1
+        real = ternary_real(mask, 5)
+        start = truth + rng.normal(0, 0.1, 2)
+        offsets = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)]) * 0.05
+        cand = start + offsets
+        others = np.array([[rng.uniform(-2, 0), rng.uniform(0, 2.8)] for _ in range(2)])
+        for use_ring in (True, False):
+            for target in (0, 250):
+                num, den, _ = kernel(cam, occ, real, use_ring, cand, others, 5, target)
+                rn, rd = score_candidates_reference(cam.P, cam, occ, real, use_ring, cand, 1.65, 0.40, 5,
+                                                    others, 1.65, 0.40, target_pixels=target)
+                np.testing.assert_array_equal(num, rn)
+                np.testing.assert_array_equal(den, rd)
+
+
+def test_exact_silhouette_scores_one_and_wins(lab):
+    cam = lab.cameras["cam1"]
+    occ = np.full((cam.height, cam.width), np.inf, np.float32)
+    truth = np.array([-1.0, 1.0])
+    real = ternary_real(person_mask(cam, truth, 1.65, 0.40), 5)
+    cand = truth + np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)]) * 0.05
+    num, den, n_in = kernel(cam, occ, real, True, cand, np.zeros((0, 2)), 5, 0)
+    e = num / den
+    assert np.argmax(e) == 4
+    assert e[4] > 0.97  # the ternary images coincide up to the ring's approximation of a dilation
+    assert np.all(e[np.arange(9) != 4] < e[4] - 0.02)
+    assert n_in[4] == person_mask(cam, truth, 1.65, 0.40).sum()
+
+
+def test_ring_rejects_an_ellipse_inside_a_big_blob(lab):
+    # The paper's Fig. 2: with a binary score an ellipse lying inside a larger blob scores 1;
+    # the −1 ring makes the matching outline win.
+    cam = lab.cameras["cam1"]
+    occ = np.full((cam.height, cam.width), np.inf, np.float32)
+    truth = np.array([-1.0, 1.0])
+    big = person_mask(cam, truth, 1.9, 0.8)
+    inner_candidate = np.array([truth, truth])
+    real = ternary_real(big, 5)
+    num_b, den_b, _ = kernel(cam, occ, real, False, inner_candidate, np.zeros((0, 2)), 5, 0)
+    assert num_b[0] / den_b[0] == 1.0           # binary (capture mode): a perfect score inside the blob
+    num_t, den_t, _ = kernel(cam, occ, real, True, inner_candidate, np.zeros((0, 2)), 5, 0)
+    assert num_t[0] / den_t[0] < 0.8            # ternary: the ring falls on foreground and costs
+
+
+def test_obstacle_hides_the_lower_body(lab):
+    cam = lab.cameras["cam1"]
+    occ = lab.occlusion("cam1").floor_distance
+    behind_desk = np.array([[-1.0, 2.9]])   # the lab's desk is at y 2.1…2.7
+    args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
+    _, _, box, valid = ellipse_forms(*args, behind_desk, np.array([1.65]), np.array([0.4]), 5.0, 0.1)
+    assert valid[0]
+    full = np.ones((cam.height, cam.width), np.int8)
+    free = np.full_like(occ, np.inf)
+    _, _, n_free = kernel(cam, free, full, True, behind_desk, np.zeros((0, 2)), 5, 0)
+    _, _, n_occ = kernel(cam, occ, full, True, behind_desk, np.zeros((0, 2)), 5, 0)
+    assert 0 < n_occ[0] < 0.85 * n_free[0]
