@@ -1,0 +1,74 @@
+"""Shared helpers for the benchmark scripts: timing, the in-run reference, tables.
+
+Machines here are noisy, so every speed figure is printed beside a reference measured in the same
+run: one ``cv2.createBackgroundSubtractorMOG2().apply`` on a frame of the same size (the work any
+video tracker must do per frame), and decoding a frame.
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+from typing import Callable, Sequence
+
+import cv2
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "results"
+DATA = ROOT.parent / "shared" / "data"
+
+cv2.setNumThreads(1)  # one core, as the targets say
+
+
+def median_time(fn: Callable[[], object], repeats: int = 20, warmup: int = 2) -> float:
+    """Median wall time (s) of ``fn()`` over ``repeats`` calls after ``warmup`` calls."""
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def mog2_apply_time(width: int, height: int, repeats: int = 30, seed: int = 0) -> float:
+    """Median time (s) of one MOG2 ``apply`` on a textured ``width × height`` frame with motion."""
+    rng = np.random.default_rng(seed)
+    base = rng.integers(60, 200, (height, width, 3), dtype=np.uint8)
+    model = cv2.createBackgroundSubtractorMOG2()
+    for _ in range(20):
+        model.apply(base)
+    frames = []
+    for k in range(repeats + 2):
+        f = base.copy()
+        x = (k * 7) % max(1, width - 40)
+        cv2.rectangle(f, (x, height // 4), (x + width // 12, height // 4 + height // 3), (20, 30, 220), -1)
+        frames.append(f)
+    it = iter(frames)
+    return median_time(lambda: model.apply(next(it)), repeats=repeats, warmup=2)
+
+
+def markdown_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
+    """A GitHub-markdown table with numbers formatted compactly."""
+    def fmt(v: object) -> str:
+        if isinstance(v, float):
+            return f"{v:.3g}" if abs(v) < 1000 else f"{v:.0f}"
+        return str(v)
+    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
+    lines += ["| " + " | ".join(fmt(v) for v in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def write_result(name: str, title: str, body: str) -> Path:
+    """Write ``benchmarks/results/<name>.md`` with a header naming the machine and date."""
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    path = RESULTS / f"{name}.md"
+    stamp = time.strftime("%Y-%m-%d %H:%M")
+    path.write_text(f"# {title}\n\nMeasured {stamp} on {os.cpu_count()} cores "
+                    f"(Python {sys.version.split()[0]}, OpenCV {cv2.__version__}), one thread.\n\n{body}\n")
+    return path
