@@ -1,8 +1,13 @@
-"""``worldtrack calibrate``: fit a camera to world/image point pairs read from a CSV file.
+"""``worldtrack calibrate``: fit a camera to world/image point pairs, or import a calibration file.
 
 The I/O edge of :mod:`worldtrack.geometry.calibrate`: reads the points, calls
 :func:`~worldtrack.geometry.calibrate.calibrate`, prints the camera block for a scene file and
 how well it fits, and optionally writes the block to a file.
+
+With ``--import FILE`` it instead reads a calibration another tool wrote (Tsai XML as PETS ships
+it, OpenCV FileStorage YAML/XML, JSON K/R/t, 3x4 matrices as text; see
+:mod:`worldtrack.io.calibration_formats`), states the units it found, converts to metres and to
+worldtrack's OpenCV camera model, rescales to the video's size and prints the same camera block.
 """
 
 from __future__ import annotations
@@ -19,6 +24,8 @@ import yaml
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.calibrate import ADVISED_POINTS, CalibrationResult, calibrate
+from worldtrack.geometry.camera import Camera
+from worldtrack.io.calibration_formats import UNITS, ImportedCamera, import_camera, read_calibration
 from worldtrack.scene.load import camera_to_dict
 
 _HEADER = ("X", "Y", "Z", "x", "y")
@@ -48,12 +55,24 @@ points all on the floor, give --intrinsics.
 
 Prints the camera block to paste under 'cameras:' in a scene file, the camera centre, a table of
 per-point reprojection errors, the RMS error and the floor back-projection error.
+
+--import FILE instead reads a calibration made by another tool and prints the same block:
+  Tsai XML (PETS 2009 View_00N.xml; its radial lens model is converted to OpenCV k1, k2, k3 by a
+  least-squares fit over the image, whose error is printed), OpenCV FileStorage YAML/XML
+  (camera_matrix, distortion_coefficients, rvec/tvec or R/t), JSON with K, R, t (+ dist), one
+  camera or several by name (--camera), or 3x4 projection matrices as text. The world unit is
+  declared with --units or detected from the size of the translation (|t| > 1000 means
+  millimetres, < 100 metres) and stated. --image-size WxH (or --scale F) rescales the camera to
+  the images you track on (e.g. a 768x576 calibration for a 480x360 video). --check X,Y,Z,u,v
+  reprojects a known point (X, Y, Z in the file's unit; u, v in pixels of the calibration's image).
 """
 
 EPILOG = """\
-example:
+examples:
   worldtrack calibrate examples/calibration/lab_cam1_points.csv --id cam1 --out cam1.yaml
   worldtrack calibrate examples/calibration/lab_cam2_points.csv --id cam2 --distortion
+  worldtrack calibrate --import View_001.xml --image-size 480x360 --check=-4140,-7400,0,514.8,232.0
+  worldtrack calibrate --import calibration.json --camera View_001 --calibration-size 768x576 --scale 0.625
 """
 
 
@@ -181,8 +200,7 @@ def _parse_intrinsics(text: str) -> list[float]:
 
 def camera_block(result: CalibrationResult) -> str:
     """The fitted camera as YAML, a one-item list indented to paste under ``cameras:``."""
-    text = yaml.safe_dump([camera_to_dict(result.camera)], sort_keys=False, default_flow_style=None)
-    return "".join("  " + line for line in text.splitlines(keepends=True))
+    return _block(result.camera)
 
 
 def _m(x: float, nd: int = 3) -> str:
@@ -239,6 +257,19 @@ def format_report(result: CalibrationResult, points: PointsFile, label: str) -> 
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.import_file is not None:
+        if args.points is not None:
+            raise InputError(f"give either POINTS.csv ({args.points}) or --import FILE, not both")
+        return run_import(args)
+    if args.points is None:
+        raise InputError("expected POINTS.csv (world/image point pairs) or --import FILE (a calibration file)")
+    stray = [flag for flag, value in (("--camera", args.camera), ("--units", args.units),
+                                      ("--scale", args.scale), ("--check", args.check),
+                                      ("--calibration-size", args.calibration_size)) if value]
+    if stray:
+        raise InputError(f"{stray[0]} only applies with --import FILE")
+    if args.id is None:
+        args.id = "cam"
     label = str(args.points)
     points = read_points(args.points)
     extra_warnings: list[str] = []
@@ -281,19 +312,199 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------------------- --import
+
+@dataclass(frozen=True)
+class CheckPoint:
+    """A ``--check X,Y,Z[,u,v]`` point: world (file units) and optionally its pixel."""
+
+    world: np.ndarray
+    pixel: np.ndarray | None
+    text: str
+
+
+def parse_check(text: str) -> CheckPoint:
+    """``X,Y,Z`` or ``X,Y,Z,u,v`` → :class:`CheckPoint`."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) not in (3, 5) or not all(math.isfinite(v) for v in values):
+        raise InputError(f"--check: expected X,Y,Z or X,Y,Z,u,v (world in the file's unit, pixels), got {text!r}")
+    return CheckPoint(np.array(values[:3]), np.array(values[3:]) if len(values) == 5 else None, text)
+
+
+def _parse_scale(text: str | None) -> float | None:
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (math.isfinite(value) and value > 0):
+        raise InputError(f"--scale: expected a positive number such as 0.625, got {text!r}")
+    return value
+
+
+def _fmt_uv(uv: np.ndarray) -> str:
+    return "outside the lens model" if not np.all(np.isfinite(uv)) else f"({uv[0]:.2f}, {uv[1]:.2f}) px"
+
+
+def import_command(args: argparse.Namespace) -> str:
+    """The command line that reproduces this import (for the header of ``--out``)."""
+    parts = ["worldtrack calibrate --import", str(args.import_file)]
+    for flag, value in (("--camera", args.camera), ("--units", args.units), ("--image-size", args.image_size),
+                        ("--scale", args.scale), ("--calibration-size", args.calibration_size),
+                        ("--radial-terms", args.radial_terms), ("--id", args.id)):
+        if value is not None:
+            parts.append(f"{flag} {value}")
+    parts += [f"--check={c}" for c in args.check]
+    if args.out is not None:
+        parts.append(f"--out {args.out}")
+    return " ".join(parts)
+
+
+def format_import_report(imp: ImportedCamera, checks: list[CheckPoint]) -> str:
+    """Everything ``worldtrack calibrate --import`` prints to standard output."""
+    cal, cam, native = imp.source, imp.camera, imp.native
+    which = f" camera {cal.camera!r}" if len(cal.cameras) > 1 else ""
+    out = [f"imported{which} from {cal.path}: {cal.format_name}, calibrated for "
+           f"{native.width}x{native.height} px",
+           f"units: {imp.units_note}"]
+    conv = imp.conversion
+    if conv is not None:
+        terms = ", ".join(f"k{i}" for i in (1, 2, 3)[:conv.radial_terms])
+        out.append(f"lens: Tsai kappa1 = {imp.tsai.kappa1_per_mm2:.6g} /mm^2 on distorted sensor coordinates, "
+                   f"converted to OpenCV radial {terms} by least squares over the image "
+                   f"(+{conv.margin:.0%} margin, {conv.n_points} points)")
+        out.append(f"Tsai -> OpenCV fit error: max {conv.max_error_px:.4f} px over every image pixel "
+                   f"(RMS {conv.rms_error_px:.4f} px); max {conv.max_error_margin_px:.4f} px including the margin")
+    if imp.scale != 1.0:
+        out.append(f"rescaled by {imp.scale:g} to {cam.width}x{cam.height} px (pixel centres at integers: "
+                   "u' = s(u + 0.5) - 0.5)")
+    out += ["", "camera block (paste under 'cameras:' in a scene file):",
+            _block(cam).rstrip("\n"), ""]
+    c = cam.centre
+    K = cam.K
+    hfov_deg = math.degrees(2 * math.atan2(cam.width / 2, K[0, 0]))
+    out.append(f"camera centre: ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m")
+    out.append(f"focal length: fx = {K[0, 0]:.2f} px, fy = {K[1, 1]:.2f} px at {cam.width}x{cam.height} "
+               f"(horizontal field of view {hfov_deg:.1f} deg); principal point ({K[0, 2]:.2f}, {K[1, 2]:.2f}) px")
+    if cam.has_distortion:
+        k1, k2, p1, p2, k3 = cam.dist
+        out.append(f"lens distortion: k1 = {k1:.5f}, k2 = {k2:.5f}, p1 = {p1:.5f}, p2 = {p2:.5f}, k3 = {k3:.5f}")
+    else:
+        out.append("lens distortion: none")
+    for chk in checks:
+        world_m = chk.world * imp.metres_per_unit
+        X, Y, Z = chk.world
+        line = f"check ({X:g}, {Y:g}, {Z:g}) {imp.units}: "
+        uv = native.project(world_m)
+        if imp.tsai is not None:
+            exact = imp.tsai.project(world_m)
+            line += f"Tsai model {_fmt_uv(exact)}, converted camera {_fmt_uv(uv)}"
+        else:
+            line += f"projects to {_fmt_uv(uv)}"
+        line += f" at {native.width}x{native.height}"
+        if chk.pixel is not None:
+            ref = imp.tsai.project(world_m) if imp.tsai is not None else uv
+            err = float(np.linalg.norm(ref - chk.pixel))
+            line += f"; given ({chk.pixel[0]:g}, {chk.pixel[1]:g}): error {err:.2f} px" if math.isfinite(err) else ""
+        if imp.scale != 1.0:
+            line += f"; {_fmt_uv(cam.project(world_m))} at {cam.width}x{cam.height}"
+        out.append(line)
+    if imp.warnings:
+        out.append("warnings:")
+        out.extend(f"  - {w}" for w in imp.warnings)
+    return "\n".join(out) + "\n"
+
+
+def _block(camera: Camera) -> str:
+    """A camera as YAML, a one-item list indented to paste under ``cameras:``."""
+    text = yaml.safe_dump([camera_to_dict(camera)], sort_keys=False, default_flow_style=None)
+    return "".join("  " + line for line in text.splitlines(keepends=True))
+
+
+def run_import(args: argparse.Namespace) -> int:
+    if args.distortion or args.intrinsics is not None:
+        raise InputError("--distortion and --intrinsics fit points; they do not apply with --import")
+    radial_terms = None
+    if args.radial_terms is not None:
+        if args.radial_terms.strip() not in ("1", "2", "3"):
+            raise InputError(f"--radial-terms: expected 1, 2 or 3, got {args.radial_terms!r}")
+        radial_terms = int(args.radial_terms)
+    units = "auto" if args.units is None else args.units.strip().lower()
+    if units not in UNITS:
+        raise InputError(f"--units: expected mm, m or auto, got {args.units!r}")
+    image_size = _parse_size(args.image_size) if args.image_size is not None else None
+    calibration_size = None
+    if args.calibration_size is not None:
+        try:
+            calibration_size = _parse_size(args.calibration_size)
+        except InputError:
+            raise InputError(f"--calibration-size: expected WxH in pixels such as 768x576, "
+                             f"got {args.calibration_size!r}") from None
+    scale = _parse_scale(args.scale)
+    if scale is not None and image_size is not None:
+        raise InputError("give --image-size or --scale, not both")
+    checks = [parse_check(c) for c in args.check]
+    cal = read_calibration(args.import_file, args.camera)
+    try:
+        imp = import_camera(cal, units=units, camera_id=args.id, image_size=image_size, scale=scale,
+                            calibration_size=calibration_size, radial_terms=radial_terms)
+    except InputError as e:          # about this file: name it once
+        text = str(e)
+        raise InputError(text if text.startswith(cal.path) else f"{cal.path}: {text}") from None
+    print(format_import_report(imp, checks), end="")
+    if args.out is not None:
+        c = imp.camera.centre
+        header = (f"# camera {imp.camera.id!r} imported by worldtrack from {cal.path}: {cal.format_name}\n"
+                  f"# units: {imp.units_note}\n")
+        if imp.conversion is not None:
+            header += (f"# Tsai lens converted to OpenCV radial terms: max error {imp.conversion.max_error_px:.4f} px "
+                       "over the image\n")
+        header += (f"# centre ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m; {imp.camera.width}x{imp.camera.height} px\n"
+                   f"# made with: {import_command(args)}\n"
+                   "# paste under 'cameras:' in a scene file\n")
+        try:
+            Path(args.out).write_text(header + _block(imp.camera))
+        except OSError as e:
+            raise InputError(f"{args.out}: cannot write ({e.strerror})") from None
+        print(f"wrote {args.out}")
+    return 0
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
-    p = subparsers.add_parser("calibrate", help="fit a camera to world/image point pairs (CSV)",
+    p = subparsers.add_parser("calibrate", help="fit a camera to point pairs (CSV) or import a calibration file",
                               description=DESCRIPTION, epilog=EPILOG,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("points", metavar="POINTS.csv", help="CSV with header X,Y,Z,x,y (metres, pixels)")
+    p.add_argument("points", metavar="POINTS.csv", nargs="?",
+                   help="CSV with header X,Y,Z,x,y (metres, pixels)")
     p.add_argument("--image-size", metavar="WxH",
-                   help="image size in pixels, e.g. 640x480 (default: the file's '# image_size:' comment)")
-    p.add_argument("--id", default="cam", metavar="CAM", help="camera id in the printed block (default: cam)")
+                   help="image size in pixels, e.g. 640x480 (default: the file's '# image_size:' comment); "
+                        "with --import: the size of the images you track on (the camera is rescaled)")
+    p.add_argument("--id", default=None, metavar="CAM",
+                   help="camera id in the printed block (default: cam; with --import the file's camera name)")
     p.add_argument("--distortion", action="store_true",
                    help="also fit radial lens distortion k1, k2 (wide-angle lenses)")
     p.add_argument("--radial-terms", metavar="N",
-                   help="fit N radial distortion terms k1..kN (1-3; 3 needs >= 20 points); implies --distortion")
+                   help="fit N radial distortion terms k1..kN (1-3; 3 needs >= 20 points); implies --distortion. "
+                        "With --import of a Tsai file: the OpenCV terms fitted to its lens (default: chosen)")
     p.add_argument("--intrinsics", metavar="fx,fy,cx,cy",
                    help="known intrinsics in pixels, held fixed; needed when all points lie on one plane")
     p.add_argument("--out", metavar="camera.yaml", help="also write the camera block to this file")
+    g = p.add_argument_group("importing a calibration file")
+    g.add_argument("--import", dest="import_file", metavar="FILE",
+                   help="read a calibration file instead of fitting points")
+    g.add_argument("--camera", metavar="NAME", help="camera of a multi-camera file (e.g. View_001)")
+    g.add_argument("--units", metavar="mm|m|auto", help="world unit of the file (default: auto, detected "
+                                                        "from |t| and stated)")
+    g.add_argument("--scale", metavar="F", help="rescale the camera by F (e.g. 0.625 for 768x576 -> 480x360); "
+                                                "or give --image-size")
+    g.add_argument("--calibration-size", metavar="WxH",
+                   help="image size the calibration was made for, when the file does not say")
+    g.add_argument("--check", action="append", default=[], metavar="X,Y,Z[,u,v]",
+                   help="reproject a world point (file units, see --units) and compare with pixel (u, v) "
+                        "of the calibration's image; repeatable. Write --check=-4140,... for a negative X")
     p.set_defaults(func=run)
