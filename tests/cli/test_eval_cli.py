@@ -101,7 +101,7 @@ def test_non_numeric_value_is_one_line_exit_2(tmp_path, capsys):
     (["--gate", "-1"], "--gate: expected a positive distance"),
     (["--gate", "wide"], "--gate: expected a distance in metres, got 'wide'"),
     (["--area", "0,0,1,1"], "--area: expected x1,y1,x2,y2,... with at least 3"),
-    (["--area", "0,0,1,x,1,1"], "--area: expected numbers"),
+    (["--area", "0,0,1,x,1,1"], "no such file, and not numbers x1,y1,x2,y2"),
 ])
 def test_bad_options_are_one_line_exit_2(capsys, extra, fragment):
     assert fragment in _one_line_error(capsys, ["eval", GT, PRED, *extra])
@@ -120,3 +120,13 @@ def test_header_only_prediction_scores_all_misses(tmp_path, capsys):
     m = _json(capsys, ["eval", GT, str(empty), "--json"])
     assert m["num_misses"] == 10 and m["mota"] == 0.0 and m["num_predictions"] == 0
     assert m["mean_error_m"] is None                            # NaN -> null in JSON
+
+
+def test_area_can_be_a_file_with_comments(tmp_path, capsys):
+    area = tmp_path / "area.txt"
+    area.write_text("# a square around everything\n-100,-100, 100,-100\n100,100,-100,100\n")
+    from worldtrack.cli import main
+    assert main(["eval", GT, PRED, "--area", str(area), "--json"]) == 0
+    inside = json.loads(capsys.readouterr().out)
+    assert main(["eval", GT, PRED, "--json"]) == 0
+    assert inside["mota"] == json.loads(capsys.readouterr().out)["mota"]

@@ -11,7 +11,9 @@ import argparse
 import csv
 import json
 import math
+import re
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -30,9 +32,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("pred", metavar="PRED", help="predicted tracks (tracks.csv or MOT txt)")
     p.add_argument("--gate", default="0.5", metavar="METRES",
                    help="largest distance at which a prediction may match a person (default 0.5 m)")
-    p.add_argument("--area", metavar="X1,Y1,X2,Y2,...",
-                   help="evaluate only inside this floor polygon (metres, >= 3 points); write "
-                        "--area=-1,0,... when the first number is negative")
+    p.add_argument("--area", metavar="AREA",
+                   help="evaluate only inside this floor polygon: a file of x1,y1,x2,y2,... ('#' comments) "
+                        "or the numbers themselves (metres, >= 3 points; write --area=-1,0,... when the "
+                        "first number is negative)")
     p.add_argument("--per-frame", metavar="CSV",
                    help="write per-frame counts: frame,num_gt,num_pred,matches,misses,fp,switches,"
                         "mean_error_m")
@@ -51,6 +54,25 @@ def parse_gate(text: str) -> float:
     if not (math.isfinite(gate) and gate > 0):
         raise InputError(f"--gate: expected a positive distance in metres, got {text!r}")
     return gate
+
+
+def read_area(text: str) -> np.ndarray:
+    """``--area``: a polygon file (numbers x1,y1,x2,y2,…, '#' comments) or the numbers, → (M, 2) m."""
+    path = Path(text)
+    if path.is_file():
+        try:
+            lines = path.read_text(encoding="utf-8").splitlines()
+        except (OSError, UnicodeDecodeError) as e:
+            raise InputError(f"--area {text}: cannot read ({getattr(e, 'strerror', None) or e})") from None
+        body = ",".join(ln.split("#", 1)[0].strip() for ln in lines if ln.split("#", 1)[0].strip())
+        body = re.sub(r"[\s,;]+", ",", body).strip(",")
+        try:
+            return parse_area(body)
+        except InputError as e:
+            raise InputError(f"--area {text}: {str(e).removeprefix('--area: ')}") from None
+    if not re.fullmatch(r"[-+0-9.eE,\s]+", text):
+        raise InputError(f"--area {text!r}: no such file, and not numbers x1,y1,x2,y2,...")
+    return parse_area(text)
 
 
 def parse_area(text: str) -> np.ndarray:
@@ -73,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     from worldtrack.io.tracks import read_tracks
 
     gate = parse_gate(args.gate)
-    area = parse_area(args.area) if args.area else None
+    area = read_area(args.area) if args.area else None
     gt = read_tracks(args.gt)
     pred = read_tracks(args.pred)
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from worldtrack.cli.eval import read_area
 from worldtrack.errors import InputError
 
 DESCRIPTION = """\
@@ -79,25 +80,6 @@ def _positive(text: str, flag: str, example: str) -> float:
     return value
 
 
-def read_area(text: str) -> np.ndarray:
-    """``--area``: a polygon file (numbers x1,y1,x2,y2,…, '#' comments) or the numbers, → (M, 2) m."""
-    from worldtrack.cli.eval import parse_area
-
-    path = Path(text)
-    if path.is_file():
-        try:
-            lines = path.read_text(encoding="utf-8").splitlines()
-        except (OSError, UnicodeDecodeError) as e:
-            raise InputError(f"--area {text}: cannot read ({getattr(e, 'strerror', None) or e})") from None
-        body = ",".join(ln.split("#", 1)[0].strip() for ln in lines if ln.split("#", 1)[0].strip())
-        body = re.sub(r"[\s,;]+", ",", body).strip(",")
-        try:
-            return parse_area(body)
-        except InputError as e:
-            raise InputError(f"--area {text}: {str(e).removeprefix('--area: ')}") from None
-    if not re.fullmatch(r"[-+0-9.eE,\s]+", text):
-        raise InputError(f"--area {text!r}: no such file, and not numbers x1,y1,x2,y2,...")
-    return parse_area(text)
 
 
 def run_import(args: argparse.Namespace) -> int:
