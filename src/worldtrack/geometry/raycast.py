@@ -96,3 +96,44 @@ def ray_plane_z(o: ArrayLike, d: np.ndarray, z: float = 0.0) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         s = (z - oz) / d[:, 2]
     return np.where((np.abs(d[:, 2]) > _EPS) & (s > 0), s, np.inf)
+
+
+def ray_capsule(o: ArrayLike, d: np.ndarray, a: ArrayLike, b: ArrayLike, radius: float) -> np.ndarray:
+    """Nearest hit of rays with a capsule: all points within ``radius`` of the segment ``a``–``b``.
+
+    The capsule is the union of a cylinder around the segment and two spheres at its ends, so the
+    nearest hit is the smallest positive parameter among the cylinder's side (only where the hit
+    lies between the end planes) and the two end spheres. Rays parallel to the axis miss the side
+    and hit a cap.
+
+    Parameters
+    ----------
+    o : (3,) or (N, 3)
+    d : (N, 3) unit directions
+    a, b : (3,) segment end points, metres
+    radius : float, metres
+    """
+    o = np.asarray(o, dtype=float)
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    d = np.asarray(d, dtype=float)
+    oa = np.broadcast_to(o - a, d.shape)
+    ba = b - a
+    baba = float(ba @ ba)
+    bard = d @ ba
+    baoa = oa @ ba
+    rdoa = np.einsum("ij,ij->i", d, oa)
+    oaoa = np.einsum("ij,ij->i", oa, oa)
+    # Side: |(oa + s·d) − ((oa + s·d)·ba / |ba|²)·ba|² = r², multiplied through by |ba|².
+    qa = baba - bard * bard
+    qb = baba * rdoa - baoa * bard
+    qc = baba * oaoa - baoa * baoa - radius * radius * baba
+    disc = qb * qb - qa * qc
+    side_ok = (qa > _EPS * max(baba, _EPS)) & (disc >= 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s_side = (-qb - np.sqrt(np.where(side_ok, disc, 0.0))) / np.where(side_ok, qa, 1.0)
+    y = baoa + s_side * bard
+    s_side = np.where(side_ok & (s_side > 0) & (y > 0) & (y < baba), s_side, np.inf)
+    s_a = ray_ellipsoid(o, d, a, (radius, radius, radius))
+    s_b = ray_ellipsoid(o, d, b, (radius, radius, radius))
+    return np.minimum(s_side, np.minimum(s_a, s_b))

@@ -1,0 +1,863 @@
+"""Built-in scenarios: the papers' experiments and a few more, each a function and a CLI name.
+
+>>> from worldtrack.synth import make_scenario, list_scenarios
+>>> sorted(list_scenarios())[:3]
+['crowd', 'desk-occlusion', 'entry']
+>>> sc = make_scenario("two-crossing", size=(160, 120), frames=5, seed=0)
+>>> sc.fps, sc.n_frames, sc.camera_ids
+(10.0, 5, ['cam1', 'cam2'])
+
+Every scenario takes ``size`` (W, H), ``frames``, ``seed`` and the common options of
+:class:`Common` (``fps``, ``noise``, ``shadow_strength``, ``reflection``, ``blur``, ``light_drift``,
+``vignetting``, ``white_balance``), plus its own keyword parameters (see each function).
+"""
+
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass, fields, replace
+from typing import Callable
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.geometry.camera import look_at_rotation
+from worldtrack.scene.load import scene_from_dict
+from worldtrack.scene.model import Scene
+from worldtrack.synth import scenes
+from worldtrack.synth.bodies import (JointAngles, body_parts, draw_body_shape, limb_rotation, HEAD, TORSO,
+                                     L_UPPER_ARM, L_FOREARM, R_UPPER_ARM, R_FOREARM, PARTS_PER_PERSON)
+from worldtrack.synth.environment import Environment, Window
+from worldtrack.synth.motion import (Track, Waypoint, WalkerSettings, finish_track, follow_target as robot_follow,
+                                     graph_route, random_walkers, scripted_track, track_from_robot)
+from worldtrack.synth.photometry import (Light, LightingSchedule, LightSegment, SensorNoise, WhiteBalance,
+                                         light_direction)
+from worldtrack.synth.render import RenderOptions
+from worldtrack.synth.sensors import SensorSpec
+from worldtrack.synth.sequence import CameraRig, Person, Scenario
+
+
+@dataclass(frozen=True)
+class Common:
+    """Options every scenario accepts (override with ``make_scenario(..., name=value)``).
+
+    Parameters
+    ----------
+    fps : float — frame rate; time = frame / fps
+    noise : float — sensor read noise σ (display units; 0 = noise-free, also no shot noise)
+    shadow_strength : float in [0, 1] — 0 switches cast shadows off
+    reflection : float in [0, 1] or None — floor reflectivity (None: the scenario's default)
+    blur : float — optical blur σ in pixels at 640 px width
+    light_drift : float — relative amplitude of the slow illumination drift
+    vignetting : float — brightness fall-off at the corners
+    white_balance : "auto" or "fixed"
+    light_steps : tuple of (time_s, level) — the room light switches to ``level`` (relative) at
+        ``time_s`` seconds, e.g. ((5.0, 0.6),) dims it by 40 % five seconds in
+    """
+
+    fps: float = 10.0
+    noise: float = 1.8
+    shadow_strength: float = 0.6
+    reflection: float | None = None
+    blur: float = 0.8
+    light_drift: float = 0.03
+    vignetting: float = 0.12
+    white_balance: str = "auto"
+    light_steps: tuple = ()
+
+
+_REGISTRY: dict[str, Callable[..., Scenario]] = {}
+_DOCS: dict[str, str] = {}
+
+
+def _register(name: str, summary: str):
+    def deco(fn):
+        _REGISTRY[name] = fn
+        _DOCS[name] = summary
+        return fn
+    return deco
+
+
+def list_scenarios() -> dict[str, str]:
+    """Names of the built-in scenarios → one-line description."""
+    return dict(_DOCS)
+
+
+def scenario_parameters(name: str) -> dict[str, object]:
+    """The scenario's own keyword parameters and their defaults (besides size/frames/seed/Common)."""
+    fn = _lookup(name)
+    return {k: p.default for k, p in inspect.signature(fn).parameters.items()
+            if p.kind == p.KEYWORD_ONLY and k not in ("size", "frames")}
+
+
+def _lookup(name: str):
+    if name not in _REGISTRY:
+        raise InputError(f"unknown scenario {name!r} (known: {', '.join(sorted(_REGISTRY))})")
+    return _REGISTRY[name]
+
+
+def make_scenario(name: str, size: tuple[int, int] | str | None = None, frames: int | None = None, seed: int = 0,
+                  **overrides) -> Scenario:
+    """Build a built-in scenario by name.
+
+    Parameters
+    ----------
+    name : str — see :func:`list_scenarios`
+    size : (width, height) pixels or "WxH", optional — every camera is scaled to it (same aspect)
+    frames : int, optional — number of frames (default: the scenario's natural length)
+    seed : int — one seed for everything random
+    **overrides : the scenario's parameters and :class:`Common` options
+
+    Raises
+    ------
+    InputError
+        Unknown scenario or parameter, or a value out of range.
+    """
+    fn = _lookup(name)
+    common_names = {f.name for f in fields(Common)}
+    own = scenario_parameters(name)
+    common_kw, own_kw = {}, {}
+    for k, v in overrides.items():
+        if k in common_names:
+            common_kw[k] = v
+        elif k in own:
+            own_kw[k] = v
+        else:
+            valid = sorted(set(own) | common_names)
+            raise InputError(f"scenario {name!r} has no parameter {k!r} (parameters: {', '.join(valid)})")
+    common = Common(**common_kw)
+    _check_common(common)
+    if frames is not None and (int(frames) != frames or frames < 1):
+        raise InputError(f"frames: expected a positive integer, got {frames!r}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError(f"seed: expected a non-negative integer, got {seed!r}")
+    sc = fn(int(seed), common, size=parse_size(size) if size is not None else None,
+            frames=int(frames) if frames is not None else None, **own_kw)
+    sc.params = {"scenario": name, "seed": int(seed), "size": list(_first_size(sc)), "frames": sc.n_frames,
+                 **{f.name: getattr(common, f.name) for f in fields(Common)}, **own, **own_kw}
+    return sc
+
+
+def parse_size(size) -> tuple[int, int]:
+    """(W, H) from a tuple or a string "WxH"."""
+    if isinstance(size, str):
+        try:
+            w, h = (int(x) for x in size.lower().split("x"))
+        except ValueError:
+            raise InputError(f"size: expected WIDTHxHEIGHT in pixels (e.g. 320x240), got {size!r}") from None
+    else:
+        try:
+            w, h = (int(x) for x in size)
+        except (TypeError, ValueError):
+            raise InputError(f"size: expected (width, height) in pixels, got {size!r}") from None
+    if w < 16 or h < 12 or w > 4096 or h > 4096:
+        raise InputError(f"size: expected 16x12 to 4096x4096 pixels, got {w}x{h}")
+    return w, h
+
+
+def _first_size(sc: Scenario) -> tuple[int, int]:
+    cam = next(iter(sc.scene.cameras.values()))
+    return cam.width, cam.height
+
+
+def _check_common(c: Common) -> None:
+    if not 0.1 <= c.fps <= 1000:
+        raise InputError(f"fps: expected 0.1–1000 frames per second, got {c.fps}")
+    for k in ("noise", "blur", "light_drift", "vignetting"):
+        if getattr(c, k) < 0:
+            raise InputError(f"{k}: expected a value ≥ 0, got {getattr(c, k)}")
+    if not 0 <= c.shadow_strength <= 1:
+        raise InputError(f"shadow_strength: expected a value in [0, 1], got {c.shadow_strength}")
+    if c.reflection is not None and not 0 <= c.reflection <= 1:
+        raise InputError(f"reflection: expected a value in [0, 1], got {c.reflection}")
+    if c.white_balance not in ("auto", "fixed"):
+        raise InputError(f"white_balance: expected 'auto' or 'fixed', got {c.white_balance!r}")
+    try:
+        steps = [(float(t), float(level)) for t, level in c.light_steps]
+    except (TypeError, ValueError):
+        raise InputError(f"light_steps: expected pairs (time_s, level), got {c.light_steps!r}") from None
+    if any(t < 0 or level < 0 for t, level in steps):
+        raise InputError(f"light_steps: expected times and levels ≥ 0, got {c.light_steps!r}")
+
+
+# ------------------------------------------------------------------------------------ helpers
+
+def _scene(data: dict, size: tuple[int, int] | None, cameras: list[str] | None = None) -> Scene:
+    """Scene from a mapping, keeping ``cameras`` (in that order) scaled to ``size`` (same aspect)."""
+    scene = scene_from_dict(data, label=data.get("name", "scene"))
+    cams = {c: scene.cameras[c] for c in (cameras or list(scene.cameras))}
+    if size is not None:
+        out = {}
+        for cid, cam in cams.items():
+            f = size[0] / cam.width
+            if abs(cam.height * f - size[1]) > 0.5:
+                raise InputError(f"size: camera {cid!r} is {cam.width}x{cam.height}; expected the same aspect "
+                                 f"ratio, e.g. {size[0]}x{int(round(cam.height * f))}, got {size[0]}x{size[1]}")
+            out[cid] = cam if f == 1 else cam.scaled(f)
+        cams = out
+    return scene.with_cameras(cams)
+
+
+def _options(common: Common, reflection_default: float = 0.0) -> RenderOptions:
+    shot = 0.05 if common.noise > 0 else 0.0
+    return RenderOptions(SensorNoise(common.noise, shot, common.blur, common.vignetting), common.shadow_strength,
+                         reflection_default if common.reflection is None else common.reflection)
+
+
+def _lighting(common: Common, rng: np.random.Generator, base: Light, segments: tuple = ()) -> LightingSchedule:
+    steps = tuple(LightSegment(float(t), "", level=float(level)) for t, level in common.light_steps)
+    return LightingSchedule(base, drift=common.light_drift, drift_period=float(rng.uniform(25.0, 60.0)),
+                            drift_phase=float(rng.uniform(0, 2 * np.pi)), segments=tuple(segments) + steps)
+
+
+def _rigs(scene: Scene, common: Common, sensors: dict[str, SensorSpec] | None = None,
+          schedule: dict | None = None) -> dict[str, CameraRig]:
+    return {cid: CameraRig(sensor=(sensors or {}).get(cid, SensorSpec()),
+                           white_balance=WhiteBalance(mode=common.white_balance, schedule=dict(schedule or {})))
+            for cid in scene.cameras}
+
+
+def _route_length(tracks: list[Track], tail_s: float, fps: float, cap: int) -> int:
+    """Frames until every scripted track has stopped for good (or left), plus a tail."""
+    last = 0
+    for tr in tracks:
+        moving = np.flatnonzero((tr.speed > 0) & tr.present)
+        gone = np.flatnonzero(tr.present)
+        end = max(moving.max() if len(moving) else 0, 0)
+        if len(gone) and gone.max() < len(tr) - 1:
+            end = max(end, gone.max())
+        last = max(last, end)
+    return int(min(cap, last + 1 + round(tail_s * fps)))
+
+
+def _trim(track: Track, n: int) -> Track:
+    return Track(*(getattr(track, f.name)[:n] for f in fields(Track)))
+
+
+def _route_frames(route: list[Waypoint], fps: float, start_time: float = 0.0, accel: float = 1.2) -> int:
+    """Enough frames to walk ``route`` (distances, dwells, braking), with a margin."""
+    t = start_time + route[0].dwell
+    for a, b in zip(route[:-1], route[1:]):
+        t += np.hypot(b.x - a.x, b.y - a.y) / b.speed + b.speed / accel + b.dwell
+    return int(np.ceil((t + 2.0) * fps)) + 2
+
+
+def _shape(rng, env: Environment, height=None, width=None):
+    return draw_body_shape(rng, height=height, shoulder_width=width, camouflage=env.background_colours())
+
+
+_MAX_FRAMES = 20000
+_FACE_CAMERA = -np.pi / 2  # in the kato lab, facing -Y looks at camera 1
+
+
+def _kato_env(scene: Scene) -> Environment:
+    top = max(c.centre[2] for c in scene.cameras.values())
+    return Environment(wall_height=max(2.7, top + 0.25), floor_style="tiles", floor_colour=(150, 158, 162),
+                       wall_colour=(185, 195, 200), obstacle_colours={"desk": (70, 110, 150), "shelf": (120, 125, 128),
+                                                                     "stool": (60, 60, 70)}, posters=3, seed=3)
+
+
+def _kato_light() -> Light:
+    return Light(ambient=0.55, direct=0.6, direction=light_direction(110.0, 62.0))
+
+
+def _dwell_route(points: list[tuple[float, float]], dwell: float, speed: float, face: float | None) -> list[Waypoint]:
+    return [Waypoint(x, y, dwell=dwell, speed=speed, face=face) for x, y in points]
+
+
+# ------------------------------------------------------------------------------------ seed 000
+
+# Table 1 of seed 000: camera 1 at 15 points — (a) full body at (0, 0)…(−2, 2), (b) lower body only at
+# y = 3, (c) upper body only at y = −0.5, where the paper's range is (0.5, −0.5)…(−1.5, −0.5);
+# camera 2 at the 12 points (0, 0)…(−2, 3).
+CAM1_GRID = ([(x, -0.5) for x in (0.5, -0.5, -1.5)]
+             + [(x, y) for y in (0.0, 1.0, 2.0, 3.0) for x in (0.0, -1.0, -2.0)])
+CAM2_GRID = [(x, y) for y in (0.0, 1.0, 2.0, 3.0) for x in (0.0, -1.0, -2.0)]
+
+
+def _serpentine(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    rows = sorted({p[1] for p in points})
+    out = []
+    for k, y in enumerate(rows):
+        xs = sorted({p[0] for p in points if p[1] == y}, reverse=(k % 2 == 0))
+        out += [(x, y) for x in xs]
+    return out
+
+
+@_register("static-grid", "seed 000 Table 1: one person standing still at the measurement grid points")
+def static_grid(seed: int, common: Common, *, size=None, frames=None, camera: str = "cam1", dwell: float = 1.5,
+                height: float | None = 1.66, width: float | None = 0.42, speed: float = 0.6) -> Scenario:
+    """One person walks slowly between the paper's grid points and stands still ``dwell`` seconds at each.
+
+    ``camera``: "cam1" (15 points, Table 1 (a)–(c)), "cam2" (12 points) or "both" (camera 1's points).
+    Defaults are the paper's subject (1.66 m, 0.42 m); ``height=None`` draws one. 160×120 by default.
+    """
+    if camera not in ("cam1", "cam2", "both"):
+        raise InputError(f"camera: expected cam1, cam2 or both, got {camera!r}")
+    if dwell <= 0 or speed <= 0:
+        raise InputError("dwell and speed: expected positive values (s, m/s)")
+    rng = np.random.default_rng(seed)
+    data = scenes.scene_dict("kato_lab")
+    data["obstacles"] = [o for o in data["obstacles"] if o["name"] != "desk"]
+    cams = ["cam1", "cam2"] if camera == "both" else [camera]
+    scene = _scene(data, size or (160, 120), cams)
+    env = _kato_env(scene)
+    shape = _shape(rng, env, height, width)
+    pts = _serpentine(CAM2_GRID if camera == "cam2" else CAM1_GRID)
+    route = _dwell_route(pts, dwell, speed, _FACE_CAMERA)
+    track = scripted_track(route, common.fps, _route_frames(route, common.fps), shape.height,
+                           initial_yaw=_FACE_CAMERA)
+    n = frames or _route_length([track], dwell + 0.3, common.fps, _MAX_FRAMES)
+    people = [Person(1, shape, _trim(_pad(track, n), n))]
+    return Scenario("static-grid", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
+                    _options(common, 0.1), _rigs(scene, common), seed,
+                    description="seed 000 Table 1: a person standing still at grid points (speed 0 while standing)")
+
+
+def _pad(track: Track, n: int) -> Track:
+    """Extend a track to n frames by holding its last state (standing still)."""
+    T = len(track)
+    if n <= T:
+        return track
+    extra = n - T
+    def hold(a, zero=False):
+        last = np.repeat(a[-1:], extra, axis=0)
+        return np.concatenate([a, np.zeros_like(last) if zero else last])
+    return Track(hold(track.xy), hold(track.yaw), hold(track.speed, True), hold(track.present), hold(track.sit),
+                 hold(track.phase), hold(track.amplitude, True))
+
+
+DESK_ROWS = (0.0, 1.0, 2.0, 3.0)
+
+
+@_register("desk-occlusion", "seed 000 Table 2: a 0.73 m desk hides the feet (and the image border the head)")
+def desk_occlusion(seed: int, common: Common, *, size=None, frames=None, hide: str = "feet", dwell: float = 1.5,
+                   height: float | None = 1.66, width: float | None = 0.42, speed: float = 0.6,
+                   camera: str = "cam1") -> Scenario:
+    """Rows of 0.73 m desks, one 0.45 m in front of each grid row (the paper moved one desk each time).
+
+    ``hide="feet"``: the 9 points of rows y = 0, 1, 2 (feet hidden, head visible — Table 2 (a));
+    ``hide="head-and-feet"``: row y = 3, where the image border also cuts the head (Table 2 (b));
+    ``hide="all"``: all 12 points. The person walks round the desks' west ends between rows.
+    """
+    if hide not in ("feet", "head-and-feet", "all"):
+        raise InputError(f"hide: expected feet, head-and-feet or all, got {hide!r}")
+    if camera not in ("cam1", "both"):
+        raise InputError(f"camera: expected cam1 or both, got {camera!r}")
+    rng = np.random.default_rng(seed)
+    rows = {"feet": DESK_ROWS[:3], "head-and-feet": DESK_ROWS[3:], "all": DESK_ROWS}[hide]
+    data = scenes.scene_dict("kato_lab")
+    data["obstacles"] = [o for o in data["obstacles"] if o["name"] != "desk"]
+    data["obstacles"] += [{"name": f"desk_{k}", "type": "box", "centre": [-1.0, y - 0.45, 0.365],
+                           "size": [2.8, 0.6, 0.73]} for k, y in enumerate(DESK_ROWS)]
+    scene = _scene(data, size or (160, 120), ["cam1", "cam2"] if camera == "both" else ["cam1"])
+    env = _kato_env(scene)
+    env = replace(env, obstacle_colours={**{f"desk_{k}": (70, 110, 150) for k in range(4)},
+                                         "shelf": (120, 125, 128)})
+    shape = _shape(rng, env, height, width)
+    route: list[Waypoint] = []
+    for y in rows:
+        route.append(Waypoint(-3.0, y, speed=speed))
+        route += _dwell_route([(-2.0, y), (-1.0, y), (0.0, y)], dwell, speed, _FACE_CAMERA)
+        route.append(Waypoint(-3.0, y, speed=speed))
+    route = route[:-1]
+    track = scripted_track(route, common.fps, _route_frames(route, common.fps), shape.height)
+    n = frames or _route_length([track], dwell + 0.3, common.fps, _MAX_FRAMES)
+    people = [Person(1, shape, _trim(_pad(track, n), n))]
+    return Scenario("desk-occlusion", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
+                    _options(common, 0.1), _rigs(scene, common), seed,
+                    description=f"seed 000 Table 2: desks hide the feet ({hide})")
+
+
+@_register("two-crossing", "seed 000 Fig. 9-10: two people crossing in camera 1's image (and passing close by)")
+def two_crossing(seed: int, common: Common, *, size=None, frames=None, passing: str = "image",
+                 speed: float = 0.9, heights: tuple | None = (1.73, 1.66),
+                 widths: tuple | None = (0.48, 0.42)) -> Scenario:
+    """Two people in the kato lab: person 1 (1.73 m, 0.48 m) walks left→right 1.6 m beyond person 2
+    (1.66 m, 0.42 m) who walks right→left, so one passes behind the other in camera 1's image.
+
+    ``passing="close"``: instead they walk past each other along Y, 0.5 m apart (identity swaps);
+    ``"both"``: the image crossing, then the close pass. ``heights=None`` draws the people.
+    """
+    if passing not in ("image", "close", "both"):
+        raise InputError(f"passing: expected image, close or both, got {passing!r}")
+    rng = np.random.default_rng(seed)
+    scene = _scene(scenes.scene_dict("kato_lab"), size or (160, 120))
+    env = _kato_env(scene)
+    hs = heights or (None, None)
+    ws = widths or (None, None)
+    shapes = [_shape(rng, env, hs[i], ws[i]) for i in range(2)]
+    v = speed
+    image = ([Waypoint(-3.0, 1.6, dwell=0.5), Waypoint(0.6, 1.6, speed=v)],
+             [Waypoint(0.6, 0.1, dwell=0.5), Waypoint(-3.0, 0.1, speed=v)])
+    close = ([Waypoint(-2.45, 3.7, speed=v), Waypoint(-2.45, -0.9, speed=v)],
+             [Waypoint(-1.95, -0.9, speed=v), Waypoint(-1.95, 3.7, speed=v)])
+    if passing == "image":
+        routes = image
+    elif passing == "close":
+        routes = ([Waypoint(close[0][0].x, close[0][0].y, dwell=0.5)] + close[0][1:],
+                  [Waypoint(close[1][0].x, close[1][0].y, dwell=0.5)] + close[1][1:])
+    else:
+        routes = (image[0] + [Waypoint(0.6, 3.7, speed=v), Waypoint(-2.45, 3.7, speed=v, dwell=0.5)] + close[0][1:],
+                  image[1] + [Waypoint(-3.0, -0.9, speed=v), Waypoint(-1.95, -0.9, speed=v, dwell=0.5)] + close[1][1:])
+    tracks = [scripted_track(r, common.fps, _route_frames(r, common.fps), s.height) for r, s in zip(routes, shapes)]
+    if passing == "both":
+        # Start the close pass together: hold whoever arrives first at its start.
+        tracks = _synchronise_last_leg(routes, tracks, shapes, common.fps)
+    n = frames or _route_length(tracks, 1.0, common.fps, _MAX_FRAMES)
+    people = [Person(i + 1, shapes[i], _trim(_pad(tracks[i], n), n)) for i in range(2)]
+    return Scenario("two-crossing", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
+                    _options(common, 0.12), _rigs(scene, common), seed,
+                    description=f"seed 000 Fig. 9-10: two people crossing ({passing})")
+
+
+def _synchronise_last_leg(routes, tracks, shapes, fps):
+    """Re-plan so both people begin their last leg at the same time (for the close pass)."""
+    arrive = []
+    for r, tr in zip(routes, tracks):
+        start = np.array([r[-2].x, r[-2].y])
+        at = np.flatnonzero(np.linalg.norm(tr.xy - start, axis=1) < 1e-6)
+        arrive.append(at[0] / fps if len(at) else 0.0)
+    t0 = max(arrive) + 0.5
+    out = []
+    for r, s, a in zip(routes, shapes, arrive):
+        r = list(r)
+        r[-2] = Waypoint(r[-2].x, r[-2].y, dwell=t0 - a + r[-2].dwell, speed=r[-2].speed)
+        out.append(scripted_track(r, fps, _route_frames(r, fps), s.height))
+    return out
+
+
+@_register("sit-down", "seed 000's posture change: a person walks to a stool, sits down, stands up, walks on")
+def sit_down(seed: int, common: Common, *, size=None, frames=None, sit_seconds: float = 5.0,
+             height: float | None = None, width: float | None = None) -> Scenario:
+    """The kato lab with a stool at (−1.8, 1.0): a person comes in by the door, sits facing camera 1
+    for ``sit_seconds``, then walks to the front of the room. The ground point while seated is the
+    pelvis over the stool; the feet are a thigh length in front of it."""
+    rng = np.random.default_rng(seed)
+    data = scenes.scene_dict("kato_lab")
+    data["obstacles"].append({"name": "stool", "type": "box", "centre": [-1.8, 1.0, 0.21], "size": [0.4, 0.4, 0.42],
+                              "blocks_walking": False})
+    scene = _scene(data, size or (160, 120))
+    env = _kato_env(scene)
+    shape = _shape(rng, env, height, width)
+    route = [Waypoint(-3.15, 3.6, dwell=0.3), Waypoint(-2.6, 2.6, speed=1.0), Waypoint(-1.8, 1.6, speed=1.0),
+             Waypoint(-1.8, 1.0, dwell=sit_seconds + 2.4, speed=0.5, sit=True, face=_FACE_CAMERA),
+             Waypoint(-0.6, 0.2, speed=1.0), Waypoint(0.2, -0.6, speed=1.0)]
+    track = scripted_track(route, common.fps, _route_frames(route, common.fps), shape.height)
+    n = frames or _route_length([track], 1.0, common.fps, _MAX_FRAMES)
+    people = [Person(1, shape, _trim(_pad(track, n), n))]
+    return Scenario("sit-down", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
+                    _options(common, 0.1), _rigs(scene, common), seed, description="seed 000: sitting down")
+
+
+# ------------------------------------------------------------------------------------ crowd
+
+@_register("crowd", "N random walkers (up to 50) in a 10 x 8 m hall seen by 1-4 corner cameras")
+def crowd(seed: int, common: Common, *, size=None, frames=None, people: int = 10, cameras: int = 2,
+          min_separation: float = 0.6, speed: tuple = (0.9, 1.4), p_stop: float = 0.3) -> Scenario:
+    """Random walkers that keep ``min_separation`` metres apart and 0.3 m inside the walkable area,
+    stop now and then (speed 0), and walk round the pillars and the table. 320×240 by default."""
+    if not 1 <= int(people) <= 50:
+        raise InputError(f"people: expected 1 to 50, got {people}")
+    if not 1 <= int(cameras) <= 4:
+        raise InputError(f"cameras: expected 1 to 4, got {cameras}")
+    rng = np.random.default_rng(seed)
+    data = scenes.scene_dict("hall")
+    scene = _scene(data, size or (320, 240), [c["id"] for c in data["cameras"][:int(cameras)]])
+    env = Environment(wall_height=4.2, floor_style="wood", floor_colour=(95, 130, 165), wall_colour=(200, 205, 200),
+                      obstacle_colours={"pillar_w": (170, 170, 165), "pillar_e": (170, 170, 165),
+                                        "table": (60, 80, 100)}, posters=6, seed=5)
+    n = frames or 100
+    shapes = [_shape(rng, env) for _ in range(int(people))]
+    settings = WalkerSettings(speed=tuple(speed), min_separation=min_separation, p_stop=p_stop)
+    tracks = random_walkers(scene, int(people), common.fps, n, rng, [s.height for s in shapes], settings)
+    persons = [Person(i + 1, shapes[i], tracks[i]) for i in range(int(people))]
+    light = Light(ambient=0.55, direct=0.55, direction=light_direction(40.0, 58.0))
+    return Scenario("crowd", scene, common.fps, n, persons, env, _lighting(common, rng, light), _options(common),
+                    _rigs(scene, common), seed, description=f"{people} random walkers")
+
+
+# ------------------------------------------------------------------------------------ seed 004
+
+@_register("entry", "seed 004: people enter side by side through a door region, then split up and leave")
+def entry(seed: int, common: Common, *, size=None, frames=None, pairs: int = 2, singles: int = 1,
+          spacing: float = 0.5, split_after: float = 2.0, interval: float = 6.0, speed: float = 1.0,
+          backlight: bool = True) -> Scenario:
+    """One fixed camera on a lobby's north wall looking at the south door. Every ``interval`` seconds
+    a pair walks in through the door side by side, ``spacing`` m apart (centre to centre), walks
+    ``split_after`` m together, then the two split to different points, wait, and leave through the
+    east door or back through the south door. ``singles`` more people cross from the east door.
+    People appear in the door corridors and vanish on leaving them. With ``backlight`` the south
+    wall beside the door is bright glass, so people coming in are seen against the light.
+    320×240 by default."""
+    if not 0 <= int(pairs) <= 6 or not 0 <= int(singles) <= 6 or int(pairs) + int(singles) == 0:
+        raise InputError(f"pairs, singles: expected 0–6 each and at least one person, got {pairs}, {singles}")
+    if not 0.3 <= spacing <= 1.5:
+        raise InputError(f"spacing: expected 0.3–1.5 m, got {spacing}")
+    rng = np.random.default_rng(seed)
+    scene = _scene(scenes.scene_dict("lobby"), size or (320, 240))
+    glass = tuple(Window(np.array([[x0, 0.01, 0.3], [x1, 0.01, 0.3], [x1, 0.01, 2.6], [x0, 0.01, 2.6]]),
+                         (245.0, 240.0, 235.0)) for x0, x1 in ((0.4, 3.0), (5.0, 7.6)))
+    env = Environment(wall_height=3.5, floor_style="tiles", floor_colour=(120, 135, 150), wall_colour=(175, 190, 205),
+                      obstacle_colours={"planter": (50, 90, 60), "counter": (90, 100, 120)}, posters=3, seed=11,
+                      windows=glass if backlight else ())
+    south_exit = [Waypoint(4.0, 0.6, speed=speed), Waypoint(4.0, -1.45, speed=speed)]
+    east_exit = [Waypoint(7.6, 3.15, speed=speed), Waypoint(9.45, 3.15, speed=speed)]
+    routes, starts, shapes = [], [], []
+    for k in range(int(pairs)):
+        t0 = 0.5 + k * interval
+        split_y = 0.3 + split_after
+        goals = [(rng.uniform(1.2, 2.8), rng.uniform(2.2, 4.3)), (rng.uniform(5.2, 6.8), rng.uniform(1.8, 4.3))]
+        for side, dx in enumerate((-spacing / 2, spacing / 2)):
+            gx, gy = goals[side]
+            exit_ = east_exit if rng.random() < 0.5 else south_exit
+            r = [Waypoint(4.0 + dx, -1.45), Waypoint(4.0 + dx, split_y, speed=speed),
+                 Waypoint(gx, gy, speed=speed * rng.uniform(0.9, 1.1), dwell=rng.uniform(1.0, 3.0))] + exit_
+            routes.append(r)
+            starts.append(t0)
+            shapes.append(_shape(rng, env))
+    for k in range(int(singles)):
+        t0 = 3.0 + k * interval
+        gx, gy = rng.uniform(1.5, 3.0), rng.uniform(2.0, 4.0)
+        routes.append([Waypoint(9.45, 3.15), Waypoint(7.5, 3.15, speed=speed), Waypoint(gx, gy, speed=speed)]
+                      + south_exit)
+        starts.append(t0)
+        shapes.append(_shape(rng, env))
+    tracks = [scripted_track(r, common.fps, _route_frames(r, common.fps, t0), s.height, start_time=t0,
+                             leave_at_end=True)
+              for r, s, t0 in zip(routes, shapes, starts)]
+    n = frames or _route_length(tracks, 1.0, common.fps, 3000)
+    persons = [Person(i + 1, shapes[i], _trim(_pad(tracks[i], n), n)) for i in range(len(tracks))]
+    light = Light(ambient=0.6, direct=0.5, direction=light_direction(250.0, 60.0))
+    return Scenario("entry", scene, common.fps, n, persons, env, _lighting(common, rng, light), _options(common),
+                    _rigs(scene, common), seed, description="seed 004: pairs entering side by side, then splitting")
+
+
+# ------------------------------------------------------------------------------------ seed 001
+
+SUN_WARM = (0.86, 0.97, 1.08)      # BGR tint of sunlight
+SHADE_BLUE = (1.15, 1.0, 0.86)     # BGR tint of skylight in shade
+
+
+@_register("follow-target", "seed 001: a robot's stereo camera follows a target among 3 others; "
+                            "front light, backlight, shade; white-balance jumps")
+def follow_target(seed: int, common: Common, *, size=None, frames=None, others: int = 3, baseline: float = 0.12,
+                  distance: float = 1.8, camera_height: float = 1.1, wb_jumps: tuple = (),
+                  segments: tuple = ("front", "backlight", "shade-front", "shade-back")) -> Scenario:
+    """A target walks a loop in a courtyard; a robot (never drawn) follows at ``distance`` m with a
+    stereo camera (``baseline`` m) at ``camera_height``. Of the ``others``, one crosses between
+    robot and target twice (short occlusions), the rest walk at random. The sequence is cut into
+    lighting ``segments`` (sun behind the camera, sun in front with lowered exposure, building
+    shade with bluish skylight lit from the front or back); the automatic white balance jumps when
+    the light's colour changes, and ``wb_jumps`` (frames) add scheduled jumps. 320×240 by default.
+    Per-frame robot poses go to frames.csv / camera_poses.csv.
+    """
+    known = {"front", "backlight", "shade-front", "shade-back"}
+    if not segments or any(s not in known for s in segments):
+        raise InputError(f"segments: expected a list from {sorted(known)}, got {segments!r}")
+    if not 0 <= int(others) <= 10:
+        raise InputError(f"others: expected 0 to 10, got {others}")
+    rng = np.random.default_rng(seed)
+    base_scene = _scene(scenes.scene_dict("courtyard"), size or (320, 240))
+    env = Environment(wall_height=6.0, ceiling=False, floor_style="paving", floor_colour=(140, 150, 160),
+                      wall_colour=(160, 175, 190), obstacle_colours={"bench": (50, 70, 90), "kiosk": (120, 90, 80)},
+                      posters=10, seed=13)
+    n = frames or 200
+    fps = common.fps
+    target_shape = _shape(rng, env)
+    loop = [(4.0, 3.0), (11.0, 2.6), (13.5, 5.5), (11.5, 9.5), (5.0, 9.2), (2.8, 6.0)]
+    wps = [Waypoint(*loop[0], dwell=1.0)]
+    for lap in range(6):
+        for k, (x, y) in enumerate(loop[1:] + loop[:1]):
+            wps.append(Waypoint(x + rng.uniform(-0.5, 0.5), y + rng.uniform(-0.5, 0.5), speed=rng.uniform(0.9, 1.2),
+                                dwell=float(rng.choice([0.0, 0.0, 1.5]))))
+    target = scripted_track(wps, fps, n, target_shape.height, initial_yaw=0.0)
+    robot = robot_follow(base_scene, target, fps, distance=distance)
+    # Crossers: one person crossing the robot–target line at 30 % and 70 % of the sequence.
+    shapes = [target_shape]
+    tracks = [target]
+    if int(others) >= 1:
+        cross_shape = _shape(rng, env)
+        tracks.append(_crosser(base_scene, robot, target, fps, n, cross_shape.height, (0.3, 0.7)))
+        shapes.append(cross_shape)
+    n_random = max(0, int(others) - 1)
+    if n_random:
+        rshapes = [_shape(rng, env) for _ in range(n_random)]
+        tracks += random_walkers(base_scene, n_random, fps, n, rng, [s.height for s in rshapes],
+                                 others=[track_from_robot(robot, fps)] + tracks, other_radius=0.7)
+        shapes += rshapes
+    persons = [Person(i + 1, shapes[i], tracks[i]) for i in range(len(tracks))]
+    # Camera poses: on the robot, looking along its heading, tilted 4° down.
+    poses = []
+    for (x, y), yaw in zip(robot.xy, robot.yaw):
+        fwd = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+        pos = np.array([x, y, camera_height]) + 0.1 * fwd
+        R = look_at_rotation(pos, pos + fwd + np.array([0.0, 0.0, -np.tan(np.radians(4.0))]))
+        poses.append((R, -R @ pos))
+    cam0 = base_scene.cameras["robot"].moved(*poses[0])
+    scene = base_scene.with_cameras({"robot": cam0})
+    seg_len = n / fps / len(segments)
+    segs = []
+    for k, name in enumerate(segments):
+        t0 = k * seg_len
+        if name == "front":
+            segs.append(LightSegment(t0, name, ambient=0.5, direct=0.75, direction=light_direction(180.0 + 25, 38.0),
+                                     tint=SUN_WARM, exposure=1.0, relative_to_camera=True))
+        elif name == "backlight":
+            segs.append(LightSegment(t0, name, ambient=0.45, direct=0.8, direction=light_direction(15.0, 22.0),
+                                     tint=SUN_WARM, exposure=0.62, relative_to_camera=True))
+        elif name == "shade-front":
+            segs.append(LightSegment(t0, name, ambient=0.7, direct=0.12, direction=light_direction(200.0, 45.0),
+                                     tint=SHADE_BLUE, exposure=1.15, relative_to_camera=True))
+        else:
+            segs.append(LightSegment(t0, name, ambient=0.7, direct=0.12, direction=light_direction(20.0, 45.0),
+                                     tint=SHADE_BLUE, exposure=1.05, relative_to_camera=True))
+    schedule = {}
+    for f in wb_jumps:
+        f = int(f)
+        if not 0 <= f < n:
+            raise InputError(f"wb_jumps: frame {f} is outside 0–{n - 1}")
+        schedule[f] = (int(rng.integers(380, 700)), int(rng.integers(380, 700)))
+    sensors = {"robot": SensorSpec("stereo", baseline=baseline)}
+    rigs = _rigs(scene, common, sensors, schedule)
+    rigs["robot"].poses = poses
+    rigs["robot"].white_balance.threshold = 30
+    return Scenario("follow-target", scene, fps, n, persons, env,
+                    _lighting(common, rng, Light(tint=SUN_WARM), tuple(segs)), _options(common), rigs, seed,
+                    description="seed 001: robot stereo camera following person 1 (the target)")
+
+
+def _crosser(scene: Scene, robot, target: Track, fps: float, n: int, height: float, at: tuple) -> Track:
+    """A person who walks across the robot–target line at the given fractions of the sequence,
+    appearing 3 m to one side and vanishing 3 m to the other."""
+    df = scene.distance_field(0.05)
+    out = Track(np.zeros((n, 2)), np.zeros(n), np.zeros(n), np.zeros(n, bool), np.zeros(n), np.zeros(n), np.zeros(n))
+    speed, half = 1.3, 3.0
+    for frac in at:
+        kc = int(frac * (n - 1))
+        mid = (robot.xy[kc] + target.xy[kc]) / 2
+        line = target.xy[kc] - robot.xy[kc]
+        perp = np.array([-line[1], line[0]]) / max(np.linalg.norm(line), 1e-9)
+        a, b = mid - half * perp, mid + half * perp
+        ends_ok = df.sample(np.array([a, b]), outside=-1.0).min() > 0.35
+        if not ends_ok:
+            a, b = b, a
+        steps = int(round(2 * half / speed * fps))
+        k0 = kc - steps // 2
+        ks = np.arange(max(k0, 0), min(k0 + steps + 1, n))
+        if len(ks) < 3:
+            continue
+        s_ = (ks - k0) / steps
+        xy = a + s_[:, None] * (b - a)
+        seg = finish_track(xy, fps, height)
+        for f in ("xy", "yaw", "speed", "phase", "amplitude"):
+            getattr(out, f)[ks] = getattr(seg, f)
+        out.present[ks] = True
+    return out
+
+
+# ------------------------------------------------------------------------------------ seed 002
+
+@_register("non-overlapping", "seed 002: an office with walls and desks seen by 4 cameras whose views do not overlap")
+def non_overlapping(seed: int, common: Common, *, size=None, frames=None, people: int = 2, legs: int = 14,
+                    speed: tuple = (1.0, 1.3)) -> Scenario:
+    """A 16 × 8 m office: a corridor along y = 4 m with desks and partitions on both sides and four
+    ceiling cameras looking down on it, 4 m apart, with gaps between their views. People walk
+    random routes along the corridor and stop at desks; between cameras nobody sees them.
+    320×240 by default."""
+    if not 1 <= int(people) <= 6:
+        raise InputError(f"people: expected 1 to 6, got {people}")
+    rng = np.random.default_rng(seed)
+    scene = _scene(scenes.scene_dict("office_4cams"), size or (320, 240))
+    colours = {o.name: ((75, 105, 140) if o.name.startswith("desk") else (150, 140, 125)) for o in scene.obstacles}
+    env = Environment(wall_height=3.0, floor_style="carpet", floor_colour=(120, 115, 105), wall_colour=(200, 205, 210),
+                      obstacle_colours=colours, posters=8, seed=17)
+    n = frames or 300
+    nodes, edges, desk_nodes = _office_graph()
+    persons = []
+    for i in range(int(people)):
+        shape = _shape(rng, env)
+        lane = (i % 3 - 1) * 0.35
+        route_idx = graph_route(nodes, edges, int(rng.integers(0, 15)), int(legs), rng)
+        wps = []
+        v = rng.uniform(*speed)
+        for j in route_idx:
+            x, y = nodes[j]
+            dwell = float(rng.uniform(1.5, 4.0)) if j in desk_nodes else 0.0
+            wps.append(Waypoint(x, y + (lane if j not in desk_nodes else 0.0), dwell=dwell, speed=v))
+        wps[0] = Waypoint(wps[0].x, wps[0].y, dwell=float(rng.uniform(0.0, 4.0)))
+        tr = scripted_track(wps, common.fps, n, shape.height)
+        persons.append(Person(i + 1, shape, tr))
+    light = Light(ambient=0.6, direct=0.45, direction=light_direction(70.0, 70.0))
+    return Scenario("non-overlapping", scene, common.fps, n, persons, env, _lighting(common, rng, light),
+                    _options(common), _rigs(scene, common), seed,
+                    description="seed 002: four non-overlapping cameras in an office")
+
+
+def _office_graph():
+    """Corridor nodes at y = 4 m every metre, desk stops beside each camera's desks."""
+    corridor = [(float(x), 4.0) for x in range(1, 16)]
+    nodes = list(corridor)
+    edges = [(i, i + 1) for i in range(len(corridor) - 1)]
+    desk_nodes = set()
+    for xc in (2.0, 6.0, 10.0, 14.0):
+        c = corridor.index((xc, 4.0))
+        for y in (3.15, 4.85):
+            nodes.append((xc + 0.3, y))
+            desk_nodes.add(len(nodes) - 1)
+            edges.append((c, len(nodes) - 1))
+    return np.array(nodes), edges, desk_nodes
+
+
+# ------------------------------------------------------------------------------------ seed 003
+
+def _booth(size, common, depth_step_mm, cam_pos, cam_target, person_height, rng):
+    data = scenes.scene_dict("booth")
+    data["cameras"][0].update(position=[float(v) for v in cam_pos], look_at=[float(v) for v in cam_target])
+    scene = _scene(data, size or (320, 240))
+    env = Environment(wall_height=2.6, floor_style="wood", floor_colour=(90, 120, 150), wall_colour=(170, 180, 185),
+                      posters=3, seed=19)
+    if depth_step_mm <= 0:
+        raise InputError(f"depth_step_mm: expected a positive step in mm, got {depth_step_mm}")
+    sensors = {"kinect": SensorSpec("rgbd", baseline=0.075, depth_step=depth_step_mm / 1000.0)}
+    return scene, env, sensors
+
+
+def _smooth_signal(rng, n, fps, amplitude, f_range=(0.08, 0.35), terms=2):
+    """Sum of sinusoids with random frequencies (Hz) and phases, peak ≈ ``amplitude``."""
+    t = np.arange(n) / fps
+    out = np.zeros(n)
+    for _ in range(terms):
+        out += np.sin(2 * np.pi * rng.uniform(*f_range) * t + rng.uniform(0, 2 * np.pi))
+    return amplitude * out / terms
+
+
+BOOTH_XY = (2.0, 2.8)
+
+
+def _booth_person(rng, env, height, n, fps):
+    shape = _shape(rng, env, height, None)
+    T = np.ones(n, bool)
+    xy = np.tile(BOOTH_XY, (n, 1))
+    tr = Track(xy, np.full(n, -np.pi / 2), np.zeros(n), T, np.zeros(n), np.zeros(n), np.zeros(n))
+    ja = JointAngles.neutral(np.array([BOOTH_XY]), np.array([-np.pi / 2]))
+    parts = body_parts([shape], ja)
+    return shape, tr, parts
+
+
+def _quat(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z), w ≥ 0, of a rotation matrix."""
+    w = np.sqrt(max(0.0, 1 + R[0, 0] + R[1, 1] + R[2, 2])) / 2
+    x = np.sqrt(max(0.0, 1 + R[0, 0] - R[1, 1] - R[2, 2])) / 2
+    y = np.sqrt(max(0.0, 1 - R[0, 0] + R[1, 1] - R[2, 2])) / 2
+    z = np.sqrt(max(0.0, 1 - R[0, 0] - R[1, 1] + R[2, 2])) / 2
+    x = np.copysign(x, R[2, 1] - R[1, 2])
+    y = np.copysign(y, R[0, 2] - R[2, 0])
+    z = np.copysign(z, R[1, 0] - R[0, 1])
+    q = np.array([w, x, y, z])
+    return q / np.linalg.norm(q)
+
+
+@_register("face-pose", "seed 003: RGB-D close-up of a face with small or large 6-DoF head motion")
+def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str = "small", distance: float = 0.8,
+              depth_step_mm: float = 5.0, height: float = 1.72) -> Scenario:
+    """A person stands facing a Kinect-like camera ``distance`` m in front of the head and moves the
+    head: ``motion="small"`` (about ±6° yaw, ±4° pitch, ±3° roll, ±1 cm) or ``"large"`` (±35°,
+    ±20°, ±12°, ±5 cm), smooth random sinusoids. Depth in ``depth_step_mm`` steps (seed 003's
+    simulation used 5 mm). pose.csv: the head centre (m), its head → world quaternion, and the head's
+    angles relative to the torso (rz, ry, rx in degrees; ZYX). 320×240 by default."""
+    if motion not in ("small", "large"):
+        raise InputError(f"motion: expected small or large, got {motion!r}")
+    if not 0.3 <= distance <= 3.0:
+        raise InputError(f"distance: expected 0.3–3 m, got {distance}")
+    rng = np.random.default_rng(seed)
+    n = frames or 100
+    fps = common.fps
+    env0 = Environment()
+    shape, tr, parts0 = _booth_person(rng, env0, height, n, fps)
+    head_c = parts0.centre[HEAD]
+    cam_pos = head_c + np.array([0.0, -distance, 0.0])
+    scene, env, sensors = _booth(size, common, depth_step_mm, cam_pos, head_c, height, rng)
+    amp = {"small": (6.0, 4.0, 3.0, 0.01), "large": (35.0, 20.0, 12.0, 0.05)}[motion]
+    head = np.column_stack([_smooth_signal(rng, n, fps, np.radians(a)) for a in amp[:3]])
+    offset = np.column_stack([_smooth_signal(rng, n, fps, amp[3]) for _ in range(3)])
+    person = Person(1, shape, tr, pose={"head": head, "torso_offset": offset})
+
+    def rows(k, t, people, parts):
+        out = []
+        for i, p in enumerate(people):
+            c = parts.centre[i * PARTS_PER_PERSON + HEAD]
+            R = parts.axes[i * PARTS_PER_PERSON + HEAD].T
+            q = _quat(R)
+            rz, ry, rx = np.degrees(p.pose["head"][k])
+            out.append({"frame": k, "time": round(t, 6), "id": p.id, "tx": round(c[0], 6), "ty": round(c[1], 6),
+                        "tz": round(c[2], 6), "qw": round(q[0], 8), "qx": round(q[1], 8), "qy": round(q[2], 8),
+                        "qz": round(q[3], 8), "rz_deg": round(rz, 5), "ry_deg": round(ry, 5), "rx_deg": round(rx, 5)})
+        return out
+
+    light = Light(ambient=0.55, direct=0.6, direction=light_direction(-60.0, 35.0))
+    return Scenario("face-pose", scene, fps, n, [person], env, _lighting(common, rng, light), _options(common),
+                    _rigs(scene, common, sensors), seed, pose_rows=rows,
+                    description=f"seed 003: face pose, {motion} motion")
+
+
+@_register("upper-body", "seed 003: RGB-D view of an upper body with 14-DoF motion "
+                          "(torso 6, shoulders 2+2, elbows 2+2)")
+def upper_body(seed: int, common: Common, *, size=None, frames=None, distance: float = 1.9,
+               depth_step_mm: float = 5.0, height: float = 1.72) -> Scenario:
+    """A person faces a Kinect-like camera ``distance`` m away and moves torso and arms: torso
+    translation (±3 cm) and ``Rz·Ry·Rx`` rotation (±9°, ±5°, ±5°), each shoulder ``Rz·Ry`` and each
+    elbow ``Rz·Ry`` (see :mod:`worldtrack.synth.bodies` for the limb frames). pose.csv: the 14
+    parameters (m, degrees) and the world unit axes of both upper arms and forearms (for seed 003's
+    limb-axis error). 320×240 by default."""
+    if not 0.8 <= distance <= 4.0:
+        raise InputError(f"distance: expected 0.8–4 m, got {distance}")
+    rng = np.random.default_rng(seed)
+    n = frames or 100
+    fps = common.fps
+    env0 = Environment()
+    shape, tr, parts0 = _booth_person(rng, env0, height, n, fps)
+    chest = parts0.centre[TORSO] + np.array([0.0, 0.0, 0.1])
+    cam_pos = chest + np.array([0.0, -distance, 0.15])
+    scene, env, sensors = _booth(size, common, depth_step_mm, cam_pos, chest, height, rng)
+    sig = lambda a, f=(0.08, 0.3): _smooth_signal(rng, n, fps, a, f)
+    torso = np.column_stack([sig(np.radians(9)), sig(np.radians(5)), sig(np.radians(5))])
+    offset = np.column_stack([sig(0.03), sig(0.03), sig(0.01)])
+    sh_rz = np.column_stack([-0.6 + sig(0.6), 0.6 + sig(0.6)])           # left: − forward; right: + forward
+    sh_ry = np.column_stack([0.85 + sig(0.55), 0.85 + sig(0.55)])         # lowered from horizontal
+    el_rz = np.column_stack([-(0.8 + sig(0.5)), 0.8 + sig(0.5)])          # forearm bends forward
+    el_ry = np.column_stack([sig(0.25), sig(0.25)])
+    shoulder = np.stack([limb_rotation(sh_rz[:, k], sh_ry[:, k]) for k in (0, 1)], axis=1)
+    elbow = np.stack([limb_rotation(el_rz[:, k], el_ry[:, k]) for k in (0, 1)], axis=1)
+    person = Person(1, shape, tr, pose={"torso": torso, "torso_offset": offset, "shoulder": shoulder, "elbow": elbow})
+
+    def rows(k, t, people, parts):
+        out = []
+        for i, p in enumerate(people):
+            base = i * PARTS_PER_PERSON
+            lumbar = parts.centre[base + TORSO] - parts.axes[base + TORSO][2] * (0.11 * p.shape.height)
+            row = {"frame": k, "time": round(t, 6), "id": p.id,
+                   "torso_tx": round(lumbar[0], 6), "torso_ty": round(lumbar[1], 6), "torso_tz": round(lumbar[2], 6)}
+            for name, val in zip(("torso_rz_deg", "torso_ry_deg", "torso_rx_deg"), np.degrees(torso[k])):
+                row[name] = round(val, 5)
+            for s, side in enumerate("lr"):
+                row[f"{side}_shoulder_rz_deg"] = round(np.degrees(sh_rz[k, s]), 5)
+                row[f"{side}_shoulder_ry_deg"] = round(np.degrees(sh_ry[k, s]), 5)
+                row[f"{side}_elbow_rz_deg"] = round(np.degrees(el_rz[k, s]), 5)
+                row[f"{side}_elbow_ry_deg"] = round(np.degrees(el_ry[k, s]), 5)
+            for name, part in (("l_upper_arm", L_UPPER_ARM), ("l_forearm", L_FOREARM),
+                               ("r_upper_arm", R_UPPER_ARM), ("r_forearm", R_FOREARM)):
+                a, b = parts.centre[base + part], parts.end[base + part]
+                ax = (b - a) / np.linalg.norm(b - a)
+                for c, v in zip("xyz", ax):
+                    row[f"{name}_axis_{c}"] = round(v, 8)
+            out.append(row)
+        return out
+
+    light = Light(ambient=0.55, direct=0.6, direction=light_direction(-60.0, 40.0))
+    return Scenario("upper-body", scene, fps, n, [person], env, _lighting(common, rng, light), _options(common),
+                    _rigs(scene, common, sensors), seed, pose_rows=rows,
+                    description="seed 003: upper-body pose, 14 DoF")
+
+
+SCENARIOS = tuple(_REGISTRY)
