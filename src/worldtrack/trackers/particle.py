@@ -1,0 +1,662 @@
+"""3-D particle filters with the height-column likelihood (seed 004).
+
+One particle filter per object, in world coordinates (metres, Z up). Every frame each filter
+
+1. **predicts** every particle with a velocity and Gaussian noise (eqs. 1–2, in real time)::
+
+       x_t = x_{t−1} + v·dt + w,   w ~ N(0, σ²·dt)      (σ in m/√s, dt in seconds)
+
+   with ``v`` each particle's own ``(x_{t−1} − x_{t−2}) / dt`` (the paper) or the object's;
+2. **observes** the likelihood π_i of each particle (:mod:`~worldtrack.trackers.particle_likelihood`:
+   the height column of eq. 11 or the point of eq. 7, multiplied over the cameras that see the
+   particle; 0 off the walkable floor or out of every view) and weights ``g_i = π_i / Σ π`` (eq. 8);
+3. **resamples** in proportion to the weights (systematic, see :class:`ParticleConfig`);
+4. reports the **object region** from the resampled particles: centre ``O = mean`` (eq. 9) and size
+   ``σ_x, σ_y, σ_z`` (eq. 10), the box ``O ± σ``.
+
+New objects are found by **detection filters** (§3.2): particles scattered uniformly over each entry
+region (in a scene without entry regions, over the walkable floor in view). A detection filter is a
+particle filter too and concentrates on what enters; when the share of its *likely* particles
+exceeds α it hands them over to a new tracking filter and is scattered afresh. A **tracking filter**
+ends when the share of its likely particles falls to β or below. Likely: the column sees at least
+``min_height`` of object (``π·dz ≥ min_height``) in every camera that sees the particle; for the
+point likelihood, ``F > γ`` there.
+
+Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as published):
+
+* objects that enter together and then part (§6's future work): a filter whose particles have become
+  two lumps on the floor is split into two tracks, a detection filter that fires on two lumps starts
+  two, and filters that settle on one object are merged;
+* explaining away: pixels inside another tracked object's image box read as background, so a filter
+  cannot take over a neighbour that shows more foreground, and a detection filter sees only what no
+  track explains;
+* a sharper column weight (the likelihood ratio of an object standing there), a column with a small
+  radius, floor contact, and cast shadows removed — see :class:`ParticleConfig`;
+* several cameras: the likelihood multiplies over the cameras that see the particle;
+* the particles' z: the column does not depend on it, so after resampling each particle's z is
+  drawn uniformly below the top its column sees — the particles then fill the object's height.
+
+A track reports: ``x, y`` the region's centre on the floor; ``z, sx, sy, sz`` (metres, in
+``Track.extra`` and the extra columns of ``tracks.csv``) the box ``(x, y, z) ± (sx, sy, sz)``;
+``sigma = sqrt((sx² + sy²) / 2)``; ``height`` the mean top the particles' columns see (column
+likelihood; the scene's person height for the point likelihood); ``width`` the scene's person width
+(a particle cloud says where an object is, not how wide); ``score`` the share of likely particles;
+``vx, vy`` the prediction velocity (m/s).
+
+Example
+-------
+>>> from worldtrack.foreground.background import StaticBackground
+>>> tracker = ParticleTracker(scene, {"cam1": StaticBackground(bg, mode="colour")})   # doctest: +SKIP
+>>> for index, t, frames in source:                                                 # doctest: +SKIP
+...     tracks = tracker.step(frames, t)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.geometry.camera import Camera
+from worldtrack.scene.model import Scene
+from worldtrack.trackers.base import PositionMap, Track
+from worldtrack.trackers.particle_config import ParticleConfig
+from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, owner_image,
+                                                     shadow_free_hits, thresholded_difference)
+from worldtrack.trackers.particle_sampling import FloorRegion, bimodal_split, polygon_distance, resampler
+
+Box = tuple[int, int, int, int]
+
+
+@dataclass(eq=False)
+class _Filter:
+    """One particle filter: a tracking filter, or a detection filter when ``track`` is None.
+
+    ``xyz`` (P, 3) particle positions (m) and ``v`` (P, 3) their own velocities (m/s); ``V`` (2,)
+    the object's floor velocity (m/s); ``centre`` (2,) the floor mean after resampling; ``region``
+    the area a detection filter scatters over; ``logw`` a detection filter's log weights of the
+    last frame (None: scatter afresh). ``logpi, likely, col_h`` hold this frame's observation.
+    """
+
+    xyz: np.ndarray
+    v: np.ndarray
+    track: Track | None = None
+    region: FloorRegion | None = None
+    V: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    centre: np.ndarray | None = None
+    logw: np.ndarray | None = None
+    low_since: float | None = None
+    t_update: float | None = None
+    split_count: int = 0
+    logpi: np.ndarray | None = None
+    likely: np.ndarray | None = None
+    col_h: np.ndarray | None = None
+
+    def take(self, idx: np.ndarray) -> None:
+        """Keep the particles ``idx`` (with repeats), this frame's observation included."""
+        self.xyz, self.v = self.xyz[idx], self.v[idx]
+        if self.logpi is not None:
+            self.logpi, self.likely, self.col_h = self.logpi[idx], self.likely[idx], self.col_h[idx]
+
+
+class ParticleTracker:
+    """Multi-object tracker: one 3-D particle filter per object, detection filters for new ones.
+
+    Parameters
+    ----------
+    scene : Scene
+    foregrounds : {camera_id: foreground model}
+        Each needs ``difference(image) -> (H, W) float`` (the Euclidean RGB distance F), e.g.
+        :class:`~worldtrack.foreground.background.StaticBackground`; with ``shadows`` also a
+        background image (``.background``, or ``.model.getBackgroundImage()``).
+    config : ParticleConfig, optional
+    position_map : PositionMap, optional — share one between trackers or processes
+    rng : numpy.random.Generator, optional — default ``default_rng(config.seed)``
+
+    Attributes
+    ----------
+    extra_columns : tuple of str — the columns ``tracks.csv`` gets besides the standard ones
+    last_masks : {camera_id: (H, W) uint8} — this frame's ``F > γ`` (for overlays)
+    filters : list — the tracking filters; ``detectors`` — the detection filters
+    """
+
+    extra_columns = ("sigma", "z", "sx", "sy", "sz")
+
+    def __init__(self, scene: Scene, foregrounds: Mapping[str, object], config: ParticleConfig | None = None,
+                 position_map: PositionMap | None = None, rng: np.random.Generator | None = None):
+        self.scene = scene
+        self.config = cfg = config or ParticleConfig()
+        self.position_map = position_map if position_map is not None else PositionMap()
+        self.rng = rng if rng is not None else np.random.default_rng(cfg.seed)
+        if not foregrounds:
+            raise InputError("particle tracker: expected at least one camera with a foreground model")
+        self.foregrounds = dict(foregrounds)
+        for cid, fg in self.foregrounds.items():
+            scene.camera(cid)
+            if not callable(getattr(fg, "difference", None)):
+                raise InputError(f"particle tracker: the foreground model of {cid} has no difference(image)")
+            if cfg.shadows and _background_image(fg) is None:
+                raise InputError(f"particle tracker: shadows=True needs the background image of {cid}'s "
+                                 "foreground model (use a static background, or set shadows=False)")
+        self._cams = {cid: CameraLikelihood(scene.camera(cid)) for cid in self.foregrounds}
+        self._floor: dict[str, np.ndarray] = {}
+        if cfg.shadows:
+            walk = scene.walkable.raster(0.01)
+            for cid in self.foregrounds:
+                occ = scene.occlusion(cid).floor_distance if scene.obstacles else None
+                self._floor[cid] = floor_pixels(scene.camera(cid), walk, occ)
+        a, b = cfg.hit_rate_object, cfg.hit_rate_background
+        self._on, self._off = math.log(a / b), math.log((1 - a) / (1 - b))
+        self._n_below = cfg.foot_samples if cfg.weighting == "ratio" else 0
+        self.heights = cfg.heights
+        self._column = np.concatenate([-cfg.dz * np.arange(self._n_below, 0, -1), self.heights])
+        self._k_min = self._n_below + min(cfg.likely_count, len(self.heights) - 1)
+        self._resample = resampler(cfg.resampling)
+        self._walkable = scene.walkable.raster(0.01).contains
+        self.filters: list[_Filter] = []
+        self.detectors = [_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=r) for r in self._detection_regions()]
+        self._last_t: float | None = None
+        self._close: dict[tuple[int, int], int] = {}
+        self.last_masks: dict[str, np.ndarray] = {}
+
+    # ------------------------------------------------------------------ set-up
+    def _detection_regions(self) -> list[FloorRegion]:
+        """Where detection filters scatter: entry regions grown by ``entry_margin``, or all floor; in view."""
+        cfg, scene = self.config, self.scene
+        births = cfg.births
+        if births == "auto":
+            births = "entry" if scene.entry_regions else "anywhere"
+        if births == "none":
+            return []
+        walk = scene.walkable.contains
+
+        def in_view(xy: np.ndarray) -> np.ndarray:
+            """Walkable, and a column of ``min_height`` there is inside some camera's image."""
+            seen = np.zeros(len(xy), dtype=bool)
+            for cl in self._cams.values():
+                cam = cl.camera
+                feet = cam.in_image(cam.project(np.column_stack([xy, np.zeros(len(xy))])))
+                head = cam.in_image(cam.project(np.column_stack([xy, np.full(len(xy), cfg.min_height)])))
+                seen |= feet & head
+            return walk(xy) & seen
+
+        if births == "anywhere":
+            reg = FloorRegion.rasterise("walkable", scene.walkable.bounds, 0.05, in_view)
+            if reg.empty:
+                raise InputError(f"particle tracker: no walkable floor of scene {scene.name!r} is in view of "
+                                 f"{', '.join(self._cams)}")
+            return [reg]
+        if not scene.entry_regions:
+            raise InputError(f"particle tracker: births='entry' but scene {scene.name!r} has no entry regions")
+        regions = []
+        m = cfg.entry_margin
+        for er in scene.entry_regions:
+            p = er.polygon
+            bounds = (p[:, 0].min() - m, p[:, 0].max() + m, p[:, 1].min() - m, p[:, 1].max() + m)
+            reg = FloorRegion.rasterise(er.name, bounds, 0.02,
+                                        lambda xy, p=p: (polygon_distance(xy, p) <= m) & in_view(xy))
+            if not reg.empty:
+                regions.append(reg)
+        if not regions:
+            raise InputError(f"particle tracker: no entry region of scene {scene.name!r} is in view of "
+                             f"{', '.join(self._cams)} (use births='anywhere')")
+        return regions
+
+    # ------------------------------------------------------------------ public
+    def init_track(self, x: float, y: float, track_id: int | None = None, mode: str = "tracking",
+                   t: float = 0.0, spread: float = 0.1) -> Track:
+        """Start a tracking filter at floor position ``(x, y)`` (m), particles spread ``spread`` (m, 1-σ)."""
+        cfg = self.config
+        n = cfg.particles
+        xyz = np.column_stack([x + spread * self.rng.standard_normal(n), y + spread * self.rng.standard_normal(n),
+                               self.rng.random(n) * cfg.max_height])
+        h, w = self.scene.people.size_of(track_id or 0)
+        tr = self.position_map.add(x, y, h, w, mode="tracking", time=t, track_id=track_id)
+        f = _Filter(xyz, np.zeros((n, 3)), track=tr)
+        self._update_region(f, t)
+        self.filters.append(f)
+        return tr
+
+    @property
+    def tracks(self) -> list[Track]:
+        """Copies of the tracking filters' tracks, in id order."""
+        return sorted((f.track.copy() for f in self.filters), key=lambda tr: tr.id)
+
+    def step(self, frames: Mapping[str, object], t: float) -> list[Track]:
+        """Update every filter with one synchronised bundle of frames taken at time ``t``.
+
+        Parameters
+        ----------
+        frames : {camera_id: Frame or (H, W, 3) uint8 BGR image}
+        t : float, seconds — must not decrease from call to call
+
+        Returns
+        -------
+        list of Track — the tracking filters' objects (never the detection filters), ids from 1
+        """
+        cfg = self.config
+        t = float(t)
+        if not math.isfinite(t):
+            raise InputError(f"particle tracker: time stamp must be a finite number of seconds, got {t}")
+        if self._last_t is not None and t < self._last_t:
+            raise InputError(f"particle tracker: time went backwards ({t} s after {self._last_t} s)")
+        dt = 0.0 if self._last_t is None else t - self._last_t
+        images = self._images(frames)
+        self._last_t = t
+        if not images:
+            return self.tracks
+
+        for f in self.filters:
+            self._predict(f, dt)
+        boxes = self._boxes(self.filters, [f.xyz[:, :2].mean(axis=0) for f in self.filters], cfg.box_margin)
+        owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
+        explain_tracks = cfg.explain == "all"
+        for i, f in enumerate(self.filters):
+            f.logpi, f.likely, f.col_h = self.likelihood(
+                f.xyz, images, owners if explain_tracks else None,
+                {cid: boxes[cid][i] for cid in images} if explain_tracks else None)
+        for f in list(self.filters):
+            self._update_tracking(f, t)
+
+        # Detection filters read past every track's box (at the updated positions, stretched along
+        # the line of sight), so the object just handed over does not fire the fresh detection
+        # filter again even where its track sits at the wrong depth.
+        if cfg.explain != "none" and self.detectors:
+            boxes = self._boxes(self.filters, [f.centre for f in self.filters], cfg.box_margin,
+                                cfg.exclusion_depth)
+            owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
+        for d in self.detectors:
+            self._move_detector(d, dt)
+            d.logpi, d.likely, d.col_h = self.likelihood(d.xyz, images, owners if cfg.explain != "none" else None)
+            self._update_detector(d, t)
+
+        if cfg.split:
+            for f in list(self.filters):
+                self._maybe_split(f, t)
+        if cfg.merge:
+            self._merge()
+        for f in self.filters:
+            f.track.age_frames += 1
+        return self.tracks
+
+    # ------------------------------------------------------------------ observation
+    def _images(self, frames: Mapping[str, object]) -> dict[str, np.ndarray]:
+        """What the likelihood reads, per camera: ``F > γ`` (column) or thresholded F (point)."""
+        cfg = self.config
+        out = {}
+        self.last_masks = {}
+        for cid, frame in frames.items():
+            if cid not in self.foregrounds:
+                continue
+            image = frame.image if hasattr(frame, "image") else frame
+            cam = self._cams[cid].camera
+            if getattr(image, "shape", (0, 0))[:2] != (cam.height, cam.width):
+                raise InputError(f"{cid}: frame is {image.shape[1]}x{image.shape[0]} but the camera is "
+                                 f"{cam.width}x{cam.height}")
+            fg = self.foregrounds[cid]
+            F = fg.difference(image) if (cfg.likelihood == "point" or not cfg.shadows) else None
+            if cfg.shadows:
+                hit = shadow_free_hits(image, _background_image(fg), cfg.gamma, where=self._floor[cid])
+            else:
+                hit = hit_image(F, cfg.gamma)
+            self.last_masks[cid] = hit
+            out[cid] = hit if cfg.likelihood == "column" else thresholded_difference(np.where(hit > 0, F, 0), cfg.gamma)
+        return out
+
+    def _boxes(self, filters: list[_Filter], centres: list[np.ndarray], margin: float,
+               depth: float = 0.0) -> dict[str, list[Box | None]]:
+        """Per camera, each filter's object box in the image at ``centres`` (see :func:`image_box`)."""
+        xy = np.array(centres, dtype=float).reshape(-1, 2)
+        widths = np.array([f.track.width for f in filters], dtype=float)
+        heights = np.array([f.track.height for f in filters], dtype=float)
+        return {cid: image_boxes(cl.camera, xy, widths, heights, margin, depth) for cid, cl in self._cams.items()}
+
+    def likelihood(self, xyz: np.ndarray, images: Mapping[str, np.ndarray],
+                   owners: Mapping[str, np.ndarray] | None = None,
+                   boxes: Mapping[str, Box | None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Log-likelihood of particles, summed over the cameras that see them.
+
+        Parameters
+        ----------
+        xyz : (N, 3) float, metres
+        images : {camera_id: image} — ``F > γ`` (uint8) for the column, thresholded F for the point
+        owners : {camera_id: (H, W) uint8}, optional — object boxes per pixel (:func:`owner_image`);
+            pixels in a box other than ``boxes[camera_id]`` read as background
+        boxes : {camera_id: box or None}, optional — the filter's own object box
+
+        Returns
+        -------
+        logpi : (N,) float — log π up to a constant: ``weighting="count"``, the log of the column's
+            share of samples on the object (eq. 11 / (T + 1)); ``"ratio"``, the log-likelihood ratio
+            of the best object top; point, ``log(F / F_MAX)`` (eq. 7). −inf if no camera sees the
+            particle, it is off the walkable floor, or (point) outside [0, max_height]
+        likely : (N,) bool — the column sees ≥ ``min_height`` of object (point: ``F > γ``) in every
+            camera that sees the particle
+        col_h : (N,) float, metres — mean over the seeing cameras of the best top (ratio) or of
+            ``π·dz`` (count); 0 for the point
+        """
+        cfg = self.config
+        n = len(xyz)
+        logpi = np.zeros(n)
+        n_seen = np.zeros(n, dtype=np.int32)
+        likely = np.ones(n, dtype=bool)
+        col = np.zeros(n)
+        S = len(self.heights)
+        with np.errstate(divide="ignore"):
+            for cid, img in images.items():
+                cl = self._cams[cid]
+                owner = owners.get(cid) if owners is not None else None
+                box = boxes.get(cid) if boxes is not None else None
+                if cfg.likelihood == "column":
+                    counts, ratio, top, seen = cl.column(img, xyz[:, :2], self._column, self._on, self._off,
+                                                         self._k_min, cfg.column_radius, -self._on, self._n_below,
+                                                         owner, box)
+                    if cfg.weighting == "count":
+                        lv = np.log(counts / S)
+                        col += np.where(seen, counts * cfg.dz, 0.0)
+                    else:
+                        lv = ratio
+                        col += np.where(seen, self._column[top], 0.0)
+                    ok = counts >= cfg.likely_count
+                else:
+                    values, seen = cl.point(img, xyz, owner, box)
+                    lv = np.log(values / F_MAX)
+                    ok = values > 0
+                logpi += np.where(seen, lv, 0.0)
+                likely &= ok | ~seen
+                n_seen += seen
+        valid = (n_seen > 0) & self._walkable(xyz[:, :2])
+        if cfg.likelihood == "point":
+            valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
+        logpi = np.where(valid, logpi, -np.inf)
+        return logpi, likely & valid, col / np.maximum(n_seen, 1)
+
+    # ------------------------------------------------------------------ prediction
+    def _predict(self, f: _Filter, dt: float) -> None:
+        """Eqs. 1–2 in real time: ``x_t = x_{t−1} + v·dt + w``, ``w ~ N(0, σ²·dt)``."""
+        cfg = self.config
+        if dt <= 0:
+            return
+        n = len(f.xyz)
+        step = self.rng.standard_normal((n, 3)) * (np.array([cfg.noise_xy, cfg.noise_xy, cfg.noise_z]) * math.sqrt(dt))
+        if cfg.velocity == "particle":
+            step += f.v * dt
+        elif cfg.velocity == "object":
+            step[:, :2] += f.V * dt
+        old = f.xyz
+        f.xyz = old + step
+        if cfg.likelihood == "point":
+            f.xyz[:, 2] = _reflect(f.xyz[:, 2], 0.0, cfg.max_height)
+        if cfg.velocity == "particle":
+            # v_t = (x_t − x_{t−1}) / dt, each particle's velocity for the next frame (eq. 2).
+            f.v = (f.xyz - old) / dt
+            _clip_speed(f.v, cfg.max_speed)
+
+    def _move_detector(self, d: _Filter, dt: float) -> None:
+        """Resample a detection filter by last frame's weights, jitter, and scatter a share afresh."""
+        cfg = self.config
+        n = cfg.detection_particles
+        if d.logw is None:
+            d.xyz, d.v = self._scatter(d.region, n), np.zeros((n, 3))
+            return
+        d.xyz = d.xyz[self._resample(self._weights(d.logw), n, self.rng)]
+        d.xyz[:, :2] += self.rng.standard_normal((n, 2)) * (cfg.detection_noise * math.sqrt(max(dt, 0.0)))
+        fresh = (self.rng.random(n) < cfg.detection_reseed) | ~d.region.contains(d.xyz[:, :2])
+        k = int(fresh.sum())
+        if k:
+            d.xyz[fresh] = self._scatter(d.region, k)
+
+    def _scatter(self, region: FloorRegion, n: int) -> np.ndarray:
+        """(n, 3) particles uniform over the region's floor and over heights [0, max_height]."""
+        return np.column_stack([region.sample(n, self.rng), self.rng.random(n) * self.config.max_height])
+
+    # ------------------------------------------------------------------ tracking filters
+    def _weights(self, logpi: np.ndarray) -> np.ndarray:
+        """Eq. 8 up to its sum (the resampler normalises): ``g ∝ π^κ``; uniform if every π is 0."""
+        m = logpi.max() if len(logpi) else -np.inf
+        if not np.isfinite(m):
+            return np.ones(len(logpi))
+        return np.exp(self.config.likelihood_power * (logpi - m))
+
+    def _resample_filter(self, f: _Filter, weights: np.ndarray, n: int) -> None:
+        f.take(self._resample(weights, n, self.rng))
+        if self.config.likelihood == "column":
+            # The column does not depend on z: put each particle's z uniformly below the top its
+            # column sees, so that the particles fill the object (the box's z extent).
+            f.xyz[:, 2] = self.rng.random(n) * f.col_h
+
+    def _update_tracking(self, f: _Filter, t: float) -> None:
+        """Share of likely particles (end at ≤ β), weights (eq. 8), resampling, object region."""
+        cfg = self.config
+        share = float(f.likely.mean())
+        if share <= cfg.beta:
+            if f.low_since is None:
+                f.low_since = t
+            if t - f.low_since >= cfg.end_after_s:
+                self._end(f)
+                return
+        else:
+            f.low_since = None
+            f.track.last_seen = t
+        self._resample_filter(f, self._weights(f.logpi), cfg.particles)
+        f.track.score = share
+        self._update_region(f, t)
+
+    def _update_region(self, f: _Filter, t: float) -> None:
+        """Object region (eqs. 9–10) and the track's fields, from the resampled particles."""
+        cfg = self.config
+        tr = f.track
+        centre = f.xyz.mean(axis=0)
+        sd = f.xyz.std(axis=0)
+        prev, f.centre = f.centre, centre[:2].copy()
+        if cfg.velocity == "object":
+            if prev is not None and f.t_update is not None and t > f.t_update:
+                a = cfg.velocity_smoothing
+                f.V = (1 - a) * f.V + a * (f.centre - prev) / (t - f.t_update)
+                _clip_speed(f.V[None, :], cfg.max_speed)
+            V = f.V
+        elif cfg.velocity == "particle":
+            V = f.v[:, :2].mean(axis=0)
+        else:
+            V = np.zeros(2)
+        f.t_update = t
+        tr.x, tr.y = float(centre[0]), float(centre[1])
+        tr.vx, tr.vy = float(V[0]), float(V[1])
+        tr.sigma = float(math.sqrt(0.5 * (sd[0] ** 2 + sd[1] ** 2)))
+        if cfg.likelihood == "column" and f.col_h is not None:
+            tr.height = float(f.col_h.mean())
+        tr.extra.update(z=float(centre[2]), sx=float(sd[0]), sy=float(sd[1]), sz=float(sd[2]))
+
+    # ------------------------------------------------------------------ detection filters
+    def _update_detector(self, d: _Filter, t: float) -> None:
+        """Fire when the share of likely particles exceeds α; else keep the weights for next frame."""
+        cfg = self.config
+        share = float(d.likely.mean()) if len(d.likely) else 0.0
+        if share > cfg.alpha:
+            self._spawn(d, np.flatnonzero(d.likely), t)
+            d.logw = None
+            return
+        d.logw = d.logpi if np.isfinite(d.logpi).any() else None
+
+    def _spawn(self, d: _Filter, idx: np.ndarray, t: float) -> None:
+        """Start tracking filters from a detection filter's likely particles, one per lump."""
+        cfg = self.config
+        for g in (self._lumps(d.xyz, idx, depth=2) if cfg.split else [idx]):
+            f = _Filter(d.xyz[g], np.zeros((len(g), 3)), logpi=d.logpi[g], likely=d.likely[g], col_h=d.col_h[g])
+            self._resample_filter(f, self._weights(f.logpi), cfg.particles)
+            self._new_track(f, t, score=float(d.likely.mean()))
+
+    def _new_track(self, f: _Filter, t: float, score: float) -> None:
+        c = f.xyz.mean(axis=0)
+        tr = self.position_map.add(c[0], c[1], mode="tracking", time=t)
+        tr.height, tr.width = self.scene.people.size_of(tr.id)
+        tr.score = score
+        f.track = tr
+        self._update_region(f, t)
+        self.filters.append(f)
+
+    def _lumps(self, xyz: np.ndarray, idx: np.ndarray, depth: int) -> list[np.ndarray]:
+        """Split particle indices ``idx`` into lumps on the floor, recursively (up to 2^depth)."""
+        side = self._two_objects(xyz[idx, :2])
+        if side is None or depth == 0:
+            return [idx]
+        return self._lumps(xyz, idx[~side], depth - 1) + self._lumps(xyz, idx[side], depth - 1)
+
+    def _two_objects(self, xy: np.ndarray) -> np.ndarray | None:
+        """Which side of a two-lump cloud each particle is on, or None for one object.
+
+        Two lumps (:func:`~worldtrack.trackers.particle_sampling.bimodal_split`) are two objects only
+        if the cameras can tell them apart: their image boxes must overlap less than
+        ``merge_overlap`` in some camera that sees both (lumps one behind the other on a single
+        camera's line of sight are the depth ambiguity of one object, not two objects).
+        """
+        cfg = self.config
+        side = bimodal_split(xy, cfg.split_distance, cfg.split_dip, cfg.split_min_mass)
+        if side is None:
+            return None
+        h, w = self.scene.people.height, self.scene.people.width
+        a, b = xy[~side].mean(axis=0), xy[side].mean(axis=0)
+        for cl in self._cams.values():
+            p = image_box(cl.camera, a[0], a[1], w, h, 0.0)
+            q = image_box(cl.camera, b[0], b[1], w, h, 0.0)
+            if p is not None and q is not None and _overlap(p, q) < cfg.merge_overlap:
+                return side
+        return None
+
+    # ------------------------------------------------------------------ split and merge
+    def _maybe_split(self, f: _Filter, t: float) -> None:
+        """Split a filter whose particles have been two lumps for ``split_frames`` frames."""
+        cfg = self.config
+        side = self._two_objects(f.xyz[:, :2])
+        f.split_count = f.split_count + 1 if side is not None else 0
+        if f.split_count < cfg.split_frames:
+            return
+        f.split_count = 0
+        keep, other = (~side, side) if (~side).sum() >= side.sum() else (side, ~side)
+        new = _Filter(f.xyz[other], f.v[other], V=f.V.copy(), centre=f.centre.copy(), t_update=f.t_update,
+                      logpi=f.logpi[other], likely=f.likely[other], col_h=f.col_h[other])
+        f.take(np.flatnonzero(keep))
+        for g in (f, new):
+            self._resample_filter(g, np.ones(len(g.xyz)), cfg.particles)
+        self._update_region(f, t)
+        self._new_track(new, t, score=f.track.score)
+
+    def _merge(self) -> None:
+        """End the younger of two filters that have stayed on one object for ``merge_frames`` frames.
+
+        On one object: their image boxes (:func:`image_box`) overlap by at least ``merge_overlap``
+        (intersection over the smaller box) in every camera that sees both.
+        """
+        cfg = self.config
+        fs = self.filters
+        boxes = self._boxes(fs, [f.centre for f in fs], 0.0)
+        close_now = set()
+        for i in range(len(fs)):
+            for j in range(i + 1, len(fs)):
+                both = [(b[i], b[j]) for b in boxes.values() if b[i] is not None and b[j] is not None]
+                if both and all(_overlap(p, q) >= cfg.merge_overlap for p, q in both):
+                    a, b = fs[i].track.id, fs[j].track.id
+                    close_now.add((min(a, b), max(a, b)))
+        self._close = {k: self._close.get(k, 0) + 1 for k in close_now}
+        by_id = {f.track.id: f for f in fs}
+        for (ia, ib), n in list(self._close.items()):
+            if n >= cfg.merge_frames and ia in by_id and ib in by_id:
+                a, b = by_id[ia], by_id[ib]
+                self._end(b if (b.track.born, b.track.id) > (a.track.born, a.track.id) else a)
+                del self._close[(ia, ib)]
+
+    def _end(self, f: _Filter) -> None:
+        if f in self.filters:
+            self.filters.remove(f)
+        if f.track is not None and f.track.id in self.position_map:
+            self.position_map.remove(f.track.id)
+
+
+def image_boxes(camera: Camera, xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: float,
+                depth: float = 0.0) -> list[Box | None]:
+    """Pixel boxes ``(u0, u1, v0, v1)`` of objects standing at ``xy`` (K, 2), None where out of view.
+
+    Each box is the projection of an upright rectangle facing the camera: ``width/2 + margin`` to
+    each side of the object across the line of sight, from ``−margin`` to ``height + margin``
+    (metres); with ``depth > 0``, of the rectangles at the object and ``depth`` (m) nearer and
+    farther along the line of sight together.
+    """
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    k = len(xy)
+    if k == 0:
+        return []
+    d = xy - camera.centre[:2]
+    n = np.hypot(d[:, 0], d[:, 1])[:, None]
+    along = np.where(n > 0, d / np.where(n > 0, n, 1.0), [0.0, 1.0])
+    across = np.column_stack([-along[:, 1], along[:, 0]])
+    hw = 0.5 * np.broadcast_to(np.asarray(widths, float), (k,)) + margin
+    top = np.broadcast_to(np.asarray(heights, float), (k,)) + margin
+    shifts = np.array([0.0] if depth <= 0 else [-depth, 0.0, depth])
+    sides = np.array([-1.0, 1.0])
+    # corners (K, shifts, sides, 2 heights, 3)
+    floor = (xy[:, None, None, :] + shifts[None, :, None, None] * along[:, None, None, :]
+             + sides[None, None, :, None] * hw[:, None, None, None] * across[:, None, None, :])
+    corners = np.empty((k, len(shifts), 2, 2, 3))
+    corners[..., :2] = floor[:, :, :, None, :]
+    corners[..., 0, 2] = -margin
+    corners[..., 1, 2] = top[:, None, None]
+    uv = camera.project(corners.reshape(k, -1, 3))
+    ok = np.isfinite(uv).all(axis=2)
+    lo = np.floor(np.where(ok[..., None], uv, np.inf).min(axis=1) + 0.5)
+    hi = np.floor(np.where(ok[..., None], uv, -np.inf).max(axis=1) + 0.5) + 1
+    out: list[Box | None] = []
+    for i in range(k):
+        if not ok[i].any():
+            out.append(None)
+            continue
+        u0, v0 = max(int(lo[i, 0]), 0), max(int(lo[i, 1]), 0)
+        u1, v1 = min(int(hi[i, 0]), camera.width), min(int(hi[i, 1]), camera.height)
+        out.append((u0, u1, v0, v1) if u0 < u1 and v0 < v1 else None)
+    return out
+
+
+def image_box(camera: Camera, x: float, y: float, width: float, height: float, margin: float,
+              depth: float = 0.0) -> Box | None:
+    """:func:`image_boxes` of one object."""
+    return image_boxes(camera, np.array([[x, y]]), np.array([width]), np.array([height]), margin, depth)[0]
+
+
+def _overlap(p: Box, q: Box) -> float:
+    """Intersection of two pixel boxes over the smaller one's area."""
+    w = min(p[1], q[1]) - max(p[0], q[0])
+    h = min(p[3], q[3]) - max(p[2], q[2])
+    if w <= 0 or h <= 0:
+        return 0.0
+    return w * h / min((p[1] - p[0]) * (p[3] - p[2]), (q[1] - q[0]) * (q[3] - q[2]))
+
+
+def _background_image(fg: object) -> np.ndarray | None:
+    """The background image of a foreground model: ``.model.getBackgroundImage()`` or ``.background``."""
+    model = getattr(fg, "model", None)
+    if model is not None and hasattr(model, "getBackgroundImage"):
+        bg = model.getBackgroundImage()
+        if bg is not None:
+            return bg
+    bg = getattr(fg, "background", None)
+    return bg if isinstance(bg, np.ndarray) else None
+
+
+def _reflect(z: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Fold values into [lo, hi] by reflection at the ends."""
+    span = hi - lo
+    r = np.mod(z - lo, 2 * span)
+    return lo + np.where(r > span, 2 * span - r, r)
+
+
+def _clip_speed(v: np.ndarray, max_speed: float) -> None:
+    """Scale rows of ``v`` (N, ≥ 2) whose floor speed exceeds ``max_speed`` (in place)."""
+    s = np.hypot(v[:, 0], v[:, 1])
+    over = s > max_speed
+    if over.any():
+        v[over, :2] *= (max_speed / s[over])[:, None]
+
+
+__all__ = ["ParticleConfig", "ParticleTracker", "image_box", "image_boxes"]

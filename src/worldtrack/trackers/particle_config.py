@@ -1,0 +1,258 @@
+"""Configuration of the particle tracker (seed 004): :class:`ParticleConfig` and its published preset.
+
+The paper's text (as we have it) gives the method but none of its numbers — no particle count, σ,
+dz, T, γ, α or β survives in it. Every default below therefore says whether it is the paper's
+choice of *method* and which number is ours. :meth:`ParticleConfig.paper` is the method as
+published (with our numbers where it states none); the default adds worldtrack's extensions.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.trackers.particle_likelihood import column_heights
+from worldtrack.trackers.particle_sampling import RESAMPLERS
+
+LIKELIHOODS = ("column", "point")
+WEIGHTINGS = ("ratio", "count")
+VELOCITIES = ("object", "particle", "none")
+BIRTHS = ("auto", "entry", "anywhere", "none")
+EXPLAIN = ("all", "detection", "none")
+
+
+@dataclass(frozen=True)
+class ParticleConfig:
+    """Parameters of :class:`~worldtrack.trackers.particle.ParticleTracker`.
+
+    Attributes
+    ----------
+    likelihood : {"column", "point"}
+        The height column (eq. 11, the paper's method) or the plain point (eq. 7, its baseline).
+    particles : int
+        Particles per tracking filter, N (not stated; 500).
+    detection_particles : int
+        Particles per detection filter (not stated; 1000).
+    dz : float, metres
+        Column step (not stated; 0.1 m).
+    max_height : float, metres
+        The height limit of objects (§4.2's assumption); the column samples ``k·dz, k = 0 … T`` with
+        ``T = round(max_height / dz)`` (not stated; 1.9 m → T = 19, 20 samples).
+    min_height : float, metres
+        A particle is *likely* when its column sees at least this much object (``π·dz ≥ min_height``)
+        in every camera that sees it — the paper's "likelihood at or above a value" that α and β
+        count. Lower ``min_height`` and ``max_height`` for children or bicycles (the paper's future
+        work). (Not stated; 0.8 m.)
+    gamma : float
+        γ: background differences ``F ≤ γ`` (Euclidean RGB distance, 0–441) count as background
+        (not stated; 25).
+    alpha : float in (0, 1)
+        A detection filter fires when the share of its likely particles exceeds α (not stated; 0.5).
+    beta : float in [0, 1)
+        A tracking filter ends when the share of its likely particles falls to β or below
+        (not stated; 0.1).
+    noise_xy, noise_z : float, m/√s
+        σ of the prediction noise ``w ~ N(0, σ²·dt)``: a random walk whose spread per second does
+        not depend on the frame rate (per frame at 10 frames/s: σ/√10, 0.3 → 0.095 m). The paper's
+        σ is per frame and not stated; 0.3.
+    velocity : {"object", "particle", "none"}
+        The velocity in ``x_t = x_{t−1} + v·dt + w``: the object centre's, from its last two
+        positions and smoothed (default); each particle's own, ``(x_{t−1} − x_{t−2}) / dt`` (the
+        paper's eq. 2 in real time — its noise accumulates into the velocity); or none.
+    velocity_smoothing : float in (0, 1]
+        Weight of the newest measurement in the object velocity (1 = the last two centres only).
+    max_speed : float, m/s
+        Velocities are clipped to this floor speed (3 m/s).
+    weighting : {"ratio", "count"}
+        How a column becomes a weight. ``count`` (the paper, eqs. 8 and 11): ``g ∝ π``, the number
+        of samples on ``F > γ``. ``ratio`` (default): the likelihood ratio of "an object stands here,
+        up to its best top h in [min_height, max_height]" against "no object": every sample below
+        h multiplies it by ``hit_rate_object / hit_rate_background`` if it hits and by
+        ``(1 − hit_rate_object) / (1 − hit_rate_background)`` if it misses. A column that misses is
+        then penalised rather than just not rewarded, which makes the weight sharp along the line
+        of sight, where the count is nearly flat (see ``benchmarks/particle_entry.py``).
+    hit_rate_object, hit_rate_background : float in (0, 1)
+        Chance that a sample on an object / on the background reads ``F > γ`` (0.8, 0.05).
+    likelihood_power : float
+        Weights ``∝ π^κ``. The paper: κ = 1. Default 0.25, which tempers the ``ratio``: the samples
+        of one column are not independent (neighbours see the same body part, a walker's legs
+        swing), so counting each at full weight makes the filter collapse onto one frame's best
+        column and follow the gait rather than the body.
+    column_radius : float, metres
+        0: the paper's column, a line of points. > 0: a sample hits if its pixel or one of the two
+        pixels ``f_x·radius / depth`` to its left and right hits (its neighbours this far across the
+        line of sight) — a thin cylinder, so that the gap between a walker's legs does not break
+        the column (0.1 m).
+    foot_samples : int
+        With ``ratio``: samples at ``−dz, −2·dz, …`` below the floor. An object standing on the floor
+        leaves them on background, so each one that hits divides the ratio by
+        ``hit_rate_object / hit_rate_background``: the column's floor contact (2).
+    shadows : bool
+        Pixels whose background is the walkable floor and that look like it darkened without a
+        change of colour are cast shadows, not object
+        (:func:`~worldtrack.trackers.particle_likelihood.shadow_free_hits`; needs a foreground model
+        with a background image). Shadows on the floor otherwise look like taller objects standing
+        on them and pull the estimate towards the camera by up to their length; the price is that
+        grey clothes over a grey floor read as shadow too.
+    explain : {"all", "detection", "none"}
+        Pixels inside another tracked object's image box (its column, ``width/2 + box_margin`` to
+        each side) read as background — for every filter (``all``: a filter cannot take over its
+        neighbour's pixels), for detection filters only (``detection``: the least that keeps the
+        fresh detection filter of §3.2 from firing again on the object it has just handed over; the
+        paper does not say how it avoids that), or never.
+    box_margin : float, metres
+        Margin of the image boxes of ``explain`` (0.05 m).
+    exclusion_depth : float, metres
+        For detection filters a track's box also covers the object placed this much nearer and
+        farther along the line of sight: one camera places an object poorly in depth, and what the
+        track's box leaves of its object must not start a second track (0.5 m).
+    resampling : {"systematic", "stratified"}
+        Systematic (default): one uniform number places all N pointers, so each particle is copied
+        ``⌊N·g⌋`` or ``⌈N·g⌉`` times — the least resampling noise of the usual schemes, O(N) and one
+        ``searchsorted``. Stratified draws one number per stratum; kept for comparison. (The paper:
+        "selection with replacement in proportion to the weight", i.e. multinomial.)
+    births : {"auto", "entry", "anywhere", "none"}
+        Where detection filters scatter: the scene's entry regions, the walkable floor in view, or
+        nowhere (tracks only from ``init_track``). ``auto``: entry regions if the scene has any.
+    entry_margin : float, metres
+        An entry region's detection filter covers the walkable floor within this distance of its
+        polygon (people become fully visible near a door, often not in it; 0 = the polygon). Every
+        detection region keeps only floor where a column of ``min_height`` is in some image (1.0).
+    detection_reseed : float in [0, 1]
+        Share of a detection filter's particles scattered afresh every frame. The rest are
+        resampled and jittered, so the filter concentrates on what enters (0.2). 1 = scatter all
+        afresh every frame, the literal reading of §3.2 (α must then be below an object's share of
+        the region's area).
+    detection_noise : float, m/√s
+        σ of the jitter of detection particles (0.15).
+    end_after_s : float, s
+        A tracking filter ends once its share has stayed ≤ β this long (paper: at once, 0; 0.3).
+    split, split_distance, split_dip, split_min_mass, split_frames
+        Split a filter whose particles form two lumps on the floor at least ``split_distance`` apart
+        (0.35 m), with a valley of at most ``split_dip`` (0.5) times the lower peak and at least
+        ``split_min_mass`` (0.2) of the particles on each side, for ``split_frames`` (2)
+        consecutive frames; a detection filter that fires on two lumps starts two tracks.
+    merge, merge_overlap, merge_frames
+        End the younger of two filters whose image boxes overlap by at least ``merge_overlap``
+        (intersection over the smaller box, 0.6) in every camera that sees both, for
+        ``merge_frames`` (3) consecutive frames.
+    seed : int
+        Seed of the tracker's random generator: same seed and input, same tracks.
+    """
+
+    likelihood: str = "column"
+    particles: int = 500
+    detection_particles: int = 1000
+    dz: float = 0.1
+    max_height: float = 1.9
+    min_height: float = 0.8
+    gamma: float = 25.0
+    alpha: float = 0.5
+    beta: float = 0.1
+    noise_xy: float = 0.3
+    noise_z: float = 0.3
+    velocity: str = "object"
+    velocity_smoothing: float = 0.5
+    max_speed: float = 3.0
+    weighting: str = "ratio"
+    hit_rate_object: float = 0.8
+    hit_rate_background: float = 0.05
+    likelihood_power: float = 0.25
+    column_radius: float = 0.1
+    foot_samples: int = 2
+    shadows: bool = True
+    explain: str = "all"
+    box_margin: float = 0.05
+    exclusion_depth: float = 0.5
+    resampling: str = "systematic"
+    births: str = "auto"
+    entry_margin: float = 1.0
+    detection_reseed: float = 0.2
+    detection_noise: float = 0.15
+    end_after_s: float = 0.3
+    split: bool = True
+    split_distance: float = 0.35
+    split_dip: float = 0.5
+    split_min_mass: float = 0.2
+    split_frames: int = 2
+    merge: bool = True
+    merge_overlap: float = 0.6
+    merge_frames: int = 3
+    seed: int = 0
+
+    @classmethod
+    def paper(cls, **overrides) -> "ParticleConfig":
+        """The method as published: each particle's own velocity (eq. 2), weights ∝ count (eqs. 8,
+        11) on the plain line column, shadows counted as object, no split, merge or explaining
+        away for tracking filters, tracks end at once. Numbers it does not state stay ours."""
+        base = cls(velocity="particle", weighting="count", likelihood_power=1.0, column_radius=0.0,
+                   foot_samples=0, shadows=False, explain="detection", split=False, merge=False,
+                   end_after_s=0.0)
+        try:
+            return replace(base, **overrides)
+        except TypeError as e:
+            raise InputError(f"particle tracker: {e}") from None
+
+    def __post_init__(self) -> None:
+        def bad(name: str, expected: str) -> InputError:
+            return InputError(f"particle tracker: {name}: expected {expected}, got {getattr(self, name)!r}")
+
+        for name, options in (("likelihood", LIKELIHOODS), ("weighting", WEIGHTINGS), ("velocity", VELOCITIES),
+                              ("births", BIRTHS), ("resampling", RESAMPLERS), ("explain", EXPLAIN)):
+            if getattr(self, name) not in options:
+                raise bad(name, "one of " + ", ".join(options))
+        for name in ("particles", "detection_particles", "split_frames", "merge_frames"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+                raise bad(name, "an integer ≥ 1")
+        if isinstance(self.foot_samples, bool) or not isinstance(self.foot_samples, (int, np.integer)) \
+                or self.foot_samples < 0:
+            raise bad("foot_samples", "an integer ≥ 0")
+        for name in ("dz", "max_height", "min_height", "max_speed", "velocity_smoothing", "split_distance"):
+            if not _number(getattr(self, name)) or not getattr(self, name) > 0:
+                raise bad(name, "a positive number")
+        for name in ("gamma", "noise_xy", "noise_z", "box_margin", "exclusion_depth", "detection_noise", "entry_margin",
+                     "end_after_s", "likelihood_power", "column_radius"):
+            if not _number(getattr(self, name)) or not getattr(self, name) >= 0:
+                raise bad(name, "a number ≥ 0")
+        for name, lo, hi, what in (("alpha", 0, 1, "(0, 1)"), ("hit_rate_object", 0, 1, "(0, 1)"),
+                                   ("hit_rate_background", 0, 1, "(0, 1)"), ("split_dip", 0, 1, "(0, 1)"),
+                                   ("split_min_mass", 0, 0.5, "(0, 0.5)")):
+            if not _number(getattr(self, name)) or not lo < getattr(self, name) < hi:
+                raise bad(name, f"a number in {what}")
+        if not _number(self.beta) or not 0 <= self.beta < 1:
+            raise bad("beta", "a share in [0, 1)")
+        if not _number(self.detection_reseed) or not 0 <= self.detection_reseed <= 1:
+            raise bad("detection_reseed", "a share in [0, 1]")
+        if not _number(self.merge_overlap) or not 0 < self.merge_overlap <= 1:
+            raise bad("merge_overlap", "a share in (0, 1]")
+        if self.velocity_smoothing > 1:
+            raise bad("velocity_smoothing", "a weight in (0, 1]")
+        if not self.hit_rate_object > self.hit_rate_background:
+            raise InputError("particle tracker: hit_rate_object must be above hit_rate_background")
+        if self.min_height > self.max_height:
+            raise InputError(f"particle tracker: min_height ({self.min_height} m) is above max_height "
+                             f"({self.max_height} m)")
+        if self.dz > self.max_height:
+            raise InputError(f"particle tracker: dz ({self.dz} m) is above max_height ({self.max_height} m)")
+
+    @property
+    def heights(self) -> np.ndarray:
+        """The column's sample heights ``k·dz``, k = 0 … T, metres."""
+        return column_heights(self.max_height, self.dz)
+
+    @property
+    def likely_count(self) -> int:
+        """Column samples on the object for a particle to be likely: ``⌈min_height / dz⌉``."""
+        return max(1, int(math.ceil(self.min_height / self.dz - 1e-9)))
+
+    @classmethod
+    def field_names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in fields(cls))
+
+
+def _number(v: object) -> bool:
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) and math.isfinite(v)

@@ -1,0 +1,445 @@
+"""Likelihoods of seed 004's particle filters: the height column (eqs. 11–13) and the plain point (eq. 7).
+
+Both read one image per camera and frame, computed once from the background difference
+``F = sqrt(ΔR² + ΔG² + ΔB²)`` (eq. 13, :func:`worldtrack.foreground.background.colour_distance`)
+with values ``F ≤ γ`` set to 0 (§4.2: against slight brightness changes of the background):
+
+* :func:`hit_image` — ``F > γ`` as (H, W) uint8, for the column likelihood;
+* :func:`shadow_free_hits` — the same without cast shadows (not in the paper; Numba, with
+  :func:`shadow_free_hits_reference` in NumPy);
+* :func:`thresholded_difference` — F with ``F ≤ γ`` set to 0, float32, for the point likelihood.
+
+**Height column** (the paper's contribution). For a particle at floor position ``(x_i, y_i)`` the
+points ``(x_i, y_i, k·dz)``, ``k = 0 … T``, are projected and those that land on ``F > γ`` counted::
+
+    π_i = Σ_k δ(x_i, y_i, k·dz),   δ = 1 if F(x_i, y_i, k·dz) > γ else 0          (eqs. 11, 12)
+
+A particle inside the object keeps hitting the object's image all the way up its column; one that is
+merely on the same line of sight as the object (in front of or behind it, Fig. 5) does not.
+
+The kernel also returns a second statistic of the same samples, the log-likelihood ratio of the best
+object top (``ratio``): an object standing at the particle and reaching up to sample ``k`` explains
+samples ``0 … k``; each adds ``on`` if it hits and ``off`` if not, samples below the floor
+(``n_below`` of them, a worldtrack extension) add ``below`` if they hit, and the best ``k ≥ k_min``
+is kept. And a column can be a thin cylinder (``radius > 0``): a sample hits if its pixel or one of
+the two pixels ``f_x·radius / depth`` to its left and right hits (the sample's neighbours ``radius``
+across the line of sight, for a camera without roll).
+
+**Point** (the baseline the paper improves on). The particle's own 3-D point is projected and
+``π_i = F(u, v)`` read there (eq. 7).
+
+**Explained pixels.** Every kernel takes an ``owner`` image — how many tracked objects' image boxes
+cover each pixel (:func:`owner_image`) — and the box of the filter's own object: a pixel inside some
+other object's box reads as background. A filter then cannot take over its neighbour's pixels, and a
+detection filter sees only what no track explains.
+
+A sample that projects outside the image, or lies behind the camera, reads background and does not
+make the camera "see" the particle. Pixels are read at the nearest pixel centre (pixel centres at
+integer coordinates, the image covering ``−0.5 ≤ u < W − 0.5``, as :class:`Camera` defines).
+
+Each kernel (:func:`column_counts`, :func:`point_values`) has a plain NumPy reference built on
+:meth:`Camera.project` (:func:`column_counts_reference`, :func:`point_values_reference`); the tests
+check that they agree exactly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from worldtrack.geometry.camera import Camera
+
+#: Largest possible Euclidean RGB distance, ``sqrt(3)·255``: divides F so that point likelihoods of
+#: several cameras multiply on a common scale.
+F_MAX = float(math.sqrt(3.0) * 255.0)
+
+#: The "no box" value of a filter's own box (a detection filter's).
+NO_BOX = np.array([-1, -1, -1, -1], dtype=np.int64)
+
+
+# ---------------------------------------------------------------------------- per-frame images
+
+def hit_image(difference: np.ndarray, gamma: float) -> np.ndarray:
+    """``F > γ`` as (H, W) uint8 (1 = object), read by the column likelihood.
+
+    Parameters
+    ----------
+    difference : (H, W) float — background difference F (Euclidean RGB distance)
+    gamma : float — threshold γ in the same units
+    """
+    return np.ascontiguousarray(np.asarray(difference) > gamma).view(np.uint8)
+
+
+def shadow_free_hits(image: np.ndarray, background: np.ndarray, gamma: float,
+                     brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
+                     where: np.ndarray | None = None) -> np.ndarray:
+    """``F > γ`` without cast shadows, (H, W) uint8.
+
+    A pixel counts as shadow when it is the background darkened without a change of colour: its
+    brightness ratio ``a = (I·B) / (B·B)`` lies in ``brightness`` and its colour distortion
+    ``‖I − a·B‖`` is at most ``chroma`` (the test of Horprasert et al. 1999, also behind OpenCV
+    MOG2's shadow detection). Not in seed 004, whose F counts shadows as object. Numba kernel;
+    :func:`shadow_free_hits_reference` is the same in NumPy.
+
+    Parameters
+    ----------
+    image, background : (H, W, 3) uint8
+    gamma : float — threshold γ on ``F = ‖I − B‖``
+    brightness : (lo, hi) — range of the brightness ratio of shadows
+    chroma : float — largest colour distortion of shadows (RGB units)
+    where : (H, W) bool, optional — the only pixels where shadows can be (e.g. those that see the
+        floor, :func:`floor_pixels`); default everywhere
+    """
+    img = np.ascontiguousarray(image)
+    bg = np.ascontiguousarray(background)
+    w = np.ones(img.shape[:2], dtype=np.bool_) if where is None else np.ascontiguousarray(where, dtype=np.bool_)
+    out = np.empty(img.shape[:2], dtype=np.uint8)
+    _shadow_free(img, bg, float(gamma), float(brightness[0]), float(brightness[1]), float(chroma), w, out)
+    return out
+
+
+@njit(cache=True)
+def _shadow_free(img, bg, gamma, lo, hi, chroma, where, out):
+    H, W = out.shape
+    g2 = gamma * gamma
+    c2 = chroma * chroma
+    for v in range(H):
+        for u in range(W):
+            i0, i1, i2 = float(img[v, u, 0]), float(img[v, u, 1]), float(img[v, u, 2])
+            b0, b1, b2 = float(bg[v, u, 0]), float(bg[v, u, 1]), float(bg[v, u, 2])
+            d0, d1, d2 = i0 - b0, i1 - b1, i2 - b2
+            if d0 * d0 + d1 * d1 + d2 * d2 <= g2:
+                out[v, u] = 0
+                continue
+            out[v, u] = 1
+            if where[v, u]:
+                a = (i0 * b0 + i1 * b1 + i2 * b2) / max(b0 * b0 + b1 * b1 + b2 * b2, 1.0)
+                if lo <= a <= hi:
+                    e0, e1, e2 = i0 - a * b0, i1 - a * b1, i2 - a * b2
+                    if e0 * e0 + e1 * e1 + e2 * e2 <= c2:
+                        out[v, u] = 0
+
+
+def shadow_free_hits_reference(image: np.ndarray, background: np.ndarray, gamma: float,
+                               brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
+                               where: np.ndarray | None = None) -> np.ndarray:
+    """:func:`shadow_free_hits` in NumPy (float64), the reference the kernel is tested against."""
+    I = image.astype(np.float64)
+    B = background.astype(np.float64)
+    d = I - B
+    F2 = np.einsum("hwc,hwc->hw", d, d)
+    bb = np.einsum("hwc,hwc->hw", B, B)
+    a = np.einsum("hwc,hwc->hw", I, B) / np.maximum(bb, 1.0)
+    e = I - a[..., None] * B
+    cd2 = np.einsum("hwc,hwc->hw", e, e)
+    shadow = (a >= brightness[0]) & (a <= brightness[1]) & (cd2 <= chroma * chroma)
+    if where is not None:
+        shadow &= where
+    return np.ascontiguousarray((F2 > gamma * gamma) & ~shadow).view(np.uint8)
+
+
+def thresholded_difference(difference: np.ndarray, gamma: float) -> np.ndarray:
+    """F with ``F ≤ γ`` set to 0, (H, W) float32, read by the point likelihood."""
+    f = np.asarray(difference, dtype=np.float32)
+    return np.ascontiguousarray(np.where(f > gamma, f, np.float32(0.0)))
+
+
+def floor_pixels(camera: Camera, walkable, occlusion_floor_distance: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) bool: pixels whose background is the walkable floor (where people cast shadows).
+
+    Parameters
+    ----------
+    camera : Camera
+    walkable : object with ``contains((N, 2) xy) -> (N,) bool`` (the scene's walkable area)
+    occlusion_floor_distance : (H, W), optional — floor distance of the obstacle seen at each pixel
+        (:class:`~worldtrack.scene.occlusion.OcclusionMap`); pixels where an obstacle is nearer
+        than the floor point are not floor
+    """
+    v, u = np.mgrid[0:camera.height, 0:camera.width]
+    p = camera.backproject(np.column_stack([u.ravel(), v.ravel()]).astype(float), 0.0)
+    ok = np.isfinite(p).all(axis=1)
+    out = np.zeros(len(p), dtype=bool)
+    out[ok] = walkable.contains(p[ok, :2])
+    if occlusion_floor_distance is not None:
+        d = np.full(len(p), np.inf)
+        d[ok] = camera.floor_distance(p[ok])
+        out &= d < np.asarray(occlusion_floor_distance).ravel()
+    return out.reshape(camera.height, camera.width)
+
+
+def owner_image(shape: tuple[int, int], boxes) -> np.ndarray:
+    """(H, W) uint8: how many of ``boxes`` — ``(u0, u1, v0, v1)`` pixel ranges, or None — cover each pixel."""
+    out = np.zeros(shape, dtype=np.uint8)
+    for b in boxes:
+        if b is not None:
+            u0, u1, v0, v1 = b
+            out[v0:v1, u0:u1] = np.minimum(out[v0:v1, u0:u1], 254) + 1
+    return out
+
+
+def column_heights(max_height: float, dz: float) -> np.ndarray:
+    """The column's sample heights ``k·dz``, ``k = 0 … T`` with ``T = round(max_height / dz)``, metres."""
+    T = int(round(max_height / dz))
+    return np.arange(T + 1, dtype=float) * dz
+
+
+# ---------------------------------------------------------------------------- Numba kernels
+
+@njit(cache=True, inline="always")
+def _cam_to_uv(cx, cy, cz, K, dist, has_dist):
+    """Camera-frame point → pixel coordinates (u, v) (no rounding, no image test); NaN behind the camera."""
+    if not cz > 1e-9:
+        return np.nan, np.nan
+    x = cx / cz
+    y = cy / cz
+    if has_dist:
+        k1, k2, p1, p2, k3 = dist[0], dist[1], dist[2], dist[3], dist[4]
+        r2 = x * x + y * y
+        radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+        xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+        yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+        x, y = xd, yd
+    return K[0, 0] * x + K[0, 1] * y + K[0, 2], K[1, 1] * y + K[1, 2]
+
+
+@njit(cache=True, inline="always")
+def _pixel_index(u, v, W, H):
+    """Nearest pixel (iu, iv) of (u, v), or (−1, −1) outside the image (or NaN)."""
+    if not (u >= -0.5 and u < W - 0.5 and v >= -0.5 and v < H - 0.5):
+        return -1, -1
+    return int(math.floor(u + 0.5)), int(math.floor(v + 0.5))
+
+
+@njit(cache=True, inline="always")
+def _cam_to_pixel(cx, cy, cz, K, dist, has_dist, W, H):
+    """Camera-frame point → integer pixel (iu, iv), or (−1, −1) if behind the camera or outside the image.
+
+    The arithmetic of :meth:`Camera.project` after ``R·p + t``, then rounding to the nearest pixel centre.
+    """
+    u, v = _cam_to_uv(cx, cy, cz, K, dist, has_dist)
+    return _pixel_index(u, v, W, H)
+
+
+@njit(cache=True, inline="always")
+def _to_pixel(px, py, pz, R, t, K, dist, has_dist, W, H):
+    """World point → integer pixel (iu, iv), or (−1, −1) (see :func:`_cam_to_pixel`)."""
+    cx = R[0, 0] * px + R[0, 1] * py + R[0, 2] * pz + t[0]
+    cy = R[1, 0] * px + R[1, 1] * py + R[1, 2] * pz + t[1]
+    cz = R[2, 0] * px + R[2, 1] * py + R[2, 2] * pz + t[2]
+    return _cam_to_pixel(cx, cy, cz, K, dist, has_dist, W, H)
+
+
+@njit(cache=True, inline="always")
+def _others(owner, box, iu, iv):
+    """True if pixel (iu, iv) lies in the box of an object other than the filter's own."""
+    n = owner[iv, iu]
+    if n == 0:
+        return False
+    own = 1 if (box[0] <= iu < box[1] and box[2] <= iv < box[3]) else 0
+    return n > own
+
+
+@njit(cache=True)
+def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray,
+                  dist: np.ndarray, has_dist: bool, radius: float, hit: np.ndarray,
+                  owner: np.ndarray, box: np.ndarray, on: float, off: float, below: float, n_below: int,
+                  k_min: int, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
+    """Height-column likelihood of every particle for one camera, in place.
+
+    Parameters
+    ----------
+    xy : (N, 2) float64, metres — particles' floor positions
+    heights : (S,) float64, metres — ``n_below`` heights below the floor, then ``k·dz``, k = 0 … T
+    R, t, K, dist : the camera's rotation (3, 3), translation (3,), intrinsics (3, 3), distortion (5,)
+    has_dist : bool — apply the distortion model
+    radius : float, metres — 0: a line of points (the paper); > 0: a thin cylinder (module docstring)
+    hit : (H, W) uint8 — ``F > γ`` (:func:`hit_image`)
+    owner : (H, W) uint8 — number of object boxes over each pixel (:func:`owner_image`)
+    box : (4,) int64 — the filter's own object box ``(u0, u1, v0, v1)``, or :data:`NO_BOX`
+    on, off, below : float — log-ratio terms for a sample on / off the object, and below the floor
+    n_below : int — how many of ``heights`` (the first ones) are below the floor
+    k_min : int — the top is searched from index ``k_min`` of ``heights`` up
+    counts : (N,) int32 — out: samples from the floor up on ``F > γ`` (π_i, eq. 11)
+    ratio : (N,) float64 — out: the best log-likelihood ratio
+    top : (N,) int32 — out: the index into ``heights`` of the best top
+    seen : (N,) bool — out: at least one sample projects into the image
+    """
+    H, W = hit.shape
+    fx = K[0, 0]
+    for i in range(xy.shape[0]):
+        # Camera-frame coordinates of the floor point; the column is linear in z.
+        b0 = R[0, 0] * xy[i, 0] + R[0, 1] * xy[i, 1] + t[0]
+        b1 = R[1, 0] * xy[i, 0] + R[1, 1] * xy[i, 1] + t[1]
+        b2 = R[2, 0] * xy[i, 0] + R[2, 1] * xy[i, 1] + t[2]
+        c = 0
+        s = False
+        run = 0.0
+        best = -1e300
+        kbest = k_min
+        for k in range(heights.shape[0]):
+            z = heights[k]
+            cz = b2 + R[2, 2] * z
+            u, v = _cam_to_uv(b0 + R[0, 2] * z, b1 + R[1, 2] * z, cz, K, dist, has_dist)
+            h = 0
+            # The centre, then (cylinder) the pixels ``radius`` to the left and right at this depth.
+            d = fx * radius / cz if radius > 0.0 and cz > 1e-9 else 0.0
+            for j in range(3 if d > 0.0 else 1):
+                iu, iv = _pixel_index(u + (0.0 if j == 0 else (-d if j == 1 else d)), v, W, H)
+                if iu >= 0:
+                    s = True
+                    if hit[iv, iu] and not _others(owner, box, iu, iv):
+                        h = 1
+                        break
+            if k < n_below:
+                if h:
+                    run += below
+                continue
+            c += h
+            run += on if h else off
+            if k >= k_min and run > best:
+                best = run
+                kbest = k
+        counts[i] = c
+        ratio[i] = best
+        top[i] = kbest
+        seen[i] = s
+
+
+@njit(cache=True)
+def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, dist: np.ndarray,
+                 has_dist: bool, F: np.ndarray, owner: np.ndarray, box: np.ndarray,
+                 values: np.ndarray, seen: np.ndarray) -> None:
+    """Point likelihood π_i = F(u, v) at each particle's own projection (eq. 7), in place.
+
+    Parameters
+    ----------
+    xyz : (N, 3) float64, metres
+    F : (H, W) float32 — background difference with ``F ≤ γ`` set to 0 (:func:`thresholded_difference`)
+    owner, box : as in :func:`column_counts`
+    values : (N,) float64 — out: F at the particle, 0 outside the image or in another object's box
+    seen : (N,) bool — out: the particle projects into the image
+    """
+    H, W = F.shape
+    for i in range(xyz.shape[0]):
+        iu, iv = _to_pixel(xyz[i, 0], xyz[i, 1], xyz[i, 2], R, t, K, dist, has_dist, W, H)
+        values[i] = 0.0
+        seen[i] = iu >= 0
+        if iu >= 0 and not _others(owner, box, iu, iv):
+            values[i] = F[iv, iu]
+
+
+# ---------------------------------------------------------------------------- NumPy references
+
+def _pixels(camera: Camera, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nearest pixel (iu, iv) of world points (..., 3) and whether they fall in the image."""
+    uv = camera.project(points)
+    inside = camera.in_image(uv) & np.isfinite(uv).all(axis=-1)
+    iu = np.where(inside, np.floor(np.nan_to_num(uv[..., 0]) + 0.5), 0).astype(np.int64)
+    iv = np.where(inside, np.floor(np.nan_to_num(uv[..., 1]) + 0.5), 0).astype(np.int64)
+    return iu, iv, inside
+
+
+def _readable(owner: np.ndarray | None, box, iu: np.ndarray, iv: np.ndarray) -> np.ndarray:
+    """False where a pixel lies in another object's box."""
+    if owner is None:
+        return np.ones(iu.shape, dtype=bool)
+    box = NO_BOX if box is None else np.asarray(box)
+    own = (iu >= box[0]) & (iu < box[1]) & (iv >= box[2]) & (iv < box[3])
+    return owner[iv, iu].astype(int) <= own
+
+
+def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray,
+                            on: float = 1.0, off: float = -1.0, k_min: int = 0, radius: float = 0.0,
+                            below: float = 0.0, n_below: int = 0, owner: np.ndarray | None = None,
+                            box=None):
+    """:func:`column_counts` written plainly: every (particle, height) point through :meth:`Camera.project`.
+
+    Returns
+    -------
+    counts : (N,) int64 — samples from the floor up on ``F > γ`` (eq. 11)
+    ratio : (N,) float — the best log-likelihood ratio
+    top : (N,) int64 — index into ``heights`` of the best top
+    seen : (N,) bool — some sample projects into the image
+    """
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    n, s = len(xy), len(heights)
+    pts = np.empty((n, s, 3))
+    pts[:, :, :2] = xy[:, None, :]
+    pts[:, :, 2] = np.asarray(heights, dtype=float)[None, :]
+    uv, depth = camera.project(pts, return_depth=True)
+    hits = np.zeros((n, s), dtype=bool)
+    seen = np.zeros(n, dtype=bool)
+    offsets = [0.0] if radius <= 0 else [0.0, -1.0, 1.0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.where(depth > 1e-9, camera.K[0, 0] * radius / depth, 0.0)
+    for o in offsets:
+        uo = uv.copy()
+        uo[..., 0] += o * d
+        inside = camera.in_image(uo) & np.isfinite(uo).all(axis=-1)
+        iu = np.where(inside, np.floor(np.nan_to_num(uo[..., 0]) + 0.5), 0).astype(np.int64)
+        iv = np.where(inside, np.floor(np.nan_to_num(uo[..., 1]) + 0.5), 0).astype(np.int64)
+        hits |= inside & (hit[iv, iu] > 0) & _readable(owner, box, iu, iv)
+        seen |= inside.any(axis=1)
+    terms = np.where(hits, on, off)
+    terms[:, :n_below] = np.where(hits[:, :n_below], below, 0.0)
+    run = np.cumsum(terms, axis=1)
+    run[:, :max(k_min, n_below)] = -np.inf
+    top = np.argmax(run, axis=1)
+    return hits[:, n_below:].sum(axis=1).astype(np.int64), run[np.arange(n), top], top, seen
+
+
+def point_values_reference(camera: Camera, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
+                           box=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`point_values` written plainly: F at each particle's projection, and ``seen``."""
+    iu, iv, inside = _pixels(camera, np.asarray(xyz, dtype=float).reshape(-1, 3))
+    ok = inside & _readable(owner, box, iu, iv)
+    return np.where(ok, F[iv, iu], 0.0).astype(float), inside
+
+
+# ---------------------------------------------------------------------------- camera wrapper
+
+class CameraLikelihood:
+    """One camera's constants for the kernels (contiguous float64 arrays), built once.
+
+    Parameters
+    ----------
+    camera : Camera
+    """
+
+    def __init__(self, camera: Camera):
+        self.camera = camera
+        self.R = np.ascontiguousarray(camera.R, dtype=np.float64)
+        self.t = np.ascontiguousarray(camera.t, dtype=np.float64)
+        self.K = np.ascontiguousarray(camera.K, dtype=np.float64)
+        self.dist = np.ascontiguousarray(camera.dist, dtype=np.float64)
+        self.has_dist = bool(camera.has_distortion)
+        self.no_owner = np.zeros((camera.height, camera.width), dtype=np.uint8)
+
+    def column(self, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
+               k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0,
+               owner: np.ndarray | None = None, box=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`."""
+        xy = np.ascontiguousarray(xy, dtype=np.float64)
+        n = len(xy)
+        counts = np.empty(n, dtype=np.int32)
+        ratio = np.empty(n, dtype=np.float64)
+        top = np.empty(n, dtype=np.int32)
+        seen = np.empty(n, dtype=np.bool_)
+        column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
+                      self.has_dist, float(radius), hit, self.no_owner if owner is None else owner,
+                      NO_BOX if box is None else np.asarray(box, dtype=np.int64), float(on), float(off),
+                      float(below), int(n_below), int(k_min), counts, ratio, top, seen)
+        return counts, ratio, top, seen
+
+    def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
+              box=None) -> tuple[np.ndarray, np.ndarray]:
+        """(F values (N,) float64, seen (N,) bool) at the points ``xyz`` (N, 3) — eq. 7."""
+        xyz = np.ascontiguousarray(xyz, dtype=np.float64)
+        values = np.empty(len(xyz), dtype=np.float64)
+        seen = np.empty(len(xyz), dtype=np.bool_)
+        point_values(xyz, self.R, self.t, self.K, self.dist, self.has_dist, F,
+                     self.no_owner if owner is None else owner,
+                     NO_BOX if box is None else np.asarray(box, dtype=np.int64), values, seen)
+        return values, seen

@@ -1,0 +1,204 @@
+"""Sampling pieces of the particle tracker: resampling, uniform floor regions and splitting a cloud in two.
+
+* :func:`systematic_resample`, :func:`stratified_resample` — "selection with replacement with
+  probability proportional to the weight" (seed 004 §2). Systematic is the default: see
+  :class:`~worldtrack.trackers.particle.ParticleConfig`.
+* :class:`FloorRegion` — a floor area rasterised once, for scattering detection particles uniformly
+  over it (§3.2) and testing whether they are still inside.
+* :func:`bimodal_split` — is a particle cloud two objects side by side? (the paper's open problem of
+  objects that enter together and then part, §6.)
+* :func:`polygon_distance` — how far floor points are from an entry region.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from worldtrack.errors import InputError
+from worldtrack.scene.floor import points_in_polygon
+
+RESAMPLERS = ("systematic", "stratified")
+
+
+# ---------------------------------------------------------------------------- resampling
+
+def systematic_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Indices of ``n`` particles drawn in proportion to ``weights`` with one uniform number.
+
+    The points ``(u + j) / n``, ``j = 0 … n−1``, ``u ~ U[0, 1)``, are looked up in the cumulative
+    weights: a particle of normalised weight ``w`` is copied ``⌊n·w⌋`` or ``⌈n·w⌉`` times.
+
+    Parameters
+    ----------
+    weights : (M,) float, ≥ 0, not all 0
+    n : int
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    (n,) int64, sorted
+    """
+    c = np.cumsum(weights, dtype=float)
+    c /= c[-1]
+    u = (rng.random() + np.arange(n)) / n
+    return np.minimum(np.searchsorted(c, u, side="right"), len(c) - 1)
+
+
+def stratified_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+    """As :func:`systematic_resample` with an independent uniform number in each stratum ``[j/n, (j+1)/n)``."""
+    c = np.cumsum(weights, dtype=float)
+    c /= c[-1]
+    u = (rng.random(n) + np.arange(n)) / n
+    return np.minimum(np.searchsorted(c, u, side="right"), len(c) - 1)
+
+
+def resampler(name: str) -> Callable[[np.ndarray, int, np.random.Generator], np.ndarray]:
+    """The resampling function by name (``"systematic"`` or ``"stratified"``)."""
+    if name == "systematic":
+        return systematic_resample
+    if name == "stratified":
+        return stratified_resample
+    raise InputError(f"resampling: expected one of {', '.join(RESAMPLERS)}, got {name!r}")
+
+
+# ---------------------------------------------------------------------------- floor regions
+
+@dataclass(frozen=True)
+class FloorRegion:
+    """A floor area as a grid of cells, for uniform sampling and inside tests.
+
+    Cell ``(j, i)`` covers ``origin + (i, j)·cell`` to ``origin + (i + 1, j + 1)·cell``.
+
+    Attributes
+    ----------
+    name : str
+    origin : (2,) float, metres
+    cell : float, metres
+    inside : (ny, nx) bool
+    """
+
+    name: str
+    origin: np.ndarray
+    cell: float
+    inside: np.ndarray
+
+    @classmethod
+    def rasterise(cls, name: str, bounds: tuple[float, float, float, float], cell: float,
+                  test: Callable[[np.ndarray], np.ndarray]) -> "FloorRegion":
+        """Cells of ``bounds = (x0, x1, y0, y1)`` whose centre passes ``test((N, 2) xy) -> (N,) bool``."""
+        x0, x1, y0, y1 = bounds
+        nx = max(1, int(np.ceil((x1 - x0) / cell)))
+        ny = max(1, int(np.ceil((y1 - y0) / cell)))
+        gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * cell, y0 + (np.arange(ny) + 0.5) * cell)
+        inside = np.asarray(test(np.column_stack([gx.ravel(), gy.ravel()])), dtype=bool).reshape(ny, nx)
+        return cls(name, np.array([x0, y0], dtype=float), float(cell), inside)
+
+    @property
+    def area(self) -> float:
+        """m²"""
+        return float(self.inside.sum()) * self.cell ** 2
+
+    @property
+    def empty(self) -> bool:
+        return not bool(self.inside.any())
+
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """(n, 2) points uniformly distributed over the region's cells, metres."""
+        flat = np.flatnonzero(self.inside)
+        k = flat[rng.integers(0, len(flat), size=n)]
+        j, i = np.divmod(k, self.inside.shape[1])
+        offs = rng.random((n, 2))
+        return self.origin + (np.column_stack([i, j]) + offs) * self.cell
+
+    def contains(self, xy: ArrayLike) -> np.ndarray:
+        """(N,) bool: the point's cell is in the region."""
+        p = np.nan_to_num(np.asarray(xy, dtype=float).reshape(-1, 2), nan=-1e9)
+        i = np.floor((p[:, 0] - self.origin[0]) / self.cell).astype(np.int64)
+        j = np.floor((p[:, 1] - self.origin[1]) / self.cell).astype(np.int64)
+        ok = (i >= 0) & (i < self.inside.shape[1]) & (j >= 0) & (j < self.inside.shape[0])
+        out = np.zeros(len(p), dtype=bool)
+        out[ok] = self.inside[j[ok], i[ok]]
+        return out
+
+
+# ---------------------------------------------------------------------------- splitting a cloud
+
+def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mass: float,
+                  bin_m: float = 0.04, smooth_m: float = 0.05) -> np.ndarray | None:
+    """Split a floor cloud of particles into two objects side by side, if it is two.
+
+    The cloud is projected on its principal axis; the projection's histogram (``bin_m`` bins,
+    Gaussian smoothing ``smooth_m``) must have two peaks at least ``min_separation`` apart whose
+    valley is at most ``max_dip`` times the lower peak, and each side of the valley must hold at
+    least ``min_mass`` of the particles.
+
+    Parameters
+    ----------
+    xy : (N, 2) float, metres — equally weighted particles
+    min_separation : float, metres
+    max_dip : float in (0, 1)
+    min_mass : float in (0, 0.5)
+
+    Returns
+    -------
+    (N,) bool or None
+        Which side of the valley each particle is on; ``None`` for a single object.
+    """
+    xy = np.asarray(xy, dtype=float)
+    n = len(xy)
+    if n < 8:
+        return None
+    c = xy - xy.mean(axis=0)
+    sxx, syy, sxy = float(c[:, 0] @ c[:, 0]) / n, float(c[:, 1] @ c[:, 1]) / n, float(c[:, 0] @ c[:, 1]) / n
+    # Largest eigenvalue of the 2×2 covariance and its eigenvector (the principal axis).
+    half = 0.5 * (sxx - syy)
+    lam = 0.5 * (sxx + syy) + np.hypot(half, sxy)
+    # Two lumps d apart holding m and 1 − m of the particles have a std of at least d·sqrt(m(1 − m))
+    # along the axis joining them: a narrower cloud cannot be split.
+    if np.sqrt(max(lam, 0.0)) < min_separation * np.sqrt(min_mass * (1 - min_mass)):
+        return None
+    axis = np.array([sxy, lam - sxx]) if abs(sxy) > 1e-15 else (np.array([1.0, 0.0]) if sxx >= syy
+                                                                   else np.array([0.0, 1.0]))
+    axis /= np.linalg.norm(axis)
+    s = c @ axis
+    lo, hi = s.min(), s.max()
+    nb = int(np.ceil((hi - lo) / bin_m)) + 1
+    h = np.bincount(np.minimum(((s - lo) / bin_m).astype(np.int64), nb - 1), minlength=nb).astype(float)
+    r = max(1, int(np.ceil(3 * smooth_m / bin_m)))
+    kx = np.arange(-r, r + 1) * bin_m
+    kernel = np.exp(-0.5 * (kx / smooth_m) ** 2)
+    hs = np.convolve(np.pad(h, r), kernel, mode="valid")
+    left = np.concatenate([[-1.0], hs[:-1]])
+    right = np.concatenate([hs[1:], [-1.0]])
+    peaks = np.flatnonzero((hs >= left) & (hs > right) & (hs > 0))
+    if len(peaks) < 2:
+        return None
+    p1 = peaks[np.argmax(hs[peaks])]
+    far = peaks[np.abs(peaks - p1) * bin_m >= min_separation]
+    if len(far) == 0:
+        return None
+    p2 = far[np.argmax(hs[far])]
+    a, b = min(p1, p2), max(p1, p2)
+    valley = a + int(np.argmin(hs[a:b + 1]))
+    if hs[valley] > max_dip * min(hs[p1], hs[p2]):
+        return None
+    side = s > lo + (valley + 0.5) * bin_m
+    m = side.mean()
+    if min(m, 1 - m) < min_mass:
+        return None
+    return side
+
+
+def polygon_distance(xy: ArrayLike, ring: ArrayLike) -> np.ndarray:
+    """(N,) distance (m) from floor points to a polygon: 0 inside, else to the nearest edge."""
+    p = np.asarray(xy, dtype=float).reshape(-1, 2)
+    a = np.asarray(ring, dtype=float)
+    ab = np.roll(a, -1, axis=0) - a
+    ap = p[:, None, :] - a[None, :, :]
+    s = np.clip((ap * ab).sum(axis=2) / np.maximum((ab * ab).sum(axis=1), 1e-12), 0.0, 1.0)
+    d = np.sqrt(((ap - s[:, :, None] * ab) ** 2).sum(axis=2)).min(axis=1)
+    return np.where(points_in_polygon(p, a), 0.0, d)

@@ -1,0 +1,416 @@
+"""Seed 004's particle tracker on small rendered scenes with exact ground truth.
+
+People are the filled outlines of upright ellipsoids (the conic of each ellipsoid at pixel centres,
+drawn far to near), in saturated colours over a smooth random colour texture with seeded sensor
+noise (σ = 2). One camera 3 m up looks across a 6 × 6 m floor; the entry region is a 1.2 m strip
+on the left edge of the view.
+
+Accuracy bound. An ellipsoid's silhouette is exactly what the height column tests, so the column
+is sharp here; what remains is the pixel grid (one image row at the feet spans 0.03–0.08 m of floor
+at 3–6 m in this 320×240, 70° view), the column's 0.1 m steps and the particles' spread. The
+tracker reaches 0.02–0.04 m mean error on a walker here; 0.10 m is asserted.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from worldtrack.errors import InputError
+from worldtrack.foreground.background import StaticBackground
+from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid
+from worldtrack.io.sources import Frame
+from worldtrack.scene import scene_from_dict
+from worldtrack.trackers import make_tracker
+from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box
+from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, hit_image,
+                                                     owner_image, point_values_reference, shadow_free_hits,
+                                                     thresholded_difference)
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, polygon_distance,
+                                                   stratified_resample, systematic_resample)
+
+W, H = 320, 240
+CAM = {"id": "cam", "image_size": [W, H], "position": [0, -1, 3], "look_at": [0, 3.5, 0.5], "hfov_deg": 70}
+CAM2 = {"id": "cam2", "image_size": [W, H], "position": [5, 7, 3], "look_at": [0, 3.5, 0.5], "hfov_deg": 70}
+FLOOR = {"walkable": [{"outer": [[-3, 0.5], [3, 0.5], [3, 6.5], [-3, 6.5]]}]}
+DOOR = [{"name": "door", "polygon": [[-2.9, 2.0], [-1.7, 2.0], [-1.7, 4.0], [-2.9, 4.0]]}]
+COLOURS = [(40, 30, 200), (200, 60, 30), (30, 170, 40), (170, 40, 170)]
+HEIGHT, WIDTH = 1.7, 0.45
+FPS = 10.0
+
+
+def make_scene(entry: bool = True, cameras=(CAM,)):
+    d = {"name": "particle-test", "cameras": list(cameras), "floor": FLOOR,
+         "people": {"height": HEIGHT, "width": WIDTH}}
+    if entry:
+        d["entry_regions"] = DOOR
+    return scene_from_dict(d)
+
+
+def texture(seed: int) -> np.ndarray:
+    """A smooth random colour texture (H, W, 3) uint8: the empty scene."""
+    rng = np.random.default_rng(seed)
+    img = cv2.GaussianBlur(rng.uniform(60, 200, (H, W, 3)).astype(np.float32), (0, 0), 3)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def render(cam, background, people, rng) -> np.ndarray:
+    """``background`` with ellipsoid people ``(x, y[, height])`` drawn far to near, plus noise σ = 2."""
+    img = background.astype(np.float32)
+    order = sorted(range(len(people)), key=lambda k: -np.hypot(people[k][0] - cam.centre[0], people[k][1] - cam.centre[1]))
+    for k in order:
+        p = people[k]
+        h = p[2] if len(p) > 2 else HEIGHT
+        centres, radii = person_ellipsoid([p[:2]], h, WIDTH)
+        C = ellipsoid_conics(cam.P, centres, radii)[0]
+        img[ellipse_mask(C, (H, W))] = COLOURS[k % len(COLOURS)]
+    img += rng.normal(0.0, 2.0, img.shape)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def run(tracker, scene, backgrounds, paths, n, seed=0):
+    """Step ``tracker`` over ``n`` frames; ``paths(t) -> list of (x, y[, h])``. Returns [(t, truth, tracks)]."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(n):
+        t = k / FPS
+        people = paths(t)
+        frames = {cid: Frame(render(cam, backgrounds[cid], people, rng), t, k) for cid, cam in scene.cameras.items()}
+        out.append((t, people, tracker.step(frames, t)))
+    return out
+
+
+def tracker_for(scene, scene_seed=0, **options):
+    bgs = {cid: texture(i + 10 * scene_seed) for i, cid in enumerate(scene.cameras)}
+    fgs = {cid: StaticBackground(bg, 30.0, "colour") for cid, bg in bgs.items()}
+    return ParticleTracker(scene, fgs, ParticleConfig(**options)), bgs
+
+
+def walker(t):
+    """Enters from the door region and walks right at 1 m/s."""
+    return [(-2.3 + 1.0 * t, 3.0)]
+
+
+# ---------------------------------------------------------------------------- kernels vs references
+
+@pytest.mark.parametrize("dist", [None, [-0.2, 0.05, 0.001, -0.002, 0.0]])
+@pytest.mark.parametrize("radius", [0.0, 0.1])
+def test_column_kernel_agrees_with_reference(dist, radius):
+    spec = dict(CAM, distortion=dist) if dist else CAM
+    cam = make_scene(cameras=(spec,)).cameras["cam"]
+    rng = np.random.default_rng(1)
+    hit = (cv2.GaussianBlur(rng.random((H, W)).astype(np.float32), (0, 0), 4) > 0.5).astype(np.uint8)
+    xy = np.column_stack([rng.uniform(-3.5, 3.5, 3000), rng.uniform(-1.5, 7.0, 3000)])
+    heights = np.concatenate([[-0.2, -0.1], np.arange(20) * 0.1])
+    boxes = [(40, 120, 30, 200), (100, 180, 0, 120), None]
+    owner = owner_image((H, W), boxes)
+    cl = CameraLikelihood(cam)
+    for box in (None, boxes[0]):
+        args = dict(on=2.77, off=-1.56, k_min=10, radius=radius, below=-2.77, n_below=2, owner=owner, box=box)
+        counts, ratio, top, seen = cl.column(hit, xy, heights, **args)
+        r_counts, r_ratio, r_top, r_seen = column_counts_reference(cam, hit, xy, heights, **args)
+        np.testing.assert_array_equal(counts, r_counts)
+        np.testing.assert_array_equal(top, r_top)
+        np.testing.assert_array_equal(seen, r_seen)
+        np.testing.assert_allclose(ratio, r_ratio, rtol=0, atol=1e-9)
+        assert seen.sum() > 1000 and counts.max() > 10  # the test exercises real hits
+
+
+def test_point_kernel_agrees_with_reference():
+    cam = make_scene().cameras["cam"]
+    rng = np.random.default_rng(2)
+    F = thresholded_difference(rng.uniform(0, 100, (H, W)).astype(np.float32), 30.0)
+    xyz = np.column_stack([rng.uniform(-3.5, 3.5, 5000), rng.uniform(-1.5, 7.0, 5000), rng.uniform(-0.5, 2.5, 5000)])
+    owner = owner_image((H, W), [(50, 150, 50, 150)])
+    for box in (None, (50, 150, 50, 150)):
+        v, s = CameraLikelihood(cam).point(F, xyz, owner, box)
+        rv, rs = point_values_reference(cam, F, xyz, owner, box)
+        np.testing.assert_array_equal(s, rs)
+        np.testing.assert_array_equal(v, rv)
+    assert s.sum() > 1000
+
+
+# ---------------------------------------------------------------------------- the paper's Fig. 5 argument
+
+def test_column_tells_the_person_from_a_point_on_the_same_line_of_sight():
+    """A particle inside the person and one on the floor behind it, on the same line of sight, project
+    to the same pixel: the point likelihood (eq. 7) cannot tell them apart, the column (eq. 11) can."""
+    scene = make_scene(entry=False)
+    cam = scene.cameras["cam"]
+    bg = texture(0)
+    img = render(cam, bg, [(0.0, 3.0)], np.random.default_rng(0))
+    F = StaticBackground(bg, 30.0, "colour").difference(img)
+    inside = np.array([0.0, 3.0, 0.85])
+    ray = inside - cam.centre
+    behind = cam.centre + ray * (cam.centre[2] / -ray[2])               # where the ray meets the floor
+    assert behind[2] == pytest.approx(0.0, abs=1e-9) and np.hypot(*(behind[:2] - inside[:2])) > 1.0
+    np.testing.assert_allclose(cam.project([inside]), cam.project([behind]), atol=1e-6)
+
+    point = CameraLikelihood(cam).point(thresholded_difference(F, 30.0), np.array([inside, behind]))[0]
+    assert point[0] == point[1] > 0
+
+    heights = np.arange(20) * 0.1
+    counts, ratio, _, _ = CameraLikelihood(cam).column(hit_image(F, 30.0), np.array([inside[:2], behind[:2]]),
+                                                       heights, 2.77, -1.56, 8)
+    assert counts[0] >= 16 and counts[1] <= counts[0] - 6
+    assert ratio[0] > ratio[1] + 10
+
+
+# ---------------------------------------------------------------------------- tracking
+
+def test_walker_is_tracked_within_bounds():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene)
+    out = run(tracker, scene, bgs, walker, 40)
+    ids = {tr.id for _, _, tracks in out for tr in tracks}
+    assert ids == {1}
+    first = next(k for k, (_, _, tracks) in enumerate(out) if tracks)
+    assert first <= 3
+    err, inside, vx = [], [], []
+    for t, truth, tracks in out[first + 5:]:
+        (tr,) = tracks
+        x, y = truth[0]
+        err.append(np.hypot(tr.x - x, tr.y - y))
+        inside.append(abs(tr.x - x) <= tr.extra["sx"] + 0.02 and abs(tr.y - y) <= tr.extra["sy"] + 0.02
+                      and abs(tr.extra["z"] - HEIGHT / 2) <= tr.extra["sz"])
+        vx.append(tr.vx)
+    assert np.mean(err) < 0.10 and np.max(err) < 0.25
+    assert np.mean(inside) > 0.5
+    assert np.median(vx) == pytest.approx(1.0, abs=0.25)        # m/s, from real time stamps
+    assert tracks[0].height == pytest.approx(HEIGHT, abs=0.25)
+    assert set(ParticleTracker.extra_columns) == {"sigma", "z", "sx", "sy", "sz"}
+
+
+def test_detection_fires_on_entry_and_not_on_empty_frames():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene)
+    empty = run(tracker, scene, bgs, lambda t: [], 15)
+    assert all(not tracks for _, _, tracks in empty)
+    rng = np.random.default_rng(5)
+    found = None
+    for k in range(15, 30):
+        t = k / FPS
+        img = render(scene.cameras["cam"], bgs["cam"], [(-2.3, 3.0)], rng)
+        if tracker.step({"cam": img}, t):
+            found = k
+            break
+    assert found is not None and found - 15 <= 3
+
+
+def test_person_outside_the_entry_region_is_not_detected():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene)
+    out = run(tracker, scene, bgs, lambda t: [(1.5, 3.0)], 15)
+    assert all(not tracks for _, _, tracks in out)
+    tracker, bgs = tracker_for(scene, births="anywhere")
+    out = run(tracker, scene, bgs, lambda t: [(1.5, 3.0)], 15)
+    assert out[-1][2] and np.hypot(out[-1][2][0].x - 1.5, out[-1][2][0].y - 3.0) < 0.15
+
+
+def test_tracking_filter_ends_after_the_person_leaves():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene, end_after_s=0.0)
+    out = run(tracker, scene, bgs, lambda t: [(-2.3 + 1.0 * t, 3.0)] if t < 2.0 else [], 30)
+    assert out[19][2]
+    assert all(not tracks for _, _, tracks in out[21:])
+
+
+def test_people_entering_together_then_parting_get_two_tracks():
+    """Two people come in side by side (0.5 m apart, across the line of sight), then walk apart."""
+    scene = make_scene(entry=False)
+
+    def pair(t):
+        y = 5.5 - 0.8 * t
+        s = 0.25 + max(0.0, t - 1.5) * 0.6
+        return [(-s, y), (s, y)]
+
+    tracker, bgs = tracker_for(scene)
+    out = run(tracker, scene, bgs, pair, 45)
+    t, truth, tracks = out[-1]
+    assert len(tracks) == 2
+    for x, y in truth:
+        assert min(np.hypot(tr.x - x, tr.y - y) for tr in tracks) < 0.15
+    assert len({tr.id for _, _, tr_ in out for tr in tr_}) == 2
+
+
+def test_one_filter_on_two_people_is_split_when_they_part():
+    scene = make_scene(entry=False)
+    tracker, bgs = tracker_for(scene, births="none")
+
+    def parting(t):
+        s = 0.15 + 0.5 * t
+        return [(-s, 3.0), (s, 3.0)]
+
+    tracker.init_track(0.0, 3.0, spread=0.15)
+    out = run(tracker, scene, bgs, parting, 25)
+    t, truth, tracks = out[-1]
+    assert len(tracks) == 2
+    for x, y in truth:
+        assert min(np.hypot(tr.x - x, tr.y - y) for tr in tracks) < 0.15
+
+
+def test_duplicate_filters_on_one_person_are_merged():
+    scene = make_scene(entry=False)
+    tracker, bgs = tracker_for(scene, births="none", explain="detection")
+    tracker.init_track(0.0, 3.0)
+    tracker.init_track(0.1, 3.05)
+    out = run(tracker, scene, bgs, lambda t: [(0.0, 3.0)], 8)
+    assert [tr.id for tr in out[-1][2]] == [1]
+
+
+def test_same_seed_gives_the_same_tracks_and_another_seed_does_not():
+    def tracks(seed):
+        scene = make_scene()
+        tracker, bgs = tracker_for(scene, seed=seed)
+        return [(tr.id, tr.x, tr.y, tr.extra["sz"]) for _, _, trs in run(tracker, scene, bgs, walker, 12) for tr in trs]
+
+    a, b, c = tracks(3), tracks(3), tracks(4)
+    assert a == b and a != c
+
+
+def test_two_cameras_multiply_likelihoods():
+    scene = make_scene(cameras=(CAM, CAM2))
+    tracker, bgs = tracker_for(scene, births="anywhere")
+    out = run(tracker, scene, bgs, lambda t: [(0.5, 3.5)], 10)
+    assert len(out[-1][2]) == 1 and np.hypot(out[-1][2][0].x - 0.5, out[-1][2][0].y - 3.5) < 0.1
+    rng = np.random.default_rng(0)
+    images = {cid: hit_image(StaticBackground(bgs[cid], 30.0, "colour").difference(
+        render(cam, bgs[cid], [(0.5, 3.5)], rng)), 30.0) for cid, cam in scene.cameras.items()}
+    xyz = np.column_stack([rng.uniform(-1, 2, 200), rng.uniform(2, 5, 200), np.zeros(200)])
+    both = tracker.likelihood(xyz, images)[0]
+    one = [tracker.likelihood(xyz, {cid: img})[0] for cid, img in images.items()]
+    np.testing.assert_allclose(both, one[0] + one[1])
+
+
+def test_short_objects_need_lower_height_limits():
+    """A 0.6 m object (a small child): below the default min_height, tracked with lower limits."""
+    scene = make_scene()
+    child = lambda t: [(-2.3 + 0.5 * t, 3.0, 0.6)]
+    tracker, bgs = tracker_for(scene)
+    assert not any(tracks for _, _, tracks in run(tracker, scene, bgs, child, 12))
+    tracker, bgs = tracker_for(scene, min_height=0.4, max_height=1.0, dz=0.05)
+    out = run(tracker, scene, bgs, child, 12)
+    (tr,) = out[-1][2]
+    x, y, _ = out[-1][1][0]
+    assert np.hypot(tr.x - x, tr.y - y) < 0.15 and tr.height == pytest.approx(0.6, abs=0.15)
+
+
+def test_paper_preset_column_beats_point():
+    """The method as published (weights ∝ count, line column, no extensions) against its baseline:
+    both spread along the line of sight, the column much less (the paper's claim)."""
+    scene = make_scene()
+    bg = texture(0)
+    err = {}
+    for likelihood in ("column", "point"):
+        tracker = make_tracker("particle", scene, {"cam": StaticBackground(bg, 30.0, "colour")}, preset="paper",
+                               likelihood=likelihood)
+        assert tracker.config.weighting == "count" and not tracker.config.split
+        out = run(tracker, scene, {"cam": bg}, walker, 25)
+        err[likelihood] = np.mean([np.hypot(trs[0].x - truth[0][0], trs[0].y - truth[0][1])
+                                   for _, truth, trs in out[10:]])
+    assert err["column"] < 0.7 and err["point"] > err["column"] + 0.4
+
+
+# ---------------------------------------------------------------------------- pieces
+
+def test_systematic_resampling_copies_floor_or_ceil_of_n_w():
+    rng = np.random.default_rng(0)
+    w = rng.random(50) ** 3
+    idx = systematic_resample(w, 1000, rng)
+    counts = np.bincount(idx, minlength=50)
+    expected = 1000 * w / w.sum()
+    assert np.all(counts >= np.floor(expected)) and np.all(counts <= np.ceil(expected))
+    s = np.bincount(stratified_resample(w, 100000, rng), minlength=50)
+    np.testing.assert_allclose(s / 100000, w / w.sum(), atol=0.003)
+
+
+def test_bimodal_split_finds_two_lumps_not_one_long_cloud():
+    rng = np.random.default_rng(0)
+    two = np.vstack([rng.normal([0, 0], 0.06, (250, 2)), rng.normal([0.6, 0], 0.06, (250, 2))])
+    side = bimodal_split(two, 0.35, 0.5, 0.2)
+    assert side is not None and side.sum() in range(230, 271)
+    long = np.column_stack([rng.uniform(-0.4, 0.4, 500), rng.normal(0, 0.05, 500)])
+    assert bimodal_split(long, 0.35, 0.5, 0.2) is None
+    assert bimodal_split(rng.normal(0, 0.1, (500, 2)), 0.35, 0.5, 0.2) is None
+
+
+def test_floor_region_samples_uniformly_inside():
+    ring = np.array([[0, 0], [2, 0], [2, 1], [0, 1]], float)
+    reg = FloorRegion.rasterise("r", (0, 2, 0, 1), 0.02, lambda xy: polygon_distance(xy, ring) == 0)
+    pts = reg.sample(20000, np.random.default_rng(0))
+    assert reg.contains(pts).all() and reg.area == pytest.approx(2.0, rel=0.01)
+    assert np.mean(pts[:, 0] < 1) == pytest.approx(0.5, abs=0.02)
+    np.testing.assert_allclose(polygon_distance([[3, 0.5], [1, 0.5], [1, -0.5]], ring), [1, 0, 0.5])
+
+
+def test_shadow_free_hits_drop_darkened_background_only():
+    bg = texture(0)
+    img = bg.copy()
+    img[100:140, 50:100] = (bg[100:140, 50:100] * 0.7).astype(np.uint8)    # a shadow
+    img[100:140, 200:250] = (40, 30, 200)                                   # an object
+    hit = shadow_free_hits(img, bg, 25.0)
+    assert hit[100:140, 50:100].mean() < 0.05 and hit[100:140, 200:250].mean() > 0.95
+    where = np.zeros((H, W), bool)
+    assert shadow_free_hits(img, bg, 25.0, where=where)[100:140, 50:100].mean() > 0.5
+
+
+def test_image_box_covers_the_person():
+    scene = make_scene()
+    cam = scene.cameras["cam"]
+    img = render(cam, np.zeros((H, W, 3), np.uint8), [(0.5, 3.0)], np.random.default_rng(0))
+    ys, xs = np.nonzero(img.max(axis=2) > 100)
+    u0, u1, v0, v1 = image_box(cam, 0.5, 3.0, WIDTH, HEIGHT, 0.0)
+    assert u0 <= xs.min() + 1 and u1 >= xs.max() and v0 <= ys.min() + 1 and v1 >= ys.max()
+    assert (u1 - u0) < 1.3 * (xs.max() - xs.min() + 1)
+
+
+@pytest.mark.parametrize("bad", [dict(alpha=1.5), dict(beta=-0.1), dict(particles=0), dict(dz=0),
+                                 dict(likelihood="blob"), dict(min_height=2.5), dict(resampling="multinomial"),
+                                 dict(hit_rate_object=0.01)])
+def test_bad_configuration_is_an_input_error(bad):
+    with pytest.raises(InputError):
+        ParticleConfig(**bad)
+
+
+def test_user_mistakes_are_input_errors():
+    scene = make_scene()
+    fgs = {"cam": StaticBackground(texture(0), 30.0, "colour")}
+    with pytest.raises(InputError):
+        make_tracker("particle", scene, fgs, no_such_option=1)
+    with pytest.raises(InputError):
+        ParticleTracker(make_scene(entry=False), fgs, ParticleConfig(births="entry"))
+    tracker = ParticleTracker(scene, fgs)
+    tracker.step({"cam": texture(0)}, 1.0)
+    with pytest.raises(InputError):
+        tracker.step({"cam": texture(0)}, 0.5)
+    with pytest.raises(InputError):
+        tracker.step({"cam": np.zeros((10, 10, 3), np.uint8)}, 2.0)
+
+
+def test_tracks_csv_gets_the_object_region_columns(tmp_path):
+    from worldtrack.io.sources import ArraySource
+    from worldtrack.io.tracks import read_tracks
+    from worldtrack.pipeline import run_tracking
+
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene)
+    rng = np.random.default_rng(0)
+    images = [{"cam": render(scene.cameras["cam"], bgs["cam"], walker(k / FPS), rng)} for k in range(8)]
+    run_tracking(scene, ArraySource(images, fps=FPS), tracker, tmp_path, write_video=False, progress=False)
+    table = read_tracks(tmp_path / "tracks.csv")
+    assert len(table) >= 5 and {"z", "sx", "sy", "sz", "sigma"} <= set(table.columns)
+    assert np.all(table.column("sz") > 0)
+
+
+def test_shadow_kernel_agrees_with_reference():
+    from worldtrack.trackers.particle_likelihood import shadow_free_hits_reference
+    rng = np.random.default_rng(3)
+    bg = texture(1)
+    img = np.clip(bg * rng.uniform(0.4, 1.1, (H, W, 1)) + rng.normal(0, 6, (H, W, 3)), 0, 255).astype(np.uint8)
+    where = rng.random((H, W)) < 0.7
+    for w in (None, where):
+        a = shadow_free_hits(img, bg, 25.0, where=w)
+        b = shadow_free_hits_reference(img, bg, 25.0, where=w)
+        np.testing.assert_array_equal(a, b)
+    assert 0.1 < a.mean() < 0.9
