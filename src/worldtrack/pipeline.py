@@ -43,8 +43,8 @@ class RunResult:
         return self.frames / self.seconds if self.seconds > 0 else 0.0
 
 
-def make_foregrounds(scene: Scene, backgrounds: Mapping[str, np.ndarray], kind: str = "grey",
-                     threshold: float | None = None) -> dict:
+def make_foregrounds(scene: Scene, backgrounds: Mapping[str, np.ndarray], kind: str = "colour",
+                     threshold: float | None = None, shadows: bool | None = None) -> dict:
     """One foreground model per camera from background images.
 
     Parameters
@@ -52,6 +52,7 @@ def make_foregrounds(scene: Scene, backgrounds: Mapping[str, np.ndarray], kind: 
     backgrounds : {camera_id: (H, W, 3) uint8}
     kind : "grey" (the paper), "colour", "mog2" or "knn"
     threshold : grey levels / RGB distance for the static kinds; default 25 / 40
+    shadows : treat cast shadows as background; default: on except for "grey" (the paper's)
     """
     if kind not in FOREGROUNDS:
         raise InputError(f"--foreground: expected one of {', '.join(FOREGROUNDS)}, got {kind!r}")
@@ -61,10 +62,12 @@ def make_foregrounds(scene: Scene, backgrounds: Mapping[str, np.ndarray], kind: 
         if (bg.shape[1], bg.shape[0]) != (cam.width, cam.height):
             raise InputError(f"background for {cid}: image is {bg.shape[1]}x{bg.shape[0]} but the camera is "
                              f"{cam.width}x{cam.height}")
+        shade = (kind != "grey") if shadows is None else shadows
         if kind in ("grey", "colour"):
-            out[cid] = StaticBackground(bg, threshold if threshold is not None else DEFAULT_THRESHOLDS[kind], kind)
+            out[cid] = StaticBackground(bg, threshold if threshold is not None else DEFAULT_THRESHOLDS[kind], kind,
+                                        shadows=shade)
         else:
-            out[cid] = AdaptiveBackground(kind, background=bg)
+            out[cid] = AdaptiveBackground(kind, background=bg, shadows=shade)
     return out
 
 

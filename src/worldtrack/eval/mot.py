@@ -304,3 +304,44 @@ def _check_area(area: ArrayLike) -> np.ndarray:
         raise InputError(f"area: expected a floor polygon of at least 3 (x, y) points in metres, "
                          f"got an array of shape {ring.shape}")
     return ring
+
+
+def drop_ignored(gt: TrackTable, pred: TrackTable, ignore: ArrayLike,
+                 gate: float = DEFAULT_GATE_M) -> tuple[TrackTable, TrackTable]:
+    """Remove ground truth that should not be scored, and the predictions that found it.
+
+    People barely in view (a hand at the image border, somebody fully behind a pillar) are
+    neither required nor forbidden: as in the MOTChallenge protocol, each frame's predictions
+    are first matched to *all* ground truth (Hungarian on distance, within ``gate``); predictions
+    matched to an ignored person are then dropped together with that person's rows.
+
+    Parameters
+    ----------
+    gt, pred : TrackTable
+    ignore : (len(gt),) bool — ground-truth rows not to score (e.g. ``max vis_<cam> < 0.2``)
+    gate : float, metres
+
+    Returns
+    -------
+    gt_kept, pred_kept : TrackTable
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    ignore = np.asarray(ignore, dtype=bool)
+    if ignore.shape != (len(gt),):
+        raise ValueError(f"ignore: expected {len(gt)} flags, got shape {ignore.shape}")
+    keep_pred = np.ones(len(pred), dtype=bool)
+    g_order, p_order = np.argsort(gt.frame, kind="stable"), np.argsort(pred.frame, kind="stable")
+    gf, pf = gt.frame[g_order], pred.frame[p_order]
+    for f in np.unique(gt.frame[ignore]):
+        gi = g_order[np.searchsorted(gf, f, "left"):np.searchsorted(gf, f, "right")]
+        pi = p_order[np.searchsorted(pf, f, "left"):np.searchsorted(pf, f, "right")]
+        if len(pi) == 0:
+            continue
+        d = floor_distances(gt.xy[gi], pred.xy[pi], gate)
+        cost = np.where(np.isnan(d), 1e6, d)
+        rows, cols = linear_sum_assignment(cost)
+        for r, c in zip(rows, cols):
+            if cost[r, c] < 1e6 and ignore[gi[r]]:
+                keep_pred[pi[c]] = False
+    return gt.select(~ignore), pred.select(keep_pred)

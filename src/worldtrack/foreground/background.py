@@ -43,9 +43,19 @@ class StaticBackground:
     mode : {"grey", "colour"}
     open_px : int
         Radius of a morphological opening that removes isolated noise pixels (0 = none, as published).
+    shadows : bool
+        Treat cast shadows as background: a pixel whose colour is the background's scaled by a
+        brightness ratio ``a`` in ``[shadow_min_ratio, 0.97]`` with little colour distortion
+        ``‖I − a·B‖`` (Horprasert et al. 1999; what MOG2's shadow detection tests) is not
+        foreground. Not in the paper, which names shadows as its main failure.
+    shadow_min_ratio : float
+        Darkest shadow, as a fraction of the background brightness.
+    shadow_distortion : float
+        Largest colour distortion of a shadow, as a fraction of ``‖B‖`` (RGB distance).
     """
 
-    def __init__(self, background: np.ndarray, threshold: float = 30.0, mode: str = "grey", open_px: int = 0):
+    def __init__(self, background: np.ndarray, threshold: float = 30.0, mode: str = "grey", open_px: int = 0,
+                 shadows: bool = False, shadow_min_ratio: float = 0.45, shadow_distortion: float = 0.08):
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise InputError(f"background: expected an (H, W, 3) uint8 colour image, got {background.shape} "
                              f"{background.dtype}")
@@ -57,6 +67,21 @@ class StaticBackground:
         self.mode = mode
         self.kernel = (cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * open_px + 1, 2 * open_px + 1))
                        if open_px > 0 else None)
+        self.shadows = bool(shadows)
+        self.shadow_min_ratio = float(shadow_min_ratio)
+        self.shadow_distortion = float(shadow_distortion)
+        bg = background.astype(np.float32)
+        self._bg = bg
+        self._bg_norm2 = np.maximum(np.einsum("hwc,hwc->hw", bg, bg), 1.0)
+
+    def shadow_mask(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) bool: pixels that look like the background in shadow."""
+        img = image.astype(np.float32)
+        a = np.einsum("hwc,hwc->hw", img, self._bg) / self._bg_norm2          # brightness ratio
+        resid = img - a[..., None] * self._bg
+        distortion2 = np.einsum("hwc,hwc->hw", resid, resid)
+        limit2 = (self.shadow_distortion ** 2) * self._bg_norm2
+        return (a >= self.shadow_min_ratio) & (a <= 0.97) & (distortion2 <= limit2)
 
     def _check(self, image: np.ndarray) -> None:
         if image.shape != self.background.shape:
@@ -70,6 +95,8 @@ class StaticBackground:
             m = (diff > self.threshold).astype(np.uint8)
         else:
             m = (colour_distance(image, self.background) > self.threshold).astype(np.uint8)
+        if self.shadows:
+            m[self.shadow_mask(image)] = 0
         if self.kernel is not None:
             m = cv2.morphologyEx(m, cv2.MORPH_OPEN, self.kernel)
         return m
