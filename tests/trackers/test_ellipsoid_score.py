@@ -25,18 +25,18 @@ def person_mask(cam, xy, height, width):
     return q.ellipse_mask(C, (cam.height, cam.width), ideal_grid=grid).astype(np.uint8)
 
 
-def kernel(cam, occ, real, use_ring, cand, others, ring, target):
+def kernel(cam, occ, real, use_ring, cand, others, ring, target, count_unexplained=False, ring_fraction=0.0):
     args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
     h = np.full(len(cand), 1.65)
     w = np.full(len(cand), 0.40)
-    ci, cr, cb, cv = ellipse_forms(*args, cand, h, w, float(ring), 0.1)
+    ci, cr, cb, cv = ellipse_forms(*args, cand, h, w, float(ring), 0.1, ring_fraction)
     oi, orr, ob, ov = ellipse_forms(*args, others, np.full(len(others), 1.65), np.full(len(others), 0.4),
-                                    float(ring), 0.1)
+                                    float(ring), 0.1, ring_fraction)
     cd = np.hypot(*(cand - cam.centre[:2]).T)
     od = np.hypot(*(others - cam.centre[:2]).T)
     grid = cam.ideal_pixel_grid if cam.has_distortion else np.zeros((1, 1, 2), np.float32)
     return score_candidates(grid, cam.has_distortion, occ, real, use_ring, ci, cr, cb, cd, cv,
-                            oi, orr, ob, od, ov, target)
+                            oi, orr, ob, od, ov, target, count_unexplained)
 
 
 @pytest.mark.parametrize("cam_id", ["cam1", "cam2"])
@@ -53,11 +53,13 @@ def test_kernel_equals_reference(lab, cam_id):
         offsets = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)]) * 0.05
         cand = start + offsets
         others = np.array([[rng.uniform(-2, 0), rng.uniform(0, 2.8)] for _ in range(2)])
-        for use_ring in (True, False):
-            for target in (0, 250):
-                num, den, _ = kernel(cam, occ, real, use_ring, cand, others, 5, target)
+        for use_ring, target, unexplained, frac in [
+                (True, 0, False, 0.0), (False, 0, False, 0.0), (True, 250, False, 0.0), (False, 250, False, 0.0),
+                (True, 0, True, 0.0), (True, 250, True, 0.0), (True, 0, True, 0.3), (True, 250, False, 0.5)]:
+                num, den, _ = kernel(cam, occ, real, use_ring, cand, others, 5, target, unexplained, frac)
                 rn, rd = score_candidates_reference(cam.P, cam, occ, real, use_ring, cand, 1.65, 0.40, 5,
-                                                    others, 1.65, 0.40, target_pixels=target)
+                                                    others, 1.65, 0.40, target_pixels=target,
+                                                    count_unexplained=unexplained, ring_fraction=frac)
                 np.testing.assert_array_equal(num, rn)
                 np.testing.assert_array_equal(den, rd)
 

@@ -41,13 +41,15 @@ from worldtrack.foreground.background import Foreground
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
-from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_candidates, ternary_real
+from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_candidates, ternary_real, track_support
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 #: Index 4 is "stay".
 _OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=float)
 _STAY = 4
 _DUMMY_GRID = np.zeros((1, 1, 2), dtype=np.float32)
+#: Sampled pixels a person must show (in all cameras together) to count as seen, or as its own.
+_MIN_OWN_PIXELS = 12
 
 
 @dataclass(frozen=True)
@@ -61,54 +63,88 @@ class EllipsoidConfig:
     ring_px_160 : float — ring width at 160×120 (paper: 5 px); scaled by ``sqrt(W·H / (160·120))``,
         i.e. with the image's linear size, so the ring covers the same part of a person at any
         resolution
+    ring_fraction : float — the simulated ring is at most this fraction of the ellipse's semi-minor
+        axis (0 = always the image's ring width, as published). At 640×480 the scaled ring is
+        20 px, wider than a person 10 m away; a narrow ring keeps neighbours apart
     capture_threshold : float — E above which a captured person switches to tracking (paper: 0.7)
+    capture_threshold_symmetric : float — with ``score="symmetric"`` a captured person is
+        confirmed after ``confirm_frames`` consecutive frames with capture-mode E above this and
+        ``min_support`` met. 0.3, not 0.7: an articulated body whose clothes match the background
+        in places covers only 30–80 % of its ellipse even at the right place
+    confirm_frames : int
+    birth_search_m : float — a just-proposed person is placed by a grid search ±this far along
+        the viewing direction (0 = start at the foot point, as the paper's capture does)
     target_pixels : int — pixels visited per candidate set (0 = all, as published)
+    score : {"paper", "symmetric"} — eq. 5 as published, or with the foreground the simulation
+        leaves unexplained added to the denominator in tracking mode (see ``ellipsoid_score``)
     adaptive_step : bool — halve the step when "stay" wins, double it (up to ``max_step_m``) when
         the best candidate is on the edge after the K rounds, up to ``max_iterations`` rounds
+    min_gain : float — with the adaptive step, a move must raise E by at least this much;
+        smaller gains are noise and count as "stay" (stops random walks along flat directions)
     min_step_m, max_step_m : float — limits of the adaptive step
     max_iterations : int — cap on rounds with the adaptive step
     predict : bool — constant-velocity prediction before matching
     velocity_smoothing : float — weight of the new velocity measurement (0..1)
+    max_speed_mps : float — velocities are clipped to this speed (a running person)
     births : {"anywhere", "entry", "none"} — where new people may appear: anywhere in view, only in
         the scene's entry regions (and on the first frame), or never (tracks only from ``init``)
     min_blob_fraction : float — unexplained blob area / expected person area to propose a person
     confirm_within_s : float — a captured person not confirmed within this time is dropped
-    keep_score : float — a tracked person whose E stays below this for ``lost_after_s`` ends
+    keep_score : float — with ``score="paper"``: a tracked person whose E stays below this for
+        ``lost_after_s`` ends
+    min_support : float — with ``score="symmetric"``: a person whose own pixels (visible, covered by
+        nobody else) are less than this share foreground for ``lost_after_s`` ends — a ghost left
+        beside the person it duplicated, or a track that lost its person; a captured person must
+        reach it to be confirmed
     lost_after_s : float
     leave_after_frames : int — frames unseen by every camera before a track ends
     merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
+    min_separation_m : float — no new person is proposed, or kept in capture, this close to
+        another (two bodies' centres are rarely nearer)
     min_depth_m : float — ellipsoids nearer than this to a camera's image plane are not drawn
     """
 
     step_m: float = 0.05
     iterations: int = 3
     ring_px_160: float = 5.0
+    ring_fraction: float = 0.5
     capture_threshold: float = 0.7
+    capture_threshold_symmetric: float = 0.3
+    confirm_frames: int = 3
+    birth_search_m: float = 1.0
     target_pixels: int = 1500
+    score: str = "symmetric"
     adaptive_step: bool = True
+    min_gain: float = 0.002
     min_step_m: float = 0.0125
     max_step_m: float = 0.4
     max_iterations: int = 8
     predict: bool = True
     velocity_smoothing: float = 0.5
+    max_speed_mps: float = 3.0
     births: str = "anywhere"
-    min_blob_fraction: float = 0.3
+    min_blob_fraction: float = 0.25
     confirm_within_s: float = 1.0
     keep_score: float = 0.2
-    lost_after_s: float = 1.5
+    min_support: float = 0.25
+    lost_after_s: float = 1.0
     leave_after_frames: int = 2
-    merge_distance_m: float = 0.3
+    merge_distance_m: float = 0.25
+    min_separation_m: float = 0.4
     min_depth_m: float = 0.1
 
     @classmethod
     def paper(cls, **overrides) -> "EllipsoidConfig":
         """The method exactly as published: fixed 50 mm steps, K = 3, every pixel, no prediction."""
-        base = cls(adaptive_step=False, predict=False, target_pixels=0)
+        base = cls(adaptive_step=False, predict=False, target_pixels=0, score="paper", birth_search_m=0.0,
+                   ring_fraction=0.0)
         return replace(base, **overrides)
 
     def __post_init__(self) -> None:
         if self.births not in ("anywhere", "entry", "none"):
             raise ValueError(f"births: expected 'anywhere', 'entry' or 'none', got {self.births!r}")
+        if self.score not in ("paper", "symmetric"):
+            raise ValueError(f"score: expected 'paper' or 'symmetric', got {self.score!r}")
         if self.step_m <= 0 or self.iterations < 1:
             raise ValueError("step_m must be positive and iterations at least 1")
 
@@ -123,12 +159,14 @@ class _CameraState:
     occ: np.ndarray
     ring_px: int
     foreground: Foreground
+    ring_fraction: float = 0.0
 
     def forms(self, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray, min_depth: float):
         """Ellipse forms of people at ``xy`` plus their floor distances from this camera."""
         c = self.camera
         inner, ring, box, valid = ellipse_forms(self.P, c.K, c.dist, c.has_distortion, c.width, c.height,
-                                                xy, heights, widths, float(self.ring_px), min_depth)
+                                                xy, heights, widths, float(self.ring_px), min_depth,
+                                                self.ring_fraction)
         dist = np.hypot(xy[:, 0] - c.centre[0], xy[:, 1] - c.centre[1])
         return inner, ring, box, valid, dist
 
@@ -156,7 +194,8 @@ class EllipsoidTracker:
             ring = max(1, int(round(self.config.ring_px_160 * math.sqrt(cam.width * cam.height / (160 * 120)))))
             occ = scene.occlusion(cid).floor_distance
             self.cams[cid] = _CameraState(cam, np.ascontiguousarray(cam.P), cam.ideal_pixel_grid
-                                          if cam.has_distortion else _DUMMY_GRID, occ, ring, fg)
+                                          if cam.has_distortion else _DUMMY_GRID, occ, ring, fg,
+                                          self.config.ring_fraction)
         self._walkable = scene.walkable.raster(0.01).contains
         self._last_t: float | None = None
         self._frame = 0
@@ -230,6 +269,10 @@ class EllipsoidTracker:
         done = np.zeros(n, dtype=bool)
         best_e = np.zeros(n)
         best_den = np.zeros(n)
+        if cfg.birth_search_m > 0:
+            for k, tr in enumerate(tracks):
+                if tr.mode == "capture" and tr.age_frames == 0:
+                    self._search_new(k, xy, hs, ws, state, real)
         rounds = cfg.max_iterations if cfg.adaptive_step else cfg.iterations
         for it in range(rounds):
             for k in range(n):
@@ -243,6 +286,8 @@ class EllipsoidTracker:
                     best_e[k], best_den[k] = e[_STAY], den[_STAY]
                     continue
                 b = int(np.argmax(e))
+                if cfg.adaptive_step and e[b] - e[_STAY] < cfg.min_gain:
+                    b = _STAY
                 best_e[k], best_den[k] = e[b], den[b]
                 if b != _STAY:
                     xy[k] = cand[b]
@@ -268,42 +313,97 @@ class EllipsoidTracker:
     def _score_person(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, step: float,
                       state: dict, real: dict[str, np.ndarray], use_ring: bool):
         """E of the 9 candidates of person ``k`` over all cameras (Σ num / Σ den)."""
-        cfg = self.config
-        # Candidate axes: the viewing direction of the camera that sees the person largest.
-        best_cam, best_den = None, -1.0
-        for cid, st in state.items():
-            box = st[2][k]
-            area = (box[1] - box[0]) * (box[3] - box[2]) if st[3][k] else 0
-            if area > best_den:
-                best_cam, best_den = cid, area
-        d = self.cams[best_cam].camera.floor_direction
-        e_perp = np.array([-d[1], d[0]])
+        d, e_perp = self._axes(k, state)
         cand = xy[k] + step * (_OFFSETS[:, :1] * d + _OFFSETS[:, 1:] * e_perp)
+        e, den, forms = self._score_candidates(k, cand, np.full(9, hs[k]), np.full(9, ws[k]), state, real, use_ring)
         walk = self._walkable(cand)
         walk[_STAY] = True
-        h9 = np.full(9, hs[k])
-        w9 = np.full(9, ws[k])
-        num = np.zeros(9)
-        den = np.zeros(9)
-        forms = {}
-        for cid, st in state.items():
-            cs = self.cams[cid]
-            f = cs.forms(cand, h9, w9, cfg.min_depth_m)
-            forms[cid] = f
-            o_valid = st[3].copy()
-            o_valid[k] = False
-            nu, de, _ = score_candidates(cs.grid, cs.camera.has_distortion, cs.occ, real[cid], use_ring,
-                                         f[0], f[1], f[2], f[4], f[3],
-                                         st[0], st[1], st[2], st[4], o_valid, cfg.target_pixels)
-            num += nu
-            den += de
-        with np.errstate(invalid="ignore", divide="ignore"):
-            e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)
         e[~walk] = -np.inf
         ok = bool(den[_STAY] > 0)
         if not ok:
             e[:] = 0.0
         return e, den, cand, forms, ok
+
+    def _search_new(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
+                    real: dict[str, np.ndarray]) -> None:
+        """Place a just-proposed person by a coarse grid search before the 9-candidate steps.
+
+        A blob's foot point is uncertain mostly along the viewing direction (feet lost in a hole of
+        the mask, two people merged), so candidates spread ±``birth_search_m`` along the axes of
+        the camera that sees the person largest, 0.1 m apart, scored over every camera.
+        """
+        cfg = self.config
+        d = self._axes(k, state)
+        along = np.arange(-cfg.birth_search_m, cfg.birth_search_m + 1e-9, 0.1)
+        across = np.array([-0.2, -0.1, 0.0, 0.1, 0.2])
+        grid = np.array([(a, c) for a in along for c in across])
+        cand = xy[k] + grid[:, :1] * d[0] + grid[:, 1:] * d[1]
+        cand = cand[self._walkable(cand)]
+        if len(cand) == 0:
+            return
+        # Scored with the ring (and, by default, the unexplained foreground): without them the
+        # smallest, farthest ellipse that fits inside the blob would win (the paper's Fig. 2).
+        e, den, forms = self._score_candidates(k, cand, np.full(len(cand), hs[k]), np.full(len(cand), ws[k]),
+                                               state, real, use_ring=True)
+        b = int(np.argmax(e))
+        if not np.isfinite(e[b]):
+            return
+        xy[k] = cand[b]
+        for cid, f in forms.items():
+            for a in range(5):
+                state[cid][a][k] = f[a][b]
+
+    def _axes(self, k: int, state: dict) -> tuple[np.ndarray, np.ndarray]:
+        """The floor viewing direction of the camera that sees person ``k`` largest, and its normal."""
+        best_cam, best_area = next(iter(state)), -1
+        for cid, st in state.items():
+            box = st[2][k]
+            area = max(0, box[1] - box[0]) * max(0, box[3] - box[2]) if st[3][k] else 0
+            if area > best_area:
+                best_cam, best_area = cid, area
+        d = self.cams[best_cam].camera.floor_direction
+        return d, np.array([-d[1], d[0]])
+
+    def _score_candidates(self, k: int, cand: np.ndarray, heights: np.ndarray, widths: np.ndarray,
+                          state: dict, real: dict[str, np.ndarray], use_ring: bool):
+        """E (C,), denominators (C,) and per-camera forms of candidate ellipsoids for person ``k``,
+        everybody else fixed in the joint image."""
+        cfg = self.config
+        num = np.zeros(len(cand))
+        den = np.zeros(len(cand))
+        forms = {}
+        for cid, st in state.items():
+            cs = self.cams[cid]
+            f = cs.forms(cand, heights, widths, cfg.min_depth_m)
+            forms[cid] = f
+            o_valid = st[3].copy()
+            o_valid[k] = False
+            nu, de, _ = score_candidates(cs.grid, cs.camera.has_distortion, cs.occ, real[cid], use_ring,
+                                         f[0], f[1], f[2], f[4], f[3],
+                                         st[0], st[1], st[2], st[4], o_valid, cfg.target_pixels,
+                                         use_ring and cfg.score == "symmetric")
+            num += nu
+            den += de
+        with np.errstate(invalid="ignore", divide="ignore"):
+            e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)
+        return e, den, forms
+
+    def _nearest_walkable(self, xy: np.ndarray, radius: float) -> np.ndarray | None:
+        """``xy`` if walkable, else the nearest walkable point within ``radius`` (5 cm grid), else None.
+
+        A proposal from a head seen above a desk can land on the desk's footprint.
+        """
+        if self._walkable([xy])[0]:
+            return np.asarray(xy, float)
+        g = np.arange(-radius, radius + 1e-9, 0.05)
+        offsets = np.array([(a, b) for a in g for b in g])
+        offsets = offsets[np.hypot(offsets[:, 0], offsets[:, 1]) <= radius]
+        cand = xy + offsets
+        ok = self._walkable(cand)
+        if not ok.any():
+            return None
+        d = np.hypot(offsets[ok, 0], offsets[ok, 1])
+        return cand[ok][int(np.argmin(d))]
 
     def _move_if_walkable(self, tr: Track, x: float, y: float) -> None:
         if self._walkable([[x, y]])[0]:
@@ -325,20 +425,27 @@ class EllipsoidTracker:
             mask = self.last_masks[cid]
             explained = np.zeros_like(mask)
             if len(tracks):
-                _, ring, box, valid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
-                _render_union(explained, ring, box, valid, cs.grid, cam.has_distortion)
+                inner, _, box, valid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+                _render_union(explained, inner, box, valid, cs.grid, cam.has_distortion)
+                explained = cv2.dilate(explained, _disc(2))
             un = mask & (1 - explained)
-            k = max(1, cs.ring_px // 2)
-            un = cv2.morphologyEx(un, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * k + 1, 2 * k + 1)))
+            # Remove speckle, then join the pieces of one body that holes in the mask split.
+            r_open, r_close = 1, max(1, cs.ring_px // 2)
+            un = cv2.morphologyEx(un, cv2.MORPH_OPEN, _disc(r_open))
+            un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, _disc(r_close))
             n, labels, stats, cent = cv2.connectedComponentsWithStats(un, connectivity=8)
             for j in range(1, n):
                 x0, y0, bw, bh, area = stats[j]
                 if area < 10:
                     continue
-                touches_bottom = y0 + bh >= cam.height - 1
                 touches_top = y0 <= 0
                 u = float(cent[j][0])
-                if not touches_bottom:
+                # The feet are lost when the blob ends at the image border or on an obstacle
+                # (a desk hides them); then the top of the head, at the default height, is used.
+                below = min(y0 + bh + 1, cam.height - 1)
+                feet_hidden = (y0 + bh >= cam.height - 1
+                               or np.isfinite(cs.occ[below, x0:x0 + bw]).mean() > 0.5)
+                if not feet_hidden:
                     p = cam.backproject([[u, y0 + bh - 0.5]], 0.0)[0]
                 elif not touches_top:
                     p = cam.backproject([[u, y0 - 0.5]], h0)[0]
@@ -346,17 +453,12 @@ class EllipsoidTracker:
                     continue
                 if not np.isfinite(p).all():
                     continue
-                pxy = p[:2]
-                if not self._walkable([pxy])[0]:
+                pxy = self._nearest_walkable(p[:2], 0.6)
+                if pxy is None:
                     continue
-                # Is the blob big enough to be a person standing there?
-                _, _, pbox, pvalid, _ = cs.forms(pxy[None], np.array([h0]), np.array([w0]), cfg.min_depth_m)
-                if not pvalid[0]:
-                    continue
-                inner, _, _, _, _ = cs.forms(pxy[None], np.array([h0]), np.array([w0]), cfg.min_depth_m)
-                a11, a12, a22 = inner[0, 2:]
-                expected = math.pi / math.sqrt(max(a11 * a22 - a12 * a12, 1e-12))
-                if area < cfg.min_blob_fraction * min(expected, cam.width * cam.height):
+                # Is the blob big enough to be (the visible part of) a person standing there?
+                expected = _visible_pixels(cs, pxy, h0, w0, cfg.min_depth_m)
+                if expected <= 0 or area < cfg.min_blob_fraction * expected:
                     continue
                 proposals.append(pxy)
         if not proposals:
@@ -366,9 +468,9 @@ class EllipsoidTracker:
         new: list[Track] = []
         existing = xy
         for p in proposals:
-            if len(existing) and np.min(np.hypot(*(existing - p).T)) < 0.6:
+            if len(existing) and np.min(np.hypot(*(existing - p).T)) < cfg.min_separation_m:
                 continue
-            if any(np.hypot(*(np.array([b.x, b.y]) - p)) < 0.6 for b in new):
+            if any(np.hypot(*(np.array([b.x, b.y]) - p)) < cfg.min_separation_m for b in new):
                 continue
             tr = self.position_map.add(p[0], p[1], h0, w0, mode="capture", time=t)
             tr.height, tr.width = self.scene.people.size_of(tr.id)
@@ -376,34 +478,77 @@ class EllipsoidTracker:
         return new
 
     # ------------------------------------------------------------------ bookkeeping
+    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float]]:
+        """Per person: (sampled visible pixels over all cameras, share of its own pixels that are
+        foreground — NaN when too few pixels are its own to tell)."""
+        cfg = self.config
+        if not tracks:
+            return {}
+        xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
+        hs = np.array([tr.height for tr in tracks], dtype=float)
+        ws = np.array([tr.width for tr in tracks], dtype=float)
+        visible = np.zeros(len(tracks))
+        own = np.zeros(len(tracks))
+        own_fg = np.zeros(len(tracks))
+        for cid, mask in self.last_masks.items():
+            cs = self.cams[cid]
+            inner, _, box, valid, dist = cs.forms(xy, hs, ws, cfg.min_depth_m)
+            vis, o, f = track_support(cs.grid, cs.camera.has_distortion, cs.occ, mask, inner, box, dist, valid,
+                                      cfg.target_pixels)
+            visible += vis
+            own += o
+            own_fg += f
+        return {tr.id: (visible[k], own_fg[k] / own[k] if own[k] >= _MIN_OWN_PIXELS else float("nan"))
+                for k, tr in enumerate(tracks)}
+
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
                        prev: dict[int, tuple[float, float]], dt: float, t: float) -> None:
         cfg = self.config
         fps_frames = (lambda s: max(1, int(round(s / dt)))) if dt > 0 else (lambda s: max(1, int(round(s * 10))))
+        symmetric = cfg.score == "symmetric"
+        support = self._support(tracks)
         for tr in tracks:
             e, den = scores.get(tr.id, (0.0, 0.0))
+            visible, sup = support.get(tr.id, (0.0, float("nan")))
+            tr.extra["support"] = sup
             tr.score = e
             tr.age_frames += 1
-            if den > 0:
+            if visible >= _MIN_OWN_PIXELS:
                 self._unseen[tr.id] = 0
                 tr.last_seen = t
             else:
                 self._unseen[tr.id] = self._unseen.get(tr.id, 0) + 1
-            if tr.id in prev and dt > 0:
+            if tr.mode == "tracking" and tr.id in prev and dt > 0:
                 px, py = prev[tr.id]
                 a = cfg.velocity_smoothing
-                tr.vx = (1 - a) * tr.vx + a * (tr.x - px) / dt
-                tr.vy = (1 - a) * tr.vy + a * (tr.y - py) / dt
+                vx = (1 - a) * tr.vx + a * (tr.x - px) / dt
+                vy = (1 - a) * tr.vy + a * (tr.y - py) / dt
+                speed = math.hypot(vx, vy)
+                scale = min(1.0, cfg.max_speed_mps / speed) if speed > 0 else 1.0
+                tr.vx, tr.vy = vx * scale, vy * scale
             if tr.mode == "capture":
-                if e > cfg.capture_threshold:
+                if self._near_confirmed(tr, cfg.min_separation_m):
+                    self._end(tr)  # slid onto somebody already tracked
+                    continue
+                if symmetric:
+                    # Held on foreground for several frames: a person, not a flicker.
+                    ok = e > cfg.capture_threshold_symmetric and sup >= cfg.min_support
+                    tr.extra["held"] = tr.extra.get("held", 0) + 1 if ok else 0
+                    confirmed = tr.extra["held"] >= cfg.confirm_frames
+                else:
+                    confirmed = e > cfg.capture_threshold
+                if confirmed:
+                    tr.extra.pop("held", None)
                     tr.mode = "tracking"
+                    tr.vx = tr.vy = 0.0  # capture moves are sliding into the blob, not walking
                     self._confirmed.add(tr.id)
                     tr.frames_low = 0
                 elif t - tr.born > cfg.confirm_within_s:
                     self._end(tr)
                     continue
             else:
-                tr.frames_low = tr.frames_low + 1 if e < cfg.keep_score else 0
+                low = sup < cfg.min_support if symmetric else e < cfg.keep_score
+                tr.frames_low = tr.frames_low + 1 if low else 0
                 if tr.frames_low >= fps_frames(cfg.lost_after_s):
                     self._end(tr)
                     continue
@@ -412,6 +557,10 @@ class EllipsoidTracker:
                 continue
             self._flag_measurability(tr)
         self._merge_duplicates()
+
+    def _near_confirmed(self, tr: Track, distance: float) -> bool:
+        return any(o.id != tr.id and o.id in self._confirmed and math.hypot(o.x - tr.x, o.y - tr.y) < distance
+                   for o in self.position_map)
 
     def _end(self, tr: Track) -> None:
         if tr.id in self.position_map:
@@ -459,6 +608,23 @@ class EllipsoidTracker:
         else:
             tr.flags.discard("unmeasurable")
             tr.sigma = 0.1
+
+
+def _disc(radius: int) -> np.ndarray:
+    """Elliptical structuring element of the given radius (pixels)."""
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+
+
+def _visible_pixels(cs: _CameraState, xy: np.ndarray, height: float, width: float, min_depth: float) -> int:
+    """Pixels of a person's ellipse at ``xy`` inside the image and not hidden by obstacles."""
+    inner, _, box, valid, dist = cs.forms(np.asarray(xy, float)[None], np.array([height]), np.array([width]),
+                                          min_depth)
+    if not valid[0]:
+        return 0
+    out = np.zeros((cs.camera.height, cs.camera.width), np.uint8)
+    _render_union(out, inner, box, valid, cs.grid, cs.camera.has_distortion)
+    u0, u1, v0, v1 = box[0]
+    return int((out[v0:v1, u0:u1].astype(bool) & (cs.occ[v0:v1, u0:u1] >= dist[0])).sum())
 
 
 def _render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: np.ndarray,

@@ -17,6 +17,13 @@ Differences from the paper, all to make it faster or well-defined:
   that person in both the ellipse and its ring: occluded pixels carry no evidence either way.
 * With lens distortion each real pixel is tested at its undistorted position (exact silhouette).
 
+Optionally (``count_unexplained``, worldtrack's default in tracking mode) foreground pixels of the
+region that no simulated person covers are added to the denominator. Eq. 5 alone measures only
+how much of the simulation is right, not how much of the foreground it explains: an ellipse that
+drifts away along the viewing direction, shrinking into the upper body while the feet are left
+unexplained, loses little. With the extra term the score is a Jaccard-like overlap of the two
+ternary images and such drift costs.
+
 Ellipses are passed in a normal form of 5 numbers ``(cx, cy, a11, a12, a22)``: a point (u, v) of
 the ideal image is inside when ``a11·du² + 2·a12·du·dv + a22·dv² < 1`` with ``du = u − cx``,
 ``dv = v − cy``. :func:`ellipse_forms` computes them for people; :func:`score_candidates` is the
@@ -52,7 +59,8 @@ def _distort_ideal_pixel(u, v, K, dist):
 
 
 @njit(cache=True)
-def ellipse_forms(P, K, dist, has_dist, width, height, xy, heights, widths, ring_px, min_depth):
+def ellipse_forms(P, K, dist, has_dist, width, height, xy, heights, widths, ring_px, min_depth,
+                  ring_fraction=0.0):
     """Normal forms, bounding boxes and floor distances of standing-person ellipsoids.
 
     Parameters
@@ -64,6 +72,8 @@ def ellipse_forms(P, K, dist, has_dist, width, height, xy, heights, widths, ring
     heights, widths : (N,) — ellipsoid sizes (2·Rb, 2·Ra), metres
     ring_px : float — ring width in pixels
     min_depth : float — an ellipsoid whose nearest point is closer than this (m) is not drawn
+    ring_fraction : float — if > 0, the ring is at most this fraction of the ellipse's semi-minor
+        axis (a far, small person gets a narrow ring instead of one wider than itself)
 
     Returns
     -------
@@ -140,8 +150,11 @@ def ellipse_forms(P, K, dist, has_dist, width, height, xy, heights, widths, ring
         e1x /= nrm
         e1y /= nrm
         e2x, e2y = -e1y, e1x
-        bx1 = ax1 + ring_px
-        bx2 = ax2 + ring_px
+        r = ring_px
+        if ring_fraction > 0.0:
+            r = min(ring_px, max(1.0, ring_fraction * ax2))
+        bx1 = ax1 + r
+        bx2 = ax2 + r
         # Ring ellipse with the same axes directions and expanded semi-axes.
         w1 = 1.0 / (bx1 * bx1)
         w2 = 1.0 / (bx2 * bx2)
@@ -187,7 +200,7 @@ def _inside(f, u, v):
 @njit(cache=True)
 def score_candidates(grid, has_dist, occ, real, use_ring,
                      c_inner, c_ring, c_box, c_dist, c_valid,
-                     o_inner, o_ring, o_box, o_dist, o_valid, target_pixels):
+                     o_inner, o_ring, o_box, o_dist, o_valid, target_pixels, count_unexplained=False):
     """Numerators and denominators of E for C candidates of one person in one camera.
 
     Parameters
@@ -199,6 +212,8 @@ def score_candidates(grid, has_dist, occ, real, use_ring,
     c_* : candidate forms from :func:`ellipse_forms` and their floor distances (C,)
     o_* : the other people's forms and floor distances (M,)
     target_pixels : int — visit about this many pixels (0 = all)
+    count_unexplained : bool — also add to the denominator the foreground pixels of the region
+        that no simulated person covers (worldtrack's symmetric score; see module notes)
 
     Returns
     -------
@@ -276,6 +291,8 @@ def score_candidates(grid, has_dist, occ, real, use_ring,
                 if s != 0:
                     num[c] += s * r
                     den[c] += 1.0
+                elif count_unexplained and r > 0:
+                    den[c] += 1.0
     return num, den, n_in
 
 
@@ -288,7 +305,8 @@ def ternary_real(mask: np.ndarray, ring_px: int) -> np.ndarray:
 
 
 def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widths, ring_px,
-                               others_xy, others_h, others_w, target_pixels=0, min_depth=0.1):
+                               others_xy, others_h, others_w, target_pixels=0, min_depth=0.1,
+                               count_unexplained=False, ring_fraction=0.0):
     """Plain NumPy version of :func:`ellipse_forms` + :func:`score_candidates` for tests.
 
     Renders each candidate's joint ternary image over the whole frame with
@@ -326,8 +344,9 @@ def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widt
             p1 = du * ca + dv * sa
             p2 = -du * sa + dv * ca
             vis = occ >= dist[k]
+            rk = min(r, max(1.0, ring_fraction * axes[k, 1])) if ring_fraction > 0 else r
             ins.append(vis & ((p1 / axes[k, 0]) ** 2 + (p2 / axes[k, 1]) ** 2 < 1))
-            rng.append(vis & ((p1 / (axes[k, 0] + r)) ** 2 + (p2 / (axes[k, 1] + r)) ** 2 < 1))
+            rng.append(vis & ((p1 / (axes[k, 0] + rk)) ** 2 + (p2 / (axes[k, 1] + rk)) ** 2 < 1))
         return ins, rng
 
     cand = forms(xy, heights, widths)
@@ -344,7 +363,7 @@ def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widt
     _, _, box, valid = ellipse_forms(*args, np.asarray(xy, float).reshape(-1, 2),
                                      np.broadcast_to(np.asarray(heights, float), (len(c_in),)).copy(),
                                      np.broadcast_to(np.asarray(widths, float), (len(c_in),)).copy(),
-                                     float(ring_px), min_depth)
+                                     float(ring_px), min_depth, ring_fraction)
     sel = valid & (box[:, 0] < box[:, 1]) & (box[:, 2] < box[:, 3])
     num = np.zeros(len(c_in))
     den = np.zeros(len(c_in))
@@ -366,4 +385,68 @@ def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widt
         sim = inside.astype(float) - ring.astype(float)
         num[c] = (sim * R).sum()
         den[c] = np.abs(sim).sum()
+        if count_unexplained:
+            den[c] += ((sim == 0) & (R > 0)).sum()
     return num, den
+
+
+@njit(cache=True)
+def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pixels):
+    """How much foreground each person alone explains.
+
+    For every person k, over the visible pixels of its ellipse (not hidden by obstacles) that no
+    other person's visible ellipse covers: the number of such pixels and how many of them are
+    foreground. A track whose own pixels are mostly background explains nothing the others do
+    not — a ghost left behind, or a track that has lost its person.
+
+    Parameters
+    ----------
+    mask : (H, W) uint8 — foreground (1) / background (0)
+    inner, box, dist, valid : the people's forms, boxes, floor distances and validity (N, …)
+    target_pixels : int — sample about this many pixels per person (0 = all)
+
+    Returns
+    -------
+    visible : (N,) float64 — sampled pixels of the ellipse inside the image and not hidden by obstacles
+    own : (N,) float64 — of those, the ones covered by nobody else
+    own_fg : (N,) float64 — of those, the foreground ones
+    """
+    n = inner.shape[0]
+    visible = np.zeros(n)
+    own = np.zeros(n)
+    own_fg = np.zeros(n)
+    for k in range(n):
+        if not valid[k]:
+            continue
+        u0, u1, v0, v1 = box[k, 0], box[k, 1], box[k, 2], box[k, 3]
+        if u0 >= u1 or v0 >= v1:
+            continue
+        stride = 1
+        if target_pixels > 0:
+            stride = max(1, int(math.sqrt((u1 - u0) * (v1 - v0) / target_pixels)))
+        for v in range(v0, v1, stride):
+            for uu in range(u0, u1, stride):
+                if has_dist:
+                    x = np.float64(grid[v, uu, 0])
+                    y = np.float64(grid[v, uu, 1])
+                else:
+                    x = np.float64(uu)
+                    y = np.float64(v)
+                o = occ[v, uu]
+                if o < dist[k] or not _inside(inner[k], x, y):
+                    continue
+                visible[k] += 1.0
+                covered = False
+                for m in range(n):
+                    if m == k or not valid[m] or o < dist[m]:
+                        continue
+                    if uu < box[m, 0] or uu >= box[m, 1] or v < box[m, 2] or v >= box[m, 3]:
+                        continue
+                    if _inside(inner[m], x, y):
+                        covered = True
+                        break
+                if not covered:
+                    own[k] += 1.0
+                    if mask[v, uu]:
+                        own_fg[k] += 1.0
+    return visible, own, own_fg
