@@ -21,7 +21,7 @@ from worldtrack.foreground.background import AdaptiveBackground, StaticBackgroun
 from worldtrack.scene.model import Scene
 
 FOREGROUNDS = ("grey", "colour", "mog2", "knn")
-DEFAULT_THRESHOLDS = {"grey": 25.0, "colour": 40.0}
+DEFAULT_THRESHOLDS = {"grey": 25.0, "colour": 20.0}
 
 
 @dataclass

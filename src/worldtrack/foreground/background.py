@@ -20,9 +20,17 @@ import numpy as np
 from worldtrack.errors import InputError
 
 
+#: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
+UNSURE = 2
+
+
 class Foreground(Protocol):
     def mask(self, image: np.ndarray) -> np.ndarray:
         """(H, W) uint8, 1 = foreground."""
+        ...
+
+    def labels(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) uint8: 0 background, 1 foreground, 2 unsure (shadow-like)."""
         ...
 
 
@@ -88,18 +96,29 @@ class StaticBackground:
             raise InputError(f"frame is {image.shape[1]}x{image.shape[0]} but the background is "
                              f"{self.background.shape[1]}x{self.background.shape[0]}")
 
-    def mask(self, image: np.ndarray) -> np.ndarray:
+    def labels(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) uint8: 0 background, 1 foreground, :data:`UNSURE` (2) changed but shadow-like.
+
+        A shadow-like change may be a cast shadow or a dark, grey garment over a grey floor;
+        trackers that can should treat it as no evidence either way rather than as background.
+        """
         self._check(image)
         if self.mode == "grey":
             diff = cv2.absdiff(cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), self.grey)
-            m = (diff > self.threshold).astype(np.uint8)
+            changed = diff > self.threshold
         else:
-            m = (colour_distance(image, self.background) > self.threshold).astype(np.uint8)
+            changed = colour_distance(image, self.background) > self.threshold
+        out = changed.astype(np.uint8)
         if self.shadows:
-            m[self.shadow_mask(image)] = 0
+            out[changed & self.shadow_mask(image)] = UNSURE
         if self.kernel is not None:
-            m = cv2.morphologyEx(m, cv2.MORPH_OPEN, self.kernel)
-        return m
+            fg = cv2.morphologyEx((out == 1).astype(np.uint8), cv2.MORPH_OPEN, self.kernel)
+            out[(out == 1) & (fg == 0)] = 0
+        return out
+
+    def mask(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) uint8, 1 = foreground (shadow-like changes excluded)."""
+        return (self.labels(image) == 1).astype(np.uint8)
 
     def difference(self, image: np.ndarray) -> np.ndarray:
         """(H, W) float32 colour distance to the background."""
@@ -140,12 +159,21 @@ class AdaptiveBackground:
             for _ in range(5):
                 self.model.apply(background, learningRate=1.0 if _ == 0 else 0.5)
 
-    def mask(self, image: np.ndarray) -> np.ndarray:
+    def labels(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) uint8: 0 background, 1 foreground, :data:`UNSURE` (2) shadow (MOG2/KNN's 127).
+
+        Updates the model (one ``apply``); call once per frame.
+        """
         raw = self.model.apply(image, learningRate=self.learning_rate)
-        m = (raw == 255).astype(np.uint8)  # 127 = shadow → background
+        out = np.where(raw == 255, 1, np.where(raw == 127, UNSURE, 0)).astype(np.uint8)
         if self.kernel is not None:
-            m = cv2.morphologyEx(m, cv2.MORPH_OPEN, self.kernel)
-        return m
+            fg = cv2.morphologyEx((out == 1).astype(np.uint8), cv2.MORPH_OPEN, self.kernel)
+            out[(out == 1) & (fg == 0)] = 0
+        return out
+
+    def mask(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) uint8, 1 = foreground; shadows count as background. Updates the model."""
+        return (self.labels(image) == 1).astype(np.uint8)
 
     def difference(self, image: np.ndarray) -> np.ndarray:
         """Colour distance to the model's current background image."""

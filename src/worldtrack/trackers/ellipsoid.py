@@ -107,7 +107,7 @@ class EllipsoidConfig:
     step_m: float = 0.05
     iterations: int = 3
     ring_px_160: float = 5.0
-    ring_fraction: float = 0.5
+    ring_fraction: float = 1.0
     capture_threshold: float = 0.7
     capture_threshold_symmetric: float = 0.3
     confirm_frames: int = 3
@@ -204,6 +204,7 @@ class EllipsoidTracker:
         self._confirmed: set[int] = set()
         #: Per camera, the last frame's foreground mask and ternary image (for overlays).
         self.last_masks: dict[str, np.ndarray] = {}
+        self.last_labels: dict[str, np.ndarray] = {}
         self.last_real: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ public
@@ -225,9 +226,11 @@ class EllipsoidTracker:
             if cid not in self.cams:
                 continue
             image = frame.image if hasattr(frame, "image") else frame
-            mask = self.cams[cid].foreground.mask(image)
-            self.last_masks[cid] = mask
-            real[cid] = ternary_real(mask, self.cams[cid].ring_px)
+            fg = self.cams[cid].foreground
+            labels = fg.labels(image) if hasattr(fg, "labels") else fg.mask(image)
+            self.last_labels[cid] = labels
+            self.last_masks[cid] = (labels == 1).astype(np.uint8)
+            real[cid] = ternary_real(labels, self.cams[cid].ring_px)
         self.last_real = real
 
         tracks = list(self.position_map)
@@ -479,8 +482,14 @@ class EllipsoidTracker:
 
     # ------------------------------------------------------------------ bookkeeping
     def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float]]:
-        """Per person: (sampled visible pixels over all cameras, share of its own pixels that are
-        foreground — NaN when too few pixels are its own to tell)."""
+        """Per person: (sampled visible pixels over all cameras, support).
+
+        Support is the share of the person's own pixels (visible, covered by nobody else) that
+        are foreground, in the camera where it is lowest among those that show at least
+        ``_MIN_OWN_PIXELS`` of them — a real person is foreground in every view; a ghost that
+        explains the legs of a tall neighbour in one view stands on floor in another. NaN when no
+        camera shows enough of the person's own pixels to tell.
+        """
         cfg = self.config
         if not tracks:
             return {}
@@ -488,18 +497,17 @@ class EllipsoidTracker:
         hs = np.array([tr.height for tr in tracks], dtype=float)
         ws = np.array([tr.width for tr in tracks], dtype=float)
         visible = np.zeros(len(tracks))
-        own = np.zeros(len(tracks))
-        own_fg = np.zeros(len(tracks))
-        for cid, mask in self.last_masks.items():
+        support = np.full(len(tracks), np.nan)
+        for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
             inner, _, box, valid, dist = cs.forms(xy, hs, ws, cfg.min_depth_m)
-            vis, o, f = track_support(cs.grid, cs.camera.has_distortion, cs.occ, mask, inner, box, dist, valid,
-                                      cfg.target_pixels)
+            vis, own, own_fg = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box, dist,
+                                             valid, cfg.target_pixels)
             visible += vis
-            own += o
-            own_fg += f
-        return {tr.id: (visible[k], own_fg[k] / own[k] if own[k] >= _MIN_OWN_PIXELS else float("nan"))
-                for k, tr in enumerate(tracks)}
+            with np.errstate(invalid="ignore", divide="ignore"):
+                here = np.where(own >= _MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
+            support = np.fmin(support, here)
+        return {tr.id: (visible[k], support[k]) for k, tr in enumerate(tracks)}
 
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
                        prev: dict[int, tuple[float, float]], dt: float, t: float) -> None:

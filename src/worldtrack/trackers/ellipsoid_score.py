@@ -296,12 +296,17 @@ def score_candidates(grid, has_dist, occ, real, use_ring,
     return num, den, n_in
 
 
-def ternary_real(mask: np.ndarray, ring_px: int) -> np.ndarray:
-    """The paper's ternary real image: 1 foreground, −1 in a ring of ``ring_px`` around it, 0 else."""
+def ternary_real(labels: np.ndarray, ring_px: int) -> np.ndarray:
+    """The paper's ternary real image: 1 foreground, −1 in a ring of ``ring_px`` around it, 0 else.
+
+    ``labels`` is a foreground mask (0/1) or foreground labels where 2 marks "unsure"
+    (shadow-like) pixels; those stay 0 — no evidence — and the ring does not cover them.
+    """
     import cv2
+    fg = (labels == 1).astype(np.uint8)
     k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * ring_px + 1, 2 * ring_px + 1))
-    dil = cv2.dilate(mask, k)
-    return (mask.astype(np.int8) - (dil & ~mask.astype(bool)).astype(np.int8)).astype(np.int8)
+    ring = (cv2.dilate(fg, k) > 0) & (labels == 0)
+    return (fg.astype(np.int8) - ring.astype(np.int8)).astype(np.int8)
 
 
 def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widths, ring_px,
@@ -401,7 +406,7 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
 
     Parameters
     ----------
-    mask : (H, W) uint8 — foreground (1) / background (0)
+    mask : (H, W) uint8 — foreground (1) / background (0) / unsure (2, not counted)
     inner, box, dist, valid : the people's forms, boxes, floor distances and validity (N, …)
     target_pixels : int — sample about this many pixels per person (0 = all)
 
@@ -445,8 +450,8 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
                     if _inside(inner[m], x, y):
                         covered = True
                         break
-                if not covered:
+                if not covered and mask[v, uu] != 2:
                     own[k] += 1.0
-                    if mask[v, uu]:
+                    if mask[v, uu] == 1:
                         own_fg[k] += 1.0
     return visible, own, own_fg
