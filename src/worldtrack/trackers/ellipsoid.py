@@ -96,6 +96,10 @@ class EllipsoidConfig:
         nobody else) are less than this share foreground for ``lost_after_s`` ends — a ghost left
         beside the person it duplicated, or a track that lost its person; a captured person must
         reach it to be confirmed
+    min_own_share : float — a captured person, or one tracked for less than ``young_s``, whose
+        visible pixels are more than ``1 − min_own_share`` covered by others for ``lost_after_s``
+        duplicates them and ends (an older track that walks behind someone is kept)
+    young_s : float
     lost_after_s : float
     leave_after_frames : int — frames unseen by every camera before a track ends
     merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
@@ -127,6 +131,8 @@ class EllipsoidConfig:
     confirm_within_s: float = 1.0
     keep_score: float = 0.2
     min_support: float = 0.25
+    min_own_share: float = 0.25
+    young_s: float = 3.0
     lost_after_s: float = 1.0
     leave_after_frames: int = 2
     merge_distance_m: float = 0.25
@@ -481,14 +487,15 @@ class EllipsoidTracker:
         return new
 
     # ------------------------------------------------------------------ bookkeeping
-    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float]]:
-        """Per person: (sampled visible pixels over all cameras, support).
+    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float]]:
+        """Per person: (sampled visible pixels over all cameras, support, own share).
 
         Support is the share of the person's own pixels (visible, covered by nobody else) that
         are foreground, in the camera where it is lowest among those that show at least
         ``_MIN_OWN_PIXELS`` of them — a real person is foreground in every view; a ghost that
         explains the legs of a tall neighbour in one view stands on floor in another. NaN when no
-        camera shows enough of the person's own pixels to tell.
+        camera shows enough of the person's own pixels to tell. Own share: the fraction of the
+        visible pixels that nobody else covers.
         """
         cfg = self.config
         if not tracks:
@@ -497,6 +504,7 @@ class EllipsoidTracker:
         hs = np.array([tr.height for tr in tracks], dtype=float)
         ws = np.array([tr.width for tr in tracks], dtype=float)
         visible = np.zeros(len(tracks))
+        own_total = np.zeros(len(tracks))
         support = np.full(len(tracks), np.nan)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
@@ -504,10 +512,12 @@ class EllipsoidTracker:
             vis, own, own_fg = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box, dist,
                                              valid, cfg.target_pixels)
             visible += vis
+            own_total += own
             with np.errstate(invalid="ignore", divide="ignore"):
                 here = np.where(own >= _MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
             support = np.fmin(support, here)
-        return {tr.id: (visible[k], support[k]) for k, tr in enumerate(tracks)}
+        own_share = np.where(visible > 0, own_total / np.maximum(visible, 1), np.nan)
+        return {tr.id: (visible[k], support[k], own_share[k]) for k, tr in enumerate(tracks)}
 
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
                        prev: dict[int, tuple[float, float]], dt: float, t: float) -> None:
@@ -517,7 +527,7 @@ class EllipsoidTracker:
         support = self._support(tracks)
         for tr in tracks:
             e, den = scores.get(tr.id, (0.0, 0.0))
-            visible, sup = support.get(tr.id, (0.0, float("nan")))
+            visible, sup, own_share = support.get(tr.id, (0.0, float("nan"), float("nan")))
             tr.extra["support"] = sup
             tr.score = e
             tr.age_frames += 1
@@ -540,9 +550,11 @@ class EllipsoidTracker:
                     continue
                 if symmetric:
                     # Held on foreground for several frames: a person, not a flicker.
-                    ok = e > cfg.capture_threshold_symmetric and sup >= cfg.min_support
+                    ok = (e > cfg.capture_threshold_symmetric and sup >= cfg.min_support
+                          and not own_share < cfg.min_own_share)
                     tr.extra["held"] = tr.extra.get("held", 0) + 1 if ok else 0
-                    confirmed = tr.extra["held"] >= cfg.confirm_frames
+                    # Strong evidence (the paper's own threshold) confirms at once.
+                    confirmed = tr.extra["held"] >= cfg.confirm_frames or (ok and e > cfg.capture_threshold)
                 else:
                     confirmed = e > cfg.capture_threshold
                 if confirmed:
@@ -556,6 +568,9 @@ class EllipsoidTracker:
                     continue
             else:
                 low = sup < cfg.min_support if symmetric else e < cfg.keep_score
+                # A young track living inside someone else's silhouette duplicates them.
+                if symmetric and t - tr.born < cfg.young_s and own_share < cfg.min_own_share:
+                    low = True
                 tr.frames_low = tr.frames_low + 1 if low else 0
                 if tr.frames_low >= fps_frames(cfg.lost_after_s):
                     self._end(tr)
