@@ -48,8 +48,8 @@ from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_candidates,
 _OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=float)
 _STAY = 4
 _DUMMY_GRID = np.zeros((1, 1, 2), dtype=np.float32)
-#: Sampled pixels a person must show (in all cameras together) to count as seen, or as its own.
-_MIN_OWN_PIXELS = 12
+#: Pixels a person must show (in all cameras together) to count as seen, or as its own.
+_MIN_OWN_PIXELS = 40
 
 
 @dataclass(frozen=True)
@@ -100,6 +100,8 @@ class EllipsoidConfig:
         visible pixels are more than ``1 − min_own_share`` covered by others for ``lost_after_s``
         duplicates them and ends (an older track that walks behind someone is kept)
     young_s : float
+    min_seen_share : float — a captured person is confirmed only once some camera shows at least
+        this share of its ellipse (a sliver at the image border fits anything)
     lost_after_s : float
     leave_after_frames : int — frames unseen by every camera before a track ends
     merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
@@ -133,6 +135,7 @@ class EllipsoidConfig:
     min_support: float = 0.25
     min_own_share: float = 0.25
     young_s: float = 3.0
+    min_seen_share: float = 0.3
     lost_after_s: float = 1.0
     leave_after_frames: int = 2
     merge_distance_m: float = 0.25
@@ -487,15 +490,16 @@ class EllipsoidTracker:
         return new
 
     # ------------------------------------------------------------------ bookkeeping
-    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float]]:
-        """Per person: (sampled visible pixels over all cameras, support, own share).
+    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float, float]]:
+        """Per person: (visible pixels over all cameras, support, own share, seen share).
 
         Support is the share of the person's own pixels (visible, covered by nobody else) that
         are foreground, in the camera where it is lowest among those that show at least
         ``_MIN_OWN_PIXELS`` of them — a real person is foreground in every view; a ghost that
         explains the legs of a tall neighbour in one view stands on floor in another. NaN when no
         camera shows enough of the person's own pixels to tell. Own share: the fraction of the
-        visible pixels that nobody else covers.
+        visible pixels that nobody else covers. Seen share: the largest fraction of the whole
+        ellipse that some camera shows (image border and obstacles cut it).
         """
         cfg = self.config
         if not tracks:
@@ -505,19 +509,21 @@ class EllipsoidTracker:
         ws = np.array([tr.width for tr in tracks], dtype=float)
         visible = np.zeros(len(tracks))
         own_total = np.zeros(len(tracks))
+        seen_share = np.zeros(len(tracks))
         support = np.full(len(tracks), np.nan)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
             inner, _, box, valid, dist = cs.forms(xy, hs, ws, cfg.min_depth_m)
-            vis, own, own_fg = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box, dist,
-                                             valid, cfg.target_pixels)
+            vis, own, own_fg, area = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box,
+                                                   dist, valid, cfg.target_pixels)
             visible += vis
             own_total += own
+            seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
             with np.errstate(invalid="ignore", divide="ignore"):
                 here = np.where(own >= _MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
             support = np.fmin(support, here)
         own_share = np.where(visible > 0, own_total / np.maximum(visible, 1), np.nan)
-        return {tr.id: (visible[k], support[k], own_share[k]) for k, tr in enumerate(tracks)}
+        return {tr.id: (visible[k], support[k], own_share[k], seen_share[k]) for k, tr in enumerate(tracks)}
 
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
                        prev: dict[int, tuple[float, float]], dt: float, t: float) -> None:
@@ -527,7 +533,7 @@ class EllipsoidTracker:
         support = self._support(tracks)
         for tr in tracks:
             e, den = scores.get(tr.id, (0.0, 0.0))
-            visible, sup, own_share = support.get(tr.id, (0.0, float("nan"), float("nan")))
+            visible, sup, own_share, seen = support.get(tr.id, (0.0, float("nan"), float("nan"), 0.0))
             tr.extra["support"] = sup
             tr.score = e
             tr.age_frames += 1
@@ -551,7 +557,7 @@ class EllipsoidTracker:
                 if symmetric:
                     # Held on foreground for several frames: a person, not a flicker.
                     ok = (e > cfg.capture_threshold_symmetric and sup >= cfg.min_support
-                          and not own_share < cfg.min_own_share)
+                          and not own_share < cfg.min_own_share and seen >= cfg.min_seen_share)
                     tr.extra["held"] = tr.extra.get("held", 0) + 1 if ok else 0
                     # Strong evidence (the paper's own threshold) confirms at once.
                     confirmed = tr.extra["held"] >= cfg.confirm_frames or (ok and e > cfg.capture_threshold)

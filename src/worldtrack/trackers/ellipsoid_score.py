@@ -412,17 +412,21 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
 
     Returns
     -------
-    visible : (N,) float64 — sampled pixels of the ellipse inside the image and not hidden by obstacles
-    own : (N,) float64 — of those, the ones covered by nobody else
+    visible : (N,) float64 — pixels of the ellipse inside the image and not hidden by obstacles
+        (estimated from the samples: each sample counts stride² pixels)
+    own : (N,) float64 — of those, the ones covered by nobody else (not counting unsure pixels)
     own_fg : (N,) float64 — of those, the foreground ones
+    area : (N,) float64 — the whole ellipse's area in pixels, image border and obstacles ignored
     """
     n = inner.shape[0]
     visible = np.zeros(n)
     own = np.zeros(n)
     own_fg = np.zeros(n)
+    area = np.zeros(n)
     for k in range(n):
         if not valid[k]:
             continue
+        area[k] = math.pi / math.sqrt(max(inner[k, 2] * inner[k, 4] - inner[k, 3] ** 2, 1e-300))
         u0, u1, v0, v1 = box[k, 0], box[k, 1], box[k, 2], box[k, 3]
         if u0 >= u1 or v0 >= v1:
             continue
@@ -440,7 +444,7 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
                 o = occ[v, uu]
                 if o < dist[k] or not _inside(inner[k], x, y):
                     continue
-                visible[k] += 1.0
+                visible[k] += stride * stride
                 covered = False
                 for m in range(n):
                     if m == k or not valid[m] or o < dist[m]:
@@ -451,7 +455,7 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
                         covered = True
                         break
                 if not covered and mask[v, uu] != 2:
-                    own[k] += 1.0
+                    own[k] += stride * stride
                     if mask[v, uu] == 1:
-                        own_fg[k] += 1.0
-    return visible, own, own_fg
+                        own_fg[k] += stride * stride
+    return visible, own, own_fg, area
