@@ -11,6 +11,7 @@ import os
 import statistics
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -51,6 +52,30 @@ def mog2_apply_time(width: int, height: int, repeats: int = 30, seed: int = 0) -
         frames.append(f)
     it = iter(frames)
     return median_time(lambda: model.apply(next(it)), repeats=repeats, warmup=2)
+
+
+@dataclass
+class ImageView:
+    """What trackers read of a rendered view: the image only."""
+
+    image: np.ndarray
+
+
+@dataclass
+class LightBundle:
+    """A rendered frame without depth, instance and shadow images (a quarter of the memory);
+    accepted by ``worldtrack.experiment.run_scenario(bundles=...)`` like a ``SynthBundle``."""
+
+    frame: int
+    time: float
+    views: dict
+    gt: list
+
+
+def render_images(scenario) -> list[LightBundle]:
+    """Render every frame of a synthetic scenario, keeping images and ground truth only."""
+    return [LightBundle(b.frame, b.time, {c: ImageView(v.image) for c, v in b.views.items()}, b.gt)
+            for b in scenario.frames()]
 
 
 def markdown_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:

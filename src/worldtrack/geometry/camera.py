@@ -352,6 +352,21 @@ class Camera:
         out[bad] = np.nan
         return out.reshape(d.shape)
 
+    def image_down_direction(self, uv: ArrayLike) -> np.ndarray:
+        """Unit image direction (..., 2) in which a world vertical through each pixel goes down.
+
+        Towards the image bottom for an oblique camera; towards the image of the camera's foot
+        point (the nadir) for one looking straight down, where people appear as spokes. NaN for
+        pixels whose ray does not reach the floor region in front of the camera.
+        """
+        p, lead = _as_points(uv, 2)
+        top = self.backproject(p, 0.5 * self.centre[2])
+        below = top - np.array([0.0, 0.0, 0.05 * abs(self.centre[2]) + 1e-3])
+        d = self.project(below) - p
+        with np.errstate(invalid="ignore", divide="ignore"):
+            d /= np.linalg.norm(d, axis=1, keepdims=True)
+        return d.reshape(lead + (2,))
+
     def in_image(self, uv: ArrayLike, margin: float = 0.0) -> np.ndarray:
         """True where pixel coordinates fall inside the image (shrunk by ``margin`` px), (...)."""
         p, lead = _as_points(uv, 2)

@@ -74,6 +74,9 @@ class EllipsoidConfig:
     confirm_frames : int
     birth_search_m : float — a just-proposed person is placed by a grid search ±this far along
         the viewing direction (0 = start at the foot point, as the paper's capture does)
+    rescue_search_m, rescue_gain, rescue_every : a tracked person whose support is failing, and
+        every person every ``rescue_every`` frames, is moved along the viewing line up to
+        ±``rescue_search_m`` if E there is higher by ``rescue_gain`` (0 = never, as published)
     target_pixels : int — pixels visited per candidate set (0 = all, as published)
     score : {"paper", "symmetric"} — eq. 5 as published, or with the foreground the simulation
         leaves unexplained added to the denominator in tracking mode (see ``ellipsoid_score``)
@@ -118,6 +121,9 @@ class EllipsoidConfig:
     capture_threshold_symmetric: float = 0.3
     confirm_frames: int = 3
     birth_search_m: float = 1.0
+    rescue_search_m: float = 1.5
+    rescue_gain: float = 0.08
+    rescue_every: int = 10
     target_pixels: int = 1500
     score: str = "symmetric"
     adaptive_step: bool = True
@@ -145,7 +151,7 @@ class EllipsoidConfig:
     @classmethod
     def paper(cls, **overrides) -> "EllipsoidConfig":
         """The method exactly as published: fixed 50 mm steps, K = 3, every pixel, no prediction."""
-        base = cls(adaptive_step=False, predict=False, target_pixels=0, score="paper", birth_search_m=0.0,
+        base = cls(adaptive_step=False, predict=False, target_pixels=0, score="paper", birth_search_m=0.0, rescue_search_m=0.0,
                    ring_fraction=0.0)
         return replace(base, **overrides)
 
@@ -317,6 +323,16 @@ class EllipsoidTracker:
                         step[k] = min(step[k] * 2, cfg.max_step_m)
             if done.all():
                 break
+        if cfg.rescue_search_m > 0:
+            for k, tr in enumerate(tracks):
+                # Periodically too, but only for someone nobody overlaps: in a group the line of
+                # sight crosses other people and a "better place" is often somebody else.
+                periodic = (cfg.rescue_every > 0 and (self._frame + tr.id) % cfg.rescue_every == 0
+                            and tr.extra.get("own_share", 0.0) >= 0.9)
+                if tr.mode == "tracking" and (tr.frames_low > 0 or periodic):
+                    e = self._rescue(k, xy, hs, ws, state, real, best_e[k], best_den[k])
+                    if e is not None:
+                        best_e[k] = e
         for k, tr in enumerate(tracks):
             tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
             result[tr.id] = (float(best_e[k]), float(best_den[k]))
@@ -345,7 +361,7 @@ class EllipsoidTracker:
         the camera that sees the person largest, 0.1 m apart, scored over every camera.
         """
         cfg = self.config
-        d = self._axes(k, state)
+        d = self._axes(k, state, xy, along_ray=True)
         along = np.arange(-cfg.birth_search_m, cfg.birth_search_m + 1e-9, 0.1)
         across = np.array([-0.2, -0.1, 0.0, 0.1, 0.2])
         grid = np.array([(a, c) for a in along for c in across])
@@ -365,15 +381,63 @@ class EllipsoidTracker:
             for a in range(5):
                 state[cid][a][k] = f[a][b]
 
-    def _axes(self, k: int, state: dict) -> tuple[np.ndarray, np.ndarray]:
-        """The floor viewing direction of the camera that sees person ``k`` largest, and its normal."""
+    def _rescue(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
+                real: dict[str, np.ndarray], e_here: float, den_here: float) -> float | None:
+        """Search the viewing line ±``rescue_search_m`` for a clearly better place (by ``rescue_gain``).
+
+        The 9-candidate steps climb E locally and cannot cross what is not walkable: a track that
+        settled behind the wrong row of desks — E has a second peak along the viewing direction
+        there — stays. Run on a track whose support is failing, and on each track every
+        ``rescue_every`` frames; never onto somebody else (``min_separation_m``).
+        """
+        cfg = self.config
+        d, n = self._axes(k, state, xy, along_ray=True)
+        along = np.arange(-cfg.rescue_search_m, cfg.rescue_search_m + 1e-9, 0.15)
+        along = along[np.abs(along) > 0.2]
+        cand = xy[k] + along[:, None] * d
+        others = np.delete(xy, k, axis=0)
+        ok = self._walkable(cand)
+        if len(others):
+            dist = np.min(np.linalg.norm(cand[:, None, :] - others[None, :, :], axis=2), axis=1)
+            ok &= dist >= cfg.min_separation_m
+        cand = cand[ok]
+        if len(cand) == 0:
+            return None
+        e, den, forms = self._score_candidates(k, cand, np.full(len(cand), hs[k]), np.full(len(cand), ws[k]),
+                                               state, real, use_ring=True)
+        # E is a ratio: a place where less of the person is in view (past the image border) can
+        # score higher on less evidence. A move must also raise the net matched evidence Σ sim·real.
+        e[e * den < e_here * den_here] = -np.inf
+        b = int(np.argmax(e))
+        if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue_gain:
+            return None
+        xy[k] = cand[b]
+        for cid, f in forms.items():
+            for a in range(5):
+                state[cid][a][k] = f[a][b]
+        return float(e[b])
+
+    def _axes(self, k: int, state: dict, xy: np.ndarray | None = None,
+              along_ray: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Floor axes for person ``k``: the viewing direction of the camera that sees the person
+        largest (the paper's), and its normal.
+
+        With ``along_ray`` the direction is that of the camera's ray through the person's
+        position ``xy[k]`` projected on the floor — the direction along which one camera cannot
+        tell depth — falling back to the optical axis for a person right below the camera.
+        """
         best_cam, best_area = next(iter(state)), -1
         for cid, st in state.items():
             box = st[2][k]
             area = max(0, box[1] - box[0]) * max(0, box[3] - box[2]) if st[3][k] else 0
             if area > best_area:
                 best_cam, best_area = cid, area
-        d = self.cams[best_cam].camera.floor_direction
+        cam = self.cams[best_cam].camera
+        d = cam.floor_direction
+        if along_ray and xy is not None:
+            r = xy[k] - cam.centre[:2]
+            if np.linalg.norm(r) > 0.3:
+                d = r / np.linalg.norm(r)
         return d, np.array([-d[1], d[0]])
 
     def _score_candidates(self, k: int, cand: np.ndarray, heights: np.ndarray, widths: np.ndarray,
@@ -447,23 +511,11 @@ class EllipsoidTracker:
             un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, _disc(r_close))
             n, labels, stats, cent = cv2.connectedComponentsWithStats(un, connectivity=8)
             for j in range(1, n):
-                x0, y0, bw, bh, area = stats[j]
+                area = int(stats[j, cv2.CC_STAT_AREA])
                 if area < 10:
                     continue
-                touches_top = y0 <= 0
-                u = float(cent[j][0])
-                # The feet are lost when the blob ends at the image border or on an obstacle
-                # (a desk hides them); then the top of the head, at the default height, is used.
-                below = min(y0 + bh + 1, cam.height - 1)
-                feet_hidden = (y0 + bh >= cam.height - 1
-                               or np.isfinite(cs.occ[below, x0:x0 + bw]).mean() > 0.5)
-                if not feet_hidden:
-                    p = cam.backproject([[u, y0 + bh - 0.5]], 0.0)[0]
-                elif not touches_top:
-                    p = cam.backproject([[u, y0 - 0.5]], h0)[0]
-                else:
-                    continue
-                if not np.isfinite(p).all():
+                p = _blob_position(cs, labels == j, cent[j], h0)
+                if p is None:
                     continue
                 pxy = self._nearest_walkable(p[:2], 0.6)
                 if pxy is None:
@@ -507,6 +559,7 @@ class EllipsoidTracker:
         xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
         hs = np.array([tr.height for tr in tracks], dtype=float)
         ws = np.array([tr.width for tr in tracks], dtype=float)
+        covers = np.array([tr.mode == "tracking" for tr in tracks])
         visible = np.zeros(len(tracks))
         own_total = np.zeros(len(tracks))
         seen_share = np.zeros(len(tracks))
@@ -515,7 +568,7 @@ class EllipsoidTracker:
             cs = self.cams[cid]
             inner, _, box, valid, dist = cs.forms(xy, hs, ws, cfg.min_depth_m)
             vis, own, own_fg, area = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box,
-                                                   dist, valid, cfg.target_pixels)
+                                                   dist, valid, cfg.target_pixels, covers)
             visible += vis
             own_total += own
             seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
@@ -535,6 +588,7 @@ class EllipsoidTracker:
             e, den = scores.get(tr.id, (0.0, 0.0))
             visible, sup, own_share, seen = support.get(tr.id, (0.0, float("nan"), float("nan"), 0.0))
             tr.extra["support"] = sup
+            tr.extra["own_share"] = own_share
             tr.score = e
             tr.age_frames += 1
             if visible >= _MIN_OWN_PIXELS:
@@ -637,6 +691,48 @@ class EllipsoidTracker:
         else:
             tr.flags.discard("unmeasurable")
             tr.sigma = 0.1
+
+
+def _blob_position(cs: _CameraState, blob: np.ndarray, centroid: np.ndarray, height: float) -> np.ndarray | None:
+    """Floor position of a person seen as ``blob`` (H, W bool), or None.
+
+    The feet are the end of the blob in the direction in which world verticals point down in
+    the image — the bottom for an oblique camera, the end nearest the image centre for one that
+    looks straight down. They are back-projected to the floor, unless the blob ends there at the
+    image border or on an obstacle (a desk hides the feet): then its other end, the top of the
+    head, is back-projected to the default ``height``.
+    """
+    cam = cs.camera
+    down = cam.image_down_direction(centroid[None])[0]
+    if not np.isfinite(down).all():
+        return None
+    vs, us = np.nonzero(blob)
+    along = (us - centroid[0]) * down[0] + (vs - centroid[1]) * down[1]
+    across = np.array([-down[1], down[0]])
+    spread = (us - centroid[0]) * across[0] + (vs - centroid[1]) * across[1]
+    n_end = max(1, len(along) // 50)
+    order = np.argsort(along)
+    # The ends: the extreme pixel along ``down``, laterally at the mean of the extreme 2 %.
+    def end(idx: np.ndarray, a: float) -> np.ndarray:
+        return centroid + a * down + spread[idx].mean() * across
+    foot = end(order[-n_end:], along[order[-1]] + 0.5)
+    head = end(order[:n_end], along[order[0]] - 0.5)
+    # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
+    half = max(1.0, 0.5 * (np.percentile(spread, 90) - np.percentile(spread, 10)))
+    beyond = np.round(foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across).astype(int)
+    inside = (beyond[:, 0] >= 0) & (beyond[:, 0] < cam.width) & (beyond[:, 1] >= 0) & (beyond[:, 1] < cam.height)
+    if not inside.all():
+        feet_hidden = True
+    else:
+        feet_hidden = np.isfinite(cs.occ[beyond[:, 1], beyond[:, 0]]).mean() > 0.5
+    if not feet_hidden:
+        p = cam.backproject(foot[None], 0.0)[0]
+    else:
+        top = np.round(head - 2 * down).astype(int)
+        if not (0 <= top[0] < cam.width and 0 <= top[1] < cam.height):
+            return None
+        p = cam.backproject(head[None], height)[0]
+    return p if np.isfinite(p).all() else None
 
 
 def _disc(radius: int) -> np.ndarray:

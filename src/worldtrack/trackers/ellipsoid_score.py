@@ -396,7 +396,7 @@ def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widt
 
 
 @njit(cache=True)
-def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pixels):
+def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pixels, covers):
     """How much foreground each person alone explains.
 
     For every person k, over the visible pixels of its ellipse (not hidden by obstacles) that no
@@ -409,6 +409,8 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
     mask : (H, W) uint8 — foreground (1) / background (0) / unsure (2, not counted)
     inner, box, dist, valid : the people's forms, boxes, floor distances and validity (N, …)
     target_pixels : int — sample about this many pixels per person (0 = all)
+    covers : (N,) bool — which people take pixels away from the others (e.g. only confirmed
+        tracks: two tentative ones on the same person must not cancel each other out)
 
     Returns
     -------
@@ -447,7 +449,7 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
                 visible[k] += stride * stride
                 covered = False
                 for m in range(n):
-                    if m == k or not valid[m] or o < dist[m]:
+                    if m == k or not valid[m] or not covers[m] or o < dist[m]:
                         continue
                     if uu < box[m, 0] or uu >= box[m, 1] or v < box[m, 2] or v >= box[m, 3]:
                         continue
