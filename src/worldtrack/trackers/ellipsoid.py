@@ -103,6 +103,9 @@ class EllipsoidConfig:
         visible pixels are more than ``1 − min_own_share`` covered by others for ``lost_after_s``
         duplicates them and ends (an older track that walks behind someone is kept)
     young_s : float
+    min_evidence : float — a tracked person ends when, for ``lost_after_s``, no camera shows at
+        least this share of its ellipse as its own foreground or explained by others (it has
+        slid past the image border or onto empty floor)
     min_seen_share : float — a captured person is confirmed only once some camera shows at least
         this share of its ellipse (a sliver at the image border fits anything)
     lost_after_s : float
@@ -140,6 +143,7 @@ class EllipsoidConfig:
     keep_score: float = 0.2
     min_support: float = 0.25
     min_own_share: float = 0.25
+    min_evidence: float = 0.2
     young_s: float = 3.0
     min_seen_share: float = 0.3
     lost_after_s: float = 1.0
@@ -407,7 +411,8 @@ class EllipsoidTracker:
                                                state, real, use_ring=True)
         # E is a ratio: a place where less of the person is in view (past the image border) can
         # score higher on less evidence. A move must also raise the net matched evidence Σ sim·real.
-        e[e * den < e_here * den_here] = -np.inf
+        with np.errstate(invalid="ignore"):
+            e[~(np.where(np.isfinite(e), e, 0.0) * den >= e_here * den_here)] = -np.inf
         b = int(np.argmax(e))
         if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue_gain:
             return None
@@ -542,8 +547,8 @@ class EllipsoidTracker:
         return new
 
     # ------------------------------------------------------------------ bookkeeping
-    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float, float]]:
-        """Per person: (visible pixels over all cameras, support, own share, seen share).
+    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float, float, float]]:
+        """Per person: (visible pixels over all cameras, support, own share, seen share, evidence).
 
         Support is the share of the person's own pixels (visible, covered by nobody else) that
         are foreground, in the camera where it is lowest among those that show at least
@@ -551,7 +556,9 @@ class EllipsoidTracker:
         explains the legs of a tall neighbour in one view stands on floor in another. NaN when no
         camera shows enough of the person's own pixels to tell. Own share: the fraction of the
         visible pixels that nobody else covers. Seen share: the largest fraction of the whole
-        ellipse that some camera shows (image border and obstacles cut it).
+        ellipse that some camera shows (image border and obstacles cut it). Evidence: the
+        largest fraction of the whole ellipse that is foreground of its own or explained by
+        others — low for a track that drifted past the image border or onto the floor.
         """
         cfg = self.config
         if not tracks:
@@ -563,6 +570,7 @@ class EllipsoidTracker:
         visible = np.zeros(len(tracks))
         own_total = np.zeros(len(tracks))
         seen_share = np.zeros(len(tracks))
+        evidence = np.zeros(len(tracks))
         support = np.full(len(tracks), np.nan)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
@@ -572,11 +580,14 @@ class EllipsoidTracker:
             visible += vis
             own_total += own
             seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
+            # Evidence: foreground of its own plus what others explain, over the whole ellipse.
+            evidence = np.maximum(evidence, np.where(area > 0, (own_fg + vis - own) / np.maximum(area, 1), 0.0))
             with np.errstate(invalid="ignore", divide="ignore"):
                 here = np.where(own >= _MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
             support = np.fmin(support, here)
         own_share = np.where(visible > 0, own_total / np.maximum(visible, 1), np.nan)
-        return {tr.id: (visible[k], support[k], own_share[k], seen_share[k]) for k, tr in enumerate(tracks)}
+        return {tr.id: (visible[k], support[k], own_share[k], seen_share[k], evidence[k])
+                for k, tr in enumerate(tracks)}
 
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
                        prev: dict[int, tuple[float, float]], dt: float, t: float) -> None:
@@ -586,7 +597,8 @@ class EllipsoidTracker:
         support = self._support(tracks)
         for tr in tracks:
             e, den = scores.get(tr.id, (0.0, 0.0))
-            visible, sup, own_share, seen = support.get(tr.id, (0.0, float("nan"), float("nan"), 0.0))
+            visible, sup, own_share, seen, evidence = support.get(
+                tr.id, (0.0, float("nan"), float("nan"), 0.0, 0.0))
             tr.extra["support"] = sup
             tr.extra["own_share"] = own_share
             tr.score = e
@@ -627,7 +639,7 @@ class EllipsoidTracker:
                     self._end(tr)
                     continue
             else:
-                low = sup < cfg.min_support if symmetric else e < cfg.keep_score
+                low = (sup < cfg.min_support or evidence < cfg.min_evidence) if symmetric else e < cfg.keep_score
                 # A young track living inside someone else's silhouette duplicates them.
                 if symmetric and t - tr.born < cfg.young_s and own_share < cfg.min_own_share:
                     low = True
