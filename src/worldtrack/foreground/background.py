@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
+from worldtrack.foreground.kernels import SHADOW_MAX_RATIO, colour_labels
 
 
 #: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
@@ -80,7 +81,7 @@ class StaticBackground:
         self.shadow_distortion = float(shadow_distortion)
         bg = background.astype(np.float32)
         self._bg = bg
-        self._bg_norm2 = np.maximum(np.einsum("hwc,hwc->hw", bg, bg), 1.0)
+        self._bg_norm2 = np.ascontiguousarray(np.maximum(np.einsum("hwc,hwc->hw", bg, bg), 1.0), np.float32)
 
     def shadow_mask(self, image: np.ndarray) -> np.ndarray:
         """(H, W) bool: pixels that look like the background in shadow."""
@@ -89,7 +90,7 @@ class StaticBackground:
         resid = img - a[..., None] * self._bg
         distortion2 = np.einsum("hwc,hwc->hw", resid, resid)
         limit2 = (self.shadow_distortion ** 2) * self._bg_norm2
-        return (a >= self.shadow_min_ratio) & (a <= 0.97) & (distortion2 <= limit2)
+        return (a >= self.shadow_min_ratio) & (a <= SHADOW_MAX_RATIO) & (distortion2 <= limit2)
 
     def _check(self, image: np.ndarray) -> None:
         if image.shape != self.background.shape:
@@ -106,11 +107,12 @@ class StaticBackground:
         if self.mode == "grey":
             diff = cv2.absdiff(cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), self.grey)
             changed = diff > self.threshold
+            out = changed.astype(np.uint8)
+            if self.shadows:
+                out[changed & self.shadow_mask(image)] = UNSURE
         else:
-            changed = colour_distance(image, self.background) > self.threshold
-        out = changed.astype(np.uint8)
-        if self.shadows:
-            out[changed & self.shadow_mask(image)] = UNSURE
+            out = colour_labels(np.ascontiguousarray(image), self.background, self._bg_norm2, self.threshold,
+                                self.shadows, self.shadow_min_ratio, self.shadow_distortion)
         if self.kernel is not None:
             fg = cv2.morphologyEx((out == 1).astype(np.uint8), cv2.MORPH_OPEN, self.kernel)
             out[(out == 1) & (fg == 0)] = 0

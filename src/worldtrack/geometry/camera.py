@@ -171,8 +171,9 @@ class Camera:
         """(3,) unit viewing direction in world coordinates."""
         return self.R[2].copy()
 
-    @property
+    @cached_property
     def has_distortion(self) -> bool:
+        """True when any lens distortion coefficient is non-zero."""
         return bool(np.any(self.dist != 0))
 
     @cached_property

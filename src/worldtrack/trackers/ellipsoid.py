@@ -513,13 +513,15 @@ class EllipsoidTracker:
             # Remove speckle, then join the pieces of one body that holes in the mask split.
             r_open, r_close = 1, max(1, cs.ring_px // 2)
             un = cv2.morphologyEx(un, cv2.MORPH_OPEN, _disc(r_open))
-            un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, _disc(r_close))
+            un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, np.ones((2 * r_close + 1, 2 * r_close + 1), np.uint8))
             n, labels, stats, cent = cv2.connectedComponentsWithStats(un, connectivity=8)
+            min_area = 10 * cam.width * cam.height / (160 * 120)
             for j in range(1, n):
                 area = int(stats[j, cv2.CC_STAT_AREA])
-                if area < 10:
+                if area < min_area:
                     continue
-                p = _blob_position(cs, labels == j, cent[j], h0)
+                x0, y0, bw, bh = stats[j, :4]
+                p = _blob_position(cs, labels[y0:y0 + bh, x0:x0 + bw] == j, (x0, y0), cent[j], h0)
                 if p is None:
                     continue
                 pxy = self._nearest_walkable(p[:2], 0.6)
@@ -705,8 +707,12 @@ class EllipsoidTracker:
             tr.sigma = 0.1
 
 
-def _blob_position(cs: _CameraState, blob: np.ndarray, centroid: np.ndarray, height: float) -> np.ndarray | None:
-    """Floor position of a person seen as ``blob`` (H, W bool), or None.
+def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
+                   height: float) -> np.ndarray | None:
+    """Floor position of a person seen as ``blob``, or None.
+
+    ``blob`` is a boolean crop of the image whose top-left pixel is ``origin`` (u, v);
+    ``centroid`` is in full-image pixels.
 
     The feet are the end of the blob in the direction in which world verticals point down in
     the image — the bottom for an oblique camera, the end nearest the image centre for one that
@@ -719,6 +725,8 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, centroid: np.ndarray, hei
     if not np.isfinite(down).all():
         return None
     vs, us = np.nonzero(blob)
+    vs = vs + origin[1]
+    us = us + origin[0]
     along = (us - centroid[0]) * down[0] + (vs - centroid[1]) * down[1]
     across = np.array([-down[1], down[0]])
     spread = (us - centroid[0]) * across[0] + (vs - centroid[1]) * across[1]

@@ -304,9 +304,17 @@ def ternary_real(labels: np.ndarray, ring_px: int) -> np.ndarray:
     """
     import cv2
     fg = (labels == 1).astype(np.uint8)
-    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * ring_px + 1, 2 * ring_px + 1))
-    ring = (cv2.dilate(fg, k) > 0) & (labels == 0)
-    return (fg.astype(np.int8) - ring.astype(np.int8)).astype(np.int8)
+    # Dilation by an octagon (a square ∩ a diamond, both separable or cheap), close to the
+    # paper's disc and ~10x faster than an elliptical kernel of radius 20 px at 640x480.
+    side = 2 * ring_px + 1
+    square = cv2.dilate(fg, np.ones((side, side), np.uint8))
+    diag = int(round(ring_px * 1.3))  # the octagon's diagonal half-width: between r and r·√2
+    cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+    diamond = cv2.dilate(fg, cross, iterations=diag) if diag > 0 else fg
+    near = (square > 0) & (diamond > 0)
+    out = fg.astype(np.int8)
+    out[near & (labels == 0)] = -1
+    return out
 
 
 def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widths, ring_px,
