@@ -89,11 +89,42 @@ def markdown_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> 
     return "\n".join(lines)
 
 
+def source_version() -> str:
+    """The commit the measured code is at, and whether ``src/`` had uncommitted changes (read-only git)."""
+    import subprocess
+
+    def git(*args: str) -> str:
+        try:
+            return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, timeout=10).stdout.strip()
+        except (OSError, subprocess.SubprocessError):
+            return ""
+
+    head = git("rev-parse", "--short", "HEAD")
+    if not head:
+        return "an unknown commit"
+    dirty = git("status", "--porcelain", "--", "src")
+    return f"commit {head}" + (" with uncommitted changes in src/" if dirty else "")
+
+
+#: Taken when a script starts, i.e. about when it imports worldtrack (others may commit while it runs).
+SOURCE_VERSION = source_version()
+
+
 def write_result(name: str, title: str, body: str) -> Path:
-    """Write ``benchmarks/results/<name>.md`` with a header naming the machine and date."""
+    """Write ``benchmarks/results/<name>.md`` with a header naming the machine, date and commit."""
     RESULTS.mkdir(parents=True, exist_ok=True)
     path = RESULTS / f"{name}.md"
     stamp = time.strftime("%Y-%m-%d %H:%M")
     path.write_text(f"# {title}\n\nMeasured {stamp} on {os.cpu_count()} cores "
-                    f"(Python {sys.version.split()[0]}, OpenCV {cv2.__version__}), one thread.\n\n{body}\n")
+                    f"(Python {sys.version.split()[0]}, OpenCV {cv2.__version__}), one thread, "
+                    f"{SOURCE_VERSION}.\n\n{body}\n")
     return path
+
+
+def save_result(name: str, title: str, text: str, quick: bool, seconds: float) -> None:
+    """Write ``results/<name>.md`` for the script ``benchmarks/<name>.py``; ``--quick`` runs only print."""
+    if quick:
+        print(f"{name}: --quick smoke run in {seconds:.0f} s; results/{name}.md not written", file=sys.stderr)
+        return
+    path = write_result(name, title, f"Command: `.venv/bin/python benchmarks/{name}.py` ({seconds:.0f} s)\n\n{text}")
+    print(f"wrote {path} in {seconds:.0f} s", file=sys.stderr)

@@ -41,6 +41,7 @@ from worldtrack.foreground.background import Foreground
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
+from worldtrack.trackers.height import measure_height
 from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_candidates, ternary_real, track_support
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
@@ -87,6 +88,13 @@ class EllipsoidConfig:
     min_step_m, max_step_m : float — limits of the adaptive step
     max_iterations : int — cap on rounds with the adaptive step
     predict : bool — constant-velocity prediction before matching
+    measure_height : bool — measure each person's height when a camera sees them whole and
+        alone (median of the last ``height_samples`` measurements within ``height_range_m``);
+        the paper fixes 1.65 m, which puts people of other heights at the wrong distance
+    height_range_m : (min, max) metres
+    height_samples : int
+    height_deadband_m : float — the measured height replaces the default only when it differs by
+        more than this: the measurement's own scatter (~4 cm) would otherwise add depth error
     velocity_smoothing : float — weight of the new velocity measurement (0..1)
     max_speed_mps : float — velocities are clipped to this speed (a running person)
     births : {"anywhere", "entry", "none"} — where new people may appear: anywhere in view, only in
@@ -135,6 +143,10 @@ class EllipsoidConfig:
     max_step_m: float = 0.4
     max_iterations: int = 8
     predict: bool = True
+    measure_height: bool = True
+    height_range_m: tuple[float, float] = (1.3, 2.1)
+    height_samples: int = 25
+    height_deadband_m: float = 0.05
     velocity_smoothing: float = 0.5
     max_speed_mps: float = 3.0
     births: str = "anywhere"
@@ -156,6 +168,7 @@ class EllipsoidConfig:
     def paper(cls, **overrides) -> "EllipsoidConfig":
         """The method exactly as published: fixed 50 mm steps, K = 3, every pixel, no prediction."""
         base = cls(adaptive_step=False, predict=False, target_pixels=0, score="paper", birth_search_m=0.0, rescue_search_m=0.0,
+                   measure_height=False,
                    ring_fraction=0.0)
         return replace(base, **overrides)
 
@@ -221,6 +234,7 @@ class EllipsoidTracker:
         self._close_frames: dict[tuple[int, int], int] = {}
         self._unseen: dict[int, int] = {}
         self._confirmed: set[int] = set()
+        self._heights: dict[int, list[float]] = {}
         #: Per camera, the last frame's foreground mask and ternary image (for overlays).
         self.last_masks: dict[str, np.ndarray] = {}
         self.last_labels: dict[str, np.ndarray] = {}
@@ -653,13 +667,54 @@ class EllipsoidTracker:
                 self._end(tr)
                 continue
             self._flag_measurability(tr)
+        if cfg.measure_height:
+            self._update_heights(tracks)
         self._merge_duplicates()
 
     def _near_confirmed(self, tr: Track, distance: float) -> bool:
         return any(o.id != tr.id and o.id in self._confirmed and math.hypot(o.x - tr.x, o.y - tr.y) < distance
                    for o in self.position_map)
 
+    def _update_heights(self, tracks: list[Track]) -> None:
+        """Measure the height of people a camera sees whole and alone; use the running median.
+
+        See :mod:`worldtrack.trackers.height`. Only tracked people whose ellipse (with its ring)
+        overlaps nobody else's in that camera are measured; a person keeps its height when never
+        measured (the scene default, the paper's 1.65 m).
+        """
+        cfg = self.config
+        tracks = [tr for tr in tracks if tr.id in self.position_map]
+        if not tracks:
+            return
+        xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
+        hs = np.array([tr.height for tr in tracks], dtype=float)
+        ws = np.array([tr.width for tr in tracks], dtype=float)
+        lo, hi = cfg.height_range_m
+        for cid, labels in self.last_labels.items():
+            cs = self.cams[cid]
+            _, ring, box, valid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+            for k, tr in enumerate(tracks):
+                if tr.mode != "tracking" or not valid[k]:
+                    continue
+                b = box[k]
+                overlap = (valid & (box[:, 0] < b[1]) & (box[:, 1] > b[0]) & (box[:, 2] < b[3]) & (box[:, 3] > b[2]))
+                overlap[k] = False
+                if overlap.any():
+                    continue
+                region = _form_mask(ring[k], b, cs.grid, cs.camera.has_distortion)
+                h = measure_height(cs.camera, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi))
+                if h is None:
+                    continue
+                samples = self._heights.setdefault(tr.id, [])
+                samples.append(h)
+                del samples[:-cfg.height_samples]
+                if len(samples) >= 3:
+                    default = self.scene.people.size_of(tr.id)[0]
+                    median = float(np.median(samples))
+                    tr.height = median if abs(median - default) > cfg.height_deadband_m else default
+
     def _end(self, tr: Track) -> None:
+        self._heights.pop(tr.id, None)
         if tr.id in self.position_map:
             self.position_map.remove(tr.id)
         self._confirmed.discard(tr.id)
@@ -772,6 +827,19 @@ def _visible_pixels(cs: _CameraState, xy: np.ndarray, height: float, width: floa
     return int((out[v0:v1, u0:u1].astype(bool) & (cs.occ[v0:v1, u0:u1] >= dist[0])).sum())
 
 
+def _form_mask(form: np.ndarray, box: np.ndarray, grid: np.ndarray, has_dist: bool) -> np.ndarray:
+    """(v1 − v0, u1 − u0) bool: pixels of ``box`` inside the ellipse of normal form ``form``."""
+    u0, u1, v0, v1 = box
+    if has_dist:
+        g = grid[v0:v1, u0:u1]
+        du = g[..., 0] - form[0]
+        dv = g[..., 1] - form[1]
+    else:
+        du = np.arange(u0, u1)[None, :] - form[0]
+        dv = np.arange(v0, v1)[:, None] - form[1]
+    return form[2] * du * du + 2 * form[3] * du * dv + form[4] * dv * dv < 1
+
+
 def _render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: np.ndarray,
                   grid: np.ndarray, has_dist: bool) -> None:
     """Set ``out`` to 1 inside the given ellipses (normal forms), within their boxes (in place)."""
@@ -781,12 +849,4 @@ def _render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: 
         u0, u1, v0, v1 = boxes[k]
         if u0 >= u1 or v0 >= v1:
             continue
-        if has_dist:
-            g = grid[v0:v1, u0:u1]
-            du = g[..., 0] - forms[k, 0]
-            dv = g[..., 1] - forms[k, 1]
-        else:
-            du = np.arange(u0, u1)[None, :] - forms[k, 0]
-            dv = np.arange(v0, v1)[:, None] - forms[k, 1]
-        inside = forms[k, 2] * du * du + 2 * forms[k, 3] * du * dv + forms[k, 4] * dv * dv < 1
-        out[v0:v1, u0:u1] |= inside.astype(np.uint8)
+        out[v0:v1, u0:u1] |= _form_mask(forms[k], boxes[k], grid, has_dist).astype(np.uint8)
