@@ -692,7 +692,9 @@ class EllipsoidTracker:
         lo, hi = cfg.height_range_m
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
-            _, ring, box, valid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+            # Where a person's pixels may be: the ellipse of the tallest plausible person (a
+            # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
+            _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws, cfg.min_depth_m)
             for k, tr in enumerate(tracks):
                 if tr.mode != "tracking" or not valid[k]:
                     continue
