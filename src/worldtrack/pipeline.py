@@ -127,7 +127,7 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
     bar = None
     if progress:
         from tqdm import tqdm
-        bar = tqdm(total=total, unit="frame", desc="tracking", leave=False, dynamic_ncols=True)
+        bar = tqdm(total=total, unit="frame", desc="tracking", leave=False, dynamic_ncols=True, mininterval=0.5)
     t_start = time.perf_counter()
     try:
         for index, t, frames in source:

@@ -69,8 +69,10 @@ def run(args: argparse.Namespace) -> int:
     videos = dict(_pair(v, "--video") for v in args.video)
     if not videos:
         raise InputError("no video given: use --video CAMERA=PATH (cameras: " + ", ".join(scene.cameras) + ")")
-    for cid in videos:
+    for cid, vpath in videos.items():
         scene.camera(cid)
+        if not Path(vpath).exists():
+            raise InputError(f"{cid}: {vpath}: no such file or folder")
     explicit = dict(_pair(b, "--background") for b in args.background)
     backgrounds = {}
     for cid, vpath in videos.items():
@@ -79,8 +81,6 @@ def run(args: argparse.Namespace) -> int:
             backgrounds[cid] = read_image(explicit[cid], cam, "background")
             continue
         guess = Path(vpath).parent / f"{cid}_background.png"
-        if Path(vpath).is_dir():
-            guess = Path(vpath).parent / f"{cid}_background.png"
         if guess.is_file():
             backgrounds[cid] = read_image(guess, cam, "background")
             print(f"{cid}: background {guess}", file=sys.stderr)

@@ -77,18 +77,35 @@ class PositionMap:
     def __init__(self) -> None:
         self._tracks: dict[int, Track] = {}
         self._next_id = 1
+        self._next_tentative = -1
 
     def add(self, x: float, y: float, height: float = 1.65, width: float = 0.40, mode: str = "capture",
-            time: float = 0.0, track_id: int | None = None) -> Track:
-        """Register a new person; ids are never reused within a map."""
-        if track_id is None:
+            time: float = 0.0, track_id: int | None = None, tentative: bool = False) -> Track:
+        """Register a new person; ids are never reused within a map.
+
+        A ``tentative`` person (a candidate not yet confirmed) gets a negative id, so the ids users
+        see count confirmed people only; :meth:`promote` gives it the next real id.
+        """
+        if tentative:
+            track_id = self._next_tentative
+            self._next_tentative -= 1
+        elif track_id is None:
             track_id = self._next_id
         if track_id in self._tracks:
             raise ValueError(f"track id {track_id} already exists")
-        self._next_id = max(self._next_id, track_id + 1)
+        if track_id > 0:
+            self._next_id = max(self._next_id, track_id + 1)
         t = Track(track_id, float(x), float(y), float(height), float(width), mode=mode, born=time, last_seen=time)
         self._tracks[track_id] = t
         return t
+
+    def promote(self, track_id: int) -> int:
+        """Give a tentative person (negative id) the next real id; returns the new id."""
+        t = self._tracks.pop(track_id)
+        t.id = self._next_id
+        self._next_id += 1
+        self._tracks[t.id] = t
+        return t.id
 
     def remove(self, track_id: int) -> Track:
         return self._tracks.pop(track_id)

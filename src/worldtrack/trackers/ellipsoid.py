@@ -557,8 +557,7 @@ class EllipsoidTracker:
                 continue
             if any(np.hypot(*(np.array([b.x, b.y]) - p)) < cfg.min_separation_m for b in new):
                 continue
-            tr = self.position_map.add(p[0], p[1], h0, w0, mode="capture", time=t)
-            tr.height, tr.width = self.scene.people.size_of(tr.id)
+            tr = self.position_map.add(p[0], p[1], h0, w0, mode="capture", time=t, tentative=True)
             new.append(tr)
         return new
 
@@ -647,6 +646,7 @@ class EllipsoidTracker:
                     confirmed = e > cfg.capture_threshold
                 if confirmed:
                     tr.extra.pop("held", None)
+                    self._promote(tr)
                     tr.mode = "tracking"
                     tr.vx = tr.vy = 0.0  # capture moves are sliding into the blob, not walking
                     self._confirmed.add(tr.id)
@@ -714,6 +714,18 @@ class EllipsoidTracker:
                     default = self.scene.people.size_of(tr.id)[0]
                     median = float(np.median(samples))
                     tr.height = median if abs(median - default) > cfg.height_deadband_m else default
+
+    def _promote(self, tr: Track) -> None:
+        """A confirmed candidate gets its public id (and per-id bookkeeping follows it)."""
+        if tr.id > 0:
+            return
+        old = tr.id
+        new = self.position_map.promote(old)
+        tr.height, tr.width = self.scene.people.size_of(new)
+        if old in self._unseen:
+            self._unseen[new] = self._unseen.pop(old)
+        if old in self._heights:
+            self._heights[new] = self._heights.pop(old)
 
     def _end(self, tr: Track) -> None:
         self._heights.pop(tr.id, None)
