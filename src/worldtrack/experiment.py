@@ -22,7 +22,7 @@ from worldtrack.eval.mot import drop_ignored, evaluate
 from worldtrack.eval.tables import PositionErrors, position_errors
 from worldtrack.io.sources import Frame
 from worldtrack.io.tracks import TrackTable
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
 from worldtrack.trackers import make_tracker
 
 
@@ -84,7 +84,8 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
     ----------
     scenario : worldtrack.synth.Scenario
     method, preset, options : passed to :func:`worldtrack.trackers.make_tracker`
-    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`)
+    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
+        the colour threshold defaults to the synthetic world's 20
     min_visibility : ground truth less visible than this in every camera is not scored
     gate : metres
     score_rows : optional ``gt -> (N,) bool`` choosing the ground-truth rows to score (e.g. only
@@ -98,6 +99,8 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
         bundles = scenario.render()
     cams = list(cameras or scenario.camera_ids)
     scene = scenario.scene
+    if threshold is None and foreground == "colour":
+        threshold = SYNTHETIC_COLOUR_THRESHOLD
     foregrounds = make_foregrounds(scene, {c: scenario.background(c) for c in cams}, foreground, threshold)
     tracker = make_tracker(method, scene, foregrounds, preset=preset, **options)
     if init_from_gt and bundles:

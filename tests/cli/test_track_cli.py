@@ -26,7 +26,8 @@ def rows(path):
 def test_track_writes_tracks_videos_and_plan(sequence, tmp_path, capsys):
     out = tmp_path / "out"
     code = main(["track", str(sequence / "scene.yaml"), "--video", f"cam1={sequence / 'cam1'}",
-                 "--video", f"cam2={sequence / 'cam2'}", "--out", str(out), "--quiet", "--json"])
+                 "--video", f"cam2={sequence / 'cam2'}", "--out", str(out), "--quiet", "--json",
+                 "--threshold", "20"])
     assert code == 0
     captured = capsys.readouterr()
     lines = [ln for ln in captured.out.splitlines() if ln.startswith("{")]

@@ -59,7 +59,8 @@ def test_static_person_is_measured_accurately(camera, bound):
 def test_person_with_head_and_feet_hidden_is_flagged_unmeasurable():
     sc = make_scenario("desk-occlusion", size=(160, 120), frames=120, seed=0, hide="head-and-feet")
     bundles = sc.render()
-    tracker = make_tracker("ellipsoid", sc.scene, make_foregrounds(sc.scene, {c: sc.background(c) for c in sc.camera_ids}))
+    tracker = make_tracker("ellipsoid", sc.scene, make_foregrounds(sc.scene, {c: sc.background(c) for c in sc.camera_ids},
+                                                                  "colour", 20))
     still = flagged = 0
     for b in bundles:
         tracks = tracker.step({c: Frame(b.views[c].image, b.time, b.frame) for c in sc.camera_ids}, b.time)
@@ -142,7 +143,7 @@ def test_new_person_is_found_and_track_ends_after_leaving_the_view():
 def test_measured_height_of_a_rendered_person():
     sc = make_scenario("static-grid", size=(320, 240), frames=170, seed=0, camera="cam1", height=1.85)
     cam = sc.scene.cameras["cam1"]
-    fg = make_foregrounds(sc.scene, {"cam1": sc.background("cam1")}, "colour")["cam1"]
+    fg = make_foregrounds(sc.scene, {"cam1": sc.background("cam1")}, "colour", 20)["cam1"]
     tr = EllipsoidTracker(sc.scene, {"cam1": fg})
     cs = tr.cams["cam1"]
     measured = []

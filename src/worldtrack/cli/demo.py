@@ -33,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
     from worldtrack.experiment import visibility
     from worldtrack.io.sources import VideoSource, read_image
     from worldtrack.io.tracks import read_tracks
-    from worldtrack.pipeline import make_foregrounds, run_tracking
+    from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds, run_tracking
     from worldtrack.scene import load_scene
     from worldtrack.synth import make_scenario, write_sequence
     from worldtrack.trackers import make_tracker
@@ -49,7 +49,8 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(synth_dir / "scene.yaml")
     videos = {c: synth_dir / f"{c}.mp4" for c in scenario.camera_ids}
     backgrounds = {c: read_image(synth_dir / f"{c}_background.png", scene.camera(c), "background") for c in videos}
-    tracker = make_tracker(args.method, scene, make_foregrounds(scene, backgrounds, "colour"))
+    tracker = make_tracker(args.method, scene,
+                           make_foregrounds(scene, backgrounds, "colour", SYNTHETIC_COLOUR_THRESHOLD))
     source = VideoSource(videos, scene.cameras, fps=scenario.fps)
     gt_all = read_tracks(synth_dir / "gt.csv")
     gt_paths = {int(i): gt_all.xy[gt_all.id == i] for i in set(gt_all.id.tolist())}

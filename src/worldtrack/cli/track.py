@@ -46,11 +46,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=METHODS, default="ellipsoid", help="tracker (default: ellipsoid)")
     p.add_argument("--preset", choices=("default", "paper"), default="default",
                    help="'paper': the method exactly as published; 'default': with worldtrack's extensions")
-    p.add_argument("--foreground", choices=FOREGROUNDS, default="grey",
-                   help="foreground model: grey or colour difference with a fixed threshold (the paper's), "
-                        "or OpenCV's adaptive mog2/knn with shadow detection")
+    p.add_argument("--foreground", choices=FOREGROUNDS, default="colour",
+                   help="foreground model: colour (default; with cast shadows set aside) or grey difference "
+                        "against the background with a fixed threshold (the paper's), or OpenCV's adaptive "
+                        "mog2/knn with shadow detection")
     p.add_argument("--threshold", type=float, default=None,
-                   help="difference threshold (grey levels, or RGB distance for colour); default 25 / 40")
+                   help="difference threshold (grey levels, or RGB distance for colour); default 25 / 30 "
+                        "(30 suits compressed video; try 20 for a clean camera)")
     p.add_argument("--init", action="append", default=[], metavar="ID,X,Y",
                    help="start a person at (X, Y) metres with this id (repeatable)")
     p.add_argument("--births", choices=("anywhere", "entry", "none"), default=None,

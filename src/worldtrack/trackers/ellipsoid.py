@@ -127,7 +127,7 @@ class EllipsoidConfig:
     step_m: float = 0.05
     iterations: int = 3
     ring_px_160: float = 5.0
-    ring_fraction: float = 1.0
+    ring_fraction: float = 2.0
     capture_threshold: float = 0.7
     capture_threshold_symmetric: float = 0.3
     confirm_frames: int = 3
