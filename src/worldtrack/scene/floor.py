@@ -178,12 +178,15 @@ class WalkableRaster:
 
     def contains(self, xy: ArrayLike) -> np.ndarray:
         """(N,) bool, exact to one cell (``resolution`` metres) at the boundary."""
-        p = np.nan_to_num(np.asarray(xy, dtype=float).reshape(-1, 2), nan=-1e9, posinf=-1e9, neginf=-1e9)
-        i = np.floor((p[:, 0] - self.origin[0]) / self.resolution).astype(np.int64)
-        j = np.floor((p[:, 1] - self.origin[1]) / self.resolution).astype(np.int64)
-        ok = (i >= 0) & (i < self.inside.shape[1]) & (j >= 0) & (j < self.inside.shape[0])
+        p = np.asarray(xy, dtype=float).reshape(-1, 2)
+        with np.errstate(invalid="ignore"):
+            fi = (p[:, 0] - self.origin[0]) / self.resolution
+            fj = (p[:, 1] - self.origin[1]) / self.resolution
+            ok = (fi >= 0) & (fi < self.inside.shape[1]) & (fj >= 0) & (fj < self.inside.shape[0])
+        i = fi[ok].astype(np.int64)
+        j = fj[ok].astype(np.int64)
         out = np.zeros(len(p), dtype=bool)
-        out[ok] = self.inside[j[ok], i[ok]]
+        out[ok] = self.inside[j, i]
         return out
 
 

@@ -42,7 +42,7 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.height import measure_height
-from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_candidates, ternary_real, track_support
+from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_camera, ternary_real, track_support
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 #: Index 4 is "stay".
@@ -467,16 +467,15 @@ class EllipsoidTracker:
         num = np.zeros(len(cand))
         den = np.zeros(len(cand))
         forms = {}
+        unexplained = use_ring and cfg.score == "symmetric"
         for cid, st in state.items():
             cs = self.cams[cid]
-            f = cs.forms(cand, heights, widths, cfg.min_depth_m)
-            forms[cid] = f
-            o_valid = st[3].copy()
-            o_valid[k] = False
-            nu, de, _ = score_candidates(cs.grid, cs.camera.has_distortion, cs.occ, real[cid], use_ring,
-                                         f[0], f[1], f[2], f[4], f[3],
-                                         st[0], st[1], st[2], st[4], o_valid, cfg.target_pixels,
-                                         use_ring and cfg.score == "symmetric")
+            c = cs.camera
+            nu, de, ci, cr, cb, cv, cd = score_camera(
+                cs.P, c.K, c.dist, c.has_distortion, c.width, c.height, c.centre, cs.grid, cs.occ, real[cid],
+                use_ring, cand, heights, widths, float(cs.ring_px), cfg.min_depth_m, cs.ring_fraction,
+                st[0], st[1], st[2], st[4], st[3], k, cfg.target_pixels, unexplained)
+            forms[cid] = (ci, cr, cb, cv, cd)
             num += nu
             den += de
         with np.errstate(invalid="ignore", divide="ignore"):

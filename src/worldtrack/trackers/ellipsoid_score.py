@@ -249,23 +249,41 @@ def score_candidates(grid, has_dist, occ, real, use_ring,
     # Align the sampling grid to absolute coordinates so that every candidate sees the same pixels.
     vs = v0 + (-v0) % stride
     us = u0 + (-u0) % stride
+    if has_dist:
+        _pixels_distorted(grid, occ, real, use_ring, count_unexplained, c_inner, c_ring, c_box, c_dist, c_valid,
+                          o_inner, o_ring, o_dist, near[:n_near], vs, v1, us, u1, stride, num, den, n_in)
+    else:
+        _pixels_by_rows(occ, real, use_ring, count_unexplained, c_inner, c_ring, c_box, c_dist, c_valid,
+                        o_inner, o_ring, o_dist, near[:n_near], vs, v1, us, u1, stride, num, den, n_in)
+    return num, den, n_in
+
+
+@njit(cache=True, inline="always")
+def _sim(inside, other_in, ring, use_ring):
+    """The joint simulated image at a pixel: 1 inside anybody, −1 in a ring, else 0."""
+    if inside or other_in:
+        return 1
+    if use_ring and ring:
+        return -1
+    return 0
+
+
+@njit(cache=True)
+def _pixels_distorted(grid, occ, real, use_ring, count_unexplained, c_inner, c_ring, c_box, c_dist, c_valid,
+                      o_inner, o_ring, o_dist, near, vs, v1, us, u1, stride, num, den, n_in):
+    """The pixel loop for a distorted camera: each pixel's ideal position from ``grid``."""
+    C = c_inner.shape[0]
     for v in range(vs, v1, stride):
         for uu in range(us, u1, stride):
-            if has_dist:
-                x = np.float64(grid[v, uu, 0])
-                y = np.float64(grid[v, uu, 1])
-            else:
-                x = np.float64(uu)
-                y = np.float64(v)
+            x = np.float64(grid[v, uu, 0])
+            y = np.float64(grid[v, uu, 1])
             o = occ[v, uu]
             r = real[v, uu]
             if not use_ring and r < 0:
                 r = 0
-            # The other people's contribution to the joint image at this pixel.
             other_in = False
             other_ring = False
-            for j in range(n_near):
-                m = near[j]
+            for m in near:
                 if o >= o_dist[m]:
                     if _inside(o_inner[m], x, y):
                         other_in = True
@@ -275,25 +293,90 @@ def score_candidates(grid, has_dist, occ, real, use_ring,
             for c in range(C):
                 if not c_valid[c]:
                     continue
-                if uu < c_box[c, 0] or uu >= c_box[c, 1] or v < c_box[c, 2] or v >= c_box[c, 3]:
-                    s = 1 if other_in else (-1 if other_ring else 0)
-                else:
-                    vis = o >= c_dist[c]
-                    if vis and _inside(c_inner[c], x, y):
-                        s = 1
-                        n_in[c] += 1
-                    elif other_in:
-                        s = 1
-                    elif use_ring and (other_ring or (vis and _inside(c_ring[c], x, y))):
-                        s = -1
-                    else:
-                        s = 0
-                if s != 0:
-                    num[c] += s * r
+                inside = False
+                ring = other_ring
+                if c_box[c, 0] <= uu < c_box[c, 1] and c_box[c, 2] <= v < c_box[c, 3] and o >= c_dist[c]:
+                    inside = _inside(c_inner[c], x, y)
+                    if use_ring and not inside and not ring:
+                        ring = _inside(c_ring[c], x, y)
+                sim = _sim(inside, other_in, ring, use_ring)
+                if inside:
+                    n_in[c] += 1
+                if sim != 0:
+                    num[c] += sim * r          # E = Σ sim·real / Σ |sim|   (eq. 5)
                     den[c] += 1.0
                 elif count_unexplained and r > 0:
                     den[c] += 1.0
-    return num, den, n_in
+
+
+@njit(cache=True, inline="always")
+def _row_span(f, v):
+    """Open interval of u where row v is inside the ellipse of normal form f (empty: lo > hi)."""
+    dv = v - f[1]
+    a = f[2]
+    b = f[3] * dv
+    disc = b * b - a * (f[4] * dv * dv - 1.0)
+    if disc <= 0.0:
+        return 1e300, -1e300
+    sq = math.sqrt(disc)
+    return f[0] + (-b - sq) / a, f[0] + (-b + sq) / a
+
+
+@njit(cache=True)
+def _pixels_by_rows(occ, real, use_ring, count_unexplained, c_inner, c_ring, c_box, c_dist, c_valid,
+                    o_inner, o_ring, o_dist, near, vs, v1, us, u1, stride, num, den, n_in):
+    """The pixel loop for a pinhole camera: each ellipse becomes an interval of u per row
+    (one square root per row and ellipse instead of a quadratic form per pixel)."""
+    C = c_inner.shape[0]
+    M = near.shape[0]
+    c_span = np.empty((C, 4))
+    o_span = np.empty((M, 4))
+    for v in range(vs, v1, stride):
+        fv = np.float64(v)
+        for c in range(C):
+            if c_valid[c] and c_box[c, 2] <= v < c_box[c, 3]:
+                c_span[c, 0], c_span[c, 1] = _row_span(c_inner[c], fv)
+                c_span[c, 2], c_span[c, 3] = _row_span(c_ring[c], fv)
+                # Outside the candidate's box columns nothing of it is drawn.
+                c_span[c, 0] = max(c_span[c, 0], c_box[c, 0] - 1.0)
+                c_span[c, 1] = min(c_span[c, 1], np.float64(c_box[c, 1]))
+                c_span[c, 2] = max(c_span[c, 2], c_box[c, 0] - 1.0)
+                c_span[c, 3] = min(c_span[c, 3], np.float64(c_box[c, 1]))
+            else:
+                c_span[c, 0], c_span[c, 1], c_span[c, 2], c_span[c, 3] = 1e300, -1e300, 1e300, -1e300
+        for j in range(M):
+            m = near[j]
+            o_span[j, 0], o_span[j, 1] = _row_span(o_inner[m], fv)
+            o_span[j, 2], o_span[j, 3] = _row_span(o_ring[m], fv)
+        for uu in range(us, u1, stride):
+            x = np.float64(uu)
+            o = occ[v, uu]
+            r = real[v, uu]
+            if not use_ring and r < 0:
+                r = 0
+            other_in = False
+            other_ring = False
+            for j in range(M):
+                if o >= o_dist[near[j]]:
+                    if o_span[j, 0] < x < o_span[j, 1]:
+                        other_in = True
+                        break
+                    if use_ring and o_span[j, 2] < x < o_span[j, 3]:
+                        other_ring = True
+            for c in range(C):
+                if not c_valid[c]:
+                    continue
+                vis = o >= c_dist[c]
+                inside = vis and c_span[c, 0] < x < c_span[c, 1]
+                ring = other_ring or (use_ring and vis and not inside and c_span[c, 2] < x < c_span[c, 3])
+                sim = _sim(inside, other_in, ring, use_ring)
+                if inside:
+                    n_in[c] += 1
+                if sim != 0:
+                    num[c] += sim * r          # E = Σ sim·real / Σ |sim|   (eq. 5)
+                    den[c] += 1.0
+                elif count_unexplained and r > 0:
+                    den[c] += 1.0
 
 
 def ternary_real(labels: np.ndarray, ring_px: int) -> np.ndarray:
@@ -469,3 +552,27 @@ def track_support(grid, has_dist, occ, mask, inner, box, dist, valid, target_pix
                     if mask[v, uu] == 1:
                         own_fg[k] += stride * stride
     return visible, own, own_fg, area
+
+
+@njit(cache=True)
+def score_camera(P, K, dist, has_dist, width, height, cam_xy, grid, occ, real, use_ring,
+                 cand, heights, widths, ring_px, min_depth, ring_fraction,
+                 o_inner, o_ring, o_box, o_dist, o_valid, skip, target_pixels, count_unexplained):
+    """:func:`ellipse_forms` of the candidates then :func:`score_candidates`, in one call.
+
+    ``o_*`` describe everybody (the person being moved included, at index ``skip``, which is left
+    out of the joint image; −1 for none). Returns ``num, den`` (C,) and the candidates' forms
+    ``inner, ring, box, valid`` and floor distances, so the caller can keep the chosen one.
+    """
+    ci, cr, cb, cv = ellipse_forms(P, K, dist, has_dist, width, height, cand, heights, widths,
+                                   ring_px, min_depth, ring_fraction)
+    n = cand.shape[0]
+    cd = np.empty(n)
+    for i in range(n):
+        cd[i] = math.hypot(cand[i, 0] - cam_xy[0], cand[i, 1] - cam_xy[1])
+    ov = o_valid.copy()
+    if skip >= 0:
+        ov[skip] = False
+    num, den, _ = score_candidates(grid, has_dist, occ, real, use_ring, ci, cr, cb, cd, cv,
+                                   o_inner, o_ring, o_box, o_dist, ov, target_pixels, count_unexplained)
+    return num, den, ci, cr, cb, cv, cd
