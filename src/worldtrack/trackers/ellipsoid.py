@@ -139,9 +139,9 @@ class EllipsoidConfig:
     score: str = "symmetric"
     adaptive_step: bool = True
     min_gain: float = 0.002
-    min_step_m: float = 0.0125
+    min_step_m: float = 0.025
     max_step_m: float = 0.4
-    max_iterations: int = 8
+    max_iterations: int = 6
     predict: bool = True
     measure_height: bool = True
     height_range_m: tuple[float, float] = (1.3, 2.1)
@@ -192,6 +192,20 @@ class _CameraState:
     ring_px: int
     foreground: Foreground
     ring_fraction: float = 0.0
+    _down: tuple | None = None
+
+    def down_direction(self, uv: np.ndarray) -> np.ndarray | None:
+        """Image direction of world-down at pixel ``uv`` (from a map built once), or None."""
+        if self._down is None:
+            step = 8  # the direction varies slowly: sample every 8 px, look up the nearest
+            v, u = np.mgrid[0:self.camera.height:step, 0:self.camera.width:step]
+            d = self.camera.image_down_direction(np.stack([u.ravel(), v.ravel()], axis=1).astype(float))
+            self._down = (step, d.reshape(u.shape + (2,)))
+        step, grid = self._down
+        j = min(int(round(uv[1] / step)), grid.shape[0] - 1)
+        i = min(int(round(uv[0] / step)), grid.shape[1] - 1)
+        d = grid[max(j, 0), max(i, 0)]
+        return d if np.isfinite(d).all() else None
 
     def forms(self, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray, min_depth: float):
         """Ellipse forms of people at ``xy`` plus their floor distances from this camera."""
@@ -789,8 +803,8 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     head, is back-projected to the default ``height``.
     """
     cam = cs.camera
-    down = cam.image_down_direction(centroid[None])[0]
-    if not np.isfinite(down).all():
+    down = cs.down_direction(centroid)
+    if down is None:
         return None
     vs, us = np.nonzero(blob)
     vs = vs + origin[1]
@@ -799,12 +813,11 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     across = np.array([-down[1], down[0]])
     spread = (us - centroid[0]) * across[0] + (vs - centroid[1]) * across[1]
     n_end = max(1, len(along) // 50)
-    order = np.argsort(along)
+    low = np.argpartition(along, n_end - 1)[:n_end]            # the extreme 2 % at either end
+    high = np.argpartition(along, len(along) - n_end)[-n_end:]
     # The ends: the extreme pixel along ``down``, laterally at the mean of the extreme 2 %.
-    def end(idx: np.ndarray, a: float) -> np.ndarray:
-        return centroid + a * down + spread[idx].mean() * across
-    foot = end(order[-n_end:], along[order[-1]] + 0.5)
-    head = end(order[:n_end], along[order[0]] - 0.5)
+    foot = centroid + (along.max() + 0.5) * down + spread[high].mean() * across
+    head = centroid + (along.min() - 0.5) * down + spread[low].mean() * across
     # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
     half = max(1.0, 0.5 * (np.percentile(spread, 90) - np.percentile(spread, 10)))
     beyond = np.round(foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across).astype(int)
