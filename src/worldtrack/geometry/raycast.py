@@ -80,7 +80,8 @@ def ray_quad(o: ArrayLike, d: np.ndarray, corners: ArrayLike) -> np.ndarray:
     denom = d @ n
     with np.errstate(divide="ignore", invalid="ignore"):
         s = ((q[0] - o) @ n if o.ndim == 1 else np.einsum("ij,j->i", q[0] - o, n)) / denom
-    p = o + s[:, None] * d
+    s = np.where(np.isfinite(s), s, np.inf)  # rays parallel to the patch never hit it
+    p = o + np.where(np.isfinite(s), s, 0.0)[:, None] * d
     inside = np.ones(len(d), dtype=bool)
     for k in range(4):
         edge = q[(k + 1) % 4] - q[k]

@@ -259,13 +259,19 @@ def score_candidates(grid, has_dist, occ, real, use_ring,
 
 
 @njit(cache=True, inline="always")
-def _sim(inside, other_in, ring, use_ring):
-    """The joint simulated image at a pixel: 1 inside anybody, −1 in a ring, else 0."""
+def _terms(inside, other_in, ring, use_ring, r, count_unexplained):
+    """One pixel's terms of eq. 5, ``E = Σ sim·real / Σ |sim|``: (sim·real, |sim|).
+
+    The joint simulated image is 1 inside anybody, −1 in a ring, 0 else; with
+    ``count_unexplained`` a foreground pixel that no ellipse covers adds 1 to the denominator.
+    """
     if inside or other_in:
-        return 1
+        return np.float64(r), 1.0
     if use_ring and ring:
-        return -1
-    return 0
+        return np.float64(-r), 1.0
+    if count_unexplained and r > 0:
+        return 0.0, 1.0
+    return 0.0, 0.0
 
 
 @njit(cache=True)
@@ -299,14 +305,11 @@ def _pixels_distorted(grid, occ, real, use_ring, count_unexplained, c_inner, c_r
                     inside = _inside(c_inner[c], x, y)
                     if use_ring and not inside and not ring:
                         ring = _inside(c_ring[c], x, y)
-                sim = _sim(inside, other_in, ring, use_ring)
+                dn, dd = _terms(inside, other_in, ring, use_ring, r, count_unexplained)
+                num[c] += dn
+                den[c] += dd
                 if inside:
                     n_in[c] += 1
-                if sim != 0:
-                    num[c] += sim * r          # E = Σ sim·real / Σ |sim|   (eq. 5)
-                    den[c] += 1.0
-                elif count_unexplained and r > 0:
-                    den[c] += 1.0
 
 
 @njit(cache=True, inline="always")
@@ -369,14 +372,11 @@ def _pixels_by_rows(occ, real, use_ring, count_unexplained, c_inner, c_ring, c_b
                 vis = o >= c_dist[c]
                 inside = vis and c_span[c, 0] < x < c_span[c, 1]
                 ring = other_ring or (use_ring and vis and not inside and c_span[c, 2] < x < c_span[c, 3])
-                sim = _sim(inside, other_in, ring, use_ring)
+                dn, dd = _terms(inside, other_in, ring, use_ring, r, count_unexplained)
+                num[c] += dn
+                den[c] += dd
                 if inside:
                     n_in[c] += 1
-                if sim != 0:
-                    num[c] += sim * r          # E = Σ sim·real / Σ |sim|   (eq. 5)
-                    den[c] += 1.0
-                elif count_unexplained and r > 0:
-                    den[c] += 1.0
 
 
 def ternary_real(labels: np.ndarray, ring_px: int) -> np.ndarray:
