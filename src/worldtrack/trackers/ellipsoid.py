@@ -95,6 +95,8 @@ class EllipsoidConfig:
     height_samples : int
     height_deadband_m : float — the measured height replaces the default only when it differs by
         more than this: the measurement's own scatter (~4 cm) would otherwise add depth error
+    height_min_px : int — measure only in views where the person is at least this tall, and
+        seen at more than 45° from the vertical
     velocity_smoothing : float — weight of the new velocity measurement (0..1)
     max_speed_mps : float — velocities are clipped to this speed (a running person)
     births : {"anywhere", "entry", "none"} — where new people may appear: anywhere in view, only in
@@ -147,6 +149,7 @@ class EllipsoidConfig:
     height_range_m: tuple[float, float] = (1.3, 2.1)
     height_samples: int = 25
     height_deadband_m: float = 0.05
+    height_min_px: int = 60
     velocity_smoothing: float = 0.5
     max_speed_mps: float = 3.0
     births: str = "anywhere"
@@ -708,10 +711,16 @@ class EllipsoidTracker:
             # Where a person's pixels may be: the ellipse of the tallest plausible person (a
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
             _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws, cfg.min_depth_m)
+            cam = cs.camera
             for k, tr in enumerate(tracks):
                 if tr.mode != "tracking" or not valid[k]:
                     continue
                 b = box[k]
+                # Only oblique views that show the person large: from above, height is neither
+                # measurable nor needed (it barely moves the person); small, it is noise.
+                flat = np.hypot(*(xy[k] - cam.centre[:2]))
+                if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height_min_px:
+                    continue
                 overlap = (valid & (box[:, 0] < b[1]) & (box[:, 1] > b[0]) & (box[:, 2] < b[3]) & (box[:, 3] > b[2]))
                 overlap[k] = False
                 if overlap.any():
