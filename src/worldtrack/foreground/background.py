@@ -35,6 +35,14 @@ class Foreground(Protocol):
         ...
 
 
+def _open_foreground(labels: np.ndarray, kernel: np.ndarray | None) -> np.ndarray:
+    """Remove foreground specks smaller than ``kernel`` (a morphological opening of label 1), in place."""
+    if kernel is not None:
+        fg = cv2.morphologyEx((labels == 1).astype(np.uint8), cv2.MORPH_OPEN, kernel)
+        labels[(labels == 1) & (fg == 0)] = 0
+    return labels
+
+
 def colour_distance(image: np.ndarray, background: np.ndarray) -> np.ndarray:
     """Euclidean RGB distance per pixel, ``sqrt(ΔR² + ΔG² + ΔB²)`` (seed 004, eq. 13), (H, W) float32."""
     d = image.astype(np.float32) - background.astype(np.float32)
@@ -113,10 +121,7 @@ class StaticBackground:
         else:
             out = colour_labels(np.ascontiguousarray(image), self.background, self._bg_norm2, self.threshold,
                                 self.shadows, self.shadow_min_ratio, self.shadow_distortion)
-        if self.kernel is not None:
-            fg = cv2.morphologyEx((out == 1).astype(np.uint8), cv2.MORPH_OPEN, self.kernel)
-            out[(out == 1) & (fg == 0)] = 0
-        return out
+        return _open_foreground(out, self.kernel)
 
     def mask(self, image: np.ndarray) -> np.ndarray:
         """(H, W) uint8, 1 = foreground (shadow-like changes excluded)."""
@@ -168,10 +173,7 @@ class AdaptiveBackground:
         """
         raw = self.model.apply(image, learningRate=self.learning_rate)
         out = np.where(raw == 255, 1, np.where(raw == 127, UNSURE, 0)).astype(np.uint8)
-        if self.kernel is not None:
-            fg = cv2.morphologyEx((out == 1).astype(np.uint8), cv2.MORPH_OPEN, self.kernel)
-            out[(out == 1) & (fg == 0)] = 0
-        return out
+        return _open_foreground(out, self.kernel)
 
     def mask(self, image: np.ndarray) -> np.ndarray:
         """(H, W) uint8, 1 = foreground; shadows count as background. Updates the model."""
