@@ -158,3 +158,20 @@ def test_measured_height_of_a_rendered_person():
     ok = [h for h in measured if h is not None]
     assert len(ok) >= 5
     assert abs(np.median(ok) - 1.85) < 0.05
+
+
+def test_compiled_rounds_equal_the_python_rounds(crossing):
+    # ellipsoid_match.run_rounds is the readable _rounds_python compiled: same tracks, same places.
+    sc, bundles = crossing
+    out = {}
+    for python in (False, True):
+        tr = make_tracker("ellipsoid", sc.scene, make_foregrounds(sc.scene, {c: sc.background(c) for c in sc.camera_ids},
+                                                                  "colour", 20))
+        tr._python_rounds = python
+        rows = []
+        for b in bundles[:30]:
+            for t in tr.step({c: Frame(b.views[c].image, b.time, b.frame) for c in sc.camera_ids}, b.time):
+                rows.append((b.frame, t.id, round(t.x, 9), round(t.y, 9), round(t.score, 9)))
+        out[python] = rows
+    assert len(out[False]) > 20
+    assert out[False] == out[True]

@@ -36,13 +36,15 @@ from typing import Mapping
 
 import cv2
 import numpy as np
+from numba.typed import List as NumbaList
 
 from worldtrack.foreground.background import Foreground
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
-from worldtrack.trackers.height import measure_height
+from worldtrack.trackers.ellipsoid_match import run_rounds
 from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_camera, ternary_real, track_support
+from worldtrack.trackers.height import measure_height
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 #: Index 4 is "stay".
@@ -196,6 +198,7 @@ class _CameraState:
     foreground: Foreground
     ring_fraction: float = 0.0
     _down: tuple | None = None
+    _smallest: float | None = None
 
     def down_direction(self, uv: np.ndarray) -> np.ndarray | None:
         """Image direction of world-down at pixel ``uv`` (from a map built once), or None."""
@@ -242,10 +245,13 @@ class EllipsoidTracker:
             cam = scene.camera(cid)
             ring = max(1, int(round(self.config.ring_px_160 * math.sqrt(cam.width * cam.height / (160 * 120)))))
             occ = scene.occlusion(cid).floor_distance
-            self.cams[cid] = _CameraState(cam, np.ascontiguousarray(cam.P), cam.ideal_pixel_grid
-                                          if cam.has_distortion else _DUMMY_GRID, occ, ring, fg,
+            # Writable copies: the compiled rounds take them in typed lists of one array type.
+            grid = np.array(cam.ideal_pixel_grid) if cam.has_distortion else _DUMMY_GRID.copy()
+            self.cams[cid] = _CameraState(cam, np.ascontiguousarray(cam.P), grid, np.array(occ), ring, fg,
                                           self.config.ring_fraction)
-        self._walkable = scene.walkable.raster(0.01).contains
+        self._walk_raster = scene.walkable.raster(0.01)
+        self._walkable = self._walk_raster.contains
+        self._python_rounds = False  # tests switch to the readable rounds to compare
         self._last_t: float | None = None
         self._frame = 0
         self._close_frames: dict[tuple[int, int], int] = {}
@@ -317,23 +323,62 @@ class EllipsoidTracker:
         xy = np.array([[tr.x, tr.y] for tr in everyone], dtype=float)
         hs = np.array([tr.height for tr in everyone], dtype=float)
         ws = np.array([tr.width for tr in everyone], dtype=float)
-        state = {cid: list(self.cams[cid].forms(xy, hs, ws, cfg.min_depth_m)) for cid in real}
-        step = np.full(n, cfg.step_m)
-        done = np.zeros(n, dtype=bool)
-        best_e = np.zeros(n)
-        best_den = np.zeros(n)
+        cids = list(real)
+        stacked = [np.stack(a) for a in zip(*(self.cams[cid].forms(xy, hs, ws, cfg.min_depth_m) for cid in cids))]
+        # Per camera, views into the stacked arrays: updates through either are shared.
+        state = {cid: [a[c] for a in stacked] for c, cid in enumerate(cids)}
         if cfg.birth_search_m > 0:
             for k, tr in enumerate(tracks):
                 if tr.mode == "capture" and tr.age_frames == 0:
                     self._search_new(k, xy, hs, ws, state, real)
+        use_ring = np.array([tr.mode != "capture" for tr in tracks])
+        if self._python_rounds:
+            best_e, best_den = self._rounds_python(use_ring, xy, hs, ws, state, real)
+        else:
+            cams = [self.cams[cid] for cid in cids]
+            best_e, best_den = run_rounds(
+                xy, hs, ws, n, use_ring,
+                np.stack([cs.P for cs in cams]), np.stack([cs.camera.K for cs in cams]),
+                np.stack([cs.camera.dist for cs in cams]), np.array([cs.camera.has_distortion for cs in cams]),
+                np.array([[cs.camera.width, cs.camera.height] for cs in cams], dtype=np.int64),
+                np.stack([cs.camera.centre for cs in cams]), np.stack([cs.camera.floor_direction for cs in cams]),
+                np.array([float(cs.ring_px) for cs in cams]), cfg.ring_fraction,
+                NumbaList([cs.grid for cs in cams]), NumbaList([cs.occ for cs in cams]),
+                NumbaList([real[cid] for cid in cids]),
+                *stacked, self._walk_raster.inside, self._walk_raster.origin, self._walk_raster.resolution,
+                cfg.step_m, cfg.min_step_m, cfg.max_step_m, cfg.iterations,
+                cfg.max_iterations, cfg.adaptive_step, cfg.min_gain, cfg.target_pixels,
+                cfg.score == "symmetric", cfg.min_depth_m)
+        if cfg.rescue_search_m > 0:
+            for k, tr in enumerate(tracks):
+                # Periodically too, but only for someone nobody overlaps: in a group the line of
+                # sight crosses other people and a "better place" is often somebody else.
+                periodic = (cfg.rescue_every > 0 and (self._frame + tr.id) % cfg.rescue_every == 0
+                            and tr.extra.get("own_share", 0.0) >= 0.9)
+                if tr.mode == "tracking" and (tr.frames_low > 0 or periodic):
+                    e = self._rescue(k, xy, hs, ws, state, real, best_e[k], best_den[k])
+                    if e is not None:
+                        best_e[k] = e
+        for k, tr in enumerate(tracks):
+            tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
+            result[tr.id] = (float(best_e[k]), float(best_den[k]))
+        return result
+
+    def _rounds_python(self, use_ring: np.ndarray, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
+                       real: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The matching rounds in plain Python: the reference for :func:`ellipsoid_match.run_rounds`."""
+        cfg = self.config
+        n = len(use_ring)
+        step = np.full(n, cfg.step_m)
+        done = np.zeros(n, dtype=bool)
+        best_e = np.zeros(n)
+        best_den = np.zeros(n)
         rounds = cfg.max_iterations if cfg.adaptive_step else cfg.iterations
         for it in range(rounds):
             for k in range(n):
                 if done[k]:
                     continue
-                tr = tracks[k]
-                e, den, cand, forms, ok = self._score_person(k, xy, hs, ws, step[k], state, real,
-                                                             use_ring=tr.mode != "capture")
+                e, den, cand, forms, ok = self._score_person(k, xy, hs, ws, step[k], state, real, bool(use_ring[k]))
                 if not ok:
                     done[k] = True
                     best_e[k], best_den[k] = e[_STAY], den[_STAY]
@@ -358,20 +403,7 @@ class EllipsoidTracker:
                         step[k] = min(step[k] * 2, cfg.max_step_m)
             if done.all():
                 break
-        if cfg.rescue_search_m > 0:
-            for k, tr in enumerate(tracks):
-                # Periodically too, but only for someone nobody overlaps: in a group the line of
-                # sight crosses other people and a "better place" is often somebody else.
-                periodic = (cfg.rescue_every > 0 and (self._frame + tr.id) % cfg.rescue_every == 0
-                            and tr.extra.get("own_share", 0.0) >= 0.9)
-                if tr.mode == "tracking" and (tr.frames_low > 0 or periodic):
-                    e = self._rescue(k, xy, hs, ws, state, real, best_e[k], best_den[k])
-                    if e is not None:
-                        best_e[k] = e
-        for k, tr in enumerate(tracks):
-            tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
-            result[tr.id] = (float(best_e[k]), float(best_den[k]))
-        return result
+        return best_e, best_den
 
     def _score_person(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, step: float,
                       state: dict, real: dict[str, np.ndarray], use_ring: bool):
@@ -499,6 +531,23 @@ class EllipsoidTracker:
             e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)
         return e, den, forms
 
+    def _smallest_person_px(self, cs: _CameraState) -> float:
+        """Image area (px) of a default-size person at the far end of what the camera sees (the
+        5th percentile over the walkable floor in view), computed once: smaller blobs cannot be
+        a person and are not looked at."""
+        if cs._smallest is None:
+            x0, x1, y0, y1 = self.scene.walkable.bounds
+            gx, gy = np.meshgrid(np.arange(x0, x1, 0.25), np.arange(y0, y1, 0.25))
+            xy = np.column_stack([gx.ravel(), gy.ravel()])
+            xy = xy[self._walkable(xy)]
+            h0, w0 = self.scene.people.height, self.scene.people.width
+            inner, _, box, valid, _ = cs.forms(xy, np.full(len(xy), h0), np.full(len(xy), w0), self.config.min_depth_m)
+            seen = valid & (box[:, 0] < box[:, 1]) & (box[:, 2] < box[:, 3])
+            det = inner[seen, 2] * inner[seen, 4] - inner[seen, 3] ** 2
+            areas = np.pi / np.sqrt(np.maximum(det, 1e-12))
+            cs._smallest = float(np.percentile(areas, 5)) if len(areas) else 0.0
+        return cs._smallest
+
     def _nearest_walkable(self, xy: np.ndarray, radius: float) -> np.ndarray | None:
         """``xy`` if walkable, else the nearest walkable point within ``radius`` (5 cm grid), else None.
 
@@ -545,7 +594,8 @@ class EllipsoidTracker:
             un = cv2.morphologyEx(un, cv2.MORPH_OPEN, _disc(r_open))
             un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, np.ones((2 * r_close + 1, 2 * r_close + 1), np.uint8))
             n, labels, stats, cent = cv2.connectedComponentsWithStats(un, connectivity=8)
-            min_area = 10 * cam.width * cam.height / (160 * 120)
+            min_area = max(10 * cam.width * cam.height / (160 * 120),
+                           0.1 * self._smallest_person_px(cs))
             for j in range(1, n):
                 area = int(stats[j, cv2.CC_STAT_AREA])
                 if area < min_area:
@@ -828,7 +878,7 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     foot = centroid + (along.max() + 0.5) * down + spread[high].mean() * across
     head = centroid + (along.min() - 0.5) * down + spread[low].mean() * across
     # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
-    half = max(1.0, 0.5 * (np.percentile(spread, 90) - np.percentile(spread, 10)))
+    half = max(1.0, 0.4 * (spread.max() - spread.min()))  # most of the blob's width
     beyond = np.round(foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across).astype(int)
     inside = (beyond[:, 0] >= 0) & (beyond[:, 0] < cam.width) & (beyond[:, 1] >= 0) & (beyond[:, 1] < cam.height)
     if not inside.all():
@@ -854,12 +904,11 @@ def _visible_pixels(cs: _CameraState, xy: np.ndarray, height: float, width: floa
     """Pixels of a person's ellipse at ``xy`` inside the image and not hidden by obstacles."""
     inner, _, box, valid, dist = cs.forms(np.asarray(xy, float)[None], np.array([height]), np.array([width]),
                                           min_depth)
-    if not valid[0]:
-        return 0
-    out = np.zeros((cs.camera.height, cs.camera.width), np.uint8)
-    _render_union(out, inner, box, valid, cs.grid, cs.camera.has_distortion)
     u0, u1, v0, v1 = box[0]
-    return int((out[v0:v1, u0:u1].astype(bool) & (cs.occ[v0:v1, u0:u1] >= dist[0])).sum())
+    if not valid[0] or u0 >= u1 or v0 >= v1:
+        return 0
+    inside = _form_mask(inner[0], box[0], cs.grid, cs.camera.has_distortion)
+    return int((inside & (cs.occ[v0:v1, u0:u1] >= dist[0])).sum())
 
 
 def _form_mask(form: np.ndarray, box: np.ndarray, grid: np.ndarray, has_dist: bool) -> np.ndarray:
