@@ -732,7 +732,7 @@ class EllipsoidTracker:
             if self._unseen.get(tr.id, 0) >= cfg.leave_after_frames:
                 self._end(tr)
                 continue
-            self._flag_measurability(tr)
+        self._flag_measurability(tracks)
         if cfg.measure_height:
             self._update_heights(tracks)
         self._merge_duplicates()
@@ -765,6 +765,8 @@ class EllipsoidTracker:
             for k, tr in enumerate(tracks):
                 if tr.mode != "tracking" or not valid[k]:
                     continue
+                if len(self._heights.get(tr.id, ())) >= 10 and (self._frame + tr.id) % 5:
+                    continue  # settled: one measurement in five frames keeps the median fresh
                 b = box[k]
                 # Only oblique views that show the person large: from above, height is neither
                 # measurable nor needed (it barely moves the person); small, it is noise.
@@ -823,29 +825,34 @@ class EllipsoidTracker:
             if key not in seen_pairs:
                 del self._close_frames[key]
 
-    def _flag_measurability(self, tr: Track) -> None:
-        """Flag a person whose head and feet are both hidden in every camera (paper Table 2 (b))."""
-        head_or_feet = False
-        seen = False
-        pts = np.array([[tr.x, tr.y, 0.0], [tr.x, tr.y, tr.height]])
+    def _flag_measurability(self, tracks: list[Track]) -> None:
+        """Flag people whose head and feet are both hidden in every camera (paper Table 2 (b)).
+
+        Such a person's place along the line of sight is unknown: ``unmeasurable`` with σ = 1 m
+        instead of a confident wrong place. Vectorised over people.
+        """
+        tracks = [tr for tr in tracks if tr.id in self.position_map]
+        if not tracks:
+            return
+        n = len(tracks)
+        pts = np.array([[[tr.x, tr.y, 0.0], [tr.x, tr.y, tr.height]] for tr in tracks]).reshape(-1, 3)
+        seen = np.zeros(n, dtype=bool)
+        head_or_feet = np.zeros(n, dtype=bool)
         for cs in self.cams.values():
             cam = cs.camera
             uv = cam.project(pts)
             inside = cam.in_image(uv)
-            if not inside.any():
-                continue
-            seen = True
-            dist = math.hypot(tr.x - cam.centre[0], tr.y - cam.centre[1])
-            hidden = self.scene.occlusion(cam.id).hidden(uv, dist - 0.05)
-            if (inside & ~hidden).any():
-                head_or_feet = True
-                break
-        if seen and not head_or_feet:
-            tr.flags.add("unmeasurable")
-            tr.sigma = 1.0
-        else:
-            tr.flags.discard("unmeasurable")
-            tr.sigma = 0.1
+            dist = np.repeat(np.hypot(pts[::2, 0] - cam.centre[0], pts[::2, 1] - cam.centre[1]), 2)
+            visible = inside & ~self.scene.occlusion(cam.id).hidden(uv, dist - 0.05)
+            seen |= inside.reshape(n, 2).any(axis=1)
+            head_or_feet |= visible.reshape(n, 2).any(axis=1)
+        for k, tr in enumerate(tracks):
+            if seen[k] and not head_or_feet[k]:
+                tr.flags.add("unmeasurable")
+                tr.sigma = 1.0
+            else:
+                tr.flags.discard("unmeasurable")
+                tr.sigma = 0.1
 
 
 def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
