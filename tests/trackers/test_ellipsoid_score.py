@@ -105,3 +105,19 @@ def test_obstacle_hides_the_lower_body(lab):
     _, _, n_free = kernel(cam, free, full, True, behind_desk, np.zeros((0, 2)), 5, 0)
     _, _, n_occ = kernel(cam, occ, full, True, behind_desk, np.zeros((0, 2)), 5, 0)
     assert 0 < n_occ[0] < 0.85 * n_free[0]
+
+
+@pytest.mark.parametrize("cam_id", ["cam1", "cam2"])
+def test_ellipse_crop_equals_the_conic_mask(lab, cam_id):
+    from worldtrack.trackers.ellipsoid_score import ellipse_crop
+    cam = lab.cameras[cam_id]
+    args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
+    xy = np.array([[-1.0, 1.0], [-0.5, 2.0]])
+    inner, _, box, valid = ellipse_forms(*args, xy, np.full(2, 1.65), np.full(2, 0.4), 5.0, 0.1)
+    grid = cam.ideal_pixel_grid if cam.has_distortion else np.zeros((1, 1, 2), np.float32)
+    for k in range(2):
+        crop = ellipse_crop(inner[k], box[k], grid, cam.has_distortion)
+        full = person_mask(cam, xy[k], 1.65, 0.4).astype(bool)
+        u0, u1, v0, v1 = box[k]
+        assert (crop != full[v0:v1, u0:u1]).sum() <= 2       # float32 grid vs float64 at the edge
+        assert crop.sum() == pytest.approx(full.sum(), abs=2)  # the box holds the whole ellipse

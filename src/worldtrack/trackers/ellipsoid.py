@@ -43,7 +43,8 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.ellipsoid_match import run_rounds
-from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_camera, ternary_real, track_support
+from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, score_camera, ternary_real,
+                                                 track_support)
 from worldtrack.trackers.height import measure_height
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
@@ -920,15 +921,7 @@ def _visible_pixels(cs: _CameraState, xy: np.ndarray, height: float, width: floa
 
 def _form_mask(form: np.ndarray, box: np.ndarray, grid: np.ndarray, has_dist: bool) -> np.ndarray:
     """(v1 − v0, u1 − u0) bool: pixels of ``box`` inside the ellipse of normal form ``form``."""
-    u0, u1, v0, v1 = box
-    if has_dist:
-        g = grid[v0:v1, u0:u1]
-        du = g[..., 0] - form[0]
-        dv = g[..., 1] - form[1]
-    else:
-        du = np.arange(u0, u1)[None, :] - form[0]
-        dv = np.arange(v0, v1)[:, None] - form[1]
-    return form[2] * du * du + 2 * form[3] * du * dv + form[4] * dv * dv < 1
+    return ellipse_crop(form, np.asarray(box, dtype=np.int64), grid, has_dist)
 
 
 def _render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: np.ndarray,

@@ -576,3 +576,20 @@ def score_camera(P, K, dist, has_dist, width, height, cam_xy, grid, occ, real, u
     num, den, _ = score_candidates(grid, has_dist, occ, real, use_ring, ci, cr, cb, cd, cv,
                                    o_inner, o_ring, o_box, o_dist, ov, target_pixels, count_unexplained)
     return num, den, ci, cr, cb, cv, cd
+
+
+@njit(cache=True)
+def ellipse_crop(form, box, grid, has_dist):
+    """(v1 − v0, u1 − u0) bool: pixels of ``box`` inside the ellipse of normal form ``form``."""
+    u0, u1, v0, v1 = box[0], box[1], box[2], box[3]
+    out = np.zeros((max(0, v1 - v0), max(0, u1 - u0)), dtype=np.bool_)
+    for v in range(v0, v1):
+        for uu in range(u0, u1):
+            if has_dist:
+                x = np.float64(grid[v, uu, 0])
+                y = np.float64(grid[v, uu, 1])
+            else:
+                x = np.float64(uu)
+                y = np.float64(v)
+            out[v - v0, uu - u0] = _inside(form, x, y)
+    return out
