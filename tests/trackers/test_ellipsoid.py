@@ -175,3 +175,16 @@ def test_compiled_rounds_equal_the_python_rounds(crossing):
         out[python] = rows
     assert len(out[False]) > 20
     assert out[False] == out[True]
+
+
+def test_two_head_rays_from_different_sides_give_the_height():
+    from worldtrack.trackers.height import triangulate_height
+    head = np.array([1.0, 2.0, 1.78])
+    rays = []
+    for cam in ((0.0, 0.0, 3.5), (4.0, 0.5, 3.2)):
+        o = np.array(cam)
+        rays.append((o, (head - o) / np.linalg.norm(head - o)))
+    assert triangulate_height(rays, np.array([1.05, 2.0])) == pytest.approx(1.78, abs=1e-9)
+    # Nearly parallel rays pin nothing; a point far from the person is someone else's head.
+    assert triangulate_height([rays[0], (rays[0][0] + 0.01, rays[0][1])], np.array([1.0, 2.0])) is None
+    assert triangulate_height(rays, np.array([2.0, 3.0])) is None

@@ -45,7 +45,7 @@ from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.ellipsoid_match import run_rounds
 from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, score_camera, ternary_real,
                                                  track_support)
-from worldtrack.trackers.height import measure_height
+from worldtrack.trackers.height import head_ray, measure_height, triangulate_height
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 #: Index 4 is "stay".
@@ -757,38 +757,65 @@ class EllipsoidTracker:
         hs = np.array([tr.height for tr in tracks], dtype=float)
         ws = np.array([tr.width for tr in tracks], dtype=float)
         lo, hi = cfg.height_range_m
+        samples_now: dict[int, list[float]] = {}
+        rays: dict[int, list] = {}
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
             # Where a person's pixels may be: the ellipse of the tallest plausible person (a
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
             _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws, cfg.min_depth_m)
             cam = cs.camera
+            # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
+            inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+            owner = np.full(labels.shape, -1, dtype=np.int32)
+            for k in range(len(tracks)):
+                if ivalid[k]:
+                    u0, u1, v0, v1 = ibox[k]
+                    if u0 >= u1 or v0 >= v1:
+                        continue  # off the image (box ends may be negative: no Python slicing then)
+                    m = _form_mask(inner[k], ibox[k], cs.grid, cam.has_distortion)
+                    sub = owner[v0:v1, u0:u1]
+                    sub[m & (sub == -1)] = k
+                    sub[m & (sub >= 0) & (sub != k)] = -2
             for k, tr in enumerate(tracks):
                 if tr.mode != "tracking" or not valid[k]:
                     continue
                 if len(self._heights.get(tr.id, ())) >= 10 and (self._frame + tr.id) % 5:
                     continue  # settled: one measurement in five frames keeps the median fresh
                 b = box[k]
-                # Only oblique views that show the person large: from above, height is neither
-                # measurable nor needed (it barely moves the person); small, it is noise.
-                flat = np.hypot(*(xy[k] - cam.centre[:2]))
-                if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height_min_px:
+                u0, u1, v0, v1 = b
+                if u0 >= u1 or v0 >= v1:
                     continue
+                region = _form_mask(ring[k], b, cs.grid, cam.has_distortion)
+                mine = owner[v0:v1, u0:u1]
+                ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b))
+                if ray is not None:
+                    rays.setdefault(tr.id, []).append(ray)
                 overlap = (valid & (box[:, 0] < b[1]) & (box[:, 1] > b[0]) & (box[:, 2] < b[3]) & (box[:, 3] > b[2]))
                 overlap[k] = False
                 if overlap.any():
                     continue
-                region = _form_mask(ring[k], b, cs.grid, cs.camera.has_distortion)
-                h = measure_height(cs.camera, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi))
-                if h is None:
+                # One camera alone: only oblique views that show the person large — from above,
+                # height is neither measurable nor needed; small, it is noise.
+                flat = np.hypot(*(xy[k] - cam.centre[:2]))
+                if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height_min_px:
                     continue
-                samples = self._heights.setdefault(tr.id, [])
-                samples.append(h)
-                del samples[:-cfg.height_samples]
-                if len(samples) >= 3:
-                    default = self.scene.people.size_of(tr.id)[0]
-                    median = float(np.median(samples))
-                    tr.height = median if abs(median - default) > cfg.height_deadband_m else default
+                h = measure_height(cam, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi))
+                if h is not None:
+                    samples_now.setdefault(tr.id, []).append(h)
+        for k, tr in enumerate(tracks):
+            # Two views of the head from different sides beat any single view.
+            h3 = triangulate_height(rays.get(tr.id, []), xy[k], height_range_m=(lo, hi))
+            new = [h3] if h3 is not None else samples_now.get(tr.id, [])
+            if not new:
+                continue
+            samples = self._heights.setdefault(tr.id, [])
+            samples.extend(new)
+            del samples[:-cfg.height_samples]
+            if len(samples) >= 3:
+                default = self.scene.people.size_of(tr.id)[0]
+                median = float(np.median(samples))
+                tr.height = median if abs(median - default) > cfg.height_deadband_m else default
 
     def _promote(self, tr: Track) -> None:
         """A confirmed candidate gets its public id (and per-id bookkeeping follows it)."""

@@ -44,21 +44,10 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
         return None  # the person may extend past the image border
-    fg = (labels[v0:v1, u0:u1] == 1) & region
-    vs, us = np.nonzero(fg)
-    if len(vs) < 30:
+    ends = _ends(camera, labels, region, box)
+    if ends is None:
         return None
-    us = us + u0
-    vs = vs + v0
-    centre = np.array([us.mean(), vs.mean()])
-    down = camera.image_down_direction(centre[None])[0]
-    if not np.isfinite(down).all():
-        return None
-    along = (us - centre[0]) * down[0] + (vs - centre[1]) * down[1]
-    n_end = max(1, len(along) // 100)
-    order = np.argsort(along)
-    top = np.array([us[order[:n_end]].mean(), vs[order[:n_end]].mean()]) - 0.5 * down
-    bottom = np.array([us[order[-n_end:]].mean(), vs[order[-n_end:]].mean()]) + 0.5 * down
+    top, bottom, down = ends
     below = np.round(bottom + 2 * down).astype(int)
     if not (0 <= below[0] < camera.width and 0 <= below[1] < camera.height) or np.isfinite(occ[below[1], below[0]]):
         return None  # feet at the border or on an obstacle's edge
@@ -74,3 +63,77 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     h = float(origin[2] + s * d[2])
     lo, hi = height_range_m
     return h if lo <= h <= hi else None
+
+
+def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.ndarray,
+             box: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray] | None:
+    """Viewing ray (origin (3,), unit direction (3,)) through the top of a person's head, or None.
+
+    Needs the top of the region inside the image and not on an obstacle; the feet may be hidden.
+    """
+    u0, u1, v0, v1 = box
+    if v0 <= 0 or u0 <= 0 or u1 >= camera.width:
+        return None
+    ends = _ends(camera, labels, region, box)
+    if ends is None:
+        return None
+    top = ends[0]
+    t = np.round(top).astype(int)
+    if not (0 <= t[0] < camera.width and 0 <= t[1] < camera.height) or np.isfinite(occ[t[1], t[0]]):
+        return None
+    origin, d = camera.rays(top[None])
+    return (origin, d[0]) if np.isfinite(d).all() else None
+
+
+def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray, max_offset_m: float = 0.5,
+                       min_angle_deg: float = 25.0,
+                       height_range_m: tuple[float, float] = (1.2, 2.2)) -> float | None:
+    """Height of the point nearest to the head rays of several cameras, or None.
+
+    Two cameras looking from different directions pin the top of the head in 3-D without the
+    feet: the least-squares point closest to all rays. None when the rays' directions on the
+    floor differ by less than ``min_angle_deg`` (nearly parallel rays pin nothing), or the point
+    is more than ``max_offset_m`` from the person's floor position ``xy``.
+    """
+    if len(rays) < 2:
+        return None
+    flat = [d[:2] / np.linalg.norm(d[:2]) for _, d in rays if np.linalg.norm(d[:2]) > 1e-6]
+    if len(flat) < 2:
+        return None
+    spread = max(np.degrees(np.arccos(np.clip(abs(a @ b), -1, 1))) for i, a in enumerate(flat) for b in flat[i + 1:])
+    if spread < min_angle_deg:
+        return None
+    A = np.zeros((3, 3))
+    b = np.zeros(3)
+    for o, d in rays:
+        M = np.eye(3) - np.outer(d, d)  # projects onto the plane normal to the ray
+        A += M
+        b += M @ o
+    p = np.linalg.solve(A, b)
+    lo, hi = height_range_m
+    if np.hypot(*(p[:2] - xy)) > max_offset_m or not lo <= p[2] <= hi:
+        return None
+    return float(p[2])
+
+
+def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray,
+          box: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Top and bottom (pixels) of the foreground in ``region`` along the image's world-down
+    direction, and that direction; None with fewer than 30 pixels."""
+    u0, u1, v0, v1 = box
+    fg = (labels[v0:v1, u0:u1] == 1) & region
+    vs, us = np.nonzero(fg)
+    if len(vs) < 30:
+        return None
+    us = us + u0
+    vs = vs + v0
+    centre = np.array([us.mean(), vs.mean()])
+    down = camera.image_down_direction(centre[None])[0]
+    if not np.isfinite(down).all():
+        return None
+    along = (us - centre[0]) * down[0] + (vs - centre[1]) * down[1]
+    n_end = max(1, len(along) // 100)
+    order = np.argsort(along)
+    top = np.array([us[order[:n_end]].mean(), vs[order[:n_end]].mean()]) - 0.5 * down
+    bottom = np.array([us[order[-n_end:]].mean(), vs[order[-n_end:]].mean()]) + 0.5 * down
+    return top, bottom, down
