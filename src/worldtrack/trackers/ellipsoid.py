@@ -43,8 +43,8 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.ellipsoid_match import run_rounds
-from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, score_camera, ternary_real,
-                                                 track_support)
+from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, owner_map, score_camera,
+                                                 ternary_real, track_support)
 from worldtrack.trackers.height import head_ray, measure_height, triangulate_height
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
@@ -759,6 +759,11 @@ class EllipsoidTracker:
         lo, hi = cfg.height_range_m
         samples_now: dict[int, list[float]] = {}
         rays: dict[int, list] = {}
+        # Settled people (10 measurements) are re-measured one frame in five.
+        due = [k for k, tr in enumerate(tracks) if tr.mode == "tracking"
+               and (len(self._heights.get(tr.id, ())) < 10 or (self._frame + tr.id) % 5 == 0)]
+        if not due:
+            return
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
             # Where a person's pixels may be: the ellipse of the tallest plausible person (a
@@ -767,28 +772,21 @@ class EllipsoidTracker:
             cam = cs.camera
             # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
             inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
-            owner = np.full(labels.shape, -1, dtype=np.int32)
-            for k in range(len(tracks)):
-                if ivalid[k]:
-                    u0, u1, v0, v1 = ibox[k]
-                    if u0 >= u1 or v0 >= v1:
-                        continue  # off the image (box ends may be negative: no Python slicing then)
-                    m = _form_mask(inner[k], ibox[k], cs.grid, cam.has_distortion)
-                    sub = owner[v0:v1, u0:u1]
-                    sub[m & (sub == -1)] = k
-                    sub[m & (sub >= 0) & (sub != k)] = -2
-            for k, tr in enumerate(tracks):
-                if tr.mode != "tracking" or not valid[k]:
+            owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
+            for k in due:
+                tr = tracks[k]
+                if not valid[k]:
                     continue
-                if len(self._heights.get(tr.id, ())) >= 10 and (self._frame + tr.id) % 5:
-                    continue  # settled: one measurement in five frames keeps the median fresh
                 b = box[k]
                 u0, u1, v0, v1 = b
                 if u0 >= u1 or v0 >= v1:
                     continue
                 region = _form_mask(ring[k], b, cs.grid, cam.has_distortion)
                 mine = owner[v0:v1, u0:u1]
-                ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b))
+                down = cs.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
+                if down is None:
+                    continue
+                ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b), down)
                 if ray is not None:
                     rays.setdefault(tr.id, []).append(ray)
                 overlap = (valid & (box[:, 0] < b[1]) & (box[:, 1] > b[0]) & (box[:, 2] < b[3]) & (box[:, 3] > b[2]))
@@ -800,7 +798,7 @@ class EllipsoidTracker:
                 flat = np.hypot(*(xy[k] - cam.centre[:2]))
                 if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height_min_px:
                     continue
-                h = measure_height(cam, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi))
+                h = measure_height(cam, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down)
                 if h is not None:
                     samples_now.setdefault(tr.id, []).append(h)
         for k, tr in enumerate(tracks):

@@ -593,3 +593,23 @@ def ellipse_crop(form, box, grid, has_dist):
                 y = np.float64(v)
             out[v - v0, uu - u0] = _inside(form, x, y)
     return out
+
+
+@njit(cache=True)
+def owner_map(height, width, inner, box, valid, grid, has_dist):
+    """(H, W) int32: index of the one person whose ellipse covers each pixel, −1 nobody, −2 several."""
+    out = np.full((height, width), -1, dtype=np.int32)
+    for k in range(inner.shape[0]):
+        if not valid[k]:
+            continue
+        for v in range(max(box[k, 2], 0), min(box[k, 3], height)):
+            for uu in range(max(box[k, 0], 0), min(box[k, 1], width)):
+                if has_dist:
+                    x = np.float64(grid[v, uu, 0])
+                    y = np.float64(grid[v, uu, 1])
+                else:
+                    x = np.float64(uu)
+                    y = np.float64(v)
+                if _inside(inner[k], x, y):
+                    out[v, uu] = k if out[v, uu] == -1 else -2
+    return out

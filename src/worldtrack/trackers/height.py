@@ -21,7 +21,7 @@ from worldtrack.geometry.camera import Camera
 
 def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                    region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
-                   height_range_m: tuple[float, float] = (1.2, 2.2)) -> float | None:
+                   height_range_m: tuple[float, float] = (1.2, 2.2), down: np.ndarray | None = None) -> float | None:
     """Height (m) of the person whose foreground lies in ``region`` of ``box``, or None.
 
     Parameters
@@ -34,6 +34,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     box : (u0, u1, v0, v1) — the region's place in the image
     max_offset_m : float — the measured feet must be this close to ``xy``
     height_range_m : (min, max) — plausible heights
+    down : (2,), optional — the image's world-down direction there (computed when not given)
 
     Returns
     -------
@@ -44,7 +45,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
         return None  # the person may extend past the image border
-    ends = _ends(camera, labels, region, box)
+    ends = _ends(camera, labels, region, box, down)
     if ends is None:
         return None
     top, bottom, down = ends
@@ -66,7 +67,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
 
 
 def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.ndarray,
-             box: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray] | None:
+             box: tuple[int, int, int, int], down: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """Viewing ray (origin (3,), unit direction (3,)) through the top of a person's head, or None.
 
     Needs the top of the region inside the image and not on an obstacle; the feet may be hidden.
@@ -74,7 +75,7 @@ def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.nda
     u0, u1, v0, v1 = box
     if v0 <= 0 or u0 <= 0 or u1 >= camera.width:
         return None
-    ends = _ends(camera, labels, region, box)
+    ends = _ends(camera, labels, region, box, down)
     if ends is None:
         return None
     top = ends[0]
@@ -116,8 +117,8 @@ def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray
     return float(p[2])
 
 
-def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray,
-          box: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
+          down: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Top and bottom (pixels) of the foreground in ``region`` along the image's world-down
     direction, and that direction; None with fewer than 30 pixels."""
     u0, u1, v0, v1 = box
@@ -128,12 +129,14 @@ def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray,
     us = us + u0
     vs = vs + v0
     centre = np.array([us.mean(), vs.mean()])
-    down = camera.image_down_direction(centre[None])[0]
+    if down is None:
+        down = camera.image_down_direction(centre[None])[0]
     if not np.isfinite(down).all():
         return None
     along = (us - centre[0]) * down[0] + (vs - centre[1]) * down[1]
     n_end = max(1, len(along) // 100)
-    order = np.argsort(along)
-    top = np.array([us[order[:n_end]].mean(), vs[order[:n_end]].mean()]) - 0.5 * down
-    bottom = np.array([us[order[-n_end:]].mean(), vs[order[-n_end:]].mean()]) + 0.5 * down
+    low = np.argpartition(along, n_end - 1)[:n_end]
+    high = np.argpartition(along, len(along) - n_end)[-n_end:]
+    top = np.array([us[low].mean(), vs[low].mean()]) - 0.5 * down
+    bottom = np.array([us[high].mean(), vs[high].mean()]) + 0.5 * down
     return top, bottom, down
