@@ -38,7 +38,7 @@ from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_e
 from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
-                                                     hit_image, shadow_free_hits, shadow_free_hits_reference)
+                                                     hit_image, hit_labels, hit_labels_reference)
 
 W, H = 640, 480
 SCENE = {"name": "speed", "cameras": [{"id": "cam", "image_size": [W, H], "position": [0, -2, 3.5],
@@ -97,8 +97,8 @@ def main() -> int:
     img = render(cam, bg, people_at(10, 0), rng)
     fg = StaticBackground(bg, 30.0, "colour")
     prep = {"F = colour distance, F > γ (paper)": median_time(lambda: hit_image(fg.difference(img), 30.0)),
-            "shadow-free F > γ (Numba, default)": median_time(lambda: shadow_free_hits(img, bg, 25.0)),
-            "shadow-free F > γ (NumPy reference)": median_time(lambda: shadow_free_hits_reference(img, bg, 25.0),
+            "shadow-free F > γ (Numba, default)": median_time(lambda: hit_labels(img, bg, 25.0)),
+            "shadow-free F > γ (NumPy reference)": median_time(lambda: hit_labels_reference(img, bg, 25.0),
                                                                repeats=5)}
     prep_rows = [[k, 1000 * v, v / mog2] for k, v in prep.items()]
 

@@ -59,7 +59,7 @@ from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # 
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 from worldtrack.trackers.ellipsoid_score import ternary_real  # noqa: E402
-from worldtrack.trackers.particle_likelihood import hit_image, shadow_free_hits  # noqa: E402
+from worldtrack.trackers.particle_likelihood import hit_image, hit_labels  # noqa: E402
 
 SEED = 0
 SIZES = ((160, 120), (640, 480))
@@ -142,8 +142,8 @@ def foreground_stage(method: str, tracker, clip: Clip):
         return lambda img: ternary_real(cs.foreground.labels(img), cs.ring_px)
     if method == "particle":
         gamma = tracker.config.gamma
-        if tracker.config.shadows:
-            return lambda img: shadow_free_hits(img, clip.background, gamma)
+        if tracker.config.shadows != "object":
+            return lambda img: hit_labels(img, clip.background, gamma)
         fg = tracker.foregrounds[clip.camera]
         return lambda img: hit_image(fg.difference(img), gamma)
     model = AdaptiveBackground("mog2", background=clip.background)

@@ -65,10 +65,14 @@ from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, owner_image,
-                                                     shadow_free_hits, thresholded_difference)
+                                                     hit_labels, thresholded_difference)
 from worldtrack.trackers.particle_sampling import FloorRegion, bimodal_split, polygon_distance, resampler
 
 Box = tuple[int, int, int, int]
+
+#: Depth (m) at which a column sample weighs 1 with ``pixel_weights``: weights are the sample's
+#: image length over that of a sample this far from the camera.
+REFERENCE_DEPTH = 5.0
 
 
 @dataclass(eq=False)
@@ -78,7 +82,8 @@ class _Filter:
     ``xyz`` (P, 3) particle positions (m) and ``v`` (P, 3) their own velocities (m/s); ``V`` (2,)
     the object's floor velocity (m/s); ``centre`` (2,) the floor mean after resampling; ``region``
     the area a detection filter scatters over; ``logw`` a detection filter's log weights of the
-    last frame (None: scatter afresh). ``logpi, likely, col_h`` hold this frame's observation.
+    last frame (None: scatter afresh). ``logpi, likely, col_h`` hold this frame's observation;
+    ``h`` (P,) each particle's object height (m), where its column's top is expected.
     """
 
     xyz: np.ndarray
@@ -94,10 +99,11 @@ class _Filter:
     logpi: np.ndarray | None = None
     likely: np.ndarray | None = None
     col_h: np.ndarray | None = None
+    h: np.ndarray | None = None
 
     def take(self, idx: np.ndarray) -> None:
         """Keep the particles ``idx`` (with repeats), this frame's observation included."""
-        self.xyz, self.v = self.xyz[idx], self.v[idx]
+        self.xyz, self.v, self.h = self.xyz[idx], self.v[idx], self.h[idx]
         if self.logpi is not None:
             self.logpi, self.likely, self.col_h = self.logpi[idx], self.likely[idx], self.col_h[idx]
 
@@ -138,12 +144,12 @@ class ParticleTracker:
             scene.camera(cid)
             if not callable(getattr(fg, "difference", None)):
                 raise InputError(f"particle tracker: the foreground model of {cid} has no difference(image)")
-            if cfg.shadows and _background_image(fg) is None:
-                raise InputError(f"particle tracker: shadows=True needs the background image of {cid}'s "
-                                 "foreground model (use a static background, or set shadows=False)")
+            if cfg.shadows != "object" and _background_image(fg) is None:
+                raise InputError(f"particle tracker: shadows={cfg.shadows!r} needs the background image of {cid}'s "
+                                 "foreground model (use a static background, or set shadows='object')")
         self._cams = {cid: CameraLikelihood(scene.camera(cid)) for cid in self.foregrounds}
         self._floor: dict[str, np.ndarray] = {}
-        if cfg.shadows:
+        if cfg.shadows != "object":
             walk = scene.walkable.raster(0.01)
             for cid in self.foregrounds:
                 occ = scene.occlusion(cid).floor_distance if scene.obstacles else None
@@ -151,13 +157,20 @@ class ParticleTracker:
         a, b = cfg.hit_rate_object, cfg.hit_rate_background
         self._on, self._off = math.log(a / b), math.log((1 - a) / (1 - b))
         self._n_below = cfg.foot_samples if cfg.weighting == "ratio" else 0
+        self._n_above = cfg.head_samples if cfg.weighting == "ratio" else 0
         self.heights = cfg.heights
-        self._column = np.concatenate([-cfg.dz * np.arange(self._n_below, 0, -1), self.heights])
+        self._column = np.concatenate([-cfg.dz * np.arange(self._n_below, 0, -1), self.heights,
+                                       self.heights[-1] + cfg.dz * np.arange(1, self._n_above + 1)])
         self._k_min = self._n_below + min(cfg.likely_count, len(self.heights) - 1)
+        # Pixel weights: a column sample REFERENCE_DEPTH from a camera weighs 1.
+        self._px_scale = {cid: (REFERENCE_DEPTH / (cl.K[1, 1] * cfg.dz) if cfg.pixel_weights else 0.0)
+                          for cid, cl in self._cams.items()}
+        self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
         self._resample = resampler(cfg.resampling)
         self._walkable = scene.walkable.raster(0.01).contains
         self.filters: list[_Filter] = []
-        self.detectors = [_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=r) for r in self._detection_regions()]
+        self.detectors = [_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=r, h=np.zeros(0))
+                          for r in self._detection_regions()]
         self._last_t: float | None = None
         self._close: dict[tuple[int, int], int] = {}
         self.last_masks: dict[str, np.ndarray] = {}
@@ -215,7 +228,7 @@ class ParticleTracker:
                                self.rng.random(n) * cfg.max_height])
         h, w = self.scene.people.size_of(track_id or 0)
         tr = self.position_map.add(x, y, h, w, mode="tracking", time=t, track_id=track_id)
-        f = _Filter(xyz, np.zeros((n, 3)), track=tr)
+        f = _Filter(xyz, np.zeros((n, 3)), track=tr, h=self._draw_heights(n, h))
         self._update_region(f, t)
         self.filters.append(f)
         return tr
@@ -257,9 +270,17 @@ class ParticleTracker:
         for i, f in enumerate(self.filters):
             f.logpi, f.likely, f.col_h = self.likelihood(
                 f.xyz, images, owners if explain_tracks else None,
-                {cid: boxes[cid][i] for cid in images} if explain_tracks else None)
+                {cid: boxes[cid][i] for cid in images} if explain_tracks else None, f.h)
         for f in list(self.filters):
             self._update_tracking(f, t)
+
+        # Splits and merges first, so a filter that just split into two objects hides both of them
+        # from the detection filters below (otherwise the second object is also "detected").
+        if cfg.split:
+            for f in list(self.filters):
+                self._maybe_split(f, t)
+        if cfg.merge:
+            self._merge()
 
         # Detection filters read past every track's box (at the updated positions, stretched along
         # the line of sight), so the object just handed over does not fire the fresh detection
@@ -270,14 +291,10 @@ class ParticleTracker:
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
         for d in self.detectors:
             self._move_detector(d, dt)
-            d.logpi, d.likely, d.col_h = self.likelihood(d.xyz, images, owners if cfg.explain != "none" else None)
+            d.logpi, d.likely, d.col_h = self.likelihood(d.xyz, images, owners if cfg.explain != "none" else None,
+                                                         None, d.h)
             self._update_detector(d, t)
 
-        if cfg.split:
-            for f in list(self.filters):
-                self._maybe_split(f, t)
-        if cfg.merge:
-            self._merge()
         for f in self.filters:
             f.track.age_frames += 1
         return self.tracks
@@ -297,13 +314,14 @@ class ParticleTracker:
                 raise InputError(f"{cid}: frame is {image.shape[1]}x{image.shape[0]} but the camera is "
                                  f"{cam.width}x{cam.height}")
             fg = self.foregrounds[cid]
-            F = fg.difference(image) if (cfg.likelihood == "point" or not cfg.shadows) else None
-            if cfg.shadows:
-                hit = shadow_free_hits(image, _background_image(fg), cfg.gamma, where=self._floor[cid])
+            F = fg.difference(image) if (cfg.likelihood == "point" or cfg.shadows == "object") else None
+            if cfg.shadows != "object":
+                hit = hit_labels(image, _background_image(fg), cfg.gamma, where=self._floor[cid],
+                                 shadow=2 if cfg.shadows == "unknown" else 0)
             else:
                 hit = hit_image(F, cfg.gamma)
             self.last_masks[cid] = hit
-            out[cid] = hit if cfg.likelihood == "column" else thresholded_difference(np.where(hit > 0, F, 0), cfg.gamma)
+            out[cid] = hit if cfg.likelihood == "column" else thresholded_difference(np.where(hit == 1, F, 0), cfg.gamma)
         return out
 
     def _boxes(self, filters: list[_Filter], centres: list[np.ndarray], margin: float,
@@ -316,7 +334,8 @@ class ParticleTracker:
 
     def likelihood(self, xyz: np.ndarray, images: Mapping[str, np.ndarray],
                    owners: Mapping[str, np.ndarray] | None = None,
-                   boxes: Mapping[str, Box | None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   boxes: Mapping[str, Box | None] | None = None,
+                   h: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Log-likelihood of particles, summed over the cameras that see them.
 
         Parameters
@@ -326,6 +345,8 @@ class ParticleTracker:
         owners : {camera_id: (H, W) uint8}, optional — object boxes per pixel (:func:`owner_image`);
             pixels in a box other than ``boxes[camera_id]`` read as background
         boxes : {camera_id: box or None}, optional — the filter's own object box
+        h : (N,) float, metres, optional — the particles' object heights: with ``top_sigma > 0``
+            each column's top gets the log prior ``−(top − h)² / (2·top_sigma²)``
 
         Returns
         -------
@@ -353,7 +374,8 @@ class ParticleTracker:
                 if cfg.likelihood == "column":
                     counts, ratio, top, seen = cl.column(img, xyz[:, :2], self._column, self._on, self._off,
                                                          self._k_min, cfg.column_radius, -self._on, self._n_below,
-                                                         owner, box)
+                                                         self._n_above, owner, box, h, self._top_sigma,
+                                                         self._px_scale[cid])
                     if cfg.weighting == "count":
                         lv = np.log(counts / S)
                         col += np.where(seen, counts * cfg.dz, 0.0)
@@ -394,20 +416,38 @@ class ParticleTracker:
             # v_t = (x_t − x_{t−1}) / dt, each particle's velocity for the next frame (eq. 2).
             f.v = (f.xyz - old) / dt
             _clip_speed(f.v, cfg.max_speed)
+        self._jitter_heights(f, dt)
+
+    def _jitter_heights(self, f: _Filter, dt: float) -> None:
+        """Random walk of the particles' object heights, ``noise_h·√dt``, kept in [min_height, max_height]."""
+        cfg = self.config
+        if self._top_sigma > 0 and cfg.noise_h > 0 and dt > 0 and len(f.h):
+            f.h = _reflect(f.h + self.rng.standard_normal(len(f.h)) * (cfg.noise_h * math.sqrt(dt)),
+                           cfg.min_height, cfg.max_height)
+
+    def _draw_heights(self, n: int, centre: float | None = None) -> np.ndarray:
+        """(n,) object heights ~ N(centre, height_spread²) in [min_height, max_height] (default centre:
+        the scene's person height)."""
+        cfg = self.config
+        c = self.scene.people.height if centre is None else centre
+        return _reflect(c + cfg.height_spread * self.rng.standard_normal(n), cfg.min_height, cfg.max_height)
 
     def _move_detector(self, d: _Filter, dt: float) -> None:
         """Resample a detection filter by last frame's weights, jitter, and scatter a share afresh."""
         cfg = self.config
         n = cfg.detection_particles
         if d.logw is None:
-            d.xyz, d.v = self._scatter(d.region, n), np.zeros((n, 3))
+            d.xyz, d.v, d.h = self._scatter(d.region, n), np.zeros((n, 3)), self._draw_heights(n)
             return
-        d.xyz = d.xyz[self._resample(self._weights(d.logw), n, self.rng)]
+        keep = self._resample(self._weights(d.logw), n, self.rng)
+        d.xyz, d.h = d.xyz[keep], d.h[keep]
         d.xyz[:, :2] += self.rng.standard_normal((n, 2)) * (cfg.detection_noise * math.sqrt(max(dt, 0.0)))
+        self._jitter_heights(d, dt)
         fresh = (self.rng.random(n) < cfg.detection_reseed) | ~d.region.contains(d.xyz[:, :2])
         k = int(fresh.sum())
         if k:
             d.xyz[fresh] = self._scatter(d.region, k)
+            d.h[fresh] = self._draw_heights(k)
 
     def _scatter(self, region: FloorRegion, n: int) -> np.ndarray:
         """(n, 3) particles uniform over the region's floor and over heights [0, max_height]."""
@@ -466,7 +506,9 @@ class ParticleTracker:
         tr.x, tr.y = float(centre[0]), float(centre[1])
         tr.vx, tr.vy = float(V[0]), float(V[1])
         tr.sigma = float(math.sqrt(0.5 * (sd[0] ** 2 + sd[1] ** 2)))
-        if cfg.likelihood == "column" and f.col_h is not None:
+        if cfg.likelihood == "column" and self._top_sigma > 0:
+            tr.height = float(f.h.mean())
+        elif cfg.likelihood == "column" and f.col_h is not None:
             tr.height = float(f.col_h.mean())
         tr.extra.update(z=float(centre[2]), sx=float(sd[0]), sy=float(sd[1]), sz=float(sd[2]))
 
@@ -485,7 +527,8 @@ class ParticleTracker:
         """Start tracking filters from a detection filter's likely particles, one per lump."""
         cfg = self.config
         for g in (self._lumps(d.xyz, idx, depth=2) if cfg.split else [idx]):
-            f = _Filter(d.xyz[g], np.zeros((len(g), 3)), logpi=d.logpi[g], likely=d.likely[g], col_h=d.col_h[g])
+            f = _Filter(d.xyz[g], np.zeros((len(g), 3)), logpi=d.logpi[g], likely=d.likely[g], col_h=d.col_h[g],
+                        h=d.h[g])
             self._resample_filter(f, self._weights(f.logpi), cfg.particles)
             self._new_track(f, t, score=float(d.likely.mean()))
 
@@ -536,7 +579,7 @@ class ParticleTracker:
             return
         f.split_count = 0
         keep, other = (~side, side) if (~side).sum() >= side.sum() else (side, ~side)
-        new = _Filter(f.xyz[other], f.v[other], V=f.V.copy(), centre=f.centre.copy(), t_update=f.t_update,
+        new = _Filter(f.xyz[other], f.v[other], V=f.V.copy(), centre=f.centre.copy(), t_update=f.t_update, h=f.h[other],
                       logpi=f.logpi[other], likely=f.likely[other], col_h=f.col_h[other])
         f.take(np.flatnonzero(keep))
         for g in (f, new):

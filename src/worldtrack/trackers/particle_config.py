@@ -22,6 +22,7 @@ WEIGHTINGS = ("ratio", "count")
 VELOCITIES = ("object", "particle", "none")
 BIRTHS = ("auto", "entry", "anywhere", "none")
 EXPLAIN = ("all", "detection", "none")
+SHADOWS = ("background", "unknown", "object")
 
 
 @dataclass(frozen=True)
@@ -90,13 +91,36 @@ class ParticleConfig:
         With ``ratio``: samples at ``−dz, −2·dz, …`` below the floor. An object standing on the floor
         leaves them on background, so each one that hits divides the ratio by
         ``hit_rate_object / hit_rate_background``: the column's floor contact (2).
-    shadows : bool
-        Pixels whose background is the walkable floor and that look like it darkened without a
-        change of colour are cast shadows, not object
-        (:func:`~worldtrack.trackers.particle_likelihood.shadow_free_hits`; needs a foreground model
-        with a background image). Shadows on the floor otherwise look like taller objects standing
-        on them and pull the estimate towards the camera by up to their length; the price is that
-        grey clothes over a grey floor read as shadow too.
+    head_samples : int
+        With ``ratio``: samples at ``dz, 2·dz, …`` above the column's top. Over an object's head is
+        background, so each one that hits divides the ratio by ``hit_rate_object /
+        hit_rate_background``. With the foot samples this is a ring round the column (seed 000's
+        −1 ring in column form): a column that stands on a body farther along the line of sight
+        and stops short inside it hits both, so depth comes from the head as well as the feet (2).
+    pixel_weights : bool
+        With ``ratio``: weight each column sample by the image length it stands for (relative to a
+        sample 5 m from the camera), so the ratio counts pixels of evidence. Samples are evenly
+        spaced in height, not in the image: unweighted, a column farther along the line of sight —
+        shorter in the image — packs more samples into the same pixels of a body and wins (True).
+    top_sigma : float, metres
+        With ``ratio``: each particle carries the object's height ``h`` as a fourth state variable,
+        and its column's top gets a Gaussian prior about it of this σ (posture, head shape, the dz
+        grid). 0: no height state, the top is free in [min_height, max_height]. One camera's column
+        leaves a valley of (depth, height) pairs that fit a body; a height that persists from frame
+        to frame closes it where the feet do not show (clothes like the floor, a shadow) (0.05).
+    height_spread : float, metres
+        σ of new particles' heights about the scene's person height (0.1).
+    noise_h : float, m/√s
+        Random walk of the particles' heights (0.02).
+    shadows : {"background", "unknown", "object"}
+        How cast shadows read. A pixel whose background is the walkable floor and that looks like
+        it darkened without a change of colour (:func:`~worldtrack.trackers.particle_likelihood.hit_labels`;
+        needs a foreground model with a background image) is a shadow: ``background`` (default) — a
+        shadow on the floor otherwise looks like a taller object standing on it and pulls the
+        estimate towards the camera by up to its length; ``unknown`` — no evidence either way
+        (dark clothes over a light floor pass the same test; but a column that stands in its
+        object's shadow then loses nothing, which biases the estimate towards the camera by half
+        the shadow, see ``benchmarks/particle_entry.py``); ``object`` — what F > γ says (the paper).
     explain : {"all", "detection", "none"}
         Pixels inside another tracked object's image box (its column, ``width/2 + box_margin`` to
         each side) read as background — for every filter (``all``: a filter cannot take over its
@@ -163,7 +187,12 @@ class ParticleConfig:
     likelihood_power: float = 0.25
     column_radius: float = 0.1
     foot_samples: int = 2
-    shadows: bool = True
+    head_samples: int = 2
+    pixel_weights: bool = True
+    top_sigma: float = 0.05
+    height_spread: float = 0.1
+    noise_h: float = 0.02
+    shadows: str = "background"
     explain: str = "all"
     box_margin: float = 0.05
     exclusion_depth: float = 0.5
@@ -189,7 +218,8 @@ class ParticleConfig:
         11) on the plain line column, shadows counted as object, no split, merge or explaining
         away for tracking filters, tracks end at once. Numbers it does not state stay ours."""
         base = cls(velocity="particle", weighting="count", likelihood_power=1.0, column_radius=0.0,
-                   foot_samples=0, shadows=False, explain="detection", split=False, merge=False,
+                   foot_samples=0, head_samples=0, pixel_weights=False, top_sigma=0.0, shadows="object", explain="detection",
+                   split=False, merge=False,
                    end_after_s=0.0)
         try:
             return replace(base, **overrides)
@@ -201,20 +231,21 @@ class ParticleConfig:
             return InputError(f"particle tracker: {name}: expected {expected}, got {getattr(self, name)!r}")
 
         for name, options in (("likelihood", LIKELIHOODS), ("weighting", WEIGHTINGS), ("velocity", VELOCITIES),
-                              ("births", BIRTHS), ("resampling", RESAMPLERS), ("explain", EXPLAIN)):
+                              ("births", BIRTHS), ("resampling", RESAMPLERS), ("explain", EXPLAIN), ("shadows", SHADOWS)):
             if getattr(self, name) not in options:
                 raise bad(name, "one of " + ", ".join(options))
         for name in ("particles", "detection_particles", "split_frames", "merge_frames"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
                 raise bad(name, "an integer ≥ 1")
-        if isinstance(self.foot_samples, bool) or not isinstance(self.foot_samples, (int, np.integer)) \
-                or self.foot_samples < 0:
-            raise bad("foot_samples", "an integer ≥ 0")
+        for name in ("foot_samples", "head_samples"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+                raise bad(name, "an integer ≥ 0")
         for name in ("dz", "max_height", "min_height", "max_speed", "velocity_smoothing", "split_distance"):
             if not _number(getattr(self, name)) or not getattr(self, name) > 0:
                 raise bad(name, "a positive number")
-        for name in ("gamma", "noise_xy", "noise_z", "box_margin", "exclusion_depth", "detection_noise", "entry_margin",
+        for name in ("gamma", "top_sigma", "height_spread", "noise_h", "noise_xy", "noise_z", "box_margin", "exclusion_depth", "detection_noise", "entry_margin",
                      "end_after_s", "likelihood_power", "column_radius"):
             if not _number(getattr(self, name)) or not getattr(self, name) >= 0:
                 raise bad(name, "a number ≥ 0")

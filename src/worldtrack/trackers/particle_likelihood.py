@@ -5,8 +5,8 @@ Both read one image per camera and frame, computed once from the background diff
 with values ``F ≤ γ`` set to 0 (§4.2: against slight brightness changes of the background):
 
 * :func:`hit_image` — ``F > γ`` as (H, W) uint8, for the column likelihood;
-* :func:`shadow_free_hits` — the same without cast shadows (not in the paper; Numba, with
-  :func:`shadow_free_hits_reference` in NumPy);
+* :func:`hit_labels` — the same with cast shadows labelled 2, "no evidence" (not in the paper;
+  Numba, with :func:`hit_labels_reference` in NumPy);
 * :func:`thresholded_difference` — F with ``F ≤ γ`` set to 0, float32, for the point likelihood.
 
 **Height column** (the paper's contribution). For a particle at floor position ``(x_i, y_i)`` the
@@ -19,9 +19,12 @@ merely on the same line of sight as the object (in front of or behind it, Fig. 5
 
 The kernel also returns a second statistic of the same samples, the log-likelihood ratio of the best
 object top (``ratio``): an object standing at the particle and reaching up to sample ``k`` explains
-samples ``0 … k``; each adds ``on`` if it hits and ``off`` if not, samples below the floor
-(``n_below`` of them, a worldtrack extension) add ``below`` if they hit, and the best ``k ≥ k_min``
-is kept. And a column can be a thin cylinder (``radius > 0``): a sample hits if its pixel or one of
+samples ``0 … k``; each adds ``on`` if it hits, ``off`` if it reads background and nothing if it
+reads "no evidence" (a shadow, label 2). A ring round the column must read background (worldtrack's
+extension, the column's counterpart of seed 000's −1 ring): ``n_below`` samples below the floor and
+the ``n_above`` samples above the top add ``below`` (< 0) each if they hit — an object standing
+here has nothing under its feet or over its head, while a column that stands on a body, or stops
+short inside one, does. The best top ``k ≥ k_min`` is kept. And a column can be a thin cylinder (``radius > 0``): a sample hits if its pixel or one of
 the two pixels ``f_x·radius / depth`` to its left and right hits (the sample's neighbours ``radius``
 across the line of sight, for a camera without roll).
 
@@ -72,16 +75,18 @@ def hit_image(difference: np.ndarray, gamma: float) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(difference) > gamma).view(np.uint8)
 
 
-def shadow_free_hits(image: np.ndarray, background: np.ndarray, gamma: float,
-                     brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
-                     where: np.ndarray | None = None) -> np.ndarray:
-    """``F > γ`` without cast shadows, (H, W) uint8.
+def hit_labels(image: np.ndarray, background: np.ndarray, gamma: float,
+               brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
+               where: np.ndarray | None = None, shadow: int = 2) -> np.ndarray:
+    """``F > γ`` with cast shadows set apart, (H, W) uint8: 0 background, 1 object, ``shadow`` shadow.
 
     A pixel counts as shadow when it is the background darkened without a change of colour: its
     brightness ratio ``a = (I·B) / (B·B)`` lies in ``brightness`` and its colour distortion
     ``‖I − a·B‖`` is at most ``chroma`` (the test of Horprasert et al. 1999, also behind OpenCV
-    MOG2's shadow detection). Not in seed 004, whose F counts shadows as object. Numba kernel;
-    :func:`shadow_free_hits_reference` is the same in NumPy.
+    MOG2's shadow detection). A shadow pixel is *no evidence* to the column: a cast shadow and dark
+    clothes over a light floor pass the same test, so it reads neither object nor background. Not
+    in seed 004, whose F counts shadows as object. Numba kernel; :func:`hit_labels_reference` is
+    the same in NumPy.
 
     Parameters
     ----------
@@ -91,17 +96,18 @@ def shadow_free_hits(image: np.ndarray, background: np.ndarray, gamma: float,
     chroma : float — largest colour distortion of shadows (RGB units)
     where : (H, W) bool, optional — the only pixels where shadows can be (e.g. those that see the
         floor, :func:`floor_pixels`); default everywhere
+    shadow : {2, 0} — the label of shadow pixels: 2 "no evidence", or 0 background
     """
     img = np.ascontiguousarray(image)
     bg = np.ascontiguousarray(background)
     w = np.ones(img.shape[:2], dtype=np.bool_) if where is None else np.ascontiguousarray(where, dtype=np.bool_)
     out = np.empty(img.shape[:2], dtype=np.uint8)
-    _shadow_free(img, bg, float(gamma), float(brightness[0]), float(brightness[1]), float(chroma), w, out)
+    _shadow_labels(img, bg, float(gamma), float(brightness[0]), float(brightness[1]), float(chroma), w, int(shadow), out)
     return out
 
 
 @njit(cache=True)
-def _shadow_free(img, bg, gamma, lo, hi, chroma, where, out):
+def _shadow_labels(img, bg, gamma, lo, hi, chroma, where, shadow, out):
     H, W = out.shape
     g2 = gamma * gamma
     c2 = chroma * chroma
@@ -119,13 +125,13 @@ def _shadow_free(img, bg, gamma, lo, hi, chroma, where, out):
                 if lo <= a <= hi:
                     e0, e1, e2 = i0 - a * b0, i1 - a * b1, i2 - a * b2
                     if e0 * e0 + e1 * e1 + e2 * e2 <= c2:
-                        out[v, u] = 0
+                        out[v, u] = shadow
 
 
-def shadow_free_hits_reference(image: np.ndarray, background: np.ndarray, gamma: float,
-                               brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
-                               where: np.ndarray | None = None) -> np.ndarray:
-    """:func:`shadow_free_hits` in NumPy (float64), the reference the kernel is tested against."""
+def hit_labels_reference(image: np.ndarray, background: np.ndarray, gamma: float,
+                         brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
+                         where: np.ndarray | None = None, shadow: int = 2) -> np.ndarray:
+    """:func:`hit_labels` in NumPy (float64), the reference the kernel is tested against."""
     I = image.astype(np.float64)
     B = background.astype(np.float64)
     d = I - B
@@ -134,10 +140,11 @@ def shadow_free_hits_reference(image: np.ndarray, background: np.ndarray, gamma:
     a = np.einsum("hwc,hwc->hw", I, B) / np.maximum(bb, 1.0)
     e = I - a[..., None] * B
     cd2 = np.einsum("hwc,hwc->hw", e, e)
-    shadow = (a >= brightness[0]) & (a <= brightness[1]) & (cd2 <= chroma * chroma)
+    is_shadow = (a >= brightness[0]) & (a <= brightness[1]) & (cd2 <= chroma * chroma)
     if where is not None:
-        shadow &= where
-    return np.ascontiguousarray((F2 > gamma * gamma) & ~shadow).view(np.uint8)
+        is_shadow &= where
+    hit = F2 > gamma * gamma
+    return np.where(hit & is_shadow, shadow, hit).astype(np.uint8)
 
 
 def thresholded_difference(difference: np.ndarray, gamma: float) -> np.ndarray:
@@ -245,66 +252,132 @@ def _others(owner, box, iu, iv):
 def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray,
                   dist: np.ndarray, has_dist: bool, radius: float, hit: np.ndarray,
                   owner: np.ndarray, box: np.ndarray, on: float, off: float, below: float, n_below: int,
-                  k_min: int, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
+                  n_above: int, k_min: int, tops: np.ndarray, top_sigma: float, px_scale: float, counts: np.ndarray,
+                  ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
     """Height-column likelihood of every particle for one camera, in place.
 
     Parameters
     ----------
     xy : (N, 2) float64, metres — particles' floor positions
-    heights : (S,) float64, metres — ``n_below`` heights below the floor, then ``k·dz``, k = 0 … T
+    heights : (S,) float64, metres — ``n_below`` heights below the floor, then ``k·dz``, k = 0 … T,
+        then ``n_above`` heights above ``T·dz``
     R, t, K, dist : the camera's rotation (3, 3), translation (3,), intrinsics (3, 3), distortion (5,)
     has_dist : bool — apply the distortion model
     radius : float, metres — 0: a line of points (the paper); > 0: a thin cylinder (module docstring)
-    hit : (H, W) uint8 — ``F > γ`` (:func:`hit_image`)
+    hit : (H, W) uint8 — 1 object, 0 background, 2 no evidence (:func:`hit_image`, :func:`hit_labels`)
     owner : (H, W) uint8 — number of object boxes over each pixel (:func:`owner_image`)
     box : (4,) int64 — the filter's own object box ``(u0, u1, v0, v1)``, or :data:`NO_BOX`
-    on, off, below : float — log-ratio terms for a sample on / off the object, and below the floor
-    n_below : int — how many of ``heights`` (the first ones) are below the floor
-    k_min : int — the top is searched from index ``k_min`` of ``heights`` up
-    counts : (N,) int32 — out: samples from the floor up on ``F > γ`` (π_i, eq. 11)
+    on, off, below : float — log-ratio terms for a sample on / off the object, and for a ring sample
+        (below the floor, or within ``n_above`` samples above the top) that reads object
+    n_below, n_above : int — how many of ``heights`` (the first / the last ones) are ring samples
+    k_min : int — the top is searched from index ``k_min`` of ``heights`` up to ``S − n_above − 1``
+    tops, top_sigma : (N,) float64 and float, metres — with ``top_sigma > 0`` each particle's own
+        object height: a top at height z adds the log prior ``−(z − tops[i])² / (2·top_sigma²)``
+    px_scale : float, 1 / pixels — 0: every sample weighs 1 (the paper's samples); > 0: each
+        sample's terms are weighted by the image length it stands for times ``px_scale``, so that a
+        column counts *pixels* of evidence and a far column, short in the image, does not gain
+        from packing more samples into the same pixels
+    counts : (N,) int32 — out: samples ``k·dz``, k = 0 … T, on ``F > γ`` (labels 1 and 2: π_i, eq. 11)
     ratio : (N,) float64 — out: the best log-likelihood ratio
     top : (N,) int32 — out: the index into ``heights`` of the best top
     seen : (N,) bool — out: at least one sample projects into the image
     """
     H, W = hit.shape
+    S = heights.shape[0]
+    last = S - n_above - 1
+    k_min = max(k_min, n_below)
     fx = K[0, 0]
+    label = np.zeros(S, dtype=np.uint8)
+    us = np.zeros(S)
+    vs = np.zeros(S)
+    wt = np.ones(S)
     for i in range(xy.shape[0]):
         # Camera-frame coordinates of the floor point; the column is linear in z.
         b0 = R[0, 0] * xy[i, 0] + R[0, 1] * xy[i, 1] + t[0]
         b1 = R[1, 0] * xy[i, 0] + R[1, 1] * xy[i, 1] + t[1]
         b2 = R[2, 0] * xy[i, 0] + R[2, 1] * xy[i, 1] + t[2]
-        c = 0
         s = False
-        run = 0.0
-        best = -1e300
-        kbest = k_min
-        for k in range(heights.shape[0]):
+        for k in range(S):
             z = heights[k]
             cz = b2 + R[2, 2] * z
             u, v = _cam_to_uv(b0 + R[0, 2] * z, b1 + R[1, 2] * z, cz, K, dist, has_dist)
-            h = 0
-            # The centre, then (cylinder) the pixels ``radius`` to the left and right at this depth.
+            us[k] = u
+            vs[k] = v
+            lab = 0
+            # The centre, then (cylinder) the pixels ``radius`` to the left and right at this depth:
+            # object if any reads object, else no evidence if any reads so.
             d = fx * radius / cz if radius > 0.0 and cz > 1e-9 else 0.0
             for j in range(3 if d > 0.0 else 1):
                 iu, iv = _pixel_index(u + (0.0 if j == 0 else (-d if j == 1 else d)), v, W, H)
                 if iu >= 0:
                     s = True
-                    if hit[iv, iu] and not _others(owner, box, iu, iv):
-                        h = 1
-                        break
-            if k < n_below:
-                if h:
-                    run += below
-                continue
-            c += h
-            run += on if h else off
-            if k >= k_min and run > best:
-                best = run
-                kbest = k
+                    if not _others(owner, box, iu, iv):
+                        p = hit[iv, iu]
+                        if p == 1:
+                            lab = 1
+                            break
+                        if p == 2:
+                            lab = 2
+            label[k] = lab
+        if px_scale > 0.0:
+            for k in range(S):
+                wt[k] = _sample_length(us, vs, k) * px_scale
+        base = 0.0
+        for k in range(n_below):
+            if label[k] == 1:
+                base += below * wt[k]
+        c = 0
+        for k in range(n_below, last + 1):
+            if label[k] != 0:
+                c += 1
+        # Ring above the top: the weight of the ``n_above`` samples above index k that read object.
+        ring = 0.0
+        for k in range(k_min + 1, min(k_min + n_above, S - 1) + 1):
+            if label[k] == 1:
+                ring += wt[k]
+        run = base
+        best = -1e300
+        kbest = k_min
+        for k in range(n_below, last + 1):
+            lab = label[k]
+            if lab == 1:
+                run += on * wt[k]
+            elif lab == 0:
+                run += off * wt[k]
+            if k >= k_min:
+                if k > k_min and n_above > 0:
+                    # Slide the ring up by one sample: k leaves it, k + n_above enters.
+                    if label[k] == 1:
+                        ring -= wt[k]
+                    if k + n_above < S and label[k + n_above] == 1:
+                        ring += wt[k + n_above]
+                score = run + ring * below
+                if top_sigma > 0.0:
+                    e = (heights[k] - tops[i]) / top_sigma
+                    score -= 0.5 * e * e
+                if score > best:
+                    best = score
+                    kbest = k
         counts[i] = c
         ratio[i] = best
         top[i] = kbest
         seen[i] = s
+
+
+@njit(cache=True, inline="always")
+def _sample_length(us, vs, k):
+    """Image length (pixels) a column sample stands for: half the distance between its neighbours'
+    projections (one neighbour at the ends); 0 where a projection is undefined."""
+    S = us.shape[0]
+    lo = k - 1 if k > 0 else k
+    hi = k + 1 if k < S - 1 else k
+    if hi == lo:
+        return 0.0
+    du = us[hi] - us[lo]
+    dv = vs[hi] - vs[lo]
+    if not (du == du and dv == dv):
+        return 0.0
+    return math.sqrt(du * du + dv * dv) / (hi - lo)
 
 
 @njit(cache=True)
@@ -352,13 +425,14 @@ def _readable(owner: np.ndarray | None, box, iu: np.ndarray, iv: np.ndarray) -> 
 
 def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray,
                             on: float = 1.0, off: float = -1.0, k_min: int = 0, radius: float = 0.0,
-                            below: float = 0.0, n_below: int = 0, owner: np.ndarray | None = None,
-                            box=None):
+                            below: float = 0.0, n_below: int = 0, n_above: int = 0,
+                            owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
+                            top_sigma: float = 0.0, px_scale: float = 0.0):
     """:func:`column_counts` written plainly: every (particle, height) point through :meth:`Camera.project`.
 
     Returns
     -------
-    counts : (N,) int64 — samples from the floor up on ``F > γ`` (eq. 11)
+    counts : (N,) int64 — samples ``k·dz``, k = 0 … T, on ``F > γ`` (eq. 11)
     ratio : (N,) float — the best log-likelihood ratio
     top : (N,) int64 — index into ``heights`` of the best top
     seen : (N,) bool — some sample projects into the image
@@ -370,6 +444,7 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
     pts[:, :, 2] = np.asarray(heights, dtype=float)[None, :]
     uv, depth = camera.project(pts, return_depth=True)
     hits = np.zeros((n, s), dtype=bool)
+    unsure = np.zeros((n, s), dtype=bool)
     seen = np.zeros(n, dtype=bool)
     offsets = [0.0] if radius <= 0 else [0.0, -1.0, 1.0]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -380,14 +455,36 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         inside = camera.in_image(uo) & np.isfinite(uo).all(axis=-1)
         iu = np.where(inside, np.floor(np.nan_to_num(uo[..., 0]) + 0.5), 0).astype(np.int64)
         iv = np.where(inside, np.floor(np.nan_to_num(uo[..., 1]) + 0.5), 0).astype(np.int64)
-        hits |= inside & (hit[iv, iu] > 0) & _readable(owner, box, iu, iv)
+        readable = inside & _readable(owner, box, iu, iv)
+        hits |= readable & (hit[iv, iu] == 1)
+        unsure |= readable & (hit[iv, iu] == 2)
         seen |= inside.any(axis=1)
-    terms = np.where(hits, on, off)
-    terms[:, :n_below] = np.where(hits[:, :n_below], below, 0.0)
-    run = np.cumsum(terms, axis=1)
+    unsure &= ~hits
+    if px_scale > 0:
+        # Each sample stands for half the image distance between its neighbours (one at the ends).
+        lo = np.maximum(np.arange(s) - 1, 0)
+        hi = np.minimum(np.arange(s) + 1, s - 1)
+        length = np.hypot(*(uv[:, hi] - uv[:, lo]).transpose(2, 0, 1)) / (hi - lo)
+        weight = np.nan_to_num(length, nan=0.0) * px_scale
+    else:
+        weight = np.ones((n, s))
+    last = s - n_above                                   # one past the highest possible top
+    terms = np.where(hits, on, np.where(unsure, 0.0, off)) * weight
+    terms[:, :n_below] = np.where(hits[:, :n_below], below, 0.0) * weight[:, :n_below]
+    run = np.cumsum(terms[:, :last], axis=1)
+    # The ring above a top at index k: samples k + 1 … k + n_above that read object.
+    ring = np.zeros_like(run)
+    hit_weight = np.where(hits, weight, 0.0)
+    for j in range(1, n_above + 1):
+        ring += np.pad(hit_weight[:, j:last + j], ((0, 0), (0, max(0, last + j - s))))[:, :last]
+    run = run + below * ring
+    if top_sigma > 0:
+        z = np.asarray(heights, dtype=float)[None, :last]
+        run = run - 0.5 * ((z - np.asarray(tops, dtype=float)[:, None]) / top_sigma) ** 2
     run[:, :max(k_min, n_below)] = -np.inf
     top = np.argmax(run, axis=1)
-    return hits[:, n_below:].sum(axis=1).astype(np.int64), run[np.arange(n), top], top, seen
+    counts = (hits | unsure)[:, n_below:last].sum(axis=1).astype(np.int64)
+    return counts, run[np.arange(n), top], top, seen
 
 
 def point_values_reference(camera: Camera, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
@@ -418,8 +515,9 @@ class CameraLikelihood:
         self.no_owner = np.zeros((camera.height, camera.width), dtype=np.uint8)
 
     def column(self, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
-               k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0,
-               owner: np.ndarray | None = None, box=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+               k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
+               owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
+               top_sigma: float = 0.0, px_scale: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`."""
         xy = np.ascontiguousarray(xy, dtype=np.float64)
         n = len(xy)
@@ -430,7 +528,9 @@ class CameraLikelihood:
         column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
                       self.has_dist, float(radius), hit, self.no_owner if owner is None else owner,
                       NO_BOX if box is None else np.asarray(box, dtype=np.int64), float(on), float(off),
-                      float(below), int(n_below), int(k_min), counts, ratio, top, seen)
+                      float(below), int(n_below), int(n_above), int(k_min),
+                      np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
+                      float(top_sigma) if tops is not None else 0.0, float(px_scale), counts, ratio, top, seen)
         return counts, ratio, top, seen
 
     def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
