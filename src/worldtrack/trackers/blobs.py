@@ -50,6 +50,7 @@ from scipy.spatial.distance import pdist
 
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import AdaptiveBackground
+from worldtrack.foreground.components import connected_components
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.quadric import ellipse_parameters, ellipsoid_conics, person_ellipsoid
 from worldtrack.scene.model import Scene
@@ -219,7 +220,7 @@ class _CameraDetector:
     def foot_points(self, mask: np.ndarray) -> np.ndarray:
         """(N, 2) floor points (m) of the blobs in ``mask`` that pass every test."""
         cfg, cam = self.config, self.camera
-        _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        _, labels, stats, _ = connected_components(mask)
         x0, y0, w, h, area = (stats[:, k].astype(float) for k in range(5))  # row 0: the background
         keep = (area >= cfg.min_area_px) & (y0 + h < cam.height)  # bottom on the border: feet cut off
         keep[0] = False

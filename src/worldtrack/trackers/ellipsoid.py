@@ -39,6 +39,7 @@ import numpy as np
 from numba.typed import List as NumbaList
 
 from worldtrack.foreground.background import Foreground
+from worldtrack.foreground.components import connected_components
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
@@ -80,7 +81,10 @@ class EllipsoidConfig:
         the viewing direction (0 = start at the foot point, as the paper's capture does)
     rescue_search_m, rescue_gain, rescue_every : a tracked person whose support is failing, and
         every person every ``rescue_every`` frames, is moved along the viewing line up to
-        ±``rescue_search_m`` if E there is higher by ``rescue_gain`` (0 = never, as published)
+        ±``rescue_search_m`` (along every seeing camera's line) if E there is higher by
+        ``rescue_gain`` (0 = never, as published)
+    rescue_retry_frames : int — after a search that found nothing better, a failing track waits
+        this many frames before the next one
     target_pixels : int — pixels visited per candidate set (0 = all, as published)
     score : {"paper", "symmetric"} — eq. 5 as published, or with the foreground the simulation
         leaves unexplained added to the denominator in tracking mode (see ``ellipsoid_score``)
@@ -121,6 +125,9 @@ class EllipsoidConfig:
         slid past the image border or onto empty floor)
     min_seen_share : float — a captured person is confirmed only once some camera shows at least
         this share of its ellipse (a sliver at the image border fits anything)
+    confirm_views : int — a captured person that passes the capture tests in a frame while at
+        least this many cameras show enough of its own pixels, all of them foreground-supported,
+        is confirmed at once instead of after ``confirm_frames`` (0 = never)
     lost_after_s : float
     leave_after_frames : int — frames unseen by every camera before a track ends
     merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
@@ -140,6 +147,7 @@ class EllipsoidConfig:
     rescue_search_m: float = 1.5
     rescue_gain: float = 0.08
     rescue_every: int = 10
+    rescue_retry_frames: int = 3
     target_pixels: int = 1500
     score: str = "symmetric"
     adaptive_step: bool = True
@@ -164,6 +172,7 @@ class EllipsoidConfig:
     min_evidence: float = 0.2
     young_s: float = 3.0
     min_seen_share: float = 0.3
+    confirm_views: int = 2
     lost_after_s: float = 1.0
     leave_after_frames: int = 2
     merge_distance_m: float = 0.25
@@ -185,6 +194,8 @@ class EllipsoidConfig:
             raise ValueError(f"score: expected 'paper' or 'symmetric', got {self.score!r}")
         if self.step_m <= 0 or self.iterations < 1:
             raise ValueError("step_m must be positive and iterations at least 1")
+        if self.confirm_views < 0 or self.rescue_retry_frames < 0:
+            raise ValueError("confirm_views and rescue_retry_frames must not be negative")
 
 
 @dataclass
@@ -259,6 +270,7 @@ class EllipsoidTracker:
         self._unseen: dict[int, int] = {}
         self._confirmed: set[int] = set()
         self._heights: dict[int, list[float]] = {}
+        self._height_tries: dict[int, int] = {}
         #: Per camera, the last frame's foreground mask and ternary image (for overlays).
         self.last_masks: dict[str, np.ndarray] = {}
         self.last_labels: dict[str, np.ndarray] = {}
@@ -352,14 +364,17 @@ class EllipsoidTracker:
                 cfg.score == "symmetric", cfg.min_depth_m)
         if cfg.rescue_search_m > 0:
             for k, tr in enumerate(tracks):
-                # Periodically too, but only for someone nobody overlaps: in a group the line of
-                # sight crosses other people and a "better place" is often somebody else.
-                periodic = (cfg.rescue_every > 0 and (self._frame + tr.id) % cfg.rescue_every == 0
-                            and tr.extra.get("own_share", 0.0) >= 0.9)
-                if tr.mode == "tracking" and (tr.frames_low > 0 or periodic):
+                # Periodically too, for everyone (``_rescue`` never moves onto somebody else).
+                periodic = cfg.rescue_every > 0 and (self._frame + tr.id) % cfg.rescue_every == 0
+                # A failing track whose search found nothing better waits a few frames before
+                # searching again: the same line of sight a frame later rarely holds a new answer.
+                failing = tr.frames_low > 0 and self._frame >= tr.extra.get("rescue_after", 0)
+                if tr.mode == "tracking" and (failing or periodic):
                     e = self._rescue(k, xy, hs, ws, state, real, best_e[k], best_den[k])
                     if e is not None:
                         best_e[k] = e
+                    elif failing:
+                        tr.extra["rescue_after"] = self._frame + cfg.rescue_retry_frames
         for k, tr in enumerate(tracks):
             tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
             result[tr.id] = (float(best_e[k]), float(best_den[k]))
@@ -459,10 +474,11 @@ class EllipsoidTracker:
         ``rescue_every`` frames; never onto somebody else (``min_separation_m``).
         """
         cfg = self.config
-        d, n = self._axes(k, state, xy, along_ray=True)
         along = np.arange(-cfg.rescue_search_m, cfg.rescue_search_m + 1e-9, 0.15)
         along = along[np.abs(along) > 0.2]
-        cand = xy[k] + along[:, None] * d
+        # Along every seeing camera's line of sight: with two cameras the error lies along the one
+        # that fixes depth worse, not necessarily the one that sees the person largest.
+        cand = np.concatenate([xy[k] + along[:, None] * d for d in self._ray_directions(k, state, xy)])
         others = np.delete(xy, k, axis=0)
         ok = self._walkable(cand)
         if len(others):
@@ -485,6 +501,18 @@ class EllipsoidTracker:
             for a in range(5):
                 state[cid][a][k] = f[a][b]
         return float(e[b])
+
+    def _ray_directions(self, k: int, state: dict, xy: np.ndarray) -> list[np.ndarray]:
+        """Unit floor directions of the rays from each camera that sees person ``k`` through its
+        position (the camera's optical axis for a person right below it); one direction at least."""
+        out = []
+        for cid, st in state.items():
+            if not st[3][k]:
+                continue
+            cam = self.cams[cid].camera
+            r = xy[k] - cam.centre[:2]
+            out.append(r / np.linalg.norm(r) if np.linalg.norm(r) > 0.3 else cam.floor_direction)
+        return out or [self._axes(k, state, xy, along_ray=True)[0]]
 
     def _axes(self, k: int, state: dict, xy: np.ndarray | None = None,
               along_ray: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -594,7 +622,9 @@ class EllipsoidTracker:
             r_open, r_close = 1, max(1, cs.ring_px // 2)
             un = cv2.morphologyEx(un, cv2.MORPH_OPEN, _disc(r_open))
             un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, np.ones((2 * r_close + 1, 2 * r_close + 1), np.uint8))
-            n, labels, stats, cent = cv2.connectedComponentsWithStats(un, connectivity=8)
+            if not cv2.countNonZero(un):
+                continue
+            n, labels, stats, cent = connected_components(un)
             min_area = max(10 * cam.width * cam.height / (160 * 120),
                            0.1 * self._smallest_person_px(cs))
             for j in range(1, n):
@@ -606,8 +636,8 @@ class EllipsoidTracker:
                 if p is None:
                     continue
                 pxy = self._nearest_walkable(p[:2], 0.6)
-                if pxy is None:
-                    continue
+                if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
+                    continue  # off the floor, or somebody already there
                 # Is the blob big enough to be (the visible part of) a person standing there?
                 expected = _visible_pixels(cs, pxy, h0, w0, cfg.min_depth_m)
                 if expected <= 0 or area < cfg.min_blob_fraction * expected:
@@ -629,8 +659,9 @@ class EllipsoidTracker:
         return new
 
     # ------------------------------------------------------------------ bookkeeping
-    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float, float, float]]:
-        """Per person: (visible pixels over all cameras, support, own share, seen share, evidence).
+    def _support(self, tracks: list[Track]) -> dict[int, tuple[float, float, float, float, float, int]]:
+        """Per person: (visible pixels over all cameras, support, own share, seen share, evidence,
+        views).
 
         Support is the share of the person's own pixels (visible, covered by nobody else) that
         are foreground, in the camera where it is lowest among those that show at least
@@ -640,7 +671,8 @@ class EllipsoidTracker:
         visible pixels that nobody else covers. Seen share: the largest fraction of the whole
         ellipse that some camera shows (image border and obstacles cut it). Evidence: the
         largest fraction of the whole ellipse that is foreground of its own or explained by
-        others — low for a track that drifted past the image border or onto the floor.
+        others — low for a track that drifted past the image border or onto the floor. Views: the
+        number of cameras that show at least ``_MIN_OWN_PIXELS`` of the person's own pixels.
         """
         cfg = self.config
         if not tracks:
@@ -654,6 +686,7 @@ class EllipsoidTracker:
         seen_share = np.zeros(len(tracks))
         evidence = np.zeros(len(tracks))
         support = np.full(len(tracks), np.nan)
+        views = np.zeros(len(tracks), dtype=int)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
             inner, _, box, valid, dist = cs.forms(xy, hs, ws, cfg.min_depth_m)
@@ -667,8 +700,9 @@ class EllipsoidTracker:
             with np.errstate(invalid="ignore", divide="ignore"):
                 here = np.where(own >= _MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
             support = np.fmin(support, here)
+            views += own >= _MIN_OWN_PIXELS
         own_share = np.where(visible > 0, own_total / np.maximum(visible, 1), np.nan)
-        return {tr.id: (visible[k], support[k], own_share[k], seen_share[k], evidence[k])
+        return {tr.id: (visible[k], support[k], own_share[k], seen_share[k], evidence[k], views[k])
                 for k, tr in enumerate(tracks)}
 
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
@@ -679,8 +713,8 @@ class EllipsoidTracker:
         support = self._support(tracks)
         for tr in tracks:
             e, den = scores.get(tr.id, (0.0, 0.0))
-            visible, sup, own_share, seen, evidence = support.get(
-                tr.id, (0.0, float("nan"), float("nan"), 0.0, 0.0))
+            visible, sup, own_share, seen, evidence, views = support.get(
+                tr.id, (0.0, float("nan"), float("nan"), 0.0, 0.0, 0))
             tr.extra["support"] = sup
             tr.extra["own_share"] = own_share
             tr.score = e
@@ -708,7 +742,9 @@ class EllipsoidTracker:
                           and not own_share < cfg.min_own_share and seen >= cfg.min_seen_share)
                     tr.extra["held"] = tr.extra.get("held", 0) + 1 if ok else 0
                     # Strong evidence (the paper's own threshold) confirms at once.
-                    confirmed = tr.extra["held"] >= cfg.confirm_frames or (ok and e > cfg.capture_threshold)
+                    # So does a person several cameras agree on (a ghost is rarely one in two views).
+                    confirmed = (tr.extra["held"] >= cfg.confirm_frames or (ok and e > cfg.capture_threshold)
+                                 or (ok and cfg.confirm_views > 0 and views >= cfg.confirm_views))
                 else:
                     confirmed = e > cfg.capture_threshold
                 if confirmed:
@@ -759,20 +795,26 @@ class EllipsoidTracker:
         lo, hi = cfg.height_range_m
         samples_now: dict[int, list[float]] = {}
         rays: dict[int, list] = {}
-        # Settled people (10 measurements) are re-measured one frame in five.
+        # Every frame until a person has 10 measurements (or 20 frames were tried: someone always
+        # in a group rarely gives one), then one frame in five.
         due = [k for k, tr in enumerate(tracks) if tr.mode == "tracking"
-               and (len(self._heights.get(tr.id, ())) < 10 or (self._frame + tr.id) % 5 == 0)]
+               and ((len(self._heights.get(tr.id, ())) < 10 and self._height_tries.get(tr.id, 0) < 20)
+                    or (self._frame + tr.id) % 5 == 0)]
         if not due:
             return
+        for k in due:
+            self._height_tries[tracks[k].id] = self._height_tries.get(tracks[k].id, 0) + 1
+        triangulate = len(self.last_labels) >= 2  # head rays from two cameras or more
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
             # Where a person's pixels may be: the ellipse of the tallest plausible person (a
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
             _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws, cfg.min_depth_m)
             cam = cs.camera
-            # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
-            inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
-            owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
+            if triangulate:
+                # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
+                inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+                owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
             for k in due:
                 tr = tracks[k]
                 if not valid[k]:
@@ -782,13 +824,14 @@ class EllipsoidTracker:
                 if u0 >= u1 or v0 >= v1:
                     continue
                 region = _form_mask(ring[k], b, cs.grid, cam.has_distortion)
-                mine = owner[v0:v1, u0:u1]
                 down = cs.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
                 if down is None:
                     continue
-                ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b), down)
-                if ray is not None:
-                    rays.setdefault(tr.id, []).append(ray)
+                if triangulate:
+                    mine = owner[v0:v1, u0:u1]
+                    ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b), down)
+                    if ray is not None:
+                        rays.setdefault(tr.id, []).append(ray)
                 overlap = (valid & (box[:, 0] < b[1]) & (box[:, 1] > b[0]) & (box[:, 2] < b[3]) & (box[:, 3] > b[2]))
                 overlap[k] = False
                 if overlap.any():
@@ -826,9 +869,12 @@ class EllipsoidTracker:
             self._unseen[new] = self._unseen.pop(old)
         if old in self._heights:
             self._heights[new] = self._heights.pop(old)
+        if old in self._height_tries:
+            self._height_tries[new] = self._height_tries.pop(old)
 
     def _end(self, tr: Track) -> None:
         self._heights.pop(tr.id, None)
+        self._height_tries.pop(tr.id, None)
         if tr.id in self.position_map:
             self.position_map.remove(tr.id)
         self._confirmed.discard(tr.id)
