@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from worldtrack.foreground.components import connected_components
+from worldtrack.foreground.components import blobs, connected_components
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -31,3 +31,34 @@ def test_two_diagonal_pixels_are_one_component_and_stats_are_exact():
     np.testing.assert_array_equal(stats[labels[1, 1]], [1, 1, 2, 2, 2])
     np.testing.assert_array_equal(stats[labels[4, 6]], [5, 4, 3, 1, 3])
     np.testing.assert_allclose(cent[labels[4, 6]], [6.0, 4.0])
+
+
+@pytest.mark.parametrize("shape", [(480, 640), (121, 161)])     # even, and not a multiple of the factor
+def test_blobs_found_at_half_resolution_are_the_full_resolution_blobs(shape):
+    rng = np.random.default_rng(7)
+    mask = np.zeros(shape, np.uint8)
+    H, W = shape
+    for k in range(10):                  # separate rectangles (≥ 4 px apart: a 4 px grid of cells)
+        y, x = 4 + 40 * (k // 4) % (H - 40), 4 + 40 * (k % 4) % (W - 40)
+        h, w = rng.integers(1, 33, size=2)
+        mask[y:y + h, x:x + w] = 1
+    mask[H - 1, W - 1] = 1               # a single pixel in the last, partial block
+    full = sorted(blobs(mask, 1, 1), key=lambda b: b[1])
+    half = sorted(blobs(mask, 1, 2), key=lambda b: b[1])
+    assert len(full) == len(half) >= 8
+    for (a0, box0, c0, m0), (a1, box1, c1, m1) in zip(full, half):
+        assert a0 == a1 and box0 == box1
+        np.testing.assert_allclose(c0, c1)
+        np.testing.assert_array_equal(m0, m1)
+    assert {b[0] for b in blobs(mask, 50, 2)} == {b[0] for b in full if b[0] >= 50}   # min_area in full pixels
+
+
+def test_blobs_one_pixel_apart_are_joined_at_half_resolution():
+    mask = np.zeros((8, 8), np.uint8)
+    mask[2:6, 1] = 1
+    mask[2:6, 3] = 1                     # one empty column between: two blobs, one 2x2 block apart
+    assert len(blobs(mask, 1, 1)) == 2
+    ((area, box, centroid, crop),) = blobs(mask, 1, 2)
+    assert area == 8 and box == (1, 2, 3, 4)
+    np.testing.assert_allclose(centroid, [2.0, 3.5])
+    assert crop.sum() == 8 and not crop[:, 1].any()

@@ -39,7 +39,7 @@ import numpy as np
 from numba.typed import List as NumbaList
 
 from worldtrack.foreground.background import Foreground
-from worldtrack.foreground.components import connected_components
+from worldtrack.foreground.components import blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
@@ -624,15 +624,12 @@ class EllipsoidTracker:
             un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, np.ones((2 * r_close + 1, 2 * r_close + 1), np.uint8))
             if not cv2.countNonZero(un):
                 continue
-            n, labels, stats, cent = connected_components(un)
             min_area = max(10 * cam.width * cam.height / (160 * 120),
                            0.1 * self._smallest_person_px(cs))
-            for j in range(1, n):
-                area = int(stats[j, cv2.CC_STAT_AREA])
-                if area < min_area:
-                    continue
-                x0, y0, bw, bh = stats[j, :4]
-                p = _blob_position(cs, labels[y0:y0 + bh, x0:x0 + bw] == j, (x0, y0), cent[j], h0)
+            # Components found at ~320 px wide (each blob then read back at full resolution):
+            # labelling the whole 640x480 frame was a third of the births' time.
+            for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
+                p = _blob_position(cs, blob, (x0, y0), centroid, h0)
                 if p is None:
                     continue
                 pxy = self._nearest_walkable(p[:2], 0.6)
