@@ -123,10 +123,9 @@ def test_header_only_prediction_scores_all_misses(tmp_path, capsys):
 
 
 def test_area_can_be_a_file_with_comments(tmp_path, capsys):
+    # The square of test_area_and_gate_options, over two lines: only GT 1 and prediction 11 inside.
     area = tmp_path / "area.txt"
-    area.write_text("# a square around everything\n-100,-100, 100,-100\n100,100,-100,100\n")
-    from worldtrack.cli import main
-    assert main(["eval", GT, PRED, "--area", str(area), "--json"]) == 0
-    inside = json.loads(capsys.readouterr().out)
-    assert main(["eval", GT, PRED, "--json"]) == 0
-    assert inside["mota"] == json.loads(capsys.readouterr().out)["mota"]
+    area.write_text("# a square around GT 1 at (0, 0)\n-1,-1, 1,-1\n1,1,-1,1\n")
+    m = _json(capsys, ["eval", GT, PRED, "--json", "--area", str(area)])
+    assert m["num_objects"] == 5 and m["num_false_positives"] == 0 and m["mota"] == 1.0
+    assert m == _json(capsys, ["eval", GT, PRED, "--json", "--area=-1,-1,1,-1,1,1,-1,1"])

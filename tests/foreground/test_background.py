@@ -42,6 +42,18 @@ def test_shadow_is_unsure_and_shirt_is_foreground():
     np.testing.assert_array_equal(fg.mask(img), (lab == 1).astype(np.uint8))
 
 
+
+def test_grey_mode_with_shadows_labels_the_cast_shadow_unsure():
+    bg, img = scene_pair()
+    lab = StaticBackground(bg, 20, "grey", shadows=True).labels(img)
+    shadow = np.zeros(lab.shape, bool)
+    shadow[35:50, 40:70] = True
+    assert (lab[shadow] == UNSURE).mean() > 0.95 and not (lab[shadow] == 1).any()
+    assert not (lab[~shadow] == UNSURE).any()               # nothing else is shadow-like
+    assert (lab[5:15, 50:60] == 1).mean() > 0.95            # brighter than the background: not shadow
+    plain = StaticBackground(bg, 20, "grey", shadows=False).labels(img)
+    assert (plain[shadow] == 1).mean() > 0.95               # without the test the shadow is foreground
+
 def test_grey_mode_misses_equal_brightness_colour():
     bg = np.full((10, 10, 3), 120, np.uint8)
     img = bg.copy()

@@ -82,7 +82,12 @@ def test_two_poses_or_none_is_an_error_and_types_are_checked():
 
 
 def test_dump_and_load_round_trip(tmp_path):
-    scene = load_scene(LAB)
+    d = lab_dict()
+    d["obstacles"][0]["yaw_deg"] = 30.0                                  # a turned desk
+    pillar = [[-2.0, 0.0], [-1.6, 0.0], [-1.6, 0.4], [-2.0, 0.4]]
+    d["floor"]["walkable"][0]["holes"] = [pillar]
+    d["people"]["overrides"] = {3: {"height": 1.80}}                    # width from the default
+    scene = scene_from_dict(d, label="scene.yaml")
     out = tmp_path / "copy.yaml"
     dump_scene(scene, out)
     again = load_scene(out)
@@ -90,6 +95,13 @@ def test_dump_and_load_round_trip(tmp_path):
         np.testing.assert_allclose(again.cameras[cid].P, cam.P, atol=1e-8)
         np.testing.assert_allclose(again.cameras[cid].dist, cam.dist)
     assert [o.name for o in again.obstacles] == ["desk", "shelf"]
+    assert again.obstacles[0].yaw == pytest.approx(np.radians(30.0))
+    np.testing.assert_allclose(again.obstacles[0].footprint, scene.obstacles[0].footprint, atol=1e-9)
+    (poly,) = again.walkable.polygons
+    assert len(poly.holes) == 1
+    np.testing.assert_allclose(poly.holes[0], pillar)
+    assert poly.contains([[-1.8, 0.2], [-1.0, 0.2]]).tolist() == [False, True]
+    assert again.people.size_of(3) == (1.80, 0.40) and again.people.size_of(7) == (1.65, 0.40)
     np.testing.assert_allclose(again.entry_regions[0].polygon, scene.entry_regions[0].polygon)
 
 

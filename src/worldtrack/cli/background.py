@@ -9,12 +9,12 @@ H.264), estimates the background and writes it as an image that ``worldtrack tra
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from worldtrack.cli._args import parse_size
 from worldtrack.errors import InputError
 
 DESCRIPTION = """\
@@ -68,13 +68,6 @@ def _positive_int(text: str, flag: str) -> int:
     if value <= 0:
         raise InputError(f"{flag}: expected a positive whole number, got {text!r}")
     return value
-
-
-def _size(text: str) -> tuple[int, int]:
-    m = re.fullmatch(r"\s*(\d+)\s*[xX×,]\s*(\d+)\s*", text)
-    if not m or min(int(m.group(1)), int(m.group(2))) <= 0:
-        raise InputError(f"--camera-size: expected WxH in pixels such as 480x360, got {text!r}")
-    return int(m.group(1)), int(m.group(2))
 
 
 def sample_frames(path: str | Path, samples: int, progress: bool = True) -> tuple[list[np.ndarray], int]:
@@ -158,7 +151,7 @@ def run(args: argparse.Namespace) -> int:
         threshold = -1.0
     if not 0 < threshold < 255:
         raise InputError(f"--threshold: expected grey levels in (0, 255), got {args.threshold!r}")
-    size = _size(args.camera_size) if args.camera_size else None
+    size = parse_size(args.camera_size, "--camera-size", "480x360") if args.camera_size else None
     out = Path(args.out)
     if out.suffix.lower() not in (".png", ".bmp", ".tif", ".tiff", ".jpg", ".jpeg"):
         raise InputError(f"--out {out}: expected an image file name (.png)")

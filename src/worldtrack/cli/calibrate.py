@@ -22,14 +22,15 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from worldtrack.cli._args import parse_size, positive
 from worldtrack.errors import InputError
 from worldtrack.geometry.calibrate import ADVISED_POINTS, CalibrationResult, calibrate
 from worldtrack.geometry.camera import Camera
 from worldtrack.io.calibration_formats import UNITS, ImportedCamera, import_camera, read_calibration
+from worldtrack.io.text import is_number, read_text
 from worldtrack.scene.load import camera_to_dict
 
 _HEADER = ("X", "Y", "Z", "x", "y")
-_SIZE = re.compile(r"^\s*(\d+)\s*[xX×,]\s*(\d+)\s*$")
 _SIZE_COMMENT = re.compile(r"^#\s*image[_ ]?size\s*[:=]\s*(.*)$", re.IGNORECASE)
 
 DESCRIPTION = f"""\
@@ -103,14 +104,6 @@ def _cells(line: str) -> list[str]:
     return cells
 
 
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
 def read_points(path: str | Path) -> PointsFile:
     """Read a calibration CSV (see ``worldtrack calibrate --help``).
 
@@ -120,16 +113,7 @@ def read_points(path: str | Path) -> PointsFile:
         Naming the file, the line and what was expected.
     """
     label = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise InputError(f"{label}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{label}: is a directory, expected a CSV file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{label}: not a text file (expected CSV with header X,Y,Z,x,y)") from None
-    except OSError as e:
-        raise InputError(f"{label}: cannot read ({e.strerror})") from None
+    text = read_text(path, "CSV with header X,Y,Z,x,y", directory="a CSV file")
 
     header_seen = False
     image_size: tuple[int, int] | None = None
@@ -142,11 +126,7 @@ def read_points(path: str | Path) -> PointsFile:
         if line.startswith("#"):
             m = _SIZE_COMMENT.match(line)
             if m:
-                size = _SIZE.match(m.group(1))
-                if not size or min(int(size.group(1)), int(size.group(2))) <= 0:
-                    raise InputError(f"{label}: line {n}: image_size: expected WxH in pixels such as 640x480, "
-                                     f"got {m.group(1).strip()!r}")
-                image_size = (int(size.group(1)), int(size.group(2)))
+                image_size = parse_size(m.group(1).strip(), f"{label}: line {n}: image_size", "640x480")
             continue
         cells = _cells(line)
         if not header_seen:
@@ -155,7 +135,7 @@ def read_points(path: str | Path) -> PointsFile:
             if names == expected:
                 header_seen = True
                 continue
-            if cells and all(_is_number(c) for c in cells):
+            if cells and all(is_number(c) for c in cells):
                 raise InputError(f"{label}: line {n}: expected the header X,Y,Z,x,y before the numbers")
             if names[:5] == expected:
                 extra = ", ".join(repr(c) for c in cells[5:])
@@ -179,13 +159,6 @@ def read_points(path: str | Path) -> PointsFile:
     return PointsFile(data[:, :3], data[:, 3:], lines, image_size)
 
 
-def _parse_size(text: str) -> tuple[int, int]:
-    m = _SIZE.match(text)
-    if not m or min(int(m.group(1)), int(m.group(2))) <= 0:
-        raise InputError(f"--image-size: expected WxH in pixels such as 640x480, got {text!r}")
-    return int(m.group(1)), int(m.group(2))
-
-
 def _parse_intrinsics(text: str) -> list[float]:
     parts = [p.strip() for p in text.split(",")]
     try:
@@ -196,6 +169,15 @@ def _parse_intrinsics(text: str) -> list[float]:
         raise InputError(f"--intrinsics: expected fx,fy,cx,cy in pixels with fx, fy > 0 "
                          f"(e.g. 554.3,554.3,319.5,239.5), got {text!r}")
     return values
+
+
+def _parse_radial_terms(text: str | None) -> int | None:
+    """``--radial-terms``: 1, 2 or 3, or None when not given."""
+    if text is None:
+        return None
+    if text.strip() not in ("1", "2", "3"):
+        raise InputError(f"--radial-terms: expected 1, 2 or 3, got {text!r}")
+    return int(text)
 
 
 def camera_block(result: CalibrationResult) -> str:
@@ -210,14 +192,9 @@ def _m(x: float, nd: int = 3) -> str:
 def format_report(result: CalibrationResult, points: PointsFile, label: str) -> str:
     """Everything ``worldtrack calibrate`` prints to standard output."""
     cam = result.camera
-    K = cam.K
     out = [f"calibrated {cam.id!r} from {result.n_points} points in {label} ({cam.width}x{cam.height} px)", "",
            "camera block (paste under 'cameras:' in a scene file):", camera_block(result).rstrip("\n"), ""]
-    c = cam.centre
-    hfov_deg = math.degrees(2 * math.atan2(cam.width / 2, K[0, 0]))
-    out.append(f"camera centre: ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m")
-    out.append(f"focal length: fx = {K[0, 0]:.2f} px, fy = {K[1, 1]:.2f} px (horizontal field of view "
-               f"{hfov_deg:.1f} deg); principal point ({K[0, 2]:.2f}, {K[1, 2]:.2f}) px")
+    out += _camera_lines(cam)
     if cam.has_distortion:
         k1, k2, _, _, k3 = cam.dist
         terms = f"k1 = {k1:.4f}, k2 = {k2:.4f}" + (f", k3 = {k3:.4f}" if k3 else "")
@@ -274,7 +251,7 @@ def run(args: argparse.Namespace) -> int:
     points = read_points(args.points)
     extra_warnings: list[str] = []
     if args.image_size is not None:
-        size = _parse_size(args.image_size)
+        size = parse_size(args.image_size, "--image-size", "640x480")
         if points.image_size is not None and points.image_size != size:
             extra_warnings.append(f"--image-size {size[0]}x{size[1]} overrides the file's image_size "
                                   f"{points.image_size[0]}x{points.image_size[1]}")
@@ -284,11 +261,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"{label}: image size unknown; give --image-size WxH (e.g. 640x480) or add a line "
                          "'# image_size: 640x480' to the file")
     intrinsics = _parse_intrinsics(args.intrinsics) if args.intrinsics is not None else None
-    distortion: bool | int = bool(args.distortion)
-    if args.radial_terms is not None:
-        if args.radial_terms.strip() not in ("1", "2", "3"):
-            raise InputError(f"--radial-terms: expected 1, 2 or 3, got {args.radial_terms!r}")
-        distortion = int(args.radial_terms)
+    radial_terms = _parse_radial_terms(args.radial_terms)
+    distortion: bool | int = bool(args.distortion) if radial_terms is None else radial_terms
     try:
         result = calibrate(points.world, points.image, size[0], size[1], camera_id=args.id,
                            distortion=distortion, intrinsics=intrinsics,
@@ -304,12 +278,26 @@ def run(args: argparse.Namespace) -> int:
         header = (f"# camera {result.camera.id!r} calibrated by worldtrack from {label}: centre "
                   f"({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m, RMS {result.rms:.3f} px\n"
                   "# paste under 'cameras:' in a scene file\n")
-        try:
-            Path(args.out).write_text(header + camera_block(result))
-        except OSError as e:
-            raise InputError(f"{args.out}: cannot write ({e.strerror})") from None
-        print(f"wrote {args.out}")
+        _write_out(args.out, header + camera_block(result))
     return 0
+
+
+def _camera_lines(cam: Camera, at: str = "") -> list[str]:
+    """The camera centre and focal-length lines of both reports; ``at`` follows ``fy = … px``."""
+    c, K = cam.centre, cam.K
+    hfov_deg = math.degrees(2 * math.atan2(cam.width / 2, K[0, 0]))
+    return [f"camera centre: ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m",
+            f"focal length: fx = {K[0, 0]:.2f} px, fy = {K[1, 1]:.2f} px{at} (horizontal field of view "
+            f"{hfov_deg:.1f} deg); principal point ({K[0, 2]:.2f}, {K[1, 2]:.2f}) px"]
+
+
+def _write_out(path: str, text: str) -> None:
+    """Write ``--out`` and say so."""
+    try:
+        Path(path).write_text(text)
+    except OSError as e:
+        raise InputError(f"{path}: cannot write ({e.strerror})") from None
+    print(f"wrote {path}")
 
 
 # ---------------------------------------------------------------------------- --import
@@ -336,15 +324,7 @@ def parse_check(text: str) -> CheckPoint:
 
 
 def _parse_scale(text: str | None) -> float | None:
-    if text is None:
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (math.isfinite(value) and value > 0):
-        raise InputError(f"--scale: expected a positive number such as 0.625, got {text!r}")
-    return value
+    return None if text is None else positive(text, "--scale", "0.625")
 
 
 def _fmt_uv(uv: np.ndarray) -> str:
@@ -385,12 +365,7 @@ def format_import_report(imp: ImportedCamera, checks: list[CheckPoint]) -> str:
                    "u' = s(u + 0.5) - 0.5)")
     out += ["", "camera block (paste under 'cameras:' in a scene file):",
             _block(cam).rstrip("\n"), ""]
-    c = cam.centre
-    K = cam.K
-    hfov_deg = math.degrees(2 * math.atan2(cam.width / 2, K[0, 0]))
-    out.append(f"camera centre: ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m")
-    out.append(f"focal length: fx = {K[0, 0]:.2f} px, fy = {K[1, 1]:.2f} px at {cam.width}x{cam.height} "
-               f"(horizontal field of view {hfov_deg:.1f} deg); principal point ({K[0, 2]:.2f}, {K[1, 2]:.2f}) px")
+    out += _camera_lines(cam, at=f" at {cam.width}x{cam.height}")
     if cam.has_distortion:
         k1, k2, p1, p2, k3 = cam.dist
         out.append(f"lens distortion: k1 = {k1:.5f}, k2 = {k2:.5f}, p1 = {p1:.5f}, p2 = {p2:.5f}, k3 = {k3:.5f}")
@@ -429,22 +404,13 @@ def _block(camera: Camera) -> str:
 def run_import(args: argparse.Namespace) -> int:
     if args.distortion or args.intrinsics is not None:
         raise InputError("--distortion and --intrinsics fit points; they do not apply with --import")
-    radial_terms = None
-    if args.radial_terms is not None:
-        if args.radial_terms.strip() not in ("1", "2", "3"):
-            raise InputError(f"--radial-terms: expected 1, 2 or 3, got {args.radial_terms!r}")
-        radial_terms = int(args.radial_terms)
+    radial_terms = _parse_radial_terms(args.radial_terms)
     units = "auto" if args.units is None else args.units.strip().lower()
     if units not in UNITS:
         raise InputError(f"--units: expected mm, m or auto, got {args.units!r}")
-    image_size = _parse_size(args.image_size) if args.image_size is not None else None
-    calibration_size = None
-    if args.calibration_size is not None:
-        try:
-            calibration_size = _parse_size(args.calibration_size)
-        except InputError:
-            raise InputError(f"--calibration-size: expected WxH in pixels such as 768x576, "
-                             f"got {args.calibration_size!r}") from None
+    image_size = parse_size(args.image_size, "--image-size", "640x480") if args.image_size is not None else None
+    calibration_size = (parse_size(args.calibration_size, "--calibration-size", "768x576")
+                        if args.calibration_size is not None else None)
     scale = _parse_scale(args.scale)
     if scale is not None and image_size is not None:
         raise InputError("give --image-size or --scale, not both")
@@ -467,11 +433,7 @@ def run_import(args: argparse.Namespace) -> int:
         header += (f"# centre ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m; {imp.camera.width}x{imp.camera.height} px\n"
                    f"# made with: {import_command(args)}\n"
                    "# paste under 'cameras:' in a scene file\n")
-        try:
-            Path(args.out).write_text(header + _block(imp.camera))
-        except OSError as e:
-            raise InputError(f"{args.out}: cannot write ({e.strerror})") from None
-        print(f"wrote {args.out}")
+        _write_out(args.out, header + _block(imp.camera))
     return 0
 
 

@@ -7,13 +7,9 @@ foot points through the scene camera onto the floor, writes ``gt.csv`` and print
 from __future__ import annotations
 
 import argparse
-import math
-import re
 import sys
-from pathlib import Path
 
-import numpy as np
-
+from worldtrack.cli._args import parse_size, positive
 from worldtrack.cli.eval import read_area
 from worldtrack.errors import InputError
 
@@ -70,24 +66,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     c.set_defaults(func=run_import)
 
 
-def _positive(text: str, flag: str, example: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{flag}: expected a positive number such as {example}, got {text!r}")
-    return value
-
-
-
-
 def run_import(args: argparse.Namespace) -> int:
     from worldtrack.io.gt_import import boxes_to_world, read_boxes
     from worldtrack.io.tracks import write_tracks
     from worldtrack.scene import load_scene
 
-    fps = _positive(args.fps, "--fps", "7")
+    fps = positive(args.fps, "--fps", "7")
     if args.scale is not None and args.gt_size is not None:
         raise InputError("give --scale or --gt-size, not both")
     area = read_area(args.area) if args.area else None
@@ -100,15 +84,13 @@ def run_import(args: argparse.Namespace) -> int:
     else:
         camera = scene.camera(args.camera)
     if args.gt_size is not None:
-        m = re.fullmatch(r"\s*(\d+)\s*[xX×,]\s*(\d+)\s*", args.gt_size)
-        if not m or min(int(m.group(1)), int(m.group(2))) <= 0:
-            raise InputError(f"--gt-size: expected WxH in pixels such as 768x576, got {args.gt_size!r}")
-        scale = camera.width / int(m.group(1))
-        if abs(int(m.group(2)) * scale - camera.height) > 1:
+        gt_width, gt_height = parse_size(args.gt_size, "--gt-size", "768x576")
+        scale = camera.width / gt_width
+        if abs(gt_height * scale - camera.height) > 1:
             raise InputError(f"--gt-size {args.gt_size}: another aspect ratio than camera {camera.id!r} "
                              f"({camera.width}x{camera.height})")
     else:
-        scale = _positive(args.scale, "--scale", "0.625") if args.scale is not None else 1.0
+        scale = positive(args.scale, "--scale", "0.625") if args.scale is not None else 1.0
     if args.pixel_origin not in (None, "0", "1"):
         raise InputError(f"--pixel-origin: expected 0 or 1, got {args.pixel_origin!r}")
     pixel_origin = None if args.pixel_origin is None else int(args.pixel_origin)

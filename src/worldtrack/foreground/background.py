@@ -18,11 +18,16 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.foreground.kernels import SHADOW_MAX_RATIO, colour_labels
+from worldtrack.foreground.kernels import colour_labels, shadow_like
 
 
 #: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
 UNSURE = 2
+
+#: MOG2/KNN output (0 background, 127 shadow, 255 foreground) → labels.
+_MOG = np.zeros(256, np.uint8)
+_MOG[255] = 1
+_MOG[127] = UNSURE
 
 
 class Foreground(Protocol):
@@ -38,8 +43,9 @@ class Foreground(Protocol):
 def _open_foreground(labels: np.ndarray, kernel: np.ndarray | None) -> np.ndarray:
     """Remove foreground specks smaller than ``kernel`` (a morphological opening of label 1), in place."""
     if kernel is not None:
-        fg = cv2.morphologyEx((labels == 1).astype(np.uint8), cv2.MORPH_OPEN, kernel)
-        labels[(labels == 1) & (fg == 0)] = 0
+        fg = labels == 1
+        opened = cv2.morphologyEx(fg.astype(np.uint8), cv2.MORPH_OPEN, kernel)
+        labels[fg & (opened == 0)] = 0
     return labels
 
 
@@ -93,12 +99,8 @@ class StaticBackground:
 
     def shadow_mask(self, image: np.ndarray) -> np.ndarray:
         """(H, W) bool: pixels that look like the background in shadow."""
-        img = image.astype(np.float32)
-        a = np.einsum("hwc,hwc->hw", img, self._bg) / self._bg_norm2          # brightness ratio
-        resid = img - a[..., None] * self._bg
-        distortion2 = np.einsum("hwc,hwc->hw", resid, resid)
-        limit2 = (self.shadow_distortion ** 2) * self._bg_norm2
-        return (a >= self.shadow_min_ratio) & (a <= SHADOW_MAX_RATIO) & (distortion2 <= limit2)
+        return shadow_like(image.astype(np.float32), self._bg, self._bg_norm2, self.shadow_min_ratio,
+                           self.shadow_distortion)
 
     def _check(self, image: np.ndarray) -> None:
         if image.shape != self.background.shape:
@@ -172,7 +174,7 @@ class AdaptiveBackground:
         Updates the model (one ``apply``); call once per frame.
         """
         raw = self.model.apply(image, learningRate=self.learning_rate)
-        out = np.where(raw == 255, 1, np.where(raw == 127, UNSURE, 0)).astype(np.uint8)
+        out = _MOG[raw]
         return _open_foreground(out, self.kernel)
 
     def mask(self, image: np.ndarray) -> np.ndarray:

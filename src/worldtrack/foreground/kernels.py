@@ -48,6 +48,25 @@ def colour_labels(image, background, bg_norm2, threshold, shadows, min_ratio, di
     return out
 
 
+def shadow_like(img, bg, bg_norm2, min_ratio, distortion):
+    """(H, W) bool: pixels whose colour is the background's in shadow (the test of :func:`colour_labels`).
+
+    A pixel ``I`` is shadow-like when ``I ≈ a·B`` with brightness ratio
+    ``a = I·B / ‖B‖²`` in ``[min_ratio, SHADOW_MAX_RATIO]`` and colour distortion
+    ``‖I − a·B‖ ≤ distortion·‖B‖`` (Horprasert et al. 1999).
+
+    Parameters
+    ----------
+    img, bg : (H, W, 3) float32
+    bg_norm2 : (H, W) float32 — ``‖B‖²`` per pixel (at least 1)
+    min_ratio, distortion : float — as for :func:`colour_labels`
+    """
+    a = np.einsum("hwc,hwc->hw", img, bg) / bg_norm2                 # brightness ratio
+    resid = img - a[..., None] * bg
+    return (a >= min_ratio) & (a <= SHADOW_MAX_RATIO) & (np.einsum("hwc,hwc->hw", resid, resid)
+                                                         <= (distortion ** 2) * bg_norm2)
+
+
 def colour_labels_reference(image, background, threshold, shadows, min_ratio, distortion):
     """NumPy version of :func:`colour_labels` (same arguments, ``bg_norm2`` computed here)."""
     img = image.astype(np.float32)
@@ -57,9 +76,5 @@ def colour_labels_reference(image, background, threshold, shadows, min_ratio, di
     out = changed.astype(np.uint8)
     if shadows:
         n2 = np.maximum(np.einsum("hwc,hwc->hw", bg, bg), 1.0)
-        a = np.einsum("hwc,hwc->hw", img, bg) / n2
-        resid = img - a[..., None] * bg
-        shade = (a >= min_ratio) & (a <= SHADOW_MAX_RATIO) & (np.einsum("hwc,hwc->hw", resid, resid)
-                                                              <= (distortion ** 2) * n2)
-        out[changed & shade] = 2
+        out[changed & shadow_like(img, bg, n2, min_ratio, distortion)] = 2
     return out

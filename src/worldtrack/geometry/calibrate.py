@@ -257,7 +257,11 @@ def dlt(world: ArrayLike, image: ArrayLike) -> np.ndarray:
     if kind != "general":
         raise InputError("all world points lie on one plane, which does not determine a 3x4 camera matrix; "
                          "add points off that plane")
-    P = _dlt(W, I)
+    return _normalised_camera(_normalised_dlt(W, I))
+
+
+def _normalised_camera(P: np.ndarray) -> np.ndarray:
+    """:func:`normalise_projection`, with a rank-deficient fit reported as an :class:`InputError`."""
     try:
         return normalise_projection(P)
     except ValueError:
@@ -265,35 +269,25 @@ def dlt(world: ArrayLike, image: ArrayLike) -> np.ndarray:
                          "check for mislabelled points") from None
 
 
-def _dlt(W: np.ndarray, I: np.ndarray) -> np.ndarray:
-    Tw, Ti = _similarity(W), _similarity(I)
-    X = _homogeneous(W) @ Tw.T                         # (N, 4) normalised world
-    x = _homogeneous(I) @ Ti.T                         # (N, 3) normalised image, last = 1
-    n = len(W)
-    A = np.zeros((2 * n, 12))
-    # Rows of x × (P X) = 0:  [0ᵀ, −w Xᵀ, v Xᵀ] and [w Xᵀ, 0ᵀ, −u Xᵀ]  (H&Z eq. 7.2)
-    A[0::2, 4:8] = -x[:, 2:3] * X
-    A[0::2, 8:12] = x[:, 1:2] * X
-    A[1::2, 0:4] = x[:, 2:3] * X
-    A[1::2, 8:12] = -x[:, 0:1] * X
-    _, _, Vt = np.linalg.svd(A)
-    P_norm = Vt[-1].reshape(3, 4)
-    return np.linalg.solve(Ti, P_norm @ Tw)            # P = T_image⁻¹ · P̃ · T_world
+def _normalised_dlt(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    """Normalised DLT for the 3×k matrix ``M`` with ``dst ~ M·[src, 1]``; (N, k−1), (N, 2) → (3, k).
 
-
-def _homography(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
-    """Normalised DLT for the 3×3 homography with ``dst ~ H·src``; (N, 2), (N, 2) → (3, 3)."""
+    With 3-D ``src`` this is the camera matrix ``P`` (k = 4), with 2-D ``src`` the plane
+    homography ``H`` (k = 3). The fit is made in Hartley-normalised coordinates and mapped back:
+    ``M = T_dst⁻¹ · M̃ · T_src``.
+    """
     Ts, Td = _similarity(src), _similarity(dst)
-    s = _homogeneous(src) @ Ts.T
-    d = _homogeneous(dst) @ Td.T
-    n = len(src)
-    A = np.zeros((2 * n, 9))
-    A[0::2, 3:6] = -d[:, 2:3] * s
-    A[0::2, 6:9] = d[:, 1:2] * s
-    A[1::2, 0:3] = d[:, 2:3] * s
-    A[1::2, 6:9] = -d[:, 0:1] * s
+    s = _homogeneous(src) @ Ts.T                       # (N, k) normalised source
+    d = _homogeneous(dst) @ Td.T                       # (N, 3) normalised image, last = 1
+    n, k = s.shape
+    A = np.zeros((2 * n, 3 * k))
+    # Rows of d × (M s) = 0:  [0ᵀ, −w sᵀ, v sᵀ] and [w sᵀ, 0ᵀ, −u sᵀ]  (H&Z eq. 7.2)
+    A[0::2, k:2 * k] = -d[:, 2:3] * s
+    A[0::2, 2 * k:] = d[:, 1:2] * s
+    A[1::2, :k] = d[:, 2:3] * s
+    A[1::2, 2 * k:] = -d[:, 0:1] * s
     _, _, Vt = np.linalg.svd(A)
-    return np.linalg.solve(Td, Vt[-1].reshape(3, 3) @ Ts)
+    return np.linalg.solve(Td, Vt[-1].reshape(3, k) @ Ts)
 
 
 def _nearest_rotation(M: np.ndarray) -> np.ndarray:
@@ -313,7 +307,7 @@ def _pose_from_plane(W: np.ndarray, I: np.ndarray, K: np.ndarray, centroid: np.n
     """
     ab = (W - centroid) @ basis[:2].T                  # (N, 2) metres in the plane
     m = _homogeneous(I) @ np.linalg.inv(K).T           # (N, 3) normalised image coordinates
-    H = _homography(ab, m[:, :2])
+    H = _normalised_dlt(ab, m[:, :2])
     lam = 2.0 / (np.linalg.norm(H[:, 0]) + np.linalg.norm(H[:, 1]))
     if H[2, 2] * lam < 0:                              # the plane's centroid must be in front
         lam = -lam
@@ -484,11 +478,7 @@ def calibrate(world: ArrayLike, image: ArrayLike, width: int, height: int, *, ca
 
     # Linear start: the paper's fit (normalised), or the plane's homography with known K.
     if kind == "general":
-        try:
-            P = normalise_projection(_dlt(W, I))
-        except ValueError:
-            raise InputError("the points do not determine a camera (the fitted 3x4 matrix has rank < 3); "
-                             "check for mislabelled points") from None
+        P = _normalised_camera(_normalised_dlt(W, I))
         linear = Camera.from_projection(camera_id, width, height, P)
         if K_fixed is None:
             K0, (R0, t0) = linear.K.copy(), (linear.R, linear.t)

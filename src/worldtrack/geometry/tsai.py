@@ -178,11 +178,6 @@ class TsaiCamera:
         """(3, 3) pinhole intrinsics of the same camera without its lens distortion."""
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
 
-    @property
-    def kappa1_normalised(self) -> float:
-        """κ1 in normalised image coordinates (``κ1·f²``, unitless)."""
-        return self.kappa1_per_mm2 * self.focal_mm ** 2
-
     # ------------------------------------------------------------------ projection
     def project(self, points: ArrayLike) -> np.ndarray:
         """Exact Tsai projection of world points to pixels.

@@ -357,7 +357,6 @@ def _from_mapping(data: Any, label: str, camera: str | None, fmt: str) -> Calibr
     rvec = get("rvec", None, None)
     t = get("t", None, None)
     dist = get("dist", None, None)
-    notes: list[str] = []
     if P is not None and K is None:
         if any(x is not None for x in (R, rvec, t)):
             raise InputError(f"{where}: give either P or K with R and t, not both")
@@ -381,7 +380,7 @@ def _from_mapping(data: Any, label: str, camera: str | None, fmt: str) -> Calibr
     if not (K[0, 0] > 0 and K[1, 1] > 0 and abs(K[2, 2] - 1) < 1e-9 and np.all(K[[1, 2, 2], [0, 0, 1]] == 0)):
         raise InputError(f"{where}: K: expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0")
     return CalibrationFile(label, fmt, name, names, _mapping_size(block, where), K=K, R=R, t=t,
-                           dist=_dist(dist, where) if dist is not None else np.zeros(5), notes=notes)
+                           dist=_dist(dist, where) if dist is not None else np.zeros(5))
 
 
 def _mapping_size(block: dict, where: str) -> tuple[int, int] | None:

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import re
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
+from worldtrack.io.text import read_text
 from worldtrack.io.tracks import TrackTable
 from worldtrack.scene.floor import points_in_polygon
 
@@ -83,20 +84,6 @@ class BoxTable:
         return np.column_stack([self.left + self.width / 2.0, self.top + self.height])
 
 
-def _read_text(path: str | Path, what: str) -> str:
-    label = str(path)
-    try:
-        return Path(path).read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise InputError(f"{label}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{label}: is a directory, expected {what}") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{label}: not a text file (expected {what})") from None
-    except OSError as e:
-        raise InputError(f"{label}: cannot read ({e.strerror})") from None
-
-
 def read_cvml(path: str | Path) -> BoxTable:
     """Read CVML XML ground truth (``<frame number><objectlist><object id><box xc yc w h>``).
 
@@ -106,8 +93,10 @@ def read_cvml(path: str | Path) -> BoxTable:
         Not XML, no frames, a missing or non-numeric attribute, a negative size, or the same id
         twice in one frame — naming the file, frame and object.
     """
-    label = str(path)
-    text = _read_text(path, "CVML XML")
+    return _parse_cvml(read_text(path, "CVML XML"), str(path))
+
+
+def _parse_cvml(text: str, label: str) -> BoxTable:
     try:
         root = ET.fromstring(text)
     except ET.ParseError as e:
@@ -147,10 +136,16 @@ def read_mot_boxes(path: str | Path, pixel_origin: int = 1) -> BoxTable:
     pixel_origin : {1, 0}
         Pixel coordinate of the image's first pixel centre in the file (MOTChallenge: 1).
     """
-    label = str(path)
+    _check_pixel_origin(pixel_origin)
+    return _parse_mot(read_text(path, "MOTChallenge text"), str(path), pixel_origin)
+
+
+def _check_pixel_origin(pixel_origin: int) -> None:
     if pixel_origin not in (0, 1):
         raise InputError(f"pixel origin: expected 0 or 1, got {pixel_origin!r}")
-    text = _read_text(path, "MOTChallenge text")
+
+
+def _parse_mot(text: str, label: str, pixel_origin: int) -> BoxTable:
     rows: list[list[float]] = []
     for n, line in enumerate(text.splitlines(), start=1):
         if not line.strip() or line.lstrip().startswith("#"):
@@ -182,24 +177,27 @@ def read_mot_boxes(path: str | Path, pixel_origin: int = 1) -> BoxTable:
         a = a[keep]
     off = float(pixel_origin)
     out = [(int(r[0]) - 1, int(r[1]), r[2] - off, r[3] - off, r[4], r[5]) for r in a]
-    table = _boxes(out, label, "mot")
-    return BoxTable(table.frame, table.id, table.left, table.top, table.width, table.height,
-                    label, "mot", dropped)
+    return replace(_boxes(out, label, "mot"), dropped=dropped)
 
 
 def read_boxes(path: str | Path, format: str = "auto", pixel_origin: int | None = None) -> BoxTable:
     """Read image-box ground truth: ``format`` ``"cvml"``, ``"mot"`` or ``"auto"`` (XML → CVML)."""
     if format not in ("auto", "cvml", "mot"):
         raise InputError(f"--format: expected auto, cvml or mot, got {format!r}")
-    if format == "auto":
-        head = _read_text(path, "CVML XML or MOTChallenge text").lstrip()
-        format = "cvml" if head.startswith("<") else "mot"
+    text = None
+    if format == "auto":                 # read once: the text decides the format and is parsed
+        text = read_text(path, "CVML XML or MOTChallenge text")
+        format = "cvml" if text.lstrip().startswith("<") else "mot"
     if format == "cvml":
         if pixel_origin not in (None, 0):
             raise InputError("--pixel-origin 1 applies to MOTChallenge text; CVML is read with pixel "
                              "centres at integers from 0")
-        return read_cvml(path)
-    return read_mot_boxes(path, 1 if pixel_origin is None else pixel_origin)
+        return read_cvml(path) if text is None else _parse_cvml(text, str(path))
+    origin = 1 if pixel_origin is None else pixel_origin
+    if text is None:
+        return read_mot_boxes(path, origin)
+    _check_pixel_origin(origin)
+    return _parse_mot(text, str(path), origin)
 
 
 def _int_attr(el: ET.Element, key: str, where: str) -> int:

@@ -43,13 +43,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
+from worldtrack.io.text import is_number
 
 #: Columns of ``tracks.csv``, in order; trackers may append more.
 TRACK_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "height", "width", "score",
                                   "mode", "flags")
-#: Columns of ``gt.csv`` before the per-camera ``vis_<cam>, head_<cam>, feet_<cam>`` triples.
-GT_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "z_head", "height", "width",
-                               "speed")
 #: Columns of a MOTChallenge text file (1-based frames and ids, ``-1`` = unknown).
 MOT_COLUMNS: tuple[str, ...] = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height",
                                 "conf", "x", "y", "z")
@@ -210,7 +208,7 @@ def read_tracks(path: str | Path) -> TrackTable:
     if first is None:
         raise InputError(f"{name}: empty file")
     tokens = [t for t in _SPLIT_MOT.split(first.strip()) if t]
-    if all(_is_number(t) for t in tokens):
+    if all(is_number(t) for t in tokens):
         if len(tokens) < len(MOT_COLUMNS):
             raise InputError(f"{name}: line 1: no header and only {len(tokens)} numeric columns; "
                              f"expected a CSV header (frame,id,x,y,…) or MOTChallenge text with "
@@ -321,14 +319,6 @@ def _finish(table: TrackTable, line_no: np.ndarray) -> TrackTable:
     return table
 
 
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
 def _floats(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
             allow_empty: bool, finite: bool = True) -> np.ndarray:
     """Parse a column of strings to float64; the first bad cell raises with its line number."""
@@ -339,7 +329,7 @@ def _floats(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
         out = None
     bad = np.zeros(values.shape, bool)
     if out is None:
-        bad = np.array([not _is_number(v) for v in vals], dtype=bool)
+        bad = np.array([not is_number(v) for v in vals], dtype=bool)
         if not np.any(bad):  # text NumPy refuses but Python's float() accepts ("1_000")
             out = np.array([float(v) for v in vals])
     if finite and out is not None:

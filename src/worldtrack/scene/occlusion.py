@@ -62,11 +62,6 @@ class OcclusionMap:
         depth.setflags(write=False)
         return cls(camera, floor, depth)
 
-    @property
-    def any(self) -> bool:
-        """True when some pixel sees an obstacle."""
-        return bool(np.isfinite(self.floor_distance).any())
-
     def hidden(self, uv: np.ndarray, distance: np.ndarray | float, true_depth: bool = False) -> np.ndarray:
         """Is a point at pixel ``uv`` and the given distance behind an obstacle?
 
@@ -88,9 +83,3 @@ class OcclusionMap:
         occ = np.full(len(uv), np.inf)
         occ[ok] = grid[iv[ok], iu[ok]]
         return occ < np.broadcast_to(np.asarray(distance, dtype=float), (len(uv),))
-
-    def visible_in_box(self, box: tuple[int, int, int, int], distance: float, true_depth: bool = False) -> np.ndarray:
-        """(v1 − v0, u1 − u0) bool: pixels of the box where something at ``distance`` is not hidden."""
-        u0, u1, v0, v1 = box
-        grid = self.depth if true_depth else self.floor_distance
-        return grid[v0:v1, u0:u1] >= distance
