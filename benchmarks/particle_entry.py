@@ -38,9 +38,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, write_result  # noqa: E402
+from common import markdown_table, render_images, write_result  # noqa: E402
 
 from worldtrack.eval import evaluate_detailed  # noqa: E402
+from worldtrack.experiment import gt_table  # noqa: E402
 from worldtrack.foreground.background import StaticBackground  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
@@ -61,18 +62,21 @@ SIDE_BY_SIDE_M = 0.8
 class Sequence:
     seed: int
     scenario: object
-    images: list
-    gt: list
+    bundles: list           # rendered frames: images and ground truth (common.render_images)
     background: np.ndarray
+
+    @property
+    def images(self) -> list:
+        return [b.views["cam"].image for b in self.bundles]
+
+    @property
+    def gt(self) -> list:
+        return [b.gt for b in self.bundles]
 
 
 def render(seed: int, size: tuple[int, int], **overrides) -> Sequence:
     sc = make_scenario("entry", size=size, seed=seed, **overrides)
-    images, gt = [], []
-    for b in sc.frames():
-        images.append(b.views["cam"].image)
-        gt.append(b.gt)
-    return Sequence(seed, sc, images, gt, sc.background("cam"))
+    return Sequence(seed, sc, render_images(sc), sc.background("cam"))
 
 
 def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
@@ -91,18 +95,10 @@ def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
     return pred, el
 
 
-def gt_table(seq: Sequence) -> TrackTable:
-    g = [r for fr in seq.gt for r in fr]
-    return TrackTable.from_arrays([r["frame"] for r in g], [r["id"] for r in g], [r["x"] for r in g],
-                                  [r["y"] for r in g],
-                                  extra={"height": [r["height"] for r in g], "vis": [r["vis_cam"] for r in g],
-                                         "head": [r["head_cam"] for r in g], "feet": [r["feet_cam"] for r in g]})
-
-
 def score(seq: Sequence, pred: TrackTable) -> dict:
     """The figures of the module docstring for one run."""
-    gt_all = gt_table(seq)
-    gt = gt_all.select(gt_all.extra["vis"] >= VIS_EVAL)
+    gt_all = gt_table(seq.bundles)
+    gt = gt_all.select(gt_all.extra["vis_cam"] >= VIS_EVAL)
     ev = evaluate_detailed(gt, pred, gate=GATE_M)
     P = ev.pairs
     out = {"mota": ev.metrics["mota"], "idf1": ev.metrics["idf1"], "recall": ev.metrics["recall"],
@@ -123,7 +119,7 @@ def score(seq: Sequence, pred: TrackTable) -> dict:
     tracks, lat = [], []
     for gid in np.unique(gt_all.id):
         sel = gt_all.select(gt_all.id == gid)
-        full = sel.frame[(sel.extra["vis"] >= 0.9) & (sel.extra["head"] > 0) & (sel.extra["feet"] > 0)]
+        full = sel.frame[(sel.extra["vis_cam"] >= 0.9) & (sel.extra["head_cam"] > 0) & (sel.extra["feet_cam"] > 0)]
         if not len(full):
             continue
         m = P["gt_id"] == gid
@@ -170,14 +166,14 @@ def given_starts(seq: Sequence, config: ParticleConfig) -> dict:
                               replace(config, births="none", split=False, merge=False))
     started: set[int] = set()
     errors, near, alive = [], [], []
-    for k, img in enumerate(seq.images):
+    for k, (img, gt) in enumerate(zip(seq.images, seq.gt)):
         t = k / sc.fps
-        for r in seq.gt[k]:
+        for r in gt:
             if r["id"] not in started and r["vis_cam"] >= 0.9 and r["head_cam"] and r["feet_cam"]:
                 tracker.init_track(r["x"], r["y"], track_id=int(r["id"]), t=t)
                 started.add(int(r["id"]))
         tracks = {tr.id: tr for tr in tracker.step({"cam": img}, t)}
-        for r in seq.gt[k]:
+        for r in gt:
             if int(r["id"]) not in started or r["vis_cam"] < 0.5:
                 continue
             tr = tracks.get(int(r["id"]))

@@ -7,15 +7,19 @@ stepped over frames in which everybody shifts by a few centimetres.
 Measured, with the median over frames after a warm-up:
 
 * the per-frame cost that does not depend on the objects — turning the frame into what the
-  likelihood reads (F > γ, with or without shadow removal);
+  likelihood reads (F > γ, with or without shadow removal, the latter on the floor pixels as the
+  tracker does);
 * ms per frame for K = 1, 2, 5, 10, 20 objects, and the per-object cost
   ``(time(K) − time(0)) / K``, as a ratio to one ``cv2.createBackgroundSubtractorMOG2().apply`` on a
   640×480 frame measured in the same run (target ≤ 0.2);
-* the likelihood kernel alone for 500 particles × 20 heights, against the NumPy reference.
+* the likelihood alone for one tracking filter of 500 particles, called as ``step`` calls it
+  (``ParticleTracker.likelihood``) for each configuration, and the bare line-column kernel against
+  its NumPy reference.
 
-Configurations: ``paper`` (500 particles, a line column of 20 heights, weights ∝ count) and
-``default`` (500 particles, a 3-line column of 22 heights, ratio weights, explaining away, split
-and merge checks).
+Configurations: ``paper`` (500 particles, a line column of 20 heights, weights ∝ count, shadows
+count as object) and ``default`` (500 particles, a 3-line column of 20 heights with 2 samples below
+the floor and 2 above the top, ratio weights with the height prior, shadows removed, explaining
+away, split and merge checks).
 
 Usage: ``.venv/bin/python benchmarks/particle_speed.py`` — writes ``benchmarks/results/particle_speed.md``.
 """
@@ -36,9 +40,10 @@ from common import markdown_table, median_time, mog2_apply_time, write_result  #
 from worldtrack.foreground.background import StaticBackground  # noqa: E402
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
-from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
+from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box  # noqa: E402
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
-                                                     hit_image, hit_labels, hit_labels_reference)
+                                                     floor_pixels, hit_image, hit_labels, hit_labels_reference,
+                                                     owner_image)
 
 W, H = 640, 480
 SCENE = {"name": "speed", "cameras": [{"id": "cam", "image_size": [W, H], "position": [0, -2, 3.5],
@@ -93,12 +98,16 @@ def main() -> int:
     mog2 = mog2_apply_time(W, H)
     print(f"MOG2 apply {W}x{H}: {1000 * mog2:.2f} ms", file=sys.stderr)
 
-    # Per-frame image preparation.
+    # Per-frame image preparation, as ParticleTracker._images does it (shadows only on the floor).
     img = render(cam, bg, people_at(10, 0), rng)
     fg = StaticBackground(bg, 30.0, "colour")
-    prep = {"F = colour distance, F > γ (paper)": median_time(lambda: hit_image(fg.difference(img), 30.0)),
-            "shadow-free F > γ (Numba, default)": median_time(lambda: hit_labels(img, bg, 25.0)),
-            "shadow-free F > γ (NumPy reference)": median_time(lambda: hit_labels_reference(img, bg, 25.0),
+    floor = floor_pixels(cam, scene.walkable.raster(0.01))
+    gamma = configs["default"].gamma
+    prep = {"F = colour distance, F > γ (paper)": median_time(lambda: hit_image(fg.difference(img), gamma)),
+            "shadow-free F > γ (Numba, default)": median_time(lambda: hit_labels(img, bg, gamma, where=floor,
+                                                                                 shadow=0)),
+            "shadow-free F > γ (NumPy reference)": median_time(lambda: hit_labels_reference(img, bg, gamma,
+                                                                                            where=floor, shadow=0),
                                                                repeats=5)}
     prep_rows = [[k, 1000 * v, v / mog2] for k, v in prep.items()]
 
@@ -106,11 +115,9 @@ def main() -> int:
     rows = []
     per_object = {}
     for name, cfg in configs.items():
-        frames_by_k = {}
         base = None
         for k in (0,) + COUNTS:
             frames = [render(cam, bg, people_at(k, f + 1), np.random.default_rng(f)) for f in range(FRAMES)]
-            frames_by_k[k] = frames
             t = step_time(cfg, k, scene, bg, frames)
             if k == 0:
                 base = t
@@ -121,26 +128,45 @@ def main() -> int:
             print(f"{name:8s} K={k:2d}: {1000 * t:7.2f} ms/frame, {1000 * po:.3f} ms/object "
                   f"= {po / mog2:.3f} MOG2", file=sys.stderr)
 
-    # The likelihood kernel alone: 500 particles x 20 heights.
+    # The likelihood alone: one tracking filter of 500 particles about one person, as step() calls
+    # ParticleTracker.likelihood (the image it reads, the filter's own box among the track boxes
+    # when explaining away, the particles' heights).
+    person = people_at(1, 0)
+    img = render(cam, bg, person, rng)
+    xy = person + rng.normal(0, 0.2, (500, 2))
+    xyz = np.column_stack([xy, rng.uniform(0, 1.7, 500)])
+    h = 1.7 + 0.1 * rng.standard_normal(500)
+    kernel_rows = []
+    for name, cfg in configs.items():
+        tracker = ParticleTracker(scene, {"cam": fg}, cfg)
+        if cfg.shadows == "object":
+            seen = hit_image(fg.difference(img), cfg.gamma)
+        else:
+            seen = hit_labels(img, bg, cfg.gamma, where=floor, shadow=2 if cfg.shadows == "unknown" else 0)
+        owners = boxes = None
+        if cfg.explain == "all":
+            box = image_box(cam, person[0, 0], person[0, 1], scene.people.width, scene.people.height,
+                            cfg.box_margin)
+            owners, boxes = {"cam": owner_image(seen.shape, [box])}, {"cam": box}
+        tk = median_time(lambda: tracker.likelihood(xyz, {"cam": seen}, owners, boxes, h), repeats=200)
+        kernel_rows.append([f"ParticleTracker.likelihood, {name} config", 1000 * tk, tk / mog2])
+    # The bare kernel: a line column of the paper's 20 heights, against the NumPy reference.
     cl = CameraLikelihood(cam)
-    hit = hit_image(fg.difference(render(cam, bg, people_at(1, 0), rng)), 30.0)
-    xy = people_at(1, 0) + rng.normal(0, 0.2, (500, 2))
-    heights = np.arange(20) * 0.1
+    hit = hit_image(fg.difference(img), gamma)
+    heights = configs["paper"].heights
     k_line = median_time(lambda: cl.column(hit, xy, heights), repeats=200)
-    k_cyl = median_time(lambda: cl.column(hit, xy, np.concatenate([[-0.2, -0.1], heights]), radius=0.1,
-                                          n_below=2), repeats=200)
     k_ref = median_time(lambda: column_counts_reference(cam, hit, xy, heights), repeats=20)
-    kernel_rows = [["Numba, line column (paper)", 1000 * k_line, k_line / mog2],
-                   ["Numba, 3-line column + 2 below the floor (default)", 1000 * k_cyl, k_cyl / mog2],
-                   ["NumPy reference, line column", 1000 * k_ref, k_ref / mog2]]
+    kernel_rows += [["column kernel alone (Numba), line column of 20 heights", 1000 * k_line, k_line / mog2],
+                    ["NumPy reference, line column of 20 heights", 1000 * k_ref, k_ref / mog2]]
 
     t1 = markdown_table(["per-frame step", "ms", "× MOG2"], prep_rows)
     t2 = markdown_table(["config", "objects", "ms/frame", "ms/object", "per object × MOG2"], rows)
-    t3 = markdown_table(["500 particles × 20 heights", "ms", "× MOG2"], kernel_rows)
+    t3 = markdown_table(["500 particles", "ms", "× MOG2"], kernel_rows)
     summary = ", ".join(f"{n}: median {np.median(v) / mog2:.3f} × MOG2 per object" for n, v in per_object.items())
     text = (f"One MOG2 apply on {W}x{H}: {1000 * mog2:.2f} ms (the reference). {summary}.\n\n"
             f"Per frame, independent of the objects:\n\n{t1}\n\nTracking (median over {FRAMES - 3} frames; "
-            f"per object = (ms/frame(K) − ms/frame(0)) / K):\n\n{t2}\n\nThe column likelihood alone:\n\n{t3}\n")
+            f"per object = (ms/frame(K) − ms/frame(0)) / K):\n\n{t2}\n\nThe likelihood alone (one filter's "
+            f"500 particles, as step calls it; default: 20 heights + 2 below + 2 above, 3 lines):\n\n{t3}\n")
     print(text)
     path = write_result("particle_speed", "Particle tracker (seed 004): speed",
                         "Command: `.venv/bin/python benchmarks/particle_speed.py`\n\n" + text)

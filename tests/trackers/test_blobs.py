@@ -26,6 +26,8 @@ from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_e
 from worldtrack.io.sources import Frame
 from worldtrack.scene import scene_from_dict
 
+from _render import texture  # tests/trackers/_render.py
+
 pytest.importorskip("stonesoup")
 
 from worldtrack.trackers import make_tracker  # noqa: E402
@@ -40,13 +42,6 @@ PERSON_BGR = (40, 30, 140)
 
 def make_scene(*cameras):
     return scene_from_dict({"name": "blobs-test", "cameras": list(cameras), "floor": FLOOR})
-
-
-def texture(seed: int) -> np.ndarray:
-    """A smooth random colour texture (H, W, 3) uint8: the empty scene."""
-    rng = np.random.default_rng(seed)
-    img = cv2.GaussianBlur(rng.uniform(60, 200, (H, W, 3)).astype(np.float32), (0, 0), 3)
-    return np.clip(img, 0, 255).astype(np.uint8)
 
 
 def render(cam, background, xy, rng) -> np.ndarray:

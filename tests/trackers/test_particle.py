@@ -30,6 +30,8 @@ from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_co
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, polygon_distance,
                                                    stratified_resample, systematic_resample)
 
+from _render import texture  # tests/trackers/_render.py
+
 W, H = 320, 240
 CAM = {"id": "cam", "image_size": [W, H], "position": [0, -1, 3], "look_at": [0, 3.5, 0.5], "hfov_deg": 70}
 CAM2 = {"id": "cam2", "image_size": [W, H], "position": [5, 7, 3], "look_at": [0, 3.5, 0.5], "hfov_deg": 70}
@@ -46,13 +48,6 @@ def make_scene(entry: bool = True, cameras=(CAM,)):
     if entry:
         d["entry_regions"] = DOOR
     return scene_from_dict(d)
-
-
-def texture(seed: int) -> np.ndarray:
-    """A smooth random colour texture (H, W, 3) uint8: the empty scene."""
-    rng = np.random.default_rng(seed)
-    img = cv2.GaussianBlur(rng.uniform(60, 200, (H, W, 3)).astype(np.float32), (0, 0), 3)
-    return np.clip(img, 0, 255).astype(np.uint8)
 
 
 def render(cam, background, people, rng) -> np.ndarray:
@@ -186,7 +181,6 @@ def test_walker_is_tracked_within_bounds():
     assert np.mean(inside) > 0.5
     assert np.median(vx) == pytest.approx(1.0, abs=0.25)        # m/s, from real time stamps
     assert tracks[0].height == pytest.approx(HEIGHT, abs=0.25)
-    assert set(ParticleTracker.extra_columns) == {"sigma", "z", "sx", "sy", "sz"}
 
 
 def test_detection_fires_on_entry_and_not_on_empty_frames():
@@ -359,8 +353,9 @@ def test_hit_labels_set_darkened_background_apart():
     hit = hit_labels(img, bg, 25.0)
     assert np.mean(hit[100:140, 50:100] == 2) > 0.95 and np.mean(hit[100:140, 200:250] == 1) > 0.95
     assert np.all(hit[:90] == 0)
+    # Shadows nowhere: every pixel with F > γ reads object, exactly the labels without shadows.
     where = np.zeros((H, W), bool)
-    assert np.mean(hit_labels(img, bg, 25.0, where=where)[100:140, 50:100] == 1) > 0.5
+    assert np.array_equal(hit_labels(img, bg, 25.0, where=where), (hit != 0).astype(np.uint8))
 
 
 def test_image_box_covers_the_person():
@@ -371,6 +366,18 @@ def test_image_box_covers_the_person():
     u0, u1, v0, v1 = image_box(cam, 0.5, 3.0, WIDTH, HEIGHT, 0.0)
     assert u0 <= xs.min() + 1 and u1 >= xs.max() and v0 <= ys.min() + 1 and v1 >= ys.max()
     assert (u1 - u0) < 1.3 * (xs.max() - xs.min() + 1)
+
+
+def test_image_box_with_depth_covers_the_object_nearer_and_farther():
+    cam = make_scene().cameras["cam"]
+    for x, y in [(0.5, 3.0), (-2.0, 5.0), (2.5, 1.5)]:       # the last one cut by the image's edges
+        along = (np.array([x, y]) - cam.centre[:2]) / np.hypot(x - cam.centre[0], y - cam.centre[1])
+        near, mid, far = (image_box(cam, *(np.array([x, y]) + s * along), WIDTH, HEIGHT, 0.05) for s in (-0.5, 0, 0.5))
+        deep = image_box(cam, x, y, WIDTH, HEIGHT, 0.05, depth=0.5)
+        together = (min(near[0], mid[0], far[0]), max(near[1], mid[1], far[1]),
+                    min(near[2], mid[2], far[2]), max(near[3], mid[3], far[3]))
+        np.testing.assert_allclose(deep, together, atol=1)     # the three boxes together, to a pixel
+        assert deep[3] - deep[2] > mid[3] - mid[2] + 10          # stretched along the line of sight
 
 
 @pytest.mark.parametrize("bad", [dict(alpha=1.5), dict(beta=-0.1), dict(particles=0), dict(dz=0),
@@ -389,6 +396,8 @@ def test_user_mistakes_are_input_errors():
     with pytest.raises(InputError):
         ParticleTracker(make_scene(entry=False), fgs, ParticleConfig(births="entry"))
     tracker = ParticleTracker(scene, fgs)
+    with pytest.raises(InputError, match="mode must be 'tracking'"):
+        tracker.init_track(0.0, 3.0, mode="capture")
     tracker.step({"cam": texture(0)}, 1.0)
     with pytest.raises(InputError):
         tracker.step({"cam": texture(0)}, 0.5)

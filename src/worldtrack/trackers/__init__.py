@@ -4,7 +4,8 @@
 and the YAML select them:
 
 * ``ellipsoid`` — analysis by synthesis with ellipsoid people (seed 000), the default;
-* ``particle`` — single-camera 3-D particle filters with the height-column likelihood (seed 004);
+* ``particle`` — 3-D particle filters with the height-column likelihood (seed 004), one or more
+  cameras (the likelihood multiplies over the cameras that see a particle);
 * ``blobs`` — the tracking-by-detection baseline (MOG2 blobs + Stone Soup), for comparison.
 """
 

@@ -50,7 +50,7 @@ from scipy.spatial.distance import pdist
 
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import AdaptiveBackground
-from worldtrack.foreground.components import connected_components
+from worldtrack.foreground.components import blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.quadric import ellipse_parameters, ellipsoid_conics, person_ellipsoid
 from worldtrack.scene.model import Scene
@@ -220,23 +220,21 @@ class _CameraDetector:
     def foot_points(self, mask: np.ndarray) -> np.ndarray:
         """(N, 2) floor points (m) of the blobs in ``mask`` that pass every test."""
         cfg, cam = self.config, self.camera
-        _, labels, stats, _ = connected_components(mask)
-        x0, y0, w, h, area = (stats[:, k].astype(float) for k in range(5))  # row 0: the background
-        keep = (area >= cfg.min_area_px) & (y0 + h < cam.height)  # bottom on the border: feet cut off
-        keep[0] = False
-        u = x0 + (w - 1) / 2
-        if cfg.foot_point == "bottom":
-            # Mean column of each blob's pixels in its lowest rows (a few blobs, each a small slice).
-            for j in np.flatnonzero(keep):
-                c0, c1, r1 = int(x0[j]), int(x0[j] + w[j]), int(y0[j] + h[j])
-                r0 = r1 - max(1, int(round(cfg.foot_band * h[j])))
-                cols = np.nonzero(labels[r0:r1, c0:c1] == j)[1]
-                u[j] = c0 + cols.mean()
-        # Pixel centres are at integers, so the bottom edge of the lowest row is at y0 + h − 0.5.
-        uv = np.column_stack([u, y0 + h - 0.5])[keep]
-        area = area[keep]
-        if not len(uv):
+        feet, areas = [], []
+        for area, (x0, y0, w, h), _, blob in blobs(mask, cfg.min_area_px):
+            if y0 + h >= cam.height:
+                continue  # bottom on the border: feet cut off
+            if cfg.foot_point == "bottom":
+                # Mean column of the blob's own pixels in its lowest rows.
+                u = x0 + np.nonzero(blob[h - max(1, int(round(cfg.foot_band * h))):])[1].mean()
+            else:
+                u = x0 + (w - 1) / 2
+            # Pixel centres are at integers, so the bottom edge of the lowest row is at y0 + h − 0.5.
+            feet.append((u, y0 + h - 0.5))
+            areas.append(area)
+        if not feet:
             return np.zeros((0, 2))
+        uv, area = np.array(feet, dtype=float), np.array(areas, dtype=float)
         xy = cam.backproject(uv, 0.0)[:, :2]
         ok = np.isfinite(xy).all(axis=1)
         xy, area = xy[ok], area[ok]

@@ -70,6 +70,10 @@ from worldtrack.trackers.particle_sampling import FloorRegion, bimodal_split, po
 
 Box = tuple[int, int, int, int]
 
+#: The per-particle arrays of a :class:`_Filter`, all indexed alike: the state (``xyz, v, h``) and
+#: this frame's observation (``logpi, likely, col_h``).
+PARTICLE_FIELDS = ("xyz", "v", "h", "logpi", "likely", "col_h")
+
 #: Depth (m) at which a column sample weighs 1 with ``pixel_weights``: weights are the sample's
 #: image length over that of a sample this far from the camera.
 REFERENCE_DEPTH = 5.0
@@ -103,9 +107,17 @@ class _Filter:
 
     def take(self, idx: np.ndarray) -> None:
         """Keep the particles ``idx`` (with repeats), this frame's observation included."""
-        self.xyz, self.v, self.h = self.xyz[idx], self.v[idx], self.h[idx]
-        if self.logpi is not None:
-            self.logpi, self.likely, self.col_h = self.logpi[idx], self.likely[idx], self.col_h[idx]
+        for name in PARTICLE_FIELDS:
+            a = getattr(self, name)
+            if a is not None:
+                setattr(self, name, a[idx])
+
+    def subset(self, idx: np.ndarray, **fields) -> "_Filter":
+        """A new filter of the particles ``idx`` (index array or mask), this frame's observation
+        included; ``fields`` set the new filter's other fields or replace its per-particle ones."""
+        own = {name: getattr(self, name)[idx] for name in PARTICLE_FIELDS
+               if name not in fields and getattr(self, name) is not None}
+        return _Filter(**own, **fields)
 
 
 class ParticleTracker:
@@ -221,7 +233,14 @@ class ParticleTracker:
     # ------------------------------------------------------------------ public
     def init_track(self, x: float, y: float, track_id: int | None = None, mode: str = "tracking",
                    t: float = 0.0, spread: float = 0.1) -> Track:
-        """Start a tracking filter at floor position ``(x, y)`` (m), particles spread ``spread`` (m, 1-σ)."""
+        """Start a tracking filter at floor position ``(x, y)`` (m), particles spread ``spread`` (m, 1-σ).
+
+        ``mode`` is there for the signature the trackers share; a particle filter only tracks, so it
+        must be ``"tracking"``.
+        """
+        if mode != "tracking":
+            raise InputError(f"particle tracker: init_track mode must be 'tracking' (a particle filter has no "
+                             f"other mode), got {mode!r}")
         cfg = self.config
         n = cfg.particles
         xyz = np.column_stack([x + spread * self.rng.standard_normal(n), y + spread * self.rng.standard_normal(n),
@@ -264,9 +283,10 @@ class ParticleTracker:
 
         for f in self.filters:
             self._predict(f, dt)
-        boxes = self._boxes(self.filters, [f.xyz[:, :2].mean(axis=0) for f in self.filters], cfg.box_margin)
-        owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
         explain_tracks = cfg.explain == "all"
+        if explain_tracks:
+            boxes = self._boxes(self.filters, [f.xyz[:, :2].mean(axis=0) for f in self.filters], cfg.box_margin)
+            owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
         for i, f in enumerate(self.filters):
             f.logpi, f.likely, f.col_h = self.likelihood(
                 f.xyz, images, owners if explain_tracks else None,
@@ -527,8 +547,7 @@ class ParticleTracker:
         """Start tracking filters from a detection filter's likely particles, one per lump."""
         cfg = self.config
         for g in (self._lumps(d.xyz, idx, depth=2) if cfg.split else [idx]):
-            f = _Filter(d.xyz[g], np.zeros((len(g), 3)), logpi=d.logpi[g], likely=d.likely[g], col_h=d.col_h[g],
-                        h=d.h[g])
+            f = d.subset(g, v=np.zeros((len(g), 3)))
             self._resample_filter(f, self._weights(f.logpi), cfg.particles)
             self._new_track(f, t, score=float(d.likely.mean()))
 
@@ -579,8 +598,7 @@ class ParticleTracker:
             return
         f.split_count = 0
         keep, other = (~side, side) if (~side).sum() >= side.sum() else (side, ~side)
-        new = _Filter(f.xyz[other], f.v[other], V=f.V.copy(), centre=f.centre.copy(), t_update=f.t_update, h=f.h[other],
-                      logpi=f.logpi[other], likely=f.likely[other], col_h=f.col_h[other])
+        new = f.subset(other, V=f.V.copy(), centre=f.centre.copy(), t_update=f.t_update)
         f.take(np.flatnonzero(keep))
         for g in (f, new):
             self._resample_filter(g, np.ones(len(g.xyz)), cfg.particles)

@@ -9,7 +9,7 @@ published (with our numbers where it states none); the default adds worldtrack's
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -58,7 +58,10 @@ class ParticleConfig:
     noise_xy, noise_z : float, m/√s
         σ of the prediction noise ``w ~ N(0, σ²·dt)``: a random walk whose spread per second does
         not depend on the frame rate (per frame at 10 frames/s: σ/√10, 0.3 → 0.095 m). The paper's
-        σ is per frame and not stated; 0.3.
+        σ is per frame and not stated; 0.3. ``noise_z`` acts only with the point likelihood: with
+        the column, each particle's z is drawn afresh at resampling (below the top its column sees)
+        before anything reads it, so ``noise_z`` has no effect there (its random draws are still
+        taken: the results do not depend on its value).
     velocity : {"object", "particle", "none"}
         The velocity in ``x_t = x_{t−1} + v·dt + w``: the object centre's, from its last two
         positions and smoothed (default); each particle's own, ``(x_{t−1} − x_{t−2}) / dt`` (the
@@ -282,10 +285,6 @@ class ParticleConfig:
     def likely_count(self) -> int:
         """Column samples on the object for a particle to be likely: ``⌈min_height / dz⌉``."""
         return max(1, int(math.ceil(self.min_height / self.dz - 1e-9)))
-
-    @classmethod
-    def field_names(cls) -> tuple[str, ...]:
-        return tuple(f.name for f in fields(cls))
 
 
 def _number(v: object) -> bool:

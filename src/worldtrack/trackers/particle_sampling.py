@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
-from worldtrack.scene.floor import points_in_polygon
+from worldtrack.scene.floor import WalkableRaster, points_in_polygon
 
 RESAMPLERS = ("systematic", "stratified")
 
@@ -69,22 +69,20 @@ def resampler(name: str) -> Callable[[np.ndarray, int, np.random.Generator], np.
 
 @dataclass(frozen=True)
 class FloorRegion:
-    """A floor area as a grid of cells, for uniform sampling and inside tests.
+    """A named floor area as a grid of cells (a :class:`~worldtrack.scene.floor.WalkableRaster`), for
+    uniform sampling and inside tests.
 
     Cell ``(j, i)`` covers ``origin + (i, j)·cell`` to ``origin + (i + 1, j + 1)·cell``.
 
     Attributes
     ----------
     name : str
-    origin : (2,) float, metres
-    cell : float, metres
-    inside : (ny, nx) bool
+    raster : WalkableRaster — the cells; ``origin`` (2,) float, metres, ``cell`` (its
+        ``resolution``) float, metres, and ``inside`` (ny, nx) bool read through to it
     """
 
     name: str
-    origin: np.ndarray
-    cell: float
-    inside: np.ndarray
+    raster: WalkableRaster
 
     @classmethod
     def rasterise(cls, name: str, bounds: tuple[float, float, float, float], cell: float,
@@ -95,7 +93,19 @@ class FloorRegion:
         ny = max(1, int(np.ceil((y1 - y0) / cell)))
         gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * cell, y0 + (np.arange(ny) + 0.5) * cell)
         inside = np.asarray(test(np.column_stack([gx.ravel(), gy.ravel()])), dtype=bool).reshape(ny, nx)
-        return cls(name, np.array([x0, y0], dtype=float), float(cell), inside)
+        return cls(name, WalkableRaster(np.array([x0, y0], dtype=float), float(cell), inside))
+
+    @property
+    def origin(self) -> np.ndarray:
+        return self.raster.origin
+
+    @property
+    def cell(self) -> float:
+        return self.raster.resolution
+
+    @property
+    def inside(self) -> np.ndarray:
+        return self.raster.inside
 
     @property
     def area(self) -> float:
@@ -115,14 +125,8 @@ class FloorRegion:
         return self.origin + (np.column_stack([i, j]) + offs) * self.cell
 
     def contains(self, xy: ArrayLike) -> np.ndarray:
-        """(N,) bool: the point's cell is in the region."""
-        p = np.nan_to_num(np.asarray(xy, dtype=float).reshape(-1, 2), nan=-1e9)
-        i = np.floor((p[:, 0] - self.origin[0]) / self.cell).astype(np.int64)
-        j = np.floor((p[:, 1] - self.origin[1]) / self.cell).astype(np.int64)
-        ok = (i >= 0) & (i < self.inside.shape[1]) & (j >= 0) & (j < self.inside.shape[0])
-        out = np.zeros(len(p), dtype=bool)
-        out[ok] = self.inside[j[ok], i[ok]]
-        return out
+        """(N,) bool: the point's cell is in the region (False for NaN)."""
+        return self.raster.contains(xy)
 
 
 # ---------------------------------------------------------------------------- splitting a cloud
