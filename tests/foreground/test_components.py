@@ -50,7 +50,8 @@ def test_blobs_found_at_half_resolution_are_the_full_resolution_blobs(shape):
         assert a0 == a1 and box0 == box1
         np.testing.assert_allclose(c0, c1)
         np.testing.assert_array_equal(m0, m1)
-    assert {b[0] for b in blobs(mask, 50, 2)} == {b[0] for b in full if b[0] >= 50}   # min_area in full pixels
+    # min_area counts full-resolution pixels
+    assert sorted(b[1] for b in blobs(mask, 50, 2)) == sorted(b[1] for b in full if b[0] >= 50)
 
 
 def test_blobs_one_pixel_apart_are_joined_at_half_resolution():
@@ -62,3 +63,11 @@ def test_blobs_one_pixel_apart_are_joined_at_half_resolution():
     assert area == 8 and box == (1, 2, 3, 4)
     np.testing.assert_allclose(centroid, [2.0, 3.5])
     assert crop.sum() == 8 and not crop[:, 1].any()
+
+
+def test_a_shrink_factor_that_would_lose_single_pixels_is_refused():
+    mask = np.zeros((100, 100), np.uint8)
+    mask[50, 50] = 1
+    assert len(blobs(mask, 1, 22)) == 1          # 255 / 22² rounds to 1: the pixel survives
+    with pytest.raises(ValueError, match="at most 22"):
+        blobs(mask, 1, 23)

@@ -101,20 +101,25 @@ def test_runner_is_followed_by_default_and_outruns_the_paper_preset():
     rng = np.random.default_rng(0)
     bg = _background(scene, rng)
     xs = -2.5 + 0.25 * np.arange(12)              # 2.5 m/s at 10 frames/s, across the view
-    final = {}
+    step_limit = 3 * 0.05                          # the paper's K x s per frame
+    final, survived = {}, {}
     for preset in ("paper", "default"):
         cfg = EllipsoidConfig.paper(births="none") if preset == "paper" else EllipsoidConfig(births="none")
         tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"), cfg)
         tr.init_track(xs[0], 1.5, track_id=1)
+        survived[preset] = 0
         for i, x in enumerate(xs):
             tr.step({"cam": Frame(_frame(scene, bg, [(x, 1.5)], rng), i / 10, i)}, i / 10)
             if 1 not in tr.position_map:
                 break
+            survived[preset] += 1
             t = tr.position_map[1]
             final[preset] = np.hypot(t.x - x, t.y - 1.5)
-        step_limit = 3 * 0.05
-    assert final["default"] < 0.1
-    assert final.get("paper", np.inf) > 0.25 - step_limit
+    assert survived["default"] == len(xs) and final["default"] < 0.1
+    # The paper's track lives long enough to fall behind (it ends on the last frame or two, its
+    # score gone), so its distance is measured, not skipped.
+    assert "paper" in final and survived["paper"] >= 10
+    assert final["paper"] > 0.25 - step_limit
 
 
 def test_paper_preset_values_are_the_papers():
@@ -145,16 +150,20 @@ def test_measured_height_of_a_rendered_person():
     cam = sc.scene.cameras["cam1"]
     fg = make_foregrounds(sc.scene, {"cam1": sc.background("cam1")}, "colour", 20)["cam1"]
     tr = EllipsoidTracker(sc.scene, {"cam1": fg})
-    cs = tr.cams["cam1"]
+    cs, (lo, hi) = tr.cams["cam1"], tr.config.height_range_m
     measured = []
     for b in sc.render():
         g = b.gt[0]
         if not (g["speed"] == 0 and g["head_cam1"] and g["feet_cam1"]):
             continue
+        # The region the tracker measures in: the tallest plausible person's ellipse, with its ring.
         xy = np.array([[g["x"], g["y"]]])
-        _, ring, box, valid, _ = cs.forms(xy, np.array([2.1]), np.array([0.5]), 0.1)
-        region = _form_mask(ring[0], box[0], cs.grid, False)
-        measured.append(measure_height(cam, fg.labels(b.views["cam1"].image), cs.occ, xy[0], region, tuple(box[0])))
+        _, ring, box, valid, _ = cs.forms(xy, np.array([hi]), np.array([1.25 * sc.scene.people.width]))
+        region = _form_mask(ring[0], box[0], cs.grid, cam.has_distortion)
+        u0, u1, v0, v1 = box[0]
+        down = cs.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
+        measured.append(measure_height(cam, fg.labels(b.views["cam1"].image), cs.occ, xy[0], region, tuple(box[0]),
+                                       height_range_m=(lo, hi), down=down))
     ok = [h for h in measured if h is not None]
     assert len(ok) >= 5
     assert abs(np.median(ok) - 1.85) < 0.05

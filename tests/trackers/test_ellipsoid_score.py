@@ -8,7 +8,7 @@ import pytest
 from worldtrack.geometry import quadric as q
 from worldtrack.scene import load_scene
 from worldtrack.trackers.ellipsoid_score import (ellipse_forms, score_candidates, score_candidates_reference,
-                                                 ternary_real)
+                                                 ternary_real, ternary_real_reference)
 
 LAB = Path(__file__).parents[2] / "examples" / "scenes" / "kato_lab.yaml"
 
@@ -93,6 +93,28 @@ def test_ring_rejects_an_ellipse_inside_a_big_blob(lab):
     assert num_t[0] / den_t[0] < 0.8            # ternary: the ring falls on foreground and costs
 
 
+@pytest.mark.parametrize("ring", [1, 5, 20])
+def test_ternary_real_dilating_the_foreground_box_equals_the_whole_frame(ring):
+    rng = np.random.default_rng(ring)
+    for trial in range(12):
+        H, W = rng.integers(20, 130), rng.integers(20, 170)
+        labels = np.zeros((H, W), np.uint8)
+        if trial == 0:
+            pass                                                         # no foreground at all
+        elif trial % 3 == 0:
+            labels[rng.random((H, W)) < 0.01] = 1                        # scattered pixels
+        else:
+            for _ in range(rng.integers(1, 4)):
+                y, x = rng.integers(0, H), rng.integers(0, W)
+                labels[y:y + rng.integers(1, 25), x:x + rng.integers(1, 25)] = 1
+        if trial % 2:
+            labels[0, rng.integers(0, W)] = labels[rng.integers(0, H), W - 1] = 1   # blobs on the border
+        labels[rng.random((H, W)) < 0.05] = 2                            # unsure pixels stay 0
+        out = ternary_real(labels, ring)
+        np.testing.assert_array_equal(out, ternary_real_reference(labels, ring))
+        assert out.dtype == np.int8 and (out == -1).any() == (labels == 1).any()
+
+
 def test_obstacle_hides_the_lower_body(lab):
     cam = lab.cameras["cam1"]
     occ = lab.occlusion("cam1").floor_distance
@@ -115,9 +137,20 @@ def test_ellipse_crop_equals_the_conic_mask(lab, cam_id):
     xy = np.array([[-1.0, 1.0], [-0.5, 2.0]])
     inner, _, box, valid = ellipse_forms(*args, xy, np.full(2, 1.65), np.full(2, 0.4), 5.0, 0.1)
     grid = cam.ideal_pixel_grid if cam.has_distortion else np.zeros((1, 1, 2), np.float32)
+    cen, rad = q.person_ellipsoid(xy, 1.65, 0.4)
+    centre, axes, angle = q.ellipse_parameters(q.ellipsoid_conics(cam.P, cen, rad))
+    if cam.has_distortion:
+        u, v = grid[..., 0].astype(float), grid[..., 1].astype(float)
+    else:
+        v, u = np.mgrid[0:cam.height, 0:cam.width].astype(float)
     for k in range(2):
         crop = ellipse_crop(inner[k], box[k], grid, cam.has_distortion)
         full = person_mask(cam, xy[k], 1.65, 0.4).astype(bool)
         u0, u1, v0, v1 = box[k]
         assert (crop != full[v0:v1, u0:u1]).sum() <= 2       # float32 grid vs float64 at the edge
         assert crop.sum() == pytest.approx(full.sum(), abs=2)  # the box holds the whole ellipse
+        # ... and the whole ring ellipse, semi-axes + 5 px, drawn independently of the kernel.
+        du, dv = u - centre[k, 0], v - centre[k, 1]
+        ca, sa = np.cos(angle[k]), np.sin(angle[k])
+        ring = ((du * ca + dv * sa) / (axes[k, 0] + 5)) ** 2 + ((dv * ca - du * sa) / (axes[k, 1] + 5)) ** 2 < 1
+        assert ring.sum() > full.sum() and ring[v0:v1, u0:u1].sum() == ring.sum()

@@ -40,7 +40,8 @@ def blobs(mask: np.ndarray, min_area: float, factor: int = 1) -> list[tuple[int,
     ----------
     mask : (H, W) uint8 — non-zero pixels are foreground
     min_area : float, pixels (full resolution)
-    factor : int — 1 (exact labelling) or the shrink factor
+    factor : int — 1 (exact labelling) or the shrink factor (at most 22: a block mean of one
+        set pixel, 255 / factor², must still round to non-zero)
 
     Returns
     -------
@@ -55,13 +56,16 @@ def blobs(mask: np.ndarray, min_area: float, factor: int = 1) -> list[tuple[int,
             if area >= min_area:
                 out.append((area, (x0, y0, w, h), cent[j], labels[y0:y0 + h, x0:x0 + w] == j))
         return out
+    if factor > 22:
+        raise ValueError(f"blobs: shrink factor must be at most 22, got {factor}")
     H, W = mask.shape
-    if W % factor == 0 and H % factor == 0:
-        # Block means of 0/255: non-zero exactly when some pixel of the block is set.
-        full = cv2.threshold(mask, 0, 255, cv2.THRESH_BINARY)[1]
-        small = cv2.resize(full, (W // factor, H // factor), interpolation=cv2.INTER_AREA)
-    else:
-        small = _block_any(mask, factor)
+    # Zeros to a multiple of the factor (a partial block at the bottom or right is then a whole
+    # one), and block means of 0/255: non-zero exactly when some pixel of the block is set.
+    full = cv2.threshold(mask, 0, 255, cv2.THRESH_BINARY)[1]
+    pad_v, pad_u = -H % factor, -W % factor
+    if pad_v or pad_u:
+        full = cv2.copyMakeBorder(full, 0, pad_v, 0, pad_u, cv2.BORDER_CONSTANT, value=0)
+    small = cv2.resize(full, ((W + pad_u) // factor, (H + pad_v) // factor), interpolation=cv2.INTER_AREA)
     n, labels, stats, _ = connected_components(small)
     out = []
     for j in range(1, n):
@@ -83,10 +87,3 @@ def blobs(mask: np.ndarray, min_area: float, factor: int = 1) -> list[tuple[int,
         out.append((area, (x0 + int(c0), y0 + int(r0), int(c1 - c0), int(r1 - r0)), centroid, crop))
     return out
 
-
-def _block_any(mask: np.ndarray, factor: int) -> np.ndarray:
-    """(ceil(H / factor), ceil(W / factor)) uint8: 1 where any pixel of the block is non-zero."""
-    H, W = mask.shape
-    padded = np.zeros((-(-H // factor) * factor, -(-W // factor) * factor), np.uint8)
-    padded[:H, :W] = mask != 0
-    return padded.reshape(padded.shape[0] // factor, factor, -1, factor).max(axis=(1, 3))

@@ -7,7 +7,7 @@ this process currently sees. It is the integration point between trackers, camer
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterator, Mapping, Protocol
 
 import numpy as np
@@ -58,9 +58,8 @@ class Track:
         return np.array([self.x, self.y])
 
     def copy(self) -> "Track":
-        return Track(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
-                     self.mode, set(self.flags), self.sigma, self.born, self.last_seen, self.frames_low,
-                     self.age_frames, dict(self.extra))
+        """An independent copy (the mutable ``flags`` and ``extra`` are copied too)."""
+        return replace(self, flags=set(self.flags), extra=dict(self.extra))
 
 
 class PositionMap:

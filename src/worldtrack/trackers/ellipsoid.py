@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Mapping
+from typing import Mapping, NamedTuple
 
 import cv2
 import numpy as np
@@ -43,15 +43,11 @@ from worldtrack.foreground.components import blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
-from worldtrack.trackers.ellipsoid_match import run_rounds
+from worldtrack.trackers.ellipsoid_match import OFFSETS, STAY, run_rounds
 from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, owner_map, score_camera,
                                                  ternary_real, track_support)
-from worldtrack.trackers.height import head_ray, measure_height, triangulate_height
+from worldtrack.trackers.height import head_ray, measure_height, pixel_clear, triangulate_height
 
-#: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
-#: Index 4 is "stay".
-_OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=float)
-_STAY = 4
 _DUMMY_GRID = np.zeros((1, 1, 2), dtype=np.float32)
 #: Pixels a person must show (in all cameras together) to count as seen, or as its own.
 _MIN_OWN_PIXELS = 40
@@ -198,17 +194,26 @@ class EllipsoidConfig:
             raise ValueError("confirm_views and rescue_retry_frames must not be negative")
 
 
+class _Forms(NamedTuple):
+    """People's ellipses in one camera (N, …): :func:`ellipse_forms` output and floor distances."""
+
+    inner: np.ndarray
+    ring: np.ndarray
+    box: np.ndarray
+    valid: np.ndarray
+    dist: np.ndarray
+
+
 @dataclass
 class _CameraState:
     """Everything about one camera that does not change from frame to frame."""
 
     camera: Camera
-    P: np.ndarray
     grid: np.ndarray
     occ: np.ndarray
     ring_px: int
     foreground: Foreground
-    ring_fraction: float = 0.0
+    config: EllipsoidConfig
     _down: tuple | None = None
     _smallest: float | None = None
 
@@ -225,14 +230,14 @@ class _CameraState:
         d = grid[max(j, 0), max(i, 0)]
         return d if np.isfinite(d).all() else None
 
-    def forms(self, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray, min_depth: float):
+    def forms(self, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray) -> _Forms:
         """Ellipse forms of people at ``xy`` plus their floor distances from this camera."""
-        c = self.camera
-        inner, ring, box, valid = ellipse_forms(self.P, c.K, c.dist, c.has_distortion, c.width, c.height,
-                                                xy, heights, widths, float(self.ring_px), min_depth,
-                                                self.ring_fraction)
+        c, cfg = self.camera, self.config
+        inner, ring, box, valid = ellipse_forms(c.P, c.K, c.dist, c.has_distortion, c.width, c.height,
+                                                xy, heights, widths, float(self.ring_px), cfg.min_depth_m,
+                                                cfg.ring_fraction)
         dist = np.hypot(xy[:, 0] - c.centre[0], xy[:, 1] - c.centre[1])
-        return inner, ring, box, valid, dist
+        return _Forms(inner, ring, box, valid, dist)
 
 
 class EllipsoidTracker:
@@ -259,8 +264,7 @@ class EllipsoidTracker:
             occ = scene.occlusion(cid).floor_distance
             # Writable copies: the compiled rounds take them in typed lists of one array type.
             grid = np.array(cam.ideal_pixel_grid) if cam.has_distortion else _DUMMY_GRID.copy()
-            self.cams[cid] = _CameraState(cam, np.ascontiguousarray(cam.P), grid, np.array(occ), ring, fg,
-                                          self.config.ring_fraction)
+            self.cams[cid] = _CameraState(cam, grid, np.array(occ), ring, fg, self.config)
         self._walk_raster = scene.walkable.raster(0.01)
         self._walkable = self._walk_raster.contains
         self._python_rounds = False  # tests switch to the readable rounds to compare
@@ -271,10 +275,9 @@ class EllipsoidTracker:
         self._confirmed: set[int] = set()
         self._heights: dict[int, list[float]] = {}
         self._height_tries: dict[int, int] = {}
-        #: Per camera, the last frame's foreground mask and ternary image (for overlays).
+        #: Per camera, the last frame's foreground mask (for overlays) and foreground labels.
         self.last_masks: dict[str, np.ndarray] = {}
         self.last_labels: dict[str, np.ndarray] = {}
-        self.last_real: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ public
     def init_track(self, x: float, y: float, track_id: int | None = None, mode: str = "tracking",
@@ -300,7 +303,6 @@ class EllipsoidTracker:
             self.last_labels[cid] = labels
             self.last_masks[cid] = (labels == 1).astype(np.uint8)
             real[cid] = ternary_real(labels, self.cams[cid].ring_px)
-        self.last_real = real
 
         tracks = list(self.position_map)
         prev = {tr.id: (tr.x, tr.y) for tr in tracks}
@@ -333,13 +335,11 @@ class EllipsoidTracker:
         result: dict[int, tuple[float, float]] = {}
         if n == 0 or not real:
             return {tr.id: (0.0, 0.0) for tr in tracks}
-        xy = np.array([[tr.x, tr.y] for tr in everyone], dtype=float)
-        hs = np.array([tr.height for tr in everyone], dtype=float)
-        ws = np.array([tr.width for tr in everyone], dtype=float)
+        xy, hs, ws = _arrays(everyone)
         cids = list(real)
-        stacked = [np.stack(a) for a in zip(*(self.cams[cid].forms(xy, hs, ws, cfg.min_depth_m) for cid in cids))]
+        stacked = [np.stack(a) for a in zip(*(self.cams[cid].forms(xy, hs, ws) for cid in cids))]
         # Per camera, views into the stacked arrays: updates through either are shared.
-        state = {cid: [a[c] for a in stacked] for c, cid in enumerate(cids)}
+        state = {cid: _Forms(*(a[c] for a in stacked)) for c, cid in enumerate(cids)}
         if cfg.birth_search_m > 0:
             for k, tr in enumerate(tracks):
                 if tr.mode == "capture" and tr.age_frames == 0:
@@ -351,7 +351,7 @@ class EllipsoidTracker:
             cams = [self.cams[cid] for cid in cids]
             best_e, best_den = run_rounds(
                 xy, hs, ws, n, use_ring,
-                np.stack([cs.P for cs in cams]), np.stack([cs.camera.K for cs in cams]),
+                np.stack([cs.camera.P for cs in cams]), np.stack([cs.camera.K for cs in cams]),
                 np.stack([cs.camera.dist for cs in cams]), np.array([cs.camera.has_distortion for cs in cams]),
                 np.array([[cs.camera.width, cs.camera.height] for cs in cams], dtype=np.int64),
                 np.stack([cs.camera.centre for cs in cams]), np.stack([cs.camera.floor_direction for cs in cams]),
@@ -397,20 +397,17 @@ class EllipsoidTracker:
                 e, den, cand, forms, ok = self._score_person(k, xy, hs, ws, step[k], state, real, bool(use_ring[k]))
                 if not ok:
                     done[k] = True
-                    best_e[k], best_den[k] = e[_STAY], den[_STAY]
+                    best_e[k], best_den[k] = e[STAY], den[STAY]
                     continue
                 b = int(np.argmax(e))
-                if cfg.adaptive_step and e[b] - e[_STAY] < cfg.min_gain:
-                    b = _STAY
+                if cfg.adaptive_step and e[b] - e[STAY] < cfg.min_gain:
+                    b = STAY
                 best_e[k], best_den[k] = e[b], den[b]
-                if b != _STAY:
+                if b != STAY:
                     xy[k] = cand[b]
-                    for cid, f in forms.items():
-                        st = state[cid]
-                        for a in range(5):
-                            st[a][k] = f[a][b]
+                    _keep(state, forms, k, b)
                 if cfg.adaptive_step:
-                    if b == _STAY:
+                    if b == STAY:
                         if step[k] <= cfg.min_step_m * 1.001:
                             done[k] = True
                         else:
@@ -425,12 +422,12 @@ class EllipsoidTracker:
                       state: dict, real: dict[str, np.ndarray], use_ring: bool):
         """E of the 9 candidates of person ``k`` over all cameras (Σ num / Σ den)."""
         d, e_perp = self._axes(k, state)
-        cand = xy[k] + step * (_OFFSETS[:, :1] * d + _OFFSETS[:, 1:] * e_perp)
+        cand = xy[k] + step * (OFFSETS[:, :1] * d + OFFSETS[:, 1:] * e_perp)
         e, den, forms = self._score_candidates(k, cand, np.full(9, hs[k]), np.full(9, ws[k]), state, real, use_ring)
         walk = self._walkable(cand)
-        walk[_STAY] = True
+        walk[STAY] = True
         e[~walk] = -np.inf
-        ok = bool(den[_STAY] > 0)
+        ok = bool(den[STAY] > 0)
         if not ok:
             e[:] = 0.0
         return e, den, cand, forms, ok
@@ -460,9 +457,7 @@ class EllipsoidTracker:
         if not np.isfinite(e[b]):
             return
         xy[k] = cand[b]
-        for cid, f in forms.items():
-            for a in range(5):
-                state[cid][a][k] = f[a][b]
+        _keep(state, forms, k, b)
 
     def _rescue(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
                 real: dict[str, np.ndarray], e_here: float, den_here: float) -> float | None:
@@ -497,21 +492,13 @@ class EllipsoidTracker:
         if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue_gain:
             return None
         xy[k] = cand[b]
-        for cid, f in forms.items():
-            for a in range(5):
-                state[cid][a][k] = f[a][b]
+        _keep(state, forms, k, b)
         return float(e[b])
 
     def _ray_directions(self, k: int, state: dict, xy: np.ndarray) -> list[np.ndarray]:
         """Unit floor directions of the rays from each camera that sees person ``k`` through its
         position (the camera's optical axis for a person right below it); one direction at least."""
-        out = []
-        for cid, st in state.items():
-            if not st[3][k]:
-                continue
-            cam = self.cams[cid].camera
-            r = xy[k] - cam.centre[:2]
-            out.append(r / np.linalg.norm(r) if np.linalg.norm(r) > 0.3 else cam.floor_direction)
+        out = [_ray_direction(self.cams[cid].camera, xy[k]) for cid, st in state.items() if st.valid[k]]
         return out or [self._axes(k, state, xy, along_ray=True)[0]]
 
     def _axes(self, k: int, state: dict, xy: np.ndarray | None = None,
@@ -525,16 +512,12 @@ class EllipsoidTracker:
         """
         best_cam, best_area = next(iter(state)), -1
         for cid, st in state.items():
-            box = st[2][k]
-            area = max(0, box[1] - box[0]) * max(0, box[3] - box[2]) if st[3][k] else 0
+            box = st.box[k]
+            area = max(0, box[1] - box[0]) * max(0, box[3] - box[2]) if st.valid[k] else 0
             if area > best_area:
                 best_cam, best_area = cid, area
         cam = self.cams[best_cam].camera
-        d = cam.floor_direction
-        if along_ray and xy is not None:
-            r = xy[k] - cam.centre[:2]
-            if np.linalg.norm(r) > 0.3:
-                d = r / np.linalg.norm(r)
+        d = _ray_direction(cam, xy[k]) if along_ray and xy is not None else cam.floor_direction
         return d, np.array([-d[1], d[0]])
 
     def _score_candidates(self, k: int, cand: np.ndarray, heights: np.ndarray, widths: np.ndarray,
@@ -550,10 +533,10 @@ class EllipsoidTracker:
             cs = self.cams[cid]
             c = cs.camera
             nu, de, ci, cr, cb, cv, cd = score_camera(
-                cs.P, c.K, c.dist, c.has_distortion, c.width, c.height, c.centre, cs.grid, cs.occ, real[cid],
-                use_ring, cand, heights, widths, float(cs.ring_px), cfg.min_depth_m, cs.ring_fraction,
-                st[0], st[1], st[2], st[4], st[3], k, cfg.target_pixels, unexplained)
-            forms[cid] = (ci, cr, cb, cv, cd)
+                c.P, c.K, c.dist, c.has_distortion, c.width, c.height, c.centre, cs.grid, cs.occ, real[cid],
+                use_ring, cand, heights, widths, float(cs.ring_px), cfg.min_depth_m, cfg.ring_fraction,
+                st.inner, st.ring, st.box, st.dist, st.valid, k, cfg.target_pixels, unexplained)
+            forms[cid] = _Forms(ci, cr, cb, cv, cd)
             num += nu
             den += de
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -570,7 +553,7 @@ class EllipsoidTracker:
             xy = np.column_stack([gx.ravel(), gy.ravel()])
             xy = xy[self._walkable(xy)]
             h0, w0 = self.scene.people.height, self.scene.people.width
-            inner, _, box, valid, _ = cs.forms(xy, np.full(len(xy), h0), np.full(len(xy), w0), self.config.min_depth_m)
+            inner, _, box, valid, _ = cs.forms(xy, np.full(len(xy), h0), np.full(len(xy), w0))
             seen = valid & (box[:, 0] < box[:, 1]) & (box[:, 2] < box[:, 3])
             det = inner[seen, 2] * inner[seen, 4] - inner[seen, 3] ** 2
             areas = np.pi / np.sqrt(np.maximum(det, 1e-12))
@@ -603,9 +586,7 @@ class EllipsoidTracker:
         """Propose new people from foreground that the current simulation does not explain."""
         cfg = self.config
         tracks = list(self.position_map)
-        xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float).reshape(-1, 2)
-        hs = np.array([tr.height for tr in tracks], dtype=float)
-        ws = np.array([tr.width for tr in tracks], dtype=float)
+        xy, hs, ws = _arrays(tracks)
         h0, w0 = self.scene.people.height, self.scene.people.width
         proposals: list[np.ndarray] = []
         for cid, r in real.items():
@@ -614,7 +595,7 @@ class EllipsoidTracker:
             mask = self.last_masks[cid]
             explained = np.zeros_like(mask)
             if len(tracks):
-                inner, _, box, valid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+                inner, _, box, valid, _ = cs.forms(xy, hs, ws)
                 _render_union(explained, inner, box, valid, cs.grid, cam.has_distortion)
                 explained = cv2.dilate(explained, _disc(2))
             un = mask & (1 - explained)
@@ -636,7 +617,7 @@ class EllipsoidTracker:
                 if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
                     continue  # off the floor, or somebody already there
                 # Is the blob big enough to be (the visible part of) a person standing there?
-                expected = _visible_pixels(cs, pxy, h0, w0, cfg.min_depth_m)
+                expected = _visible_pixels(cs, pxy, h0, w0)
                 if expected <= 0 or area < cfg.min_blob_fraction * expected:
                     continue
                 proposals.append(pxy)
@@ -644,11 +625,9 @@ class EllipsoidTracker:
             return []
         if cfg.births == "entry" and self._frame > 0 and self.scene.entry_regions:
             proposals = [p for p in proposals if self.scene.entry_region_index([p])[0] >= 0]
+        # Each proposal is already clear of the existing people; keep the proposals apart too.
         new: list[Track] = []
-        existing = xy
         for p in proposals:
-            if len(existing) and np.min(np.hypot(*(existing - p).T)) < cfg.min_separation_m:
-                continue
             if any(np.hypot(*(np.array([b.x, b.y]) - p)) < cfg.min_separation_m for b in new):
                 continue
             tr = self.position_map.add(p[0], p[1], h0, w0, mode="capture", time=t, tentative=True)
@@ -674,9 +653,7 @@ class EllipsoidTracker:
         cfg = self.config
         if not tracks:
             return {}
-        xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
-        hs = np.array([tr.height for tr in tracks], dtype=float)
-        ws = np.array([tr.width for tr in tracks], dtype=float)
+        xy, hs, ws = _arrays(tracks)
         covers = np.array([tr.mode == "tracking" for tr in tracks])
         visible = np.zeros(len(tracks))
         own_total = np.zeros(len(tracks))
@@ -686,7 +663,7 @@ class EllipsoidTracker:
         views = np.zeros(len(tracks), dtype=int)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
-            inner, _, box, valid, dist = cs.forms(xy, hs, ws, cfg.min_depth_m)
+            inner, _, box, valid, dist = cs.forms(xy, hs, ws)
             vis, own, own_fg, area = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box,
                                                    dist, valid, cfg.target_pixels, covers)
             visible += vis
@@ -786,9 +763,7 @@ class EllipsoidTracker:
         tracks = [tr for tr in tracks if tr.id in self.position_map]
         if not tracks:
             return
-        xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
-        hs = np.array([tr.height for tr in tracks], dtype=float)
-        ws = np.array([tr.width for tr in tracks], dtype=float)
+        xy, hs, ws = _arrays(tracks)
         lo, hi = cfg.height_range_m
         samples_now: dict[int, list[float]] = {}
         rays: dict[int, list] = {}
@@ -806,11 +781,11 @@ class EllipsoidTracker:
             cs = self.cams[cid]
             # Where a person's pixels may be: the ellipse of the tallest plausible person (a
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
-            _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws, cfg.min_depth_m)
+            _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws)
             cam = cs.camera
             if triangulate:
                 # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
-                inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws, cfg.min_depth_m)
+                inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws)
                 owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
             for k in due:
                 tr = tracks[k]
@@ -911,8 +886,7 @@ class EllipsoidTracker:
             cam = cs.camera
             uv = cam.project(pts)
             inside = cam.in_image(uv)
-            dist = np.repeat(np.hypot(pts[::2, 0] - cam.centre[0], pts[::2, 1] - cam.centre[1]), 2)
-            visible = inside & ~self.scene.occlusion(cam.id).hidden(uv, dist - 0.05)
+            visible = inside & ~self.scene.occlusion(cam.id).hidden(uv, cam.floor_distance(pts) - 0.05)
             seen |= inside.reshape(n, 2).any(axis=1)
             head_or_feet |= visible.reshape(n, 2).any(axis=1)
         for k, tr in enumerate(tracks):
@@ -955,20 +929,38 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     head = centroid + (along.min() - 0.5) * down + spread[low].mean() * across
     # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
     half = max(1.0, 0.4 * (spread.max() - spread.min()))  # most of the blob's width
-    beyond = np.round(foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across).astype(int)
-    inside = (beyond[:, 0] >= 0) & (beyond[:, 0] < cam.width) & (beyond[:, 1] >= 0) & (beyond[:, 1] < cam.height)
-    if not inside.all():
-        feet_hidden = True
-    else:
-        feet_hidden = np.isfinite(cs.occ[beyond[:, 1], beyond[:, 0]]).mean() > 0.5
+    beyond = foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across
+    feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, cs.occ, beyond)).mean() > 0.5
     if not feet_hidden:
         p = cam.backproject(foot[None], 0.0)[0]
-    else:
-        top = np.round(head - 2 * down).astype(int)
-        if not (0 <= top[0] < cam.width and 0 <= top[1] < cam.height):
-            return None
+    elif pixel_clear(cam, None, head - 2 * down):  # the head inside the image
         p = cam.backproject(head[None], height)[0]
+    else:
+        return None
     return p if np.isfinite(p).all() else None
+
+
+def _arrays(tracks: list[Track]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Floor positions (N, 2), heights (N,) and widths (N,) of ``tracks``."""
+    xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float).reshape(-1, 2)
+    hs = np.array([tr.height for tr in tracks], dtype=float)
+    ws = np.array([tr.width for tr in tracks], dtype=float)
+    return xy, hs, ws
+
+
+def _keep(state: dict[str, _Forms], forms: dict[str, _Forms], k: int, b: int) -> None:
+    """Person ``k`` moves to candidate ``b``: copy the candidate's forms into everybody's, per camera."""
+    for cid, f in forms.items():
+        for dst, src in zip(state[cid], f):
+            dst[k] = src[b]
+
+
+def _ray_direction(cam: Camera, xy: np.ndarray) -> np.ndarray:
+    """Unit floor direction of the camera's ray through floor point ``xy`` — the direction along
+    which one camera cannot tell depth — or the optical axis's for a point right below the camera."""
+    r = xy - cam.centre[:2]
+    n = np.linalg.norm(r)
+    return r / n if n > 0.3 else cam.floor_direction
 
 
 def _disc(radius: int) -> np.ndarray:
@@ -976,10 +968,9 @@ def _disc(radius: int) -> np.ndarray:
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
 
 
-def _visible_pixels(cs: _CameraState, xy: np.ndarray, height: float, width: float, min_depth: float) -> int:
+def _visible_pixels(cs: _CameraState, xy: np.ndarray, height: float, width: float) -> int:
     """Pixels of a person's ellipse at ``xy`` inside the image and not hidden by obstacles."""
-    inner, _, box, valid, dist = cs.forms(np.asarray(xy, float)[None], np.array([height]), np.array([width]),
-                                          min_depth)
+    inner, _, box, valid, dist = cs.forms(np.asarray(xy, float)[None], np.array([height]), np.array([width]))
     u0, u1, v0, v1 = box[0]
     if not valid[0] or u0 >= u1 or v0 >= v1:
         return 0

@@ -9,12 +9,10 @@ Python overhead per person and round, which at 640×480 was ~40 % of the tracker
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
-from worldtrack.trackers.ellipsoid_score import ellipse_forms, score_candidates
+from worldtrack.trackers.ellipsoid_score import score_camera
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=np.float64)
@@ -97,19 +95,16 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
             num = np.zeros(9)
             den = np.zeros(9)
             for c in range(C):
-                ci, cr, cb, cv = ellipse_forms(cam_P[c], cam_K[c], cam_dist[c], cam_has_dist[c], cam_size[c, 0],
-                                               cam_size[c, 1], cand, h9, w9, cam_ring_px[c], min_depth, ring_fraction)
-                for j in range(9):
-                    f_dist[c, j] = math.hypot(cand[j, 0] - cam_centre[c, 0], cand[j, 1] - cam_centre[c, 1])
+                nu, de, ci, cr, cb, cv, cd = score_camera(
+                    cam_P[c], cam_K[c], cam_dist[c], cam_has_dist[c], cam_size[c, 0], cam_size[c, 1], cam_centre[c],
+                    grids[c], occs[c], reals[c], use_ring[k], cand, h9, w9, cam_ring_px[c], min_depth,
+                    ring_fraction, s_inner[c], s_ring[c], s_box[c], s_dist[c], s_valid[c], k, target_pixels,
+                    use_ring[k] and symmetric)
                 f_inner[c] = ci
                 f_ring[c] = cr
                 f_box[c] = cb
                 f_valid[c] = cv
-                ov = s_valid[c].copy()
-                ov[k] = False
-                nu, de, _ = score_candidates(grids[c], cam_has_dist[c], occs[c], reals[c], use_ring[k], ci, cr, cb,
-                                             f_dist[c], cv, s_inner[c], s_ring[c], s_box[c], s_dist[c], ov,
-                                             target_pixels, use_ring[k] and symmetric)
+                f_dist[c] = cd
                 num += nu
                 den += de
             if not den[STAY] > 0:

@@ -49,8 +49,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     if ends is None:
         return None
     top, bottom, down = ends
-    below = np.round(bottom + 2 * down).astype(int)
-    if not (0 <= below[0] < camera.width and 0 <= below[1] < camera.height) or np.isfinite(occ[below[1], below[0]]):
+    if not pixel_clear(camera, occ, bottom + 2 * down):
         return None  # feet at the border or on an obstacle's edge
     feet = camera.backproject(bottom[None], 0.0)[0]
     if not np.isfinite(feet).all() or np.hypot(*(feet[:2] - xy)) > max_offset_m:
@@ -79,11 +78,21 @@ def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.nda
     if ends is None:
         return None
     top = ends[0]
-    t = np.round(top).astype(int)
-    if not (0 <= t[0] < camera.width and 0 <= t[1] < camera.height) or np.isfinite(occ[t[1], t[0]]):
+    if not pixel_clear(camera, occ, top):
         return None
     origin, d = camera.rays(top[None])
     return (origin, d[0]) if np.isfinite(d).all() else None
+
+
+def pixel_clear(camera: Camera, occ: np.ndarray | None, p: np.ndarray) -> np.ndarray:
+    """Whether point(s) ``p`` (..., 2), rounded to the nearest pixel, are inside the image and
+    (unless ``occ`` is None) not on an obstacle (``occ`` finite there); bool (...)."""
+    q = np.round(p).astype(int)
+    u, v = q[..., 0], q[..., 1]
+    inside = (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
+    if occ is None:
+        return inside
+    return inside & ~np.isfinite(occ[np.clip(v, 0, camera.height - 1), np.clip(u, 0, camera.width - 1)])
 
 
 def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray, max_offset_m: float = 0.5,
