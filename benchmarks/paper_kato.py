@@ -56,12 +56,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, mog2_apply_time, render_images, save_result  # noqa: E402
 
 from worldtrack.eval import position_errors  # noqa: E402
-from worldtrack.experiment import gt_table, run_scenario  # noqa: E402
-from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.experiment import bundle_frames, gt_table, run_scenario, step_tracker, synthetic_tracker  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
-from worldtrack.trackers import make_tracker  # noqa: E402
 
 SEED = 0
 GATE_M = 1.5
@@ -106,21 +103,17 @@ def render(name: str, size: tuple[int, int], **params) -> Sequence:
 
 
 def _tracker(seq: Sequence, preset: str, foreground: str, **options):
-    sc = seq.scenario
-    fgs = make_foregrounds(sc.scene, {c: sc.background(c) for c in sc.camera_ids}, foreground,
-                           SYNTHETIC_COLOUR_THRESHOLD if foreground == "colour" else None)
-    return make_tracker("ellipsoid", sc.scene, fgs, preset=preset, **options)
+    return synthetic_tracker(seq.scenario, "ellipsoid", preset, foreground, **options)
+
+
+def _flagged_row(frame: int, t: float, tr) -> tuple:
+    return (frame, t, tr.id, tr.x, tr.y, float("unmeasurable" in tr.flags))
 
 
 def _step_all(tracker, bundles, rows: list) -> float:
     """Step ``tracker`` over ``bundles``, appending (frame, time, id, x, y, unmeasurable) rows; seconds."""
-    seconds = 0.0
-    for b in bundles:
-        frames = {c: Frame(v.image, b.time, b.frame) for c, v in b.views.items()}
-        t0 = time.perf_counter()
-        tracks = tracker.step(frames, b.time)
-        seconds += time.perf_counter() - t0
-        rows += [(b.frame, b.time, tr.id, tr.x, tr.y, float("unmeasurable" in tr.flags)) for tr in tracks]
+    new, seconds = step_tracker(tracker, bundle_frames(bundles), row=_flagged_row)
+    rows += new
     return seconds
 
 

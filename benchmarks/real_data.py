@@ -44,6 +44,7 @@ from common import DATA, ROOT, markdown_table, save_result  # noqa: E402
 
 from worldtrack.cli.eval import read_area  # noqa: E402
 from worldtrack.eval import evaluate_detailed, position_errors  # noqa: E402
+from worldtrack.experiment import predictions_table, step_tracker  # noqa: E402
 from worldtrack.foreground.background import estimate_background  # noqa: E402
 from worldtrack.io.gt_import import boxes_to_world, read_boxes  # noqa: E402
 from worldtrack.io.sources import Frame  # noqa: E402
@@ -109,16 +110,9 @@ def track(method: str, scene, camera: str, background: np.ndarray, frames: list,
     """Run one tracker over the frames; (predictions, frames/s of ``step``)."""
     fgs = make_foregrounds(scene, {camera: background}, FOREGROUND)
     tracker = make_tracker(method, scene, fgs)
-    rows, seconds = [], 0.0
-    for k, img in enumerate(frames):
-        t = k / fps
-        t0 = time.perf_counter()
-        tracks = tracker.step({camera: Frame(img, t, k)}, t)
-        seconds += time.perf_counter() - t0
-        rows += [(k, t, tr.id, tr.x, tr.y) for tr in tracks]
-    a = np.array(rows, dtype=float).reshape(-1, 5)
-    pred = TrackTable.from_arrays(a[:, 0].astype(int), a[:, 2].astype(int), a[:, 3], a[:, 4], time=a[:, 1])
-    return pred, len(frames) / seconds
+    rows, seconds = step_tracker(tracker, ((k, k / fps, {camera: Frame(img, k / fps, k)})
+                                           for k, img in enumerate(frames)))
+    return predictions_table(rows), len(frames) / seconds
 
 
 def run_folder(folder: Path, limit: int | None) -> list[list]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
@@ -74,6 +74,61 @@ def visibility(gt: TrackTable) -> np.ndarray:
     return np.max(np.vstack(vis), axis=0) if vis else np.ones(len(gt))
 
 
+def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
+                      threshold: float | None = None, cameras: list[str] | None = None, **options):
+    """A tracker for a synthetic scenario, its foregrounds made from the scenario's background plates.
+
+    Parameters
+    ----------
+    scenario : worldtrack.synth.Scenario
+    method, preset, options : passed to :func:`worldtrack.trackers.make_tracker`
+    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
+        the colour threshold defaults to the synthetic world's 20
+    cameras : the cameras to track with (default: all)
+    """
+    if threshold is None and foreground == "colour":
+        threshold = SYNTHETIC_COLOUR_THRESHOLD
+    cams = list(cameras or scenario.camera_ids)
+    foregrounds = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, foreground, threshold)
+    return make_tracker(method, scenario.scene, foregrounds, preset=preset, **options)
+
+
+def bundle_frames(bundles, cameras: list[str] | None = None) -> Iterator[tuple[int, float, dict[str, Frame]]]:
+    """``(frame, time, {camera: Frame})`` of each rendered bundle: the views of ``cameras`` (default: all)."""
+    for b in bundles:
+        cams = b.views if cameras is None else cameras
+        yield b.frame, b.time, {c: Frame(b.views[c].image, b.time, b.frame) for c in cams}
+
+
+def track_row(index: int, t: float, track) -> tuple:
+    """``(frame, time, id, x, y)`` of a reported track: the default row of :func:`step_tracker`."""
+    return (index, t, track.id, track.x, track.y)
+
+
+def step_tracker(tracker, frames: Iterable[tuple[int, float, dict]],
+                 row: Callable | None = track_row) -> tuple[list, float]:
+    """Step ``tracker`` over ``(index, time, {camera: Frame})`` items (e.g. :func:`bundle_frames`).
+
+    Returns ``row(index, time, track)`` for every reported track, in order (nothing when ``row``
+    is None), and the seconds spent in ``tracker.step`` alone.
+    """
+    rows: list = []
+    seconds = 0.0
+    for index, t, views in frames:
+        t0 = time.perf_counter()
+        tracks = tracker.step(views, t)
+        seconds += time.perf_counter() - t0
+        if row is not None:
+            rows += [row(index, t, tr) for tr in tracks]
+    return rows, seconds
+
+
+def predictions_table(rows) -> TrackTable:
+    """A TrackTable of :func:`track_row` rows ``(frame, time, id, x, y)``."""
+    a = np.array(rows, dtype=float).reshape(-1, 5)
+    return TrackTable.from_arrays(a[:, 0].astype(int), a[:, 2].astype(int), a[:, 3], a[:, 4], time=a[:, 1])
+
+
 def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
                  threshold: float | None = None, min_visibility: float = 0.2, gate: float = 0.5,
                  score_rows: Callable[[TrackTable], np.ndarray] | None = None, init_from_gt: bool = False,
@@ -98,24 +153,12 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
     if bundles is None:
         bundles = scenario.render()
     cams = list(cameras or scenario.camera_ids)
-    scene = scenario.scene
-    if threshold is None and foreground == "colour":
-        threshold = SYNTHETIC_COLOUR_THRESHOLD
-    foregrounds = make_foregrounds(scene, {c: scenario.background(c) for c in cams}, foreground, threshold)
-    tracker = make_tracker(method, scene, foregrounds, preset=preset, **options)
+    tracker = synthetic_tracker(scenario, method, preset, foreground, threshold, cams, **options)
     if init_from_gt and bundles:
         for r in bundles[0].gt:
             tracker.init_track(r["x"], r["y"], track_id=int(r["id"]))
-    rows = []
-    seconds = 0.0
-    for b in bundles:
-        frames = {c: Frame(b.views[c].image, b.time, b.frame) for c in cams}
-        t0 = time.perf_counter()
-        tracks = tracker.step(frames, b.time)
-        seconds += time.perf_counter() - t0
-        rows += [(b.frame, b.time, tr.id, tr.x, tr.y) for tr in tracks]
-    a = np.array(rows, dtype=float).reshape(-1, 5)
-    pred_all = TrackTable.from_arrays(a[:, 0].astype(int), a[:, 2].astype(int), a[:, 3], a[:, 4], time=a[:, 1])
+    rows, seconds = step_tracker(tracker, bundle_frames(bundles, cams))
+    pred_all = predictions_table(rows)
     gt_all = gt_table(bundles)
     ignore = visibility(gt_all) < min_visibility
     if score_rows is not None:

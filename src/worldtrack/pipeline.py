@@ -141,7 +141,6 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
             writer.write(index, t, rows)
             for tr in tracks:
                 paths.setdefault(tr.id, []).append((tr.x, tr.y))
-                result.track_ids.add(tr.id)
             if json_stream is not None:
                 json_stream.write(json.dumps({"frame": index, "time": round(t, 6), "tracks": rows}) + "\n")
                 json_stream.flush()
@@ -176,6 +175,7 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
         writer.close()
         for v in videos.values():
             v.close()
+        result.track_ids = set(paths)
         arr = {k: np.array(v) for k, v in paths.items()}
         result.floorplan = save_floorplan(scene, out / "floorplan.png", paths=arr, reference_paths=gt_paths,
                                           title=f"{scene.name}: {len(arr)} trajectories, {result.frames} frames")

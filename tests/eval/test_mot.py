@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from worldtrack.errors import InputError
-from worldtrack.eval.mot import (accumulate, evaluate, evaluate_detailed, evaluated_frames,
+from worldtrack.eval.mot import (accumulate, drop_ignored, evaluate, evaluate_detailed, evaluated_frames,
                                  floor_distances, summarize)
 from worldtrack.io.tracks import TrackTable, read_tracks
 
@@ -208,3 +208,20 @@ def test_accumulator_path_reproduces_motmetrics_published_tud_numbers(name):
     got = summarize(accumulate(_tud_frames(folder)))
     for k, v in TUD_EXPECTED[name].items():
         assert got[k] == pytest.approx(v, abs=1e-3), k
+
+
+def test_drop_ignored_removes_ignored_people_and_the_predictions_that_found_them():
+    # Frame 0: person 1 (ignored) and person 2 (scored), a prediction near each.
+    # Frame 1: the ignored person has no prediction; person 2's and a far false positive stay.
+    # Frame 2: one prediction between them, nearer the scored person: it matches person 2 and stays.
+    gt = TrackTable.from_arrays([0, 0, 1, 1, 2, 2], [1, 2, 1, 2, 1, 2],
+                                [0.0, 3.0, 0.1, 3.1, 0.2, 0.6], [0.0] * 6)
+    ignore = gt.id == 1
+    pred = TrackTable.from_arrays([0, 0, 1, 1, 2], [10, 20, 20, 30, 20],
+                                  [0.1, 3.1, 3.2, 6.0, 0.45], [0.0] * 5)
+    gt_kept, pred_kept = drop_ignored(gt, pred, ignore, gate=0.5)
+    assert list(zip(gt_kept.frame.tolist(), gt_kept.id.tolist())) == [(0, 2), (1, 2), (2, 2)]
+    assert list(zip(pred_kept.frame.tolist(), pred_kept.id.tolist())) == [(0, 20), (1, 20), (1, 30), (2, 20)]
+    np.testing.assert_allclose(pred_kept.x, [3.1, 3.2, 6.0, 0.45])
+    with pytest.raises(ValueError, match="ignore"):
+        drop_ignored(gt, pred, ignore[:-1])

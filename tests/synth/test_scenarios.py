@@ -10,6 +10,8 @@ from worldtrack.geometry.rotation import rotation_angle_deg
 from worldtrack.scene import load_scene, scene_from_dict
 from worldtrack.synth import list_scenarios, make_scenario, scenario_parameters
 from worldtrack.synth import scenes
+from worldtrack.synth.bodies import (HEAD, L_FOREARM, L_UPPER_ARM, PARTS_PER_PERSON, R_FOREARM,
+                                     R_UPPER_ARM)
 from worldtrack.synth.scenarios import CAM1_GRID, CAM2_GRID
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
@@ -100,6 +102,21 @@ def test_example_scene_files_match_the_builtin_scenes(name):
     _same_scene(load_scene(EXAMPLES / f"{name}.yaml"), scene_from_dict(scenes.scene_dict(name)))
 
 
+def _quat_matrix(q):
+    """Rotation matrix of a quaternion (w, x, y, z), renormalised (pose.csv rounds it)."""
+    w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def _angle_deg(A, B):
+    """Angle of A·Bᵀ in degrees, accurate near 0 (atan2 of the sine and cosine parts, not arccos)."""
+    D = A @ B.T
+    s = np.linalg.norm([D[2, 1] - D[1, 2], D[0, 2] - D[2, 0], D[1, 0] - D[0, 1]]) / 2
+    return np.degrees(np.arctan2(s, (np.trace(D) - 1) / 2))
+
+
 def test_pose_scenarios_report_the_rendered_pose():
     sc = make_scenario("face-pose", motion="large", frames=12, size=(64, 48), seed=1)
     rows = [r for b in sc.frames() for r in b.pose]
@@ -108,12 +125,27 @@ def test_pose_scenarios_report_the_rendered_pose():
     np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-7)
     yaw = np.array([r["rz_deg"] for r in rows])
     assert np.ptp(yaw) > 3.0                                   # the head turns
+    # Every row is the rendered head: its quaternion is head → world (the head's axes as columns,
+    # parts.axes[k].T) and its translation the head's centre. Rounding to 8 decimals bounds the
+    # angle at ~1.2e-6°; a transposed or identity rotation is off by tens of degrees.
+    for r, qr in zip(rows, q):
+        people, parts = sc.pose_people(r["frame"])
+        k = [p.id for p in people].index(r["id"]) * PARTS_PER_PERSON + HEAD
+        assert _angle_deg(_quat_matrix(qr), parts.axes[k].T) < 2e-6
+        np.testing.assert_allclose([r["tx"], r["ty"], r["tz"]], parts.centre[k], atol=1e-6)
     ub = make_scenario("upper-body", frames=3, size=(64, 48), seed=1)
-    row = next(iter(ub.frames())).pose[0]
-    assert len([k for k in row if k.endswith("_deg")]) == 3 + 8          # 14 DoF = 3 translations + 11 angles
-    for limb in ("l_upper_arm", "l_forearm", "r_upper_arm", "r_forearm"):
-        axis = np.array([row[f"{limb}_axis_{c}"] for c in "xyz"])
-        assert np.linalg.norm(axis) == pytest.approx(1.0, abs=1e-7)
+    for b in ub.frames():
+        row = b.pose[0]
+        assert len([k for k in row if k.endswith("_deg")]) == 3 + 8          # 14 DoF = 3 translations + 11 angles
+        people, parts = ub.pose_people(b.frame)
+        base = [p.id for p in people].index(row["id"]) * PARTS_PER_PERSON
+        for limb, part in (("l_upper_arm", L_UPPER_ARM), ("l_forearm", L_FOREARM),
+                           ("r_upper_arm", R_UPPER_ARM), ("r_forearm", R_FOREARM)):
+            axis = np.array([row[f"{limb}_axis_{c}"] for c in "xyz"])
+            assert np.linalg.norm(axis) == pytest.approx(1.0, abs=1e-7)
+            seg = parts.end[base + part] - parts.centre[base + part]
+            np.testing.assert_allclose(axis, seg / np.linalg.norm(seg), atol=1e-7)
+            np.testing.assert_allclose(axis, parts.axes[base + part][0], atol=1e-7)   # the capsule's own x axis
 
 
 def test_face_pose_quaternion_matches_the_head_rotation():

@@ -142,10 +142,20 @@ def evaluated_frames(gt: TrackTable, pred: TrackTable) -> np.ndarray:
 def frame_distances(gt: TrackTable, pred: TrackTable, frames: ArrayLike,
                     gate: float) -> Iterator[FrameDistances]:
     """Per frame of ``frames``: ids present in each table and their distance matrix (metres)."""
-    gt, pred = gt.sorted(), pred.sorted()
+    return _sorted_frame_distances(gt.sorted(), pred.sorted(), frames, gate)
+
+
+def _frame_bounds(row_frames: np.ndarray, frames: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)``: the rows of frame ``frames[k]`` in the sorted ``row_frames`` are ``lo[k]:hi[k]``."""
+    return np.searchsorted(row_frames, frames, "left"), np.searchsorted(row_frames, frames, "right")
+
+
+def _sorted_frame_distances(gt: TrackTable, pred: TrackTable, frames: ArrayLike,
+                            gate: float) -> Iterator[FrameDistances]:
+    """:func:`frame_distances` of tables already :meth:`~TrackTable.sorted`."""
     frames = np.asarray(frames, dtype=np.int64)
-    g_lo, g_hi = np.searchsorted(gt.frame, frames, "left"), np.searchsorted(gt.frame, frames, "right")
-    p_lo, p_hi = np.searchsorted(pred.frame, frames, "left"), np.searchsorted(pred.frame, frames, "right")
+    g_lo, g_hi = _frame_bounds(gt.frame, frames)
+    p_lo, p_hi = _frame_bounds(pred.frame, frames)
     gxy, pxy = gt.xy, pred.xy
     for k, f in enumerate(frames):
         gs, ps = slice(g_lo[k], g_hi[k]), slice(p_lo[k], p_hi[k])
@@ -202,7 +212,7 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         gt = gt.select(inside_area(gt, ring))
         pred = pred.select(inside_area(pred, ring))
     pred = pred.select((pred.frame >= frames[0]) & (pred.frame <= frames[-1]))
-    acc = accumulate(frame_distances(gt, pred, frames, gate))
+    acc = accumulate(_sorted_frame_distances(gt, pred, frames, gate))   # select() keeps the order
     m = summarize(acc)
 
     metrics: dict[str, Any] = {
@@ -294,8 +304,8 @@ def evaluate(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GATE_M,
 
 def _count_per_frame(row_frames: np.ndarray, frames: np.ndarray) -> np.ndarray:
     """How many of the sorted ``row_frames`` fall on each of ``frames``."""
-    return (np.searchsorted(row_frames, frames, "right")
-            - np.searchsorted(row_frames, frames, "left")).astype(np.int64)
+    lo, hi = _frame_bounds(row_frames, frames)
+    return (hi - lo).astype(np.int64)
 
 
 def _check_area(area: ArrayLike) -> np.ndarray:

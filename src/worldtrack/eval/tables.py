@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import linear_sum_assignment
 
+from worldtrack.eval.mot import _frame_bounds
 from worldtrack.geometry.rotation import rotation_angle_deg
 from worldtrack.io.tracks import TrackTable
 
@@ -87,8 +88,8 @@ def position_errors(gt: TrackTable, pred: TrackTable, gate: float = 0.5) -> Posi
         raise ValueError(f"gate must be a positive distance in metres, got {gate!r}")
     gt, pred = gt.sorted(), pred.sorted()
     frames = np.intersect1d(gt.frame, pred.frame)
-    g_lo, g_hi = np.searchsorted(gt.frame, frames, "left"), np.searchsorted(gt.frame, frames, "right")
-    p_lo, p_hi = np.searchsorted(pred.frame, frames, "left"), np.searchsorted(pred.frame, frames, "right")
+    g_lo, g_hi = _frame_bounds(gt.frame, frames)
+    p_lo, p_hi = _frame_bounds(pred.frame, frames)
     gxy, pxy = gt.xy, pred.xy
     gi_all: list[np.ndarray] = []
     pi_all: list[np.ndarray] = []

@@ -301,20 +301,7 @@ def trace_shadows_reference(points: np.ndarray, receiver: np.ndarray, light: np.
     if len(idx) == 0 or len(geom) == 0:
         return shadow
     o = points.reshape(-1, 3)[idx].astype(np.float64)
-    d = np.broadcast_to(np.asarray(light, dtype=float), o.shape)
-    best = np.full(len(idx), np.inf)
-    for row in geom:
-        if row[0] == 0:
-            M = row[8:17].reshape(3, 3)
-            radii = 1.0 / np.linalg.norm(M, axis=1)
-            s = ray_ellipsoid(o, d, row[1:4], radii, M * radii[:, None])
-        else:
-            s = _capsule_from_points(o, d, row[1:4], row[4:7], row[7])
-        best = np.minimum(best, s)
-    shadow.ravel()[idx] = np.isfinite(best)
+    d = np.ascontiguousarray(np.broadcast_to(np.asarray(light, dtype=float), o.shape))
+    s, _ = hit_parts_reference(o, d, geom)
+    shadow.ravel()[idx] = np.isfinite(s)
     return shadow
-
-
-def _capsule_from_points(o: np.ndarray, d: np.ndarray, a, b, r) -> np.ndarray:
-    """:func:`ray_capsule` for per-ray origins (N, 3)."""
-    return ray_capsule(o, np.ascontiguousarray(d), a, b, r)

@@ -86,11 +86,10 @@ def finish_track(xy: ArrayLike, fps: float, height: float, present: ArrayLike | 
     # Gait: amplitude follows a lightly smoothed speed (no swing while standing).
     kernel = np.array([0.25, 0.5, 0.25])
     smooth = np.convolve(np.pad(speed, 1, mode="edge"), kernel, mode="valid") if T > 2 else speed.copy()
-    smooth[speed == 0] = np.minimum(smooth[speed == 0], 0.0)
+    smooth[speed == 0] = 0.0
     amp = gait_amplitude(smooth) * (1.0 - np.clip(sit, 0, 1))
     phase = np.zeros(T)
-    for k in range(1, T):
-        phase[k] = phase[k - 1] + 2 * np.pi * smooth[k] * dt / float(stride_length(height, smooth[k]))
+    phase[1:] = np.cumsum(2 * np.pi * smooth[1:] * dt / stride_length(height, smooth[1:]))
     return Track(xy, yaw, speed, present, sit, phase, amp)
 
 
@@ -175,11 +174,8 @@ def scripted_track(waypoints: Sequence[Waypoint], fps: float, n_frames: int, hei
                 v = 0.0
         else:
             pos = pos + (goal - pos) / dist * step
-    # Positions are recorded at the start of each frame's step; shift so xy[k] is the position at t_k.
-    out = np.empty_like(xy)
-    out[:] = xy
-    tr = finish_track(out, fps, height, present, sit, face, initial_yaw=initial_yaw)
-    return tr
+    # xy[k] was recorded before frame k's step: the position at t_k.
+    return finish_track(xy, fps, height, present, sit, face, initial_yaw=initial_yaw)
 
 
 # ------------------------------------------------------------------------------------ random walkers
@@ -259,7 +255,7 @@ def random_walkers(scene: Scene, n: int, fps: float, n_frames: int, rng: np.rand
     else:
         pos = np.asarray(start, dtype=float).reshape(n, 2).copy()
     pref = rng.uniform(*s.speed, size=n)
-    goals = np.array([_sample_goal(scene, df, rng, p, s) if True else None for p in pos], dtype=object)
+    goals = np.array([_sample_goal(scene, df, rng, p, s) for p in pos], dtype=object)
     goal = np.array([g if g is not None else p for g, p in zip(goals, pos)], dtype=float).reshape(n, 2)
     dwell = np.zeros(n)
     stuck = np.zeros(n)

@@ -146,6 +146,17 @@ class WhiteBalance:
         return self.r, self.b
 
 
+def grey_world_mean(raw: np.ndarray) -> np.ndarray:
+    """Mean BGR (3,) of a raw (pre-white-balance) image (H, W, 3), what :meth:`WhiteBalance.update` reads.
+
+    Every 4th pixel in both directions, leaving out dark (≤ 3) and saturated (≥ 250) ones; the
+    plain mean (+ 1e-3) when 10 or fewer remain.
+    """
+    sub = raw[::4, ::4].reshape(-1, 3)
+    ok = np.all((sub > 3) & (sub < 250), axis=1)
+    return sub[ok].mean(axis=0) if ok.sum() > 10 else sub.mean(axis=0) + 1e-3
+
+
 @dataclass(frozen=True)
 class SensorNoise:
     """Optics and sensor: blur, vignetting, shot and read noise (display units, 0–255).

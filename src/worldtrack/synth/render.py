@@ -35,7 +35,8 @@ from worldtrack.scene.model import Scene
 from worldtrack.synth import kernels
 from worldtrack.synth.bodies import CAPSULE, ELLIPSOID, PARTS_PER_PERSON, TEX_HEAD, TEX_STRIPES, PartArrays
 from worldtrack.synth.environment import FLOOR, Environment, StaticLayer, render_static, static_depth, value_noise
-from worldtrack.synth.photometry import WB_UNITY, Light, SensorNoise, WhiteBalance, expose, vignetting_map
+from worldtrack.synth.photometry import (WB_UNITY, Light, SensorNoise, WhiteBalance, expose, grey_world_mean,
+                                         vignetting_map)
 from worldtrack.synth.sensors import SensorSpec, kinect_depth, second_view, stereo_measurement
 
 
@@ -124,14 +125,23 @@ def _intrinsics(camera: Camera) -> np.ndarray:
 def camera_frame_rays(camera: Camera) -> np.ndarray:
     """(H, W, 3) float64 unit rays of every pixel in the camera frame (distortion undone)."""
     v, u = np.mgrid[0:camera.height, 0:camera.width]
-    uv = np.column_stack([u.ravel(), v.ravel()]).astype(float)
-    xy = camera.undistort_normalised(camera._pixels_to_normalised(uv))
-    d = np.column_stack([xy, np.ones(len(xy))])
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    return np.ascontiguousarray(d.reshape(camera.height, camera.width, 3), dtype=np.float64)
+    uv = np.stack([u, v], axis=-1).astype(float)
+    _, d = camera.moved(np.eye(3), np.zeros(3)).rays(uv)      # world frame = camera frame
+    return np.ascontiguousarray(d, dtype=np.float64)
 
 
 # ------------------------------------------------------------------------------------ screen boxes
+
+def _rect_edge_points(x0: np.ndarray, x1: np.ndarray, y0: np.ndarray, y1: np.ndarray, n: int = 9) -> np.ndarray:
+    """(B, 4n, 2) points along the edges of the rectangles ``[x0, x1] × [y0, y1]`` (each (B,)):
+    ``n`` evenly spaced points, corners included, on the y0, y1, x0 and x1 edges in turn."""
+    t = np.linspace(0.0, 1.0, n)[None, :]
+    x0, x1, y0, y1 = (np.asarray(a, dtype=float)[:, None] for a in (x0, x1, y0, y1))
+    xs, ys = x0 + (x1 - x0) * t, y0 + (y1 - y0) * t
+    edge_x = np.concatenate([xs, xs, np.repeat(x0, n, 1), np.repeat(x1, n, 1)], axis=1)
+    edge_y = np.concatenate([np.repeat(y0, n, 1), np.repeat(y1, n, 1), ys, ys], axis=1)
+    return np.stack([edge_x, edge_y], axis=-1)
+
 
 def _blob_boxes(camera: Camera, centres: np.ndarray, S: np.ndarray, margin: float = 1.5) -> np.ndarray:
     """Pixel boxes (B, 4) float [u0, u1, v0, v1] of ellipsoids ``(x − c)ᵀ S⁻¹ (x − c) ≤ 1``.
@@ -156,13 +166,7 @@ def _blob_boxes(camera: Camera, centres: np.ndarray, S: np.ndarray, margin: floa
     box[behind] = [np.inf, -np.inf, np.inf, -np.inf]
     if camera.has_distortion:
         ok = np.all(np.isfinite(box), axis=1)
-        t = np.linspace(0.0, 1.0, 9)
-        u0, u1, v0, v1 = (box[ok, k][:, None] for k in range(4))
-        pts = np.concatenate([
-            np.stack([u0 + (u1 - u0) * t, np.broadcast_to(v0, (len(u0), 9))], -1),
-            np.stack([u0 + (u1 - u0) * t, np.broadcast_to(v1, (len(u0), 9))], -1),
-            np.stack([np.broadcast_to(u0, (len(u0), 9)), v0 + (v1 - v0) * t], -1),
-            np.stack([np.broadcast_to(u1, (len(u0), 9)), v0 + (v1 - v0) * t], -1)], axis=1)
+        pts = _rect_edge_points(*(box[ok, k] for k in range(4)))
         real = camera.distort_pixels(pts.reshape(-1, 2)).reshape(pts.shape)
         box[ok] = np.column_stack([real[..., 0].min(1), real[..., 0].max(1), real[..., 1].min(1), real[..., 1].max(1)])
         margin += 1.0
@@ -233,11 +237,8 @@ def shadow_boxes(camera: Camera, parts: PartArrays, n_people: int, light_dir: np
     x1 = np.maximum(np.maximum.reduceat(foot[:, 0] + rad, start), np.maximum.reduceat(sph[:, 0], start) + 0.3)
     y0 = np.minimum(np.minimum.reduceat(foot[:, 1] - rad, start), np.minimum.reduceat(sph[:, 1], start) - 0.3)
     y1 = np.maximum(np.maximum.reduceat(foot[:, 1] + rad, start), np.maximum.reduceat(sph[:, 1], start) + 0.3)
-    t = np.linspace(0.0, 1.0, 9)[None, :]
-    xs, ys = x0[:, None] + (x1 - x0)[:, None] * t, y0[:, None] + (y1 - y0)[:, None] * t
-    edge_x = np.concatenate([xs, xs, np.repeat(x0[:, None], 9, 1), np.repeat(x1[:, None], 9, 1)], axis=1)
-    edge_y = np.concatenate([np.repeat(y0[:, None], 9, 1), np.repeat(y1[:, None], 9, 1), ys, ys], axis=1)
-    pts = np.stack([edge_x, edge_y, np.zeros_like(edge_x)], axis=-1)          # (N, 36, 3)
+    edge = _rect_edge_points(x0, x1, y0, y1)
+    pts = np.concatenate([edge, np.zeros(edge.shape[:-1] + (1,))], axis=-1)   # (N, 36, 3) on the floor
     uv = camera.project(pts)
     ok = np.all(np.isfinite(uv), axis=(1, 2))
     u0 = np.floor(np.nanmin(uv[..., 0], axis=1, initial=np.inf, where=np.isfinite(uv[..., 0]))) - 2
@@ -483,10 +484,7 @@ class Renderer:
             flat[eidx] += np.float32(light.exposure) * layer.emissive.reshape(-1, 3)[eidx]
 
         # Camera: white balance from the raw frame's grey world, then exposure to 8 bits.
-        sub = raw[::4, ::4].reshape(-1, 3)
-        ok = np.all((sub > 3) & (sub < 250), axis=1)
-        mean = sub[ok].mean(axis=0) if ok.sum() > 10 else sub.mean(axis=0) + 1e-3
-        r_gain, b_gain = wb.update(frame, mean)
+        r_gain, b_gain = wb.update(frame, grey_world_mean(raw))
         gains = np.array([b_gain / WB_UNITY, 1.0, r_gain / WB_UNITY], dtype=np.float32)
         image = expose(raw, gains, opts.noise if with_noise else SensorNoise(0, 0, opts.noise.blur_sigma,
                                                                              opts.noise.vignetting),

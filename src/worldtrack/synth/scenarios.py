@@ -34,7 +34,7 @@ from worldtrack.synth.photometry import (Light, LightingSchedule, LightSegment, 
                                          light_direction)
 from worldtrack.synth.render import RenderOptions
 from worldtrack.synth.sensors import SensorSpec
-from worldtrack.synth.sequence import CameraRig, Person, Scenario
+from worldtrack.synth.sequence import CameraRig, Person, Scenario, head_pose
 
 
 @dataclass(frozen=True)
@@ -711,7 +711,7 @@ def _office_graph():
 
 # ------------------------------------------------------------------------------------ seed 003
 
-def _booth(size, common, depth_step_mm, cam_pos, cam_target, person_height, rng):
+def _booth(size, depth_step_mm, cam_pos, cam_target):
     data = scenes.scene_dict("booth")
     data["cameras"][0].update(position=[float(v) for v in cam_pos], look_at=[float(v) for v in cam_target])
     scene = _scene(data, size or (320, 240))
@@ -777,7 +777,7 @@ def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str 
     shape, tr, parts0 = _booth_person(rng, env0, height, n, fps)
     head_c = parts0.centre[HEAD]
     cam_pos = head_c + np.array([0.0, -distance, 0.0])
-    scene, env, sensors = _booth(size, common, depth_step_mm, cam_pos, head_c, height, rng)
+    scene, env, sensors = _booth(size, depth_step_mm, cam_pos, head_c)
     amp = {"small": (6.0, 4.0, 3.0, 0.01), "large": (35.0, 20.0, 12.0, 0.05)}[motion]
     head = np.column_stack([_smooth_signal(rng, n, fps, np.radians(a)) for a in amp[:3]])
     offset = np.column_stack([_smooth_signal(rng, n, fps, amp[3]) for _ in range(3)])
@@ -786,8 +786,7 @@ def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str 
     def rows(k, t, people, parts):
         out = []
         for i, p in enumerate(people):
-            c = parts.centre[i * PARTS_PER_PERSON + HEAD]
-            R = parts.axes[i * PARTS_PER_PERSON + HEAD].T
+            c, R = head_pose(parts, i)
             q = _quat(R)
             rz, ry, rx = np.degrees(p.pose["head"][k])
             out.append({"frame": k, "time": round(t, 6), "id": p.id, "tx": round(c[0], 6), "ty": round(c[1], 6),
@@ -819,7 +818,7 @@ def upper_body(seed: int, common: Common, *, size=None, frames=None, distance: f
     shape, tr, parts0 = _booth_person(rng, env0, height, n, fps)
     chest = parts0.centre[TORSO] + np.array([0.0, 0.0, 0.1])
     cam_pos = chest + np.array([0.0, -distance, 0.15])
-    scene, env, sensors = _booth(size, common, depth_step_mm, cam_pos, chest, height, rng)
+    scene, env, sensors = _booth(size, depth_step_mm, cam_pos, chest)
     sig = lambda a, f=(0.08, 0.3): _smooth_signal(rng, n, fps, a, f)
     torso = np.column_stack([sig(np.radians(9)), sig(np.radians(5)), sig(np.radians(5))])
     offset = np.column_stack([sig(0.03), sig(0.03), sig(0.01)])

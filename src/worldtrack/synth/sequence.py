@@ -25,7 +25,7 @@ from worldtrack.synth.bodies import (HEAD, PARTS_PER_PERSON, BodyShape, JointAng
                                      hair_colours, posed)
 from worldtrack.synth.environment import Environment
 from worldtrack.synth.motion import Track
-from worldtrack.synth.photometry import LightingSchedule, WhiteBalance
+from worldtrack.synth.photometry import LightingSchedule, WhiteBalance, grey_world_mean
 from worldtrack.synth.render import Renderer, RenderOptions, SynthFrame
 from worldtrack.synth.sensors import SensorSpec
 
@@ -204,6 +204,7 @@ class Scenario:
             meta[f"{cid}_x"], meta[f"{cid}_y"], meta[f"{cid}_z"] = (round(float(v), 6) for v in c)
             meta[f"{cid}_yaw_deg"] = round(float(np.degrees(_camera_yaw(cam))), 4)
         gt = []
+        fraction = {cid: v.fraction for cid, v in vis.items()}
         for i, p in enumerate(people):
             row = {"frame": k, "time": round(t, 6), "id": p.id,
                    "x": round(float(p.track.xy[k, 0]), 6), "y": round(float(p.track.xy[k, 1]), 6),
@@ -211,7 +212,7 @@ class Scenario:
                    "width": round(p.shape.shoulder_width, 6), "speed": round(float(p.track.speed[k]), 6)}
             for cid in self.camera_ids:
                 v = vis[cid]
-                row[f"vis_{cid}"] = round(float(v.fraction[i]), 4)
+                row[f"vis_{cid}"] = round(float(fraction[cid][i]), 4)
                 row[f"head_{cid}"] = int(v.head_visible[i])
                 row[f"feet_{cid}"] = int(v.feet_visible[i])
             gt.append(row)
@@ -226,9 +227,7 @@ class Scenario:
         lit, _ = self._renderer.lit_static(cam, layer, light)
         raw = lit * np.float32(light.level * light.exposure) * np.asarray(light.tint, np.float32) \
             + np.float32(light.exposure) * layer.emissive
-        sub = raw[::4, ::4].reshape(-1, 3)
-        ok = np.all((sub > 3) & (sub < 250), axis=1)
-        return sub[ok].mean(axis=0) if ok.sum() > 10 else sub.mean(axis=0) + 1e-3
+        return grey_world_mean(raw)
 
     def _initial_white_balance(self, camera_id: str) -> WhiteBalance:
         """The camera's white balance before frame 0: settled on the empty scene (auto mode)."""
