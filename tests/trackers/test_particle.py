@@ -25,8 +25,8 @@ from worldtrack.scene import scene_from_dict
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, hit_image,
-                                                     owner_image, point_values_reference, hit_labels,
-                                                     thresholded_difference)
+                                                     occluder_layers, owner_image, point_values_reference,
+                                                     hit_labels, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, polygon_distance,
                                                    stratified_resample, systematic_resample)
 
@@ -103,11 +103,14 @@ def test_column_kernel_agrees_with_reference(dist, radius, px_scale):
     tops = rng.uniform(1.4, 2.0, len(xy))
     boxes = [(40, 120, 30, 200), (100, 180, 0, 120), None]
     owner = owner_image((H, W), boxes)
+    occluders = occluder_layers((H, W), boxes, [2.0, 4.5, 3.0])
     cl = CameraLikelihood(cam)
-    for box, n_above, sigma in ((None, 2, 0.0), (boxes[0], 2, 0.1), (None, 0, 0.05)):
+    for box, n_above, sigma, me in ((None, 2, 0.0, -1), (boxes[0], 2, 0.1, 0), (None, 0, 0.05, -1),
+                                    (boxes[1], 2, 0.1, 1)):
         hs = heights if n_above else heights[:-2]
         args = dict(on=2.77, off=-1.56, k_min=10, radius=radius, below=-2.77, n_below=2, n_above=n_above,
-                    owner=owner, box=box, tops=tops, top_sigma=sigma, px_scale=px_scale)
+                    owner=owner, box=box, tops=tops, top_sigma=sigma, px_scale=px_scale,
+                    occluders=occluders if me >= 0 else None, me=me, margin=0.3)
         counts, ratio, top, seen = cl.column(hit, xy, hs, **args)
         r_counts, r_ratio, r_top, r_seen = column_counts_reference(cam, hit, xy, hs, **args)
         np.testing.assert_array_equal(counts, r_counts)
@@ -117,6 +120,49 @@ def test_column_kernel_agrees_with_reference(dist, radius, px_scale):
         # Ties between tops (equal scores up to rounding) may resolve either way.
         assert same.mean() > 0.999
         assert seen.sum() > 1000 and counts.max() > 10  # the test exercises real hits
+
+
+def test_occluder_layers_keep_the_two_nearest_boxes():
+    boxes = [(0, 10, 0, 10), (5, 15, 5, 15), None, (8, 12, 8, 12)]
+    near1, id1, near2 = occluder_layers((20, 20), boxes, [3.0, 2.0, 1.0, 4.0])
+    assert (near1[0, 0], id1[0, 0], near2[0, 0]) == (3.0, 0, np.inf)
+    assert (near1[9, 9], id1[9, 9], near2[9, 9]) == (2.0, 1, 3.0)          # boxes 0, 1, 3 overlap here
+    assert (near1[11, 11], id1[11, 11], near2[11, 11]) == (2.0, 1, 4.0)
+    assert (near1[19, 19], id1[19, 19]) == (np.inf, -1)
+    depth = occluder_layers((20, 20), boxes, [3.0, 2.0, 1.0, 4.0]).depth_for(1)
+    assert depth[9, 9] == 3.0 and depth[11, 11] == 4.0 and depth[0, 0] == 3.0
+
+
+def test_a_person_behind_another_is_occluded_not_background():
+    """A column standing behind a nearer tracked person reads that person's box as no evidence; in
+    front of (or beside) it, the box still reads background (explained by the other person)."""
+    scene = make_scene(entry=False)
+    cam = scene.cameras["cam"]
+    cl = CameraLikelihood(cam)
+    hs = np.concatenate([[-0.2, -0.1], np.arange(20) * 0.1, [2.0, 2.1]])
+    near, far = np.array([0.0, 2.0]), np.array([0.0, 4.0])      # on one line of sight of the camera
+    # The far person's image: only its head shows above the near person's box.
+    hit = np.zeros((H, W), np.uint8)
+    far_box = image_box(cam, *far, WIDTH, HEIGHT, 0.0)
+    near_box = image_box(cam, *near, WIDTH, HEIGHT, 0.05)
+    hit[far_box[2]:far_box[3], far_box[0]:far_box[1]] = 1
+    hit[near_box[2]:near_box[3], near_box[0]:near_box[1]] = 1
+    boxes = [near_box, far_box]
+    owner = owner_image((H, W), boxes)
+    depth = [float(np.hypot(*(p - cam.centre[:2]))) for p in (near, far)]
+    args = dict(on=2.77, off=-1.56, k_min=10, radius=0.0, below=-2.77, n_below=2, n_above=2, owner=owner)
+    plain = cl.column(hit, far[None], hs, box=far_box, **args)
+    occluded = cl.column(hit, far[None], hs, box=far_box, occluders=occluder_layers((H, W), boxes, depth), me=1,
+                         margin=0.3, **args)
+    # Behind the near person every hidden sample cost `off` before; now it costs nothing.
+    assert occluded[1][0] > plain[1][0] + 5 * 1.56
+    # Every sample up to the person's 1.7 m counts (hits, or no evidence behind the near person).
+    assert occluded[0][0] == 18 and plain[0][0] < 18
+    # The near person's column does not gain from the far person's box (it is farther, so explained).
+    a = cl.column(hit, near[None], hs, box=near_box, **args)
+    b = cl.column(hit, near[None], hs, box=near_box, occluders=occluder_layers((H, W), boxes, depth), me=0,
+                  margin=0.3, **args)
+    assert a[1][0] == b[1][0]
 
 
 def test_point_kernel_agrees_with_reference():
@@ -356,6 +402,30 @@ def test_hit_labels_set_darkened_background_apart():
     # Shadows nowhere: every pixel with F > γ reads object, exactly the labels without shadows.
     where = np.zeros((H, W), bool)
     assert np.array_equal(hit_labels(img, bg, 25.0, where=where), (hit != 0).astype(np.uint8))
+
+
+def test_hit_labels_tell_shadows_from_grey_clothes_by_texture():
+    """Both regions are the background darkened without a change of colour; only the shadow keeps
+    the background's texture. Over a plain background the test cannot tell: no evidence."""
+    bg = texture(0)
+    rng = np.random.default_rng(5)
+    # A strongly textured floor patch (grey-level σ ≈ 25) and a plain one.
+    floor = np.clip(128 + 25 * rng.standard_normal((80, 80)), 0, 255)[..., None] * np.ones(3)
+    bg[140:220, 20:100] = floor.astype(np.uint8)
+    bg[140:220, 200:280] = 128
+    img = bg.copy()
+    img[150:210, 30:60] = (bg[150:210, 30:60] * 0.7).astype(np.uint8)       # shadow on texture
+    img[150:210, 60:90] = (0.7 * floor[10:70, 40:70].mean()).astype(np.uint8)  # plain grey cloth on texture
+    img[150:210, 210:270] = 90                                              # darker over a plain floor
+    hit = hit_labels(img, bg, 25.0, shadow=0)
+    inner = (slice(153, 207),)
+    assert np.mean(hit[inner[0], 33:57] == 0) > 0.9           # shadow: background
+    # Cloth: object (the rest are pixels where the random floor happens to match the cloth, F ≤ γ).
+    assert np.mean(hit[inner[0], 63:87] == 1) > 0.8 and np.all(hit[inner[0], 63:87] != 2)
+    assert np.mean(hit[inner[0], 213:267] == 2) > 0.9         # cannot tell: no evidence
+    # Without the texture test both darkened regions on the textured floor were shadows.
+    old = hit_labels(img, bg, 25.0, shadow=0, texture=False)
+    assert np.mean(old[inner[0], 63:87] == 1) < 0.05
 
 
 def test_image_box_covers_the_person():

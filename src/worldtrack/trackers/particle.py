@@ -64,8 +64,8 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
-from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, owner_image,
-                                                     hit_labels, thresholded_difference)
+from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, hit_labels,
+                                                     occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import FloorRegion, bimodal_split, polygon_distance, resampler
 
 Box = tuple[int, int, int, int]
@@ -284,13 +284,19 @@ class ParticleTracker:
         for f in self.filters:
             self._predict(f, dt)
         explain_tracks = cfg.explain == "all"
+        owners = occluders = None
         if explain_tracks:
-            boxes = self._boxes(self.filters, [f.xyz[:, :2].mean(axis=0) for f in self.filters], cfg.box_margin)
+            centres = [f.xyz[:, :2].mean(axis=0) for f in self.filters]
+            boxes = self._boxes(self.filters, centres, cfg.box_margin)
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
+            if cfg.occlusion:
+                occluders = {cid: occluder_layers(img.shape, boxes[cid],
+                                                  [float(np.hypot(*(c - self._cams[cid].centre))) for c in centres])
+                             for cid, img in images.items()}
         for i, f in enumerate(self.filters):
             f.logpi, f.likely, f.col_h = self.likelihood(
-                f.xyz, images, owners if explain_tracks else None,
-                {cid: boxes[cid][i] for cid in images} if explain_tracks else None, f.h)
+                f.xyz, images, owners, {cid: boxes[cid][i] for cid in images} if explain_tracks else None, f.h,
+                occluders, i)
         for f in list(self.filters):
             self._update_tracking(f, t)
 
@@ -355,7 +361,8 @@ class ParticleTracker:
     def likelihood(self, xyz: np.ndarray, images: Mapping[str, np.ndarray],
                    owners: Mapping[str, np.ndarray] | None = None,
                    boxes: Mapping[str, Box | None] | None = None,
-                   h: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   h: np.ndarray | None = None, occluders: Mapping[str, object] | None = None,
+                   me: int = -1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Log-likelihood of particles, summed over the cameras that see them.
 
         Parameters
@@ -367,6 +374,10 @@ class ParticleTracker:
         boxes : {camera_id: box or None}, optional — the filter's own object box
         h : (N,) float, metres, optional — the particles' object heights: with ``top_sigma > 0``
             each column's top gets the log prior ``−(top − h)² / (2·top_sigma²)``
+        occluders : {camera_id: Occluders}, optional — :func:`occluder_layers` of the same boxes as
+            ``owners``, with ``me`` the filter's index among them: a column sample in the box of an
+            object nearer to the camera by more than ``occlusion_margin`` is occluded (no evidence)
+            rather than background
 
         Returns
         -------
@@ -395,7 +406,9 @@ class ParticleTracker:
                     counts, ratio, top, seen = cl.column(img, xyz[:, :2], self._column, self._on, self._off,
                                                          self._k_min, cfg.column_radius, -self._on, self._n_below,
                                                          self._n_above, owner, box, h, self._top_sigma,
-                                                         self._px_scale[cid])
+                                                         self._px_scale[cid],
+                                                         occluders.get(cid) if occluders is not None else None, me,
+                                                         cfg.occlusion_margin)
                     if cfg.weighting == "count":
                         lv = np.log(counts / S)
                         col += np.where(seen, counts * cfg.dz, 0.0)

@@ -135,6 +135,12 @@ class ParticleConfig:
         paper does not say how it avoids that), or never.
     box_margin : float, metres
         Margin of the image boxes of ``explain`` (0.05 m).
+    occlusion, occlusion_margin
+        With ``explain="all"``: a column sample inside the box of another object that stands more
+        than ``occlusion_margin`` (0.3 m) nearer to the camera (floor distance, as seed 000 orders
+        its ellipsoids) is *occluded* — no evidence — instead of background. Without it a person
+        walking behind another is penalised at their true place for every sample the nearer person
+        hides, and the filter is pushed off along the line of sight or ends (True).
     exclusion_depth : float, metres
         For detection filters a track's box also covers the object placed this much nearer and
         farther along the line of sight: one camera places an object poorly in depth, and what the
@@ -201,6 +207,8 @@ class ParticleConfig:
     shadows: str = "background"
     explain: str = "all"
     box_margin: float = 0.05
+    occlusion: bool = True
+    occlusion_margin: float = 0.3
     exclusion_depth: float = 0.5
     resampling: str = "systematic"
     births: str = "auto"
@@ -225,6 +233,7 @@ class ParticleConfig:
         away for tracking filters, tracks end at once. Numbers it does not state stay ours."""
         base = cls(velocity="particle", weighting="count", likelihood_power=1.0, column_radius=0.0,
                    foot_samples=0, head_samples=0, pixel_weights=False, top_sigma=0.0, shadows="object", explain="detection",
+                   occlusion=False,
                    split=False, merge=False,
                    end_after_s=0.0)
         try:
@@ -251,7 +260,7 @@ class ParticleConfig:
         for name in ("dz", "max_height", "min_height", "max_speed", "velocity_smoothing", "split_distance"):
             if not _number(getattr(self, name)) or not getattr(self, name) > 0:
                 raise bad(name, "a positive number")
-        for name in ("gamma", "top_sigma", "height_spread", "noise_h", "noise_xy", "noise_z", "box_margin", "exclusion_depth", "detection_noise", "entry_margin",
+        for name in ("gamma", "top_sigma", "height_spread", "noise_h", "noise_xy", "noise_z", "box_margin", "occlusion_margin", "exclusion_depth", "detection_noise", "entry_margin",
                      "end_after_s", "likelihood_power", "column_radius"):
             if not _number(getattr(self, name)) or not getattr(self, name) >= 0:
                 raise bad(name, "a number ≥ 0")

@@ -5,8 +5,8 @@ Both read one image per camera and frame, computed once from the background diff
 with values ``F ≤ γ`` set to 0 (§4.2: against slight brightness changes of the background):
 
 * :func:`hit_image` — ``F > γ`` as (H, W) uint8, for the column likelihood;
-* :func:`hit_labels` — the same with cast shadows labelled 2, "no evidence" (not in the paper;
-  Numba, with :func:`hit_labels_reference` in NumPy);
+* :func:`hit_labels` — the same with cast shadows set apart (background or "no evidence", 2) by
+  colour and texture (not in the paper; Numba, with :func:`hit_labels_reference` in NumPy);
 * :func:`thresholded_difference` — F with ``F ≤ γ`` set to 0, float32, for the point likelihood.
 
 **Height column** (the paper's contribution). For a particle at floor position ``(x_i, y_i)`` the
@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 from numba import njit
 
@@ -75,18 +76,32 @@ def hit_image(difference: np.ndarray, gamma: float) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(difference) > gamma).view(np.uint8)
 
 
+#: Texture test of shadow candidates: window (pixels), least background contrast (grey-level σ) for
+#: the test to apply, and the normalised cross-correlation at or above which the candidate is a
+#: shadow / below which it is object.
+TEXTURE_WINDOW = 5
+TEXTURE_MIN_SD = 4.0
+TEXTURE_NCC = (0.2, 0.5)
+
+
 def hit_labels(image: np.ndarray, background: np.ndarray, gamma: float,
                brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
-               where: np.ndarray | None = None, shadow: int = 2) -> np.ndarray:
-    """``F > γ`` with cast shadows set apart, (H, W) uint8: 0 background, 1 object, ``shadow`` shadow.
+               where: np.ndarray | None = None, shadow: int = 2, texture: bool = True) -> np.ndarray:
+    """``F > γ`` with cast shadows set apart, (H, W) uint8: 0 background, 1 object, 2 no evidence.
 
-    A pixel counts as shadow when it is the background darkened without a change of colour: its
-    brightness ratio ``a = (I·B) / (B·B)`` lies in ``brightness`` and its colour distortion
+    A pixel is a shadow *candidate* when it is the background darkened without a change of colour:
+    its brightness ratio ``a = (I·B) / (B·B)`` lies in ``brightness`` and its colour distortion
     ``‖I − a·B‖`` is at most ``chroma`` (the test of Horprasert et al. 1999, also behind OpenCV
-    MOG2's shadow detection). A shadow pixel is *no evidence* to the column: a cast shadow and dark
-    clothes over a light floor pass the same test, so it reads neither object nor background. Not
-    in seed 004, whose F counts shadows as object. Numba kernel; :func:`hit_labels_reference` is
-    the same in NumPy.
+    MOG2's shadow detection). Grey trousers over a grey floor pass that test as well as a shadow
+    does, so with ``texture`` a candidate is then judged by whether the background's texture shows
+    through (a shadow darkens the floor's pattern, cloth replaces it): over a
+    ``TEXTURE_WINDOW``-pixel window where the background's grey level varies (σ ≥
+    ``TEXTURE_MIN_SD``), a normalised cross-correlation of image and background ≥
+    ``TEXTURE_NCC[1]`` makes it a shadow and < ``TEXTURE_NCC[0]`` object; otherwise (a plain
+    floor, or in between) it cannot be told and reads 2, no evidence. Shadows get the label
+    ``shadow``: 2 (no evidence) or 0 (background). Without ``texture`` every candidate is a shadow.
+    Not in seed 004, whose F counts shadows as object. The per-pixel test is a Numba kernel, the
+    texture test box filters (OpenCV); :func:`hit_labels_reference` is the same in NumPy.
 
     Parameters
     ----------
@@ -96,14 +111,62 @@ def hit_labels(image: np.ndarray, background: np.ndarray, gamma: float,
     chroma : float — largest colour distortion of shadows (RGB units)
     where : (H, W) bool, optional — the only pixels where shadows can be (e.g. those that see the
         floor, :func:`floor_pixels`); default everywhere
-    shadow : {2, 0} — the label of shadow pixels: 2 "no evidence", or 0 background
+    shadow : {2, 0} — the label of shadow pixels
+    texture : bool — apply the texture test to the candidates
     """
     img = np.ascontiguousarray(image)
     bg = np.ascontiguousarray(background)
     w = np.ones(img.shape[:2], dtype=np.bool_) if where is None else np.ascontiguousarray(where, dtype=np.bool_)
     out = np.empty(img.shape[:2], dtype=np.uint8)
-    _shadow_labels(img, bg, float(gamma), float(brightness[0]), float(brightness[1]), float(chroma), w, int(shadow), out)
-    return out
+    _shadow_labels(img, bg, float(gamma), float(brightness[0]), float(brightness[1]), float(chroma), w,
+                   CANDIDATE if texture else int(shadow), out)
+    return _judge_texture(out, img, bg, shadow) if texture else out
+
+
+#: Temporary label of shadow candidates before the texture test.
+CANDIDATE = 3
+
+
+def _judge_texture(labels: np.ndarray, image: np.ndarray, background: np.ndarray, shadow: int) -> np.ndarray:
+    """Relabel the ``CANDIDATE`` pixels of ``labels`` by the texture test of :func:`hit_labels`, in place."""
+    cand = labels == CANDIDATE
+    if not cand.any():
+        return labels
+    ncc, sd = texture_correlation(image, background, TEXTURE_WINDOW)
+    textured = sd >= TEXTURE_MIN_SD
+    judged = np.full(labels.shape, 2, dtype=np.uint8)
+    judged[textured & (ncc >= TEXTURE_NCC[1])] = shadow
+    judged[textured & (ncc < TEXTURE_NCC[0])] = 1
+    labels[cand] = judged[cand]
+    return labels
+
+
+def texture_correlation(image: np.ndarray, background: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
+    """Local normalised cross-correlation of the grey levels of ``image`` and ``background``.
+
+    Parameters
+    ----------
+    image, background : (H, W, 3) uint8 BGR
+    window : int — side of the square window (pixels, odd)
+
+    Returns
+    -------
+    ncc : (H, W) float32 in [−1, 1] (0 where either window is flat)
+    background_sd : (H, W) float32 — the background's grey-level σ in the window
+    """
+    a = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY).astype(np.float32)
+    b = cv2.cvtColor(background, cv2.COLOR_BGR2GRAY).astype(np.float32)
+
+    def mean(x: np.ndarray) -> np.ndarray:
+        return cv2.boxFilter(x, -1, (window, window), borderType=cv2.BORDER_REFLECT)
+
+    ma, mb = mean(a), mean(b)
+    va = np.maximum(mean(a * a) - ma * ma, 0.0)
+    vb = np.maximum(mean(b * b) - mb * mb, 0.0)
+    cov = mean(a * b) - ma * mb
+    denom = np.sqrt(va * vb)
+    ncc = np.where(denom > 1e-3, cov / np.maximum(denom, 1e-3), 0.0).astype(np.float32)
+    return ncc, np.sqrt(vb)
 
 
 @njit(cache=True)
@@ -130,8 +193,9 @@ def _shadow_labels(img, bg, gamma, lo, hi, chroma, where, shadow, out):
 
 def hit_labels_reference(image: np.ndarray, background: np.ndarray, gamma: float,
                          brightness: tuple[float, float] = (0.5, 0.95), chroma: float = 10.0,
-                         where: np.ndarray | None = None, shadow: int = 2) -> np.ndarray:
-    """:func:`hit_labels` in NumPy (float64), the reference the kernel is tested against."""
+                         where: np.ndarray | None = None, shadow: int = 2, texture: bool = True) -> np.ndarray:
+    """:func:`hit_labels` in NumPy (float64), the reference the kernel is tested against (the
+    texture test is the same code)."""
     I = image.astype(np.float64)
     B = background.astype(np.float64)
     d = I - B
@@ -144,7 +208,8 @@ def hit_labels_reference(image: np.ndarray, background: np.ndarray, gamma: float
     if where is not None:
         is_shadow &= where
     hit = F2 > gamma * gamma
-    return np.where(hit & is_shadow, shadow, hit).astype(np.uint8)
+    labels = np.where(hit & is_shadow, CANDIDATE if texture else shadow, hit).astype(np.uint8)
+    return _judge_texture(labels, image, background, shadow) if texture else labels
 
 
 def thresholded_difference(difference: np.ndarray, gamma: float) -> np.ndarray:
@@ -184,6 +249,54 @@ def owner_image(shape: tuple[int, int], boxes) -> np.ndarray:
             u0, u1, v0, v1 = b
             out[v0:v1, u0:u1] = np.minimum(out[v0:v1, u0:u1], 254) + 1
     return out
+
+
+def occluder_layers(shape: tuple[int, int], boxes, depths) -> "Occluders":
+    """Per pixel, the nearest and second-nearest of ``boxes`` that cover it, for depth-ordered reading.
+
+    Parameters
+    ----------
+    shape : (H, W)
+    boxes : sequence of ``(u0, u1, v0, v1)`` pixel ranges or None, one per tracked object
+    depths : sequence of float, metres — each object's floor distance from the camera
+
+    Returns
+    -------
+    Occluders — ``near1`` (H, W) float64, the depth of the nearest box over each pixel (inf where
+    none), ``id1`` (H, W) int32 its index in ``boxes`` (−1 where none), ``near2`` (H, W) float64 the
+    depth of the second nearest (inf where fewer than two)
+    """
+    near1 = np.full(shape, np.inf)
+    near2 = np.full(shape, np.inf)
+    id1 = np.full(shape, -1, dtype=np.int32)
+    for k, (b, d) in enumerate(zip(boxes, depths)):
+        if b is None:
+            continue
+        u0, u1, v0, v1 = b
+        n1, i1, n2 = near1[v0:v1, u0:u1], id1[v0:v1, u0:u1], near2[v0:v1, u0:u1]
+        closer = d < n1
+        n2[...] = np.where(closer, n1, np.minimum(n2, d))
+        i1[...] = np.where(closer, k, i1)
+        n1[...] = np.where(closer, d, n1)
+    return Occluders(near1, id1, near2)
+
+
+class Occluders(tuple):
+    """``(near1, id1, near2)`` of :func:`occluder_layers`; :data:`NO_OCCLUDERS` when there are none."""
+
+    def __new__(cls, near1: np.ndarray, id1: np.ndarray, near2: np.ndarray):
+        return super().__new__(cls, (np.ascontiguousarray(near1, dtype=np.float64),
+                                     np.ascontiguousarray(id1, dtype=np.int32),
+                                     np.ascontiguousarray(near2, dtype=np.float64)))
+
+    def depth_for(self, me: int) -> np.ndarray:
+        """(H, W): the depth of the nearest box over each pixel other than box ``me``'s (inf where none)."""
+        near1, id1, near2 = self
+        return np.where(id1 == me, near2, near1)
+
+
+#: No occluders: reading by depth disabled.
+NO_OCCLUDERS = Occluders(np.zeros((0, 0)), np.zeros((0, 0), dtype=np.int32), np.zeros((0, 0)))
 
 
 def column_heights(max_height: float, dz: float) -> np.ndarray:
@@ -248,10 +361,20 @@ def _others(owner, box, iu, iv):
     return n > own
 
 
+@njit(cache=True, inline="always")
+def _occluded(near1, id1, near2, me, iu, iv, depth, margin):
+    """True if the nearest other object's box over pixel (iu, iv) is nearer than ``depth − margin``."""
+    if near1.shape[0] == 0:
+        return False
+    d = near2[iv, iu] if id1[iv, iu] == me else near1[iv, iu]
+    return d < depth - margin
+
+
 @njit(cache=True)
 def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray,
                   dist: np.ndarray, has_dist: bool, radius: float, hit: np.ndarray,
-                  owner: np.ndarray, box: np.ndarray, on: float, off: float, below: float, n_below: int,
+                  owner: np.ndarray, box: np.ndarray, near1: np.ndarray, id1: np.ndarray, near2: np.ndarray,
+                  me: int, centre: np.ndarray, margin: float, on: float, off: float, below: float, n_below: int,
                   n_above: int, k_min: int, tops: np.ndarray, top_sigma: float, px_scale: float, counts: np.ndarray,
                   ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
     """Height-column likelihood of every particle for one camera, in place.
@@ -267,6 +390,13 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     hit : (H, W) uint8 — 1 object, 0 background, 2 no evidence (:func:`hit_image`, :func:`hit_labels`)
     owner : (H, W) uint8 — number of object boxes over each pixel (:func:`owner_image`)
     box : (4,) int64 — the filter's own object box ``(u0, u1, v0, v1)``, or :data:`NO_BOX`
+    near1, id1, near2 : :func:`occluder_layers` of the same boxes, or the empty arrays of
+        :data:`NO_OCCLUDERS`. With them, a sample in another object's box whose object is nearer
+        to the camera than the particle by more than ``margin`` is *occluded*: no evidence (label 2)
+        instead of background
+    me : int — the filter's own index in the boxes of ``near1, id1, near2``
+    centre : (2,) float64, metres — the camera centre's floor position (depths are floor distances)
+    margin : float, metres
     on, off, below : float — log-ratio terms for a sample on / off the object, and for a ring sample
         (below the floor, or within ``n_above`` samples above the top) that reads object
     n_below, n_above : int — how many of ``heights`` (the first / the last ones) are ring samples
@@ -292,6 +422,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     vs = np.zeros(S)
     wt = np.ones(S)
     for i in range(xy.shape[0]):
+        depth = math.hypot(xy[i, 0] - centre[0], xy[i, 1] - centre[1])
         # Camera-frame coordinates of the floor point; the column is linear in z.
         b0 = R[0, 0] * xy[i, 0] + R[0, 1] * xy[i, 1] + t[0]
         b1 = R[1, 0] * xy[i, 0] + R[1, 1] * xy[i, 1] + t[1]
@@ -318,6 +449,8 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                             break
                         if p == 2:
                             lab = 2
+                    elif _occluded(near1, id1, near2, me, iu, iv, depth, margin):
+                        lab = 2
             label[k] = lab
         if px_scale > 0.0:
             for k in range(S):
@@ -427,7 +560,8 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
                             on: float = 1.0, off: float = -1.0, k_min: int = 0, radius: float = 0.0,
                             below: float = 0.0, n_below: int = 0, n_above: int = 0,
                             owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
-                            top_sigma: float = 0.0, px_scale: float = 0.0):
+                            top_sigma: float = 0.0, px_scale: float = 0.0, occluders: Occluders | None = None,
+                            me: int = -1, margin: float = 0.0):
     """:func:`column_counts` written plainly: every (particle, height) point through :meth:`Camera.project`.
 
     Returns
@@ -458,6 +592,10 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         readable = inside & _readable(owner, box, iu, iv)
         hits |= readable & (hit[iv, iu] == 1)
         unsure |= readable & (hit[iv, iu] == 2)
+        if occluders is not None and occluders[0].size:
+            # In a nearer object's box: occluded, no evidence.
+            particle_depth = np.hypot(xy[:, 0] - camera.centre[0], xy[:, 1] - camera.centre[1])[:, None]
+            unsure |= inside & ~readable & (occluders.depth_for(me)[iv, iu] < particle_depth - margin)
         seen |= inside.any(axis=1)
     unsure &= ~hits
     if px_scale > 0:
@@ -513,12 +651,18 @@ class CameraLikelihood:
         self.dist = np.ascontiguousarray(camera.dist, dtype=np.float64)
         self.has_dist = bool(camera.has_distortion)
         self.no_owner = np.zeros((camera.height, camera.width), dtype=np.uint8)
+        self.centre = np.ascontiguousarray(camera.centre[:2], dtype=np.float64)
 
     def column(self, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
                k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
                owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
-               top_sigma: float = 0.0, px_scale: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`."""
+               top_sigma: float = 0.0, px_scale: float = 0.0, occluders: "Occluders | None" = None, me: int = -1,
+               margin: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`.
+
+        ``occluders`` (:func:`occluder_layers` of the boxes behind ``owner``) with ``me`` (the
+        filter's index among them) and ``margin`` (m): samples behind a nearer object read as no
+        evidence."""
         xy = np.ascontiguousarray(xy, dtype=np.float64)
         n = len(xy)
         counts = np.empty(n, dtype=np.int32)
@@ -527,8 +671,9 @@ class CameraLikelihood:
         seen = np.empty(n, dtype=np.bool_)
         column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
                       self.has_dist, float(radius), hit, self.no_owner if owner is None else owner,
-                      NO_BOX if box is None else np.asarray(box, dtype=np.int64), float(on), float(off),
-                      float(below), int(n_below), int(n_above), int(k_min),
+                      NO_BOX if box is None else np.asarray(box, dtype=np.int64),
+                      *(NO_OCCLUDERS if occluders is None else occluders), int(me), self.centre, float(margin),
+                      float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
                       np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
                       float(top_sigma) if tops is not None else 0.0, float(px_scale), counts, ratio, top, seen)
         return counts, ratio, top, seen
