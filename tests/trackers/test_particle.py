@@ -77,9 +77,11 @@ def run(tracker, scene, backgrounds, paths, n, seed=0):
 
 
 def tracker_for(scene, scene_seed=0, **options):
+    """A tracker with static backgrounds. An ellipsoid's lowest point is on its axis (a person's is
+    the near side of the feet), so the column stands on the particle: ``surface_offset=0``."""
     bgs = {cid: texture(i + 10 * scene_seed) for i, cid in enumerate(scene.cameras)}
     fgs = {cid: StaticBackground(bg, 30.0, "colour") for cid, bg in bgs.items()}
-    return ParticleTracker(scene, fgs, ParticleConfig(**options)), bgs
+    return ParticleTracker(scene, fgs, ParticleConfig(**{"surface_offset": 0.0, **options})), bgs
 
 
 def walker(t):
@@ -163,6 +165,24 @@ def test_a_person_behind_another_is_occluded_not_background():
     b = cl.column(hit, near[None], hs, box=near_box, occluders=occluder_layers((H, W), boxes, depth), me=0,
                   margin=0.3, **args)
     assert a[1][0] == b[1][0]
+
+
+def test_column_stands_on_the_near_surface():
+    """Each camera's column stands ``surface_offset`` nearer to it than the particle, on the floor
+    line from the camera's foot point."""
+    scene = make_scene(cameras=(CAM, CAM2))
+    tracker = ParticleTracker(scene, {cid: StaticBackground(texture(0), 30.0, "colour") for cid in scene.cameras},
+                              ParticleConfig(surface_offset=0.25))
+    xy = np.array([[0.0, 3.0], [1.0, 2.0]])
+    for cid, cl in tracker._cams.items():
+        c = scene.cameras[cid].centre[:2]
+        moved = tracker._near_surface(xy, cl)
+        np.testing.assert_allclose(np.hypot(*(xy - c).T) - np.hypot(*(moved - c).T), 0.25, atol=1e-12)
+        cross = (xy - c)[:, 0] * (moved - c)[:, 1] - (xy - c)[:, 1] * (moved - c)[:, 0]
+        np.testing.assert_allclose(cross, 0.0, atol=1e-12)               # on the same line of sight
+    plain = ParticleTracker(scene, {"cam": StaticBackground(texture(0), 30.0, "colour")},
+                            ParticleConfig(surface_offset=0.0))
+    assert np.array_equal(plain._near_surface(xy, plain._cams["cam"]), xy)
 
 
 def test_point_kernel_agrees_with_reference():

@@ -12,7 +12,10 @@ One particle filter per object, in world coordinates (metres, Z up). Every frame
    particle; 0 off the walkable floor or out of every view) and weights ``g_i = π_i / Σ π`` (eq. 8);
 3. **resamples** in proportion to the weights (systematic, see :class:`ParticleConfig`);
 4. reports the **object region** from the resampled particles: centre ``O = mean`` (eq. 9) and size
-   ``σ_x, σ_y, σ_z`` (eq. 10), the box ``O ± σ``.
+   ``σ_x, σ_y, σ_z`` (eq. 10), the box ``O ± σ``. The paper's particles fill the object; with the
+   sharp ``ratio`` weighting ours gather on the object's axis, so the region adds the object's
+   own extent: z drawn uniformly below the top each column sees (see below), and in x and y a
+   disc of the person's width, ``σ_x² = var(x) + (width/4)²``.
 
 New objects are found by **detection filters** (§3.2): particles scattered uniformly over each entry
 region (in a scene without entry regions, over the walkable floor in view). A detection filter is a
@@ -403,7 +406,7 @@ class ParticleTracker:
                 owner = owners.get(cid) if owners is not None else None
                 box = boxes.get(cid) if boxes is not None else None
                 if cfg.likelihood == "column":
-                    counts, ratio, top, seen = cl.column(img, xyz[:, :2], self._column, self._on, self._off,
+                    counts, ratio, top, seen = cl.column(img, self._near_surface(xyz[:, :2], cl), self._column, self._on, self._off,
                                                          self._k_min, cfg.column_radius, -self._on, self._n_below,
                                                          self._n_above, owner, box, h, self._top_sigma,
                                                          self._px_scale[cid],
@@ -428,6 +431,15 @@ class ParticleTracker:
             valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
         logpi = np.where(valid, logpi, -np.inf)
         return logpi, likely & valid, col / np.maximum(n_seen, 1)
+
+    def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
+        """Where a camera's column stands for particles at ``xy`` (N, 2): ``surface_offset`` m nearer to it."""
+        r = self.config.surface_offset
+        if r <= 0:
+            return xy
+        d = xy - cl.centre
+        n = np.hypot(d[:, 0], d[:, 1])[:, None]
+        return xy - r * d / np.maximum(n, 1e-9)
 
     # ------------------------------------------------------------------ prediction
     def _predict(self, f: _Filter, dt: float) -> None:
@@ -543,6 +555,10 @@ class ParticleTracker:
             tr.height = float(f.h.mean())
         elif cfg.likelihood == "column" and f.col_h is not None:
             tr.height = float(f.col_h.mean())
+        if cfg.likelihood == "column" and cfg.weighting == "ratio":
+            # The particles are the object's axis on the floor; the object fills a disc of radius
+            # width/2 round it (per-axis variance r²/4), as its z fills the height below the top.
+            sd[:2] = np.hypot(sd[:2], 0.25 * tr.width)
         tr.extra.update(z=float(centre[2]), sx=float(sd[0]), sy=float(sd[1]), sz=float(sd[2]))
 
     # ------------------------------------------------------------------ detection filters
