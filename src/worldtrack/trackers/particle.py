@@ -32,9 +32,11 @@ Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as p
   two, and filters that settle on one object are merged;
 * explaining away: pixels inside another tracked object's image box read as background, so a filter
   cannot take over a neighbour that shows more foreground, and a detection filter sees only what no
-  track explains;
+  track explains; where that object stands nearer to the camera they read as occluded (no
+  evidence), so a person walking behind another is neither penalised nor pushed off;
 * a sharper column weight (the likelihood ratio of an object standing there), a column with a small
-  radius, floor contact, and cast shadows removed — see :class:`ParticleConfig`;
+  radius standing on the body's near side, floor contact, and cast shadows removed by colour and
+  texture — see :class:`ParticleConfig`;
 * several cameras: the likelihood multiplies over the cameras that see the particle;
 * the particles' z: the column does not depend on it, so after resampling each particle's z is
   drawn uniformly below the top its column sees — the particles then fill the object's height.
