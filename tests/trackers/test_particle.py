@@ -516,8 +516,26 @@ def test_shadow_kernel_agrees_with_reference():
     bg = texture(1)
     img = np.clip(bg * rng.uniform(0.4, 1.1, (H, W, 1)) + rng.normal(0, 6, (H, W, 3)), 0, 255).astype(np.uint8)
     where = rng.random((H, W)) < 0.7
-    for w in (None, where):
+    # Shadows possible only inside the image, or only at a corner: the texture test then works on
+    # the candidates' box alone, and must agree with the reference's whole image.
+    inner, corner = np.zeros((H, W), bool), np.zeros((H, W), bool)
+    inner[60:150, 100:220] = True
+    corner[:40, -50:] = True
+    for w in (None, where, inner, corner):
         a = hit_labels(img, bg, 25.0, where=w)
         b = hit_labels_reference(img, bg, 25.0, where=w)
         np.testing.assert_array_equal(a, b)
+        if w is inner:
+            assert 0.1 < np.mean(a[inner] == 2) < 0.9 and np.all(a[~inner] != 2)
+    a = hit_labels(img, bg, 25.0, where=where)
     assert all(0.1 < np.mean(a == v) < 0.9 for v in (0, 1, 2))
+    # A 3-pixel strip of shadow in a plain dark object: the texture windows of its pixels reach
+    # into the object, which a box cut to the strip alone would miss (all shadow, not 84 of 120).
+    floor = np.clip(128 + 25 * rng.standard_normal((H, W)), 0, 255)[..., None].repeat(3, 2).astype(np.uint8)
+    img = np.full_like(floor, 60)
+    img[100:140, 100:103] = (floor[100:140, 100:103] * 0.7).astype(np.uint8)
+    strip = np.zeros((H, W), bool)
+    strip[100:140, 100:103] = True
+    a = hit_labels(img, floor, 25.0, where=strip, shadow=0)
+    np.testing.assert_array_equal(a, hit_labels_reference(img, floor, 25.0, where=strip, shadow=0))
+    assert 0 < np.sum(a[strip] == 2) < np.sum(a[strip] == 0)

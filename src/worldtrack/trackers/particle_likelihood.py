@@ -127,17 +127,27 @@ def hit_labels(image: np.ndarray, background: np.ndarray, gamma: float,
 CANDIDATE = 3
 
 
-def _judge_texture(labels: np.ndarray, image: np.ndarray, background: np.ndarray, shadow: int) -> np.ndarray:
-    """Relabel the ``CANDIDATE`` pixels of ``labels`` by the texture test of :func:`hit_labels`, in place."""
+def _judge_texture(labels: np.ndarray, image: np.ndarray, background: np.ndarray, shadow: int,
+                   crop: bool = True) -> np.ndarray:
+    """Relabel the ``CANDIDATE`` pixels of ``labels`` by the texture test of :func:`hit_labels`, in place.
+
+    ``crop``: compute the correlation only over the candidates' bounding box grown by half a window
+    (each candidate's window lies inside it, or meets the image border there, so the result is the
+    same as over the whole image, which ``crop=False`` computes — the reference's way)."""
     cand = labels == CANDIDATE
-    if not cand.any():
+    rows, cols = np.flatnonzero(cand.any(axis=1)), np.flatnonzero(cand.any(axis=0))
+    if not len(rows):
         return labels
-    ncc, sd = texture_correlation(image, background, TEXTURE_WINDOW)
+    m = TEXTURE_WINDOW // 2
+    box = ((slice(max(rows[0] - m, 0), rows[-1] + m + 1), slice(max(cols[0] - m, 0), cols[-1] + m + 1))
+           if crop else (slice(None), slice(None)))
+    ncc, sd = texture_correlation(image[box], background[box], TEXTURE_WINDOW)
     textured = sd >= TEXTURE_MIN_SD
-    judged = np.full(labels.shape, 2, dtype=np.uint8)
+    judged = np.full(ncc.shape, 2, dtype=np.uint8)
     judged[textured & (ncc >= TEXTURE_NCC[1])] = shadow
     judged[textured & (ncc < TEXTURE_NCC[0])] = 1
-    labels[cand] = judged[cand]
+    sub, c = labels[box], cand[box]
+    sub[c] = judged[c]
     return labels
 
 
@@ -209,7 +219,7 @@ def hit_labels_reference(image: np.ndarray, background: np.ndarray, gamma: float
         is_shadow &= where
     hit = F2 > gamma * gamma
     labels = np.where(hit & is_shadow, CANDIDATE if texture else shadow, hit).astype(np.uint8)
-    return _judge_texture(labels, image, background, shadow) if texture else labels
+    return _judge_texture(labels, image, background, shadow, crop=False) if texture else labels
 
 
 def thresholded_difference(difference: np.ndarray, gamma: float) -> np.ndarray:
