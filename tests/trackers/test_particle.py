@@ -131,6 +131,11 @@ def test_occluder_layers_keep_the_two_nearest_boxes():
     assert (near1[9, 9], id1[9, 9], near2[9, 9]) == (2.0, 1, 3.0)          # boxes 0, 1, 3 overlap here
     assert (near1[11, 11], id1[11, 11], near2[11, 11]) == (2.0, 1, 4.0)
     assert (near1[19, 19], id1[19, 19]) == (np.inf, -1)
+    # Reused for other boxes: the old ones are cleared, the result is as if made afresh.
+    reused = occluder_layers((20, 20), [(2, 6, 12, 18)], [5.0], out=occluder_layers((20, 20), boxes, [3, 2, 1, 4]))
+    fresh = occluder_layers((20, 20), [(2, 6, 12, 18)], [5.0])
+    for a, b in zip(reused, fresh):
+        np.testing.assert_array_equal(a, b)
     depth = occluder_layers((20, 20), boxes, [3.0, 2.0, 1.0, 4.0]).depth_for(1)
     assert depth[9, 9] == 3.0 and depth[11, 11] == 4.0 and depth[0, 0] == 3.0
 

@@ -190,6 +190,7 @@ class ParticleTracker:
                           for r in self._detection_regions()]
         self._last_t: float | None = None
         self._close: dict[tuple[int, int], int] = {}
+        self._layers: dict = {}          # per camera, the occluder layers reused frame to frame
         self.last_masks: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ set-up
@@ -295,9 +296,11 @@ class ParticleTracker:
             boxes = self._boxes(self.filters, centres, cfg.box_margin)
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
             if cfg.occlusion:
-                occluders = {cid: occluder_layers(img.shape, boxes[cid],
-                                                  [float(np.hypot(*(c - self._cams[cid].centre))) for c in centres])
+                occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
+                                                  [float(np.hypot(*(c - self._cams[cid].centre))) for c in centres],
+                                                  self._layers.get(cid))
                              for cid, img in images.items()}
+                self._layers.update(occluders)
         for i, f in enumerate(self.filters):
             f.logpi, f.likely, f.col_h = self.likelihood(
                 f.xyz, images, owners, {cid: boxes[cid][i] for cid in images} if explain_tracks else None, f.h,
