@@ -126,3 +126,15 @@ def test_scaled_camera_projects_to_scaled_pixels():
     assert (small.width, small.height) == (480, 360)
     pts = np.array([[-1, 1, 0], [0, 2, 1.7], [-2, 0.5, 0.3]])
     np.testing.assert_allclose(small.project(pts), 0.625 * (cam.project(pts) + 0.5) - 0.5, atol=1e-9)
+
+
+def test_floor_rays_point_from_the_foot_point():
+    cam = Camera.look_at("c", 320, 240, position=(1.0, -2.0, 3.0), target=(1.0, 3.0, 0.0), hfov_deg=60)
+    along, dist = cam.floor_rays(np.array([[4.0, 2.0], [1.0, -2.0], [1.1, -2.0]]))
+    np.testing.assert_allclose(along[0], [0.6, 0.8], atol=1e-12)
+    np.testing.assert_allclose(dist, [5.0, 0.0, 0.1], atol=1e-12)
+    np.testing.assert_allclose(along[1], cam.floor_direction)               # the foot point itself
+    np.testing.assert_allclose(along[2], [1.0, 0.0], atol=1e-12)
+    near, _ = cam.floor_rays(np.array([1.1, -2.0]), min_distance=0.3)       # too near to trust
+    np.testing.assert_allclose(near, cam.floor_direction)
+    np.testing.assert_allclose(cam.floor_distance([[4.0, 2.0, 1.7]]), [5.0])

@@ -232,6 +232,29 @@ def test_column_tells_the_person_from_a_point_on_the_same_line_of_sight():
 
 # ---------------------------------------------------------------------------- tracking
 
+def test_a_track_walking_behind_another_person_is_held():
+    """One person stands 2.2 m from the camera, another walks across behind them at 4.2 m. Reading
+    the near person's box as occlusion, the far track coasts through and is found again; reading
+    it as background (the explaining away alone) pushes the far track off."""
+    def paths(t):
+        return [(0.0, 2.2), (-1.5 + 1.0 * t, 4.2)]
+
+    worst = {}
+    for occlusion in (True, False):
+        scene = make_scene(entry=False)
+        tracker, bgs = tracker_for(scene, births="none", occlusion=occlusion)
+        tracker.init_track(0.0, 2.2, track_id=1)
+        tracker.init_track(-1.5, 4.2, track_id=2)
+        errors = []
+        for _, truth, tracks in run(tracker, scene, bgs, paths, 31):
+            far = {tr.id: tr for tr in tracks}.get(2)
+            errors.append(np.inf if far is None else np.hypot(far.x - truth[1][0], far.y - truth[1][1]))
+        worst[occlusion] = max(errors)
+        if occlusion:
+            assert np.mean(errors) < 0.2 and errors[-1] < 0.15
+    assert worst[True] < 0.7 < 1.0 < worst[False]
+
+
 def test_walker_is_tracked_within_bounds():
     scene = make_scene()
     tracker, bgs = tracker_for(scene)
@@ -250,6 +273,8 @@ def test_walker_is_tracked_within_bounds():
         vx.append(tr.vx)
     assert np.mean(err) < 0.10 and np.max(err) < 0.25
     assert np.mean(inside) > 0.5
+    # The region's floor size is at least the body's (a disc of the person's width: σ = width/4).
+    assert tracks[0].extra["sx"] >= 0.25 * WIDTH and tracks[0].extra["sy"] >= 0.25 * WIDTH
     assert np.median(vx) == pytest.approx(1.0, abs=0.25)        # m/s, from real time stamps
     assert tracks[0].height == pytest.approx(HEIGHT, abs=0.25)
 

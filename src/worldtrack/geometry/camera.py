@@ -202,6 +202,24 @@ class Camera:
         p, lead = _as_points(points, 3)
         return np.hypot(p[:, 0] - self.centre[0], p[:, 1] - self.centre[1]).reshape(lead)
 
+    def floor_rays(self, xy: ArrayLike, min_distance: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The camera's lines of sight on the floor through floor points ``xy`` (..., 2).
+
+        Returns
+        -------
+        along : (..., 2) unit vectors from the camera's foot point towards the points — the
+            direction in which one camera cannot tell depth; :attr:`floor_direction` for points
+            within ``min_distance`` (m, at least 1e-9) of the foot point, where it is undefined
+            or unstable
+        distance : (...) floor distance (m) from the foot point, as :meth:`floor_distance`
+        """
+        p, lead = _as_points(xy, 2)
+        d = p - self.centre[:2]
+        n = np.hypot(d[:, 0], d[:, 1])
+        far = n > max(min_distance, 1e-9)          # the centre is recovered to ~1e-15 m
+        along = np.where(far[:, None], d / np.where(far, n, 1.0)[:, None], self.floor_direction)
+        return along.reshape(lead + (2,)), n.reshape(lead)
+
     # ------------------------------------------------------------------ projection
     def project(self, points: ArrayLike, return_depth: bool = False):
         """Project world points to pixels, lens distortion included.

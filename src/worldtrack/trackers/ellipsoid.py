@@ -958,9 +958,7 @@ def _keep(state: dict[str, _Forms], forms: dict[str, _Forms], k: int, b: int) ->
 def _ray_direction(cam: Camera, xy: np.ndarray) -> np.ndarray:
     """Unit floor direction of the camera's ray through floor point ``xy`` — the direction along
     which one camera cannot tell depth — or the optical axis's for a point right below the camera."""
-    r = xy - cam.centre[:2]
-    n = np.linalg.norm(r)
-    return r / n if n > 0.3 else cam.floor_direction
+    return cam.floor_rays(xy, min_distance=0.3)[0]
 
 
 def _disc(radius: int) -> np.ndarray:

@@ -297,7 +297,7 @@ class ParticleTracker:
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
             if cfg.occlusion:
                 occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
-                                                  [float(np.hypot(*(c - self._cams[cid].centre))) for c in centres],
+                                                  self._cams[cid].camera.floor_rays(np.reshape(centres, (-1, 2)))[1],
                                                   self._layers.get(cid))
                              for cid, img in images.items()}
                 self._layers.update(occluders)
@@ -442,9 +442,8 @@ class ParticleTracker:
         r = self.config.surface_offset
         if r <= 0:
             return xy
-        d = xy - cl.centre
-        n = np.hypot(d[:, 0], d[:, 1])[:, None]
-        return xy - r * d / np.maximum(n, 1e-9)
+        along, _ = cl.camera.floor_rays(xy)
+        return xy - r * along
 
     # ------------------------------------------------------------------ prediction
     def _predict(self, f: _Filter, dt: float) -> None:
@@ -683,9 +682,7 @@ def image_boxes(camera: Camera, xy: np.ndarray, widths: np.ndarray, heights: np.
     k = len(xy)
     if k == 0:
         return []
-    d = xy - camera.centre[:2]
-    n = np.hypot(d[:, 0], d[:, 1])[:, None]
-    along = np.where(n > 0, d / np.where(n > 0, n, 1.0), [0.0, 1.0])
+    along, _ = camera.floor_rays(xy)
     across = np.column_stack([-along[:, 1], along[:, 0]])
     hw = 0.5 * np.broadcast_to(np.asarray(widths, float), (k,)) + margin
     top = np.broadcast_to(np.asarray(heights, float), (k,)) + margin

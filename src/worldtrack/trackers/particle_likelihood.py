@@ -624,7 +624,7 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         unsure |= readable & (hit[iv, iu] == 2)
         if occluders is not None and occluders[0].size:
             # In a nearer object's box: occluded, no evidence.
-            particle_depth = np.hypot(xy[:, 0] - camera.centre[0], xy[:, 1] - camera.centre[1])[:, None]
+            particle_depth = camera.floor_rays(xy)[1][:, None]
             unsure |= inside & ~readable & (occluders.depth_for(me)[iv, iu] < particle_depth - margin)
         seen |= inside.any(axis=1)
     unsure &= ~hits
