@@ -19,7 +19,8 @@ Measured, with the median over frames after a warm-up:
 Configurations: ``paper`` (500 particles, a line column of 20 heights, weights ∝ count, shadows
 count as object) and ``default`` (500 particles, a 3-line column of 20 heights with 2 samples below
 the floor and 2 above the top, ratio weights with the height prior, shadows removed, explaining
-away, split and merge checks).
+away, split and merge checks, the colour model of ``particle_appearance``) and ``no-appearance``
+(the default without the colour model, to show what it costs).
 
 Usage: ``.venv/bin/python benchmarks/particle_speed.py`` — writes ``benchmarks/results/particle_speed.md``.
 """
@@ -94,7 +95,8 @@ def main() -> int:
     rng = np.random.default_rng(0)
     bg = np.clip(cv2.GaussianBlur(rng.uniform(60, 200, (H, W, 3)).astype(np.float32), (0, 0), 3), 0, 255).astype(np.uint8)
     configs = {"paper": ParticleConfig.paper(births="none", end_after_s=1e9),
-               "default": ParticleConfig(births="none", end_after_s=1e9)}
+               "default": ParticleConfig(births="none", end_after_s=1e9),
+               "no-appearance": ParticleConfig(births="none", end_after_s=1e9, appearance_weight=0.0)}
     mog2 = mog2_apply_time(W, H)
     print(f"MOG2 apply {W}x{H}: {1000 * mog2:.2f} ms", file=sys.stderr)
 

@@ -69,6 +69,7 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
+from worldtrack.trackers.particle_appearance import ColourModel, column_bins
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import FloorRegion, bimodal_split, polygon_distance, resampler
@@ -109,6 +110,7 @@ class _Filter:
     likely: np.ndarray | None = None
     col_h: np.ndarray | None = None
     h: np.ndarray | None = None
+    colours: dict = field(default_factory=dict)
 
     def take(self, idx: np.ndarray) -> None:
         """Keep the particles ``idx`` (with repeats), this frame's observation included."""
@@ -191,6 +193,7 @@ class ParticleTracker:
         self._last_t: float | None = None
         self._close: dict[tuple[int, int], int] = {}
         self._layers: dict = {}          # per camera, the occluder layers reused frame to frame
+        self._frames: dict[str, np.ndarray] = {}  # per camera, this frame's image (appearance)
         self.last_masks: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ set-up
@@ -304,9 +307,11 @@ class ParticleTracker:
         for i, f in enumerate(self.filters):
             f.logpi, f.likely, f.col_h = self.likelihood(
                 f.xyz, images, owners, {cid: boxes[cid][i] for cid in images} if explain_tracks else None, f.h,
-                occluders, i)
+                occluders, i, f.colours)
         for f in list(self.filters):
             self._update_tracking(f, t)
+        if cfg.appearance_weight > 0:
+            self._learn_colours(images)
 
         # Splits and merges first, so a filter that just split into two objects hides both of them
         # from the detection filters below (otherwise the second object is also "detected").
@@ -355,6 +360,8 @@ class ParticleTracker:
             else:
                 hit = hit_image(F, cfg.gamma)
             self.last_masks[cid] = hit
+            if cfg.appearance_weight > 0:
+                self._frames[cid] = image
             out[cid] = hit if cfg.likelihood == "column" else thresholded_difference(np.where(hit == 1, F, 0), cfg.gamma)
         return out
 
@@ -370,7 +377,8 @@ class ParticleTracker:
                    owners: Mapping[str, np.ndarray] | None = None,
                    boxes: Mapping[str, Box | None] | None = None,
                    h: np.ndarray | None = None, occluders: Mapping[str, object] | None = None,
-                   me: int = -1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   me: int = -1, colours: Mapping[str, ColourModel] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Log-likelihood of particles, summed over the cameras that see them.
 
         Parameters
@@ -386,6 +394,9 @@ class ParticleTracker:
             ``owners``, with ``me`` the filter's index among them: a column sample in the box of an
             object nearer to the camera by more than ``occlusion_margin`` is occluded (no evidence)
             rather than background
+        colours : {camera_id: ColourModel}, optional — the object's learnt colours: each particle
+            adds ``appearance_weight`` times the colour log-ratio of its colour column (see
+            :mod:`~worldtrack.trackers.particle_appearance`)
 
         Returns
         -------
@@ -424,6 +435,10 @@ class ParticleTracker:
                         lv = ratio
                         col += np.where(seen, self._column[top], 0.0)
                     ok = counts >= cfg.likely_count
+                    model = colours.get(cid) if colours else None
+                    if model is not None and model.hist is not None and cid in self._frames:
+                        lv = lv + cfg.appearance_weight * model.log_ratio(
+                            column_bins(cl.camera, self._frames[cid], img, self._near_surface(xyz[:, :2], cl)))
                 else:
                     values, seen = cl.point(img, xyz, owner, box)
                     lv = np.log(values / F_MAX)
@@ -436,6 +451,32 @@ class ParticleTracker:
             valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
         logpi = np.where(valid, logpi, -np.inf)
         return logpi, likely & valid, col / np.maximum(n_seen, 1)
+
+    def _learn_colours(self, images: Mapping[str, np.ndarray]) -> None:
+        """Teach each filter the colours on its column, in the cameras where its box overlaps no other's.
+
+        The column at the particles' mean and two beside it (±width/4 across the line of sight),
+        object samples only; filters with fewer than half their particles likely learn nothing.
+        """
+        cfg = self.config
+        fs = [f for f in self.filters if f.likely is not None and f.likely.mean() > 0.5]
+        if not fs:
+            return
+        boxes = self._boxes(self.filters, [f.centre for f in self.filters], cfg.box_margin)
+        index = {id(f): i for i, f in enumerate(self.filters)}
+        for cid, hit in images.items():
+            cl = self._cams[cid]
+            bs = boxes[cid]
+            for f in fs:
+                i = index[id(f)]
+                if bs[i] is None or any(j != i and b is not None and _overlap(bs[i], b) > 0 for j, b in enumerate(bs)):
+                    continue
+                centre = self._near_surface(f.centre[None, :], cl)
+                along, _ = cl.camera.floor_rays(centre)
+                across = np.array([-along[0, 1], along[0, 0]]) * 0.25 * f.track.width
+                xy = np.vstack([centre, centre + across, centre - across])
+                f.colours.setdefault(cid, ColourModel()).learn(
+                    column_bins(cl.camera, self._frames[cid], hit, xy), cfg.appearance_rate)
 
     def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
         """Where a camera's column stands for particles at ``xy`` (N, 2): ``surface_offset`` m nearer to it."""

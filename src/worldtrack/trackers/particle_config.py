@@ -150,6 +150,15 @@ class ParticleConfig:
         its ellipsoids) is *occluded* — no evidence — instead of background. Without it a person
         walking behind another is penalised at their true place for every sample the nearer person
         hides, and the filter is pushed off along the line of sight or ends (True).
+    appearance_weight, appearance_rate
+        Beyond the paper: each tracking filter learns, per camera, the colour histogram of the
+        object pixels on its column in frames where its image box overlaps no other track's (a
+        running average with weight ``appearance_rate``, 0.1), and a particle's log-likelihood
+        loses ``appearance_weight`` (1.0) times the log-ratio of every column colour its object
+        rarely shows (:mod:`~worldtrack.trackers.particle_appearance`). It keeps a filter from
+        going on with another person when two cross in one camera's image: on the entry scenario
+        tracks per person 2.0 → 1.73, IDF1 0.59 → 0.68, mean error 0.144 → 0.132 m. 0 = off (the
+        paper preset).
     exclusion_depth : float, metres
         For detection filters a track's box also covers the object placed this much nearer and
         farther along the line of sight: one camera places an object poorly in depth, and what the
@@ -219,6 +228,8 @@ class ParticleConfig:
     surface_offset: float = 0.1
     occlusion: bool = True
     occlusion_margin: float = 0.3
+    appearance_weight: float = 1.0
+    appearance_rate: float = 0.1
     exclusion_depth: float = 0.5
     resampling: str = "systematic"
     births: str = "auto"
@@ -243,7 +254,7 @@ class ParticleConfig:
         away for tracking filters, tracks end at once. Numbers it does not state stay ours."""
         base = cls(velocity="particle", weighting="count", likelihood_power=1.0, column_radius=0.0,
                    foot_samples=0, head_samples=0, pixel_weights=False, top_sigma=0.0, shadows="object", explain="detection",
-                   occlusion=False, surface_offset=0.0,
+                   occlusion=False, appearance_weight=0.0, surface_offset=0.0,
                    split=False, merge=False,
                    end_after_s=0.0)
         try:
@@ -271,7 +282,7 @@ class ParticleConfig:
             if not _number(getattr(self, name)) or not getattr(self, name) > 0:
                 raise bad(name, "a positive number")
         for name in ("gamma", "top_sigma", "height_spread", "noise_h", "noise_xy", "noise_z", "box_margin", "surface_offset", "occlusion_margin", "exclusion_depth", "detection_noise", "entry_margin",
-                     "end_after_s", "likelihood_power", "column_radius"):
+                     "end_after_s", "likelihood_power", "column_radius", "appearance_weight"):
             if not _number(getattr(self, name)) or not getattr(self, name) >= 0:
                 raise bad(name, "a number ≥ 0")
         for name, lo, hi, what in (("alpha", 0, 1, "(0, 1)"), ("hit_rate_object", 0, 1, "(0, 1)"),
@@ -283,6 +294,8 @@ class ParticleConfig:
             raise bad("beta", "a share in [0, 1)")
         if not _number(self.detection_reseed) or not 0 <= self.detection_reseed <= 1:
             raise bad("detection_reseed", "a share in [0, 1]")
+        if not _number(self.appearance_rate) or not 0 < self.appearance_rate <= 1:
+            raise bad("appearance_rate", "a weight in (0, 1]")
         if not _number(self.merge_overlap) or not 0 < self.merge_overlap <= 1:
             raise bad("merge_overlap", "a share in (0, 1]")
         if self.velocity_smoothing > 1:

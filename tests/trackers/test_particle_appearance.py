@@ -1,0 +1,127 @@
+"""The particle tracker's colour model: bins, learning, the penalty, and where a filter learns."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_particle import make_scene, run, tracker_for  # noqa: E402
+
+from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
+                                                     SAT_BINS, ColourModel, colour_bins, colour_bins_reference,
+                                                     column_bins, column_bins_reference)
+
+
+def bgr(*colours) -> np.ndarray:
+    return np.array([colours], dtype=np.uint8)
+
+
+def test_colour_bins_tell_hues_and_greys_apart():
+    red, green, blue = (0, 0, 255), (0, 255, 0), (255, 0, 0)
+    black, white, mid_grey = (0, 0, 0), (255, 255, 255), (128, 128, 128)
+    b = colour_bins(bgr(red, green, blue, black, white, mid_grey))[0]
+    # Full saturation: the top saturation bin of hue 0° (red), 120° (green, OpenCV hue 60), 240° (blue, 120).
+    assert b[0] == 0 * SAT_BINS + SAT_BINS - 1
+    assert b[1] == (60 * HUE_BINS // 180) * SAT_BINS + SAT_BINS - 1
+    assert b[2] == (120 * HUE_BINS // 180) * SAT_BINS + SAT_BINS - 1
+    # Greys go by value: black the first grey bin, white the last, mid grey in between.
+    assert b[3] == HUE_BINS * SAT_BINS
+    assert b[4] == N_BINS - 1
+    assert b[5] == HUE_BINS * SAT_BINS + 128 * GREY_BINS // 256
+    assert len(set(b.tolist())) == 6
+    assert b.max() < N_BINS
+
+
+def test_colour_model_learns_a_running_average():
+    m = ColourModel()
+    assert not m.learn(np.full(MIN_LEARN_SAMPLES - 1, 3), 0.1)          # too few samples
+    assert m.hist is None and m.frames == 0
+    assert m.learn(np.array([3] * 6 + [-1] * 10), 0.1)                   # −1 (not object) ignored
+    np.testing.assert_allclose(m.hist[3], 1.0)
+    assert m.learn(np.array([5] * 8), 0.25)
+    assert m.hist[3] == pytest.approx(0.75) and m.hist[5] == pytest.approx(0.25)
+    assert m.hist.sum() == pytest.approx(1.0) and m.frames == 2
+
+
+def test_colour_penalty_hits_foreign_colours_only():
+    m = ColourModel()
+    assert np.all(m.log_ratio(np.array([[1, 2, -1]])) == 0.0)          # nothing learnt: no term
+    m.learn(np.array([3] * 10), 1.0)
+    rows = np.array([[3, 3, 3], [7, 7, -1], [3, 7, -1], [-1, -1, -1]])
+    lr = m.log_ratio(rows)
+    absent = math.log(EPSILON / (1 + EPSILON))
+    np.testing.assert_allclose(lr, [0.0, 2 * absent, absent, 0.0])       # own colour: 0, never a reward
+    assert np.all(lr <= 0.0)
+
+
+def test_column_bins_read_the_colour_of_object_pixels_on_the_column():
+    scene = make_scene(entry=False)
+    cam = scene.camera("cam")
+    H, W = cam.height, cam.width
+    hit = np.zeros((H, W), dtype=np.uint8)
+    image = np.full((H, W, 3), 128, dtype=np.uint8)
+    xy = np.array([[0.0, 3.0], [1.5, 3.0]])
+    heights = np.array([0.5, 1.0, 2.5])
+    uv = cam.project(np.array([[0.0, 3.0, 0.5], [0.0, 3.0, 1.0]]))
+    for u, v in np.round(uv).astype(int):
+        hit[v, u] = 1
+        image[v, u] = (0, 0, 255)
+    red = int(colour_bins(bgr((0, 0, 255)))[0, 0])
+    out = column_bins(cam, image, hit, xy, heights)
+    assert out.shape == (2, 3)
+    np.testing.assert_array_equal(out[0], [red, red, -1])                # object, object, background
+    np.testing.assert_array_equal(out[1], [-1, -1, -1])                  # a column on background
+
+
+def test_colour_bins_lookup_agrees_with_arithmetic():
+    img = np.random.default_rng(5).integers(0, 256, (60, 80, 3)).astype(np.uint8)
+    np.testing.assert_array_equal(colour_bins(img), colour_bins_reference(img))
+
+
+@pytest.mark.parametrize("dist", [None, [-0.2, 0.05, 0.001, -0.002, 0.0]])
+def test_column_bins_kernel_agrees_with_reference(dist):
+    from worldtrack.scene import scene_from_dict
+    from test_particle import CAM, FLOOR
+    scene = scene_from_dict({"name": "t", "cameras": [{**CAM, **({"distortion": dist} if dist else {})}], "floor": FLOOR})
+    cam = scene.camera("cam")
+    rng = np.random.default_rng(3)
+    hit = rng.integers(0, 3, (cam.height, cam.width)).astype(np.uint8)
+    image = rng.integers(0, 256, (cam.height, cam.width, 3)).astype(np.uint8)
+    xy = np.column_stack([rng.uniform(-4, 4, 400), rng.uniform(0.2, 7, 400)])    # some outside the view
+    fast, slow = column_bins(cam, image, hit, xy), column_bins_reference(cam, image, hit, xy)
+    assert fast.dtype == slow.dtype and (slow >= 0).sum() > 100 and (slow < 0).sum() > 100
+    np.testing.assert_array_equal(fast, slow)
+
+
+def test_filters_learn_colours_only_while_their_boxes_are_apart():
+    """Two people 1.5 m apart across the view: each filter learns its own person's colour. Two
+    people on one line of sight (boxes overlapping): nobody learns."""
+    def apart(t):
+        return [(-1.0, 3.0), (1.0, 3.0)]
+
+    def behind(t):
+        return [(0.0, 2.5), (0.0, 4.5)]
+
+    for paths, learns in ((apart, True), (behind, False)):
+        scene = make_scene(entry=False)
+        tracker, bgs = tracker_for(scene, births="none")
+        people = paths(0.0)
+        for i, (x, y) in enumerate(people, start=1):
+            tracker.init_track(x, y, track_id=i)
+        run(tracker, scene, bgs, paths, 5)
+        models = [f.colours.get("cam") for f in sorted(tracker.filters, key=lambda f: f.track.id)]
+        if not learns:
+            assert all(m is None or m.hist is None for m in models)
+            continue
+        # Each learnt histogram peaks on its own person's colour bin (test_particle.COLOURS).
+        from test_particle import COLOURS
+        own = [int(colour_bins(bgr(COLOURS[k]))[0, 0]) for k in range(2)]
+        assert own[0] != own[1]
+        for k, m in enumerate(models):
+            assert m is not None and m.frames >= 4
+            assert int(np.argmax(m.hist)) == own[k] and m.hist[own[1 - k]] < 0.05
