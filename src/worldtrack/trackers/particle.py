@@ -422,7 +422,8 @@ class ParticleTracker:
                 owner = owners.get(cid) if owners is not None else None
                 box = boxes.get(cid) if boxes is not None else None
                 if cfg.likelihood == "column":
-                    counts, ratio, top, seen = cl.column(img, self._near_surface(xyz[:, :2], cl), self._column, self._on, self._off,
+                    surface = self._near_surface(xyz[:, :2], cl)
+                    counts, ratio, top, seen = cl.column(img, surface, self._column, self._on, self._off,
                                                          self._k_min, cfg.column_radius, -self._on, self._n_below,
                                                          self._n_above, owner, box, h, self._top_sigma,
                                                          self._px_scale[cid],
@@ -438,7 +439,7 @@ class ParticleTracker:
                     model = colours.get(cid) if colours else None
                     if model is not None and model.hist is not None and cid in self._frames:
                         lv = lv + cfg.appearance_weight * model.log_ratio(
-                            column_bins(cl.camera, self._frames[cid], img, self._near_surface(xyz[:, :2], cl)))
+                            column_bins(cl.camera, self._frames[cid], img, surface))
                 else:
                     values, seen = cl.point(img, xyz, owner, box)
                     lv = np.log(values / F_MAX)

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from ..geometry.camera import Camera
-from .particle_likelihood import _to_pixel
+from .particle_likelihood import _pixels, _to_pixel
 
 HUE_BINS = 12
 SAT_BINS = 3          # saturated pixels only: saturation ≥ GREY_SATURATION
@@ -127,10 +127,7 @@ def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy
     pts = np.empty((n, s, 3))
     pts[:, :, :2] = xy[:, None, :]
     pts[:, :, 2] = np.asarray(heights, dtype=float)[None, :]
-    uv = camera.project(pts)
-    inside = camera.in_image(uv) & np.isfinite(uv).all(axis=-1)
-    iu = np.where(inside, np.floor(np.nan_to_num(uv[..., 0]) + 0.5), 0).astype(np.int64)
-    iv = np.where(inside, np.floor(np.nan_to_num(uv[..., 1]) + 0.5), 0).astype(np.int64)
+    iu, iv, inside = _pixels(camera, pts)
     on = inside & (hit[iv, iu] == 1)
     return np.where(on, bins[iv, iu].astype(np.int16), np.int16(-1))
 
