@@ -10,11 +10,14 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_particle import make_scene, run, tracker_for  # noqa: E402
+from test_particle import CAM, COLOURS, FLOOR, make_scene, render, run, tracker_for  # noqa: E402
 
 from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
                                                      SAT_BINS, ColourModel, colour_bins, colour_bins_reference,
                                                      column_bins, column_bins_reference)
+from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.scene import scene_from_dict  # noqa: E402
+from worldtrack.trackers.particle_likelihood import CameraLikelihood  # noqa: E402
 
 
 def bgr(*colours) -> np.ndarray:
@@ -72,7 +75,7 @@ def test_column_bins_read_the_colour_of_object_pixels_on_the_column():
         hit[v, u] = 1
         image[v, u] = (0, 0, 255)
     red = int(colour_bins(bgr((0, 0, 255)))[0, 0])
-    out = column_bins(cam, image, hit, xy, heights)
+    out = column_bins(CameraLikelihood(cam), image, hit, xy, heights)
     assert out.shape == (2, 3)
     np.testing.assert_array_equal(out[0], [red, red, -1])                # object, object, background
     np.testing.assert_array_equal(out[1], [-1, -1, -1])                  # a column on background
@@ -85,15 +88,13 @@ def test_colour_bins_lookup_agrees_with_arithmetic():
 
 @pytest.mark.parametrize("dist", [None, [-0.2, 0.05, 0.001, -0.002, 0.0]])
 def test_column_bins_kernel_agrees_with_reference(dist):
-    from worldtrack.scene import scene_from_dict
-    from test_particle import CAM, FLOOR
     scene = scene_from_dict({"name": "t", "cameras": [{**CAM, **({"distortion": dist} if dist else {})}], "floor": FLOOR})
     cam = scene.camera("cam")
     rng = np.random.default_rng(3)
     hit = rng.integers(0, 3, (cam.height, cam.width)).astype(np.uint8)
     image = rng.integers(0, 256, (cam.height, cam.width, 3)).astype(np.uint8)
     xy = np.column_stack([rng.uniform(-4, 4, 400), rng.uniform(0.2, 7, 400)])    # some outside the view
-    fast, slow = column_bins(cam, image, hit, xy), column_bins_reference(cam, image, hit, xy)
+    fast, slow = column_bins(CameraLikelihood(cam), image, hit, xy), column_bins_reference(cam, image, hit, xy)
     assert fast.dtype == slow.dtype and (slow >= 0).sum() > 100 and (slow < 0).sum() > 100
     np.testing.assert_array_equal(fast, slow)
 
@@ -119,9 +120,29 @@ def test_filters_learn_colours_only_while_their_boxes_are_apart():
             assert all(m is None or m.hist is None for m in models)
             continue
         # Each learnt histogram peaks on its own person's colour bin (test_particle.COLOURS).
-        from test_particle import COLOURS
         own = [int(colour_bins(bgr(COLOURS[k]))[0, 0]) for k in range(2)]
         assert own[0] != own[1]
         for k, m in enumerate(models):
             assert m is not None and m.frames >= 4
             assert int(np.argmax(m.hist)) == own[k] and m.hist[own[1 - k]] < 0.05
+
+
+def test_likelihood_penalises_particles_on_another_persons_colours():
+    """With person 1's learnt colours, particles on person 2 lose the colour penalty; particles on
+    person 1 lose nothing; without colours both read the same column terms as before."""
+    scene = make_scene(entry=False)
+    tracker, bgs = tracker_for(scene, births="none")
+    people = [(-1.0, 3.0), (1.0, 3.0)]
+    for i, (x, y) in enumerate(people, start=1):
+        tracker.init_track(x, y, track_id=i)
+    run(tracker, scene, bgs, lambda t: people, 5)
+    first = min(tracker.filters, key=lambda f: f.track.id)
+    assert first.colours["cam"].hist is not None
+    frame = render(scene.camera("cam"), bgs["cam"], people, np.random.default_rng(9))
+    images = tracker._images({"cam": Frame(frame, 1.0, 10)})
+    xyz = np.array([[-1.0, 3.0, 0.8], [1.0, 3.0, 0.8]])
+    plain, _, _ = tracker.likelihood(xyz, images)
+    coloured, _, _ = tracker.likelihood(xyz, images, colours=first.colours)
+    assert coloured[0] == pytest.approx(plain[0])                        # own colours: no change
+    absent = math.log(EPSILON / (1 + EPSILON))
+    assert coloured[1] - plain[1] < 3 * absent                           # ≥ 3 samples of a foreign colour

@@ -439,7 +439,7 @@ class ParticleTracker:
                     model = colours.get(cid) if colours else None
                     if model is not None and model.hist is not None and cid in self._frames:
                         lv = lv + cfg.appearance_weight * model.log_ratio(
-                            column_bins(cl.camera, self._frames[cid], img, surface))
+                            column_bins(cl, self._frames[cid], img, surface))
                 else:
                     values, seen = cl.point(img, xyz, owner, box)
                     lv = np.log(values / F_MAX)
@@ -477,7 +477,7 @@ class ParticleTracker:
                 across = np.array([-along[0, 1], along[0, 0]]) * 0.25 * f.track.width
                 xy = np.vstack([centre, centre + across, centre - across])
                 f.colours.setdefault(cid, ColourModel()).learn(
-                    column_bins(cl.camera, self._frames[cid], hit, xy), cfg.appearance_rate)
+                    column_bins(cl, self._frames[cid], hit, xy), cfg.appearance_rate)
 
     def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
         """Where a camera's column stands for particles at ``xy`` (N, 2): ``surface_offset`` m nearer to it."""

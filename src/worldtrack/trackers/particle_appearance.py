@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from ..geometry.camera import Camera
-from .particle_likelihood import _pixels, _to_pixel
+from .particle_likelihood import CameraLikelihood, _pixels, _to_pixel, column_points
 
 HUE_BINS = 12
 SAT_BINS = 3          # saturated pixels only: saturation ≥ GREY_SATURATION
@@ -72,7 +72,7 @@ _SAT_LUT = np.clip((_LEVELS - GREY_SATURATION) * SAT_BINS // (256 - GREY_SATURAT
 _GREY_LUT = (HUE_BINS * SAT_BINS + _LEVELS * GREY_BINS // 256).astype(np.uint8)
 
 
-def column_bins(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
+def column_bins(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
                 heights: np.ndarray = COLOUR_HEIGHTS) -> np.ndarray:
     """Colour bins along columns standing at ``xy``, where they read object.
 
@@ -82,7 +82,7 @@ def column_bins(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarr
 
     Parameters
     ----------
-    camera : Camera
+    cl : CameraLikelihood — the camera's constants, as the column kernel takes them
     image : (H, W, 3) uint8 — the BGR frame
     hit : (H, W) uint8 — the column likelihood's labels (1 = object)
     xy : (N, 2) float, metres — the columns' floor positions
@@ -95,10 +95,8 @@ def column_bins(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarr
     """
     xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
     flat = np.empty((len(xy), len(heights)), dtype=np.int64)
-    _column_pixels(xy, np.ascontiguousarray(heights, dtype=np.float64),
-                   np.ascontiguousarray(camera.R, dtype=np.float64), np.ascontiguousarray(camera.t, dtype=np.float64),
-                   np.ascontiguousarray(camera.K, dtype=np.float64), np.ascontiguousarray(camera.dist, dtype=np.float64),
-                   bool(camera.has_distortion), hit, flat)
+    _column_pixels(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.R, cl.t, cl.K, cl.dist, cl.has_dist,
+                   hit, flat)
     out = np.full(flat.shape, -1, dtype=np.int16)
     on = flat >= 0
     if on.any():
@@ -122,12 +120,7 @@ def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy
     """:func:`column_bins` written plainly: the whole frame's bins, every sample through
     :meth:`Camera.project`."""
     bins = colour_bins_reference(image)
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    n, s = len(xy), len(heights)
-    pts = np.empty((n, s, 3))
-    pts[:, :, :2] = xy[:, None, :]
-    pts[:, :, 2] = np.asarray(heights, dtype=float)[None, :]
-    iu, iv, inside = _pixels(camera, pts)
+    iu, iv, inside = _pixels(camera, column_points(xy, heights))
     on = inside & (hit[iv, iu] == 1)
     return np.where(on, bins[iv, iu].astype(np.int16), np.int16(-1))
 

@@ -568,6 +568,16 @@ def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, d
 
 # ---------------------------------------------------------------------------- NumPy references
 
+def column_points(xy: np.ndarray, heights: np.ndarray) -> np.ndarray:
+    """(N, S, 3) world points of vertical columns: floor positions ``xy`` (N, 2) at ``heights`` (S,), metres."""
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    heights = np.asarray(heights, dtype=float)
+    pts = np.empty((len(xy), len(heights), 3))
+    pts[:, :, :2] = xy[:, None, :]
+    pts[:, :, 2] = heights[None, :]
+    return pts
+
+
 def _pixels(camera: Camera, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Nearest pixel (iu, iv) of world points (..., 3) and whether they fall in the image."""
     uv = camera.project(points)
@@ -603,10 +613,7 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
     """
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     n, s = len(xy), len(heights)
-    pts = np.empty((n, s, 3))
-    pts[:, :, :2] = xy[:, None, :]
-    pts[:, :, 2] = np.asarray(heights, dtype=float)[None, :]
-    uv, depth = camera.project(pts, return_depth=True)
+    uv, depth = camera.project(column_points(xy, heights), return_depth=True)
     hits = np.zeros((n, s), dtype=bool)
     unsure = np.zeros((n, s), dtype=bool)
     seen = np.zeros(n, dtype=bool)
