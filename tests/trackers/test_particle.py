@@ -569,3 +569,50 @@ def test_shadow_kernel_agrees_with_reference():
     a = hit_labels(img, floor, 25.0, where=strip, shadow=0)
     np.testing.assert_array_equal(a, hit_labels_reference(img, floor, 25.0, where=strip, shadow=0))
     assert 0 < np.sum(a[strip] == 2) < np.sum(a[strip] == 0)
+
+
+# ---------------------------------------------------------------------------- leaving through an exit
+
+def _walks_out_and_waits(wait_until):
+    """Walks left from x = −1 at 1 m/s out through the door region to the floor's edge (x = −3),
+    stands at x = −2.85 until ``wait_until`` s, then is gone."""
+    return lambda t: [(max(-1.0 - 1.0 * t, -2.85), 3.0)] if t < wait_until else []
+
+
+def test_a_track_leaving_through_the_exit_ends_and_is_not_detected_again():
+    scene = make_scene()
+    tracks_by_frame = {}
+    for name, options in (("exit", {}), ("no exit rule", {"exit_lookahead_s": 0.0}),
+                          ("no hold", {"exit_hold_s": 0.0})):
+        tracker, bgs = tracker_for(scene, **options)
+        tracker.init_track(-1.0, 3.0)
+        out = run(tracker, scene, bgs, _walks_out_and_waits(2.25), 35)
+        tracks_by_frame[name] = [[tr.id for tr in tracks] for _, _, tracks in out]
+    exit_, no_rule, no_hold = (tracks_by_frame[k] for k in ("exit", "no exit rule", "no hold"))
+    # Followed through the door; ended at the floor's edge (x ≈ −2.8 at 1.8 s: 0.2 s ahead is off
+    # the floor), and the person still standing there for 0.45 s is not detected as somebody new.
+    assert exit_[16] == [1]
+    last = max(k for k, ids in enumerate(exit_) if ids)
+    assert 16 <= last <= 19
+    assert all(not ids for ids in exit_[last + 1:])
+    # Without the rule the filter stays on the person at the edge, past their last frame (22).
+    assert no_rule[22] == [1]
+    # Without the hold, the person at the edge is detected again as a new track.
+    assert any(ids and ids[0] != 1 for ids in no_hold[last + 1:])
+
+
+def test_exit_rule_needs_an_entry_region_and_outward_motion():
+    scene = make_scene()
+    tracker, _ = tracker_for(scene)
+    tracker.init_track(-2.85, 3.0)
+    f = tracker.filters[0]
+    tr = f.track
+    for (x, vx, vy), leaving in (((-2.85, -1.0, 0.0), True),    # in the door, walking off the edge
+                                 ((-2.85, 1.0, 0.0), False),    # in the door, walking in
+                                 ((-2.85, -0.2, 0.0), False),   # too slow to be walking out
+                                 ((-2.5, -1.0, 0.0), False),    # 0.2 s ahead still on the floor
+                                 ((2.85, 1.0, 0.0), False)):    # off the right edge, no entry region there
+        tr.x, tr.vx, tr.vy = x, vx, vy
+        assert tracker._left_through_exit(f) is leaving, (x, vx, vy)
+    tr.x, tr.vx = -2.85, -1.0
+    assert not ParticleTracker(scene, tracker.foregrounds, ParticleConfig.paper())._left_through_exit(f)

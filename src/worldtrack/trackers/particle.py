@@ -38,6 +38,10 @@ Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as p
   radius standing on the body's near side, floor contact, and cast shadows removed by colour and
   texture — see :class:`ParticleConfig`;
 * several cameras: the likelihood multiplies over the cameras that see the particle;
+* leaving through an exit: a filter walking off the floor's edge inside an entry region ends at
+  once instead of living on with whoever stands in front of the door on its line of sight, and its
+  last box stays explained to the detection filters for a moment (``exit_*`` in
+  :class:`ParticleConfig`);
 * the particles' z: the column does not depend on it, so after resampling each particle's z is
   drawn uniformly below the top its column sees — the particles then fill the object's height.
 
@@ -194,6 +198,7 @@ class ParticleTracker:
         self._close: dict[tuple[int, int], int] = {}
         self._layers: dict = {}          # per camera, the occluder layers reused frame to frame
         self._frames: dict[str, np.ndarray] = {}  # per camera, this frame's image (appearance)
+        self._leaving: list[tuple[Track, float]] = []  # tracks ended at an exit, and when
         self.last_masks: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ set-up
@@ -327,6 +332,16 @@ class ParticleTracker:
         if cfg.explain != "none" and self.detectors:
             boxes = self._boxes(self.filters, [f.centre for f in self.filters], cfg.box_margin,
                                 cfg.exclusion_depth)
+            # Objects that just left through an exit may still show at the floor's edge: their
+            # last boxes stay explained for ``exit_hold_s``.
+            self._leaving = [(tr, t0) for tr, t0 in self._leaving if t - t0 <= cfg.exit_hold_s]
+            if self._leaving:
+                xy = np.array([[tr.x, tr.y] for tr, _ in self._leaving])
+                widths = np.array([tr.width for tr, _ in self._leaving])
+                heights = np.array([tr.height for tr, _ in self._leaving])
+                for cid, cl in self._cams.items():
+                    boxes[cid] = list(boxes[cid]) + list(image_boxes(cl.camera, xy, widths, heights, cfg.box_margin,
+                                                                     cfg.exclusion_depth))
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
         for d in self.detectors:
             self._move_detector(d, dt)
@@ -575,6 +590,9 @@ class ParticleTracker:
         self._resample_filter(f, self._weights(f.logpi), cfg.particles)
         f.track.score = share
         self._update_region(f, t)
+        if self._left_through_exit(f):
+            self._leaving.append((f.track, t))
+            self._end(f)
 
     def _update_region(self, f: _Filter, t: float) -> None:
         """Object region (eqs. 9–10) and the track's fields, from the resampled particles."""
@@ -606,6 +624,23 @@ class ParticleTracker:
             # width/2 round it (per-axis variance r²/4), as its z fills the height below the top.
             sd[:2] = np.hypot(sd[:2], 0.25 * tr.width)
         tr.extra.update(z=float(centre[2]), sx=float(sd[0]), sy=float(sd[1]), sz=float(sd[2]))
+
+    def _left_through_exit(self, f: _Filter) -> bool:
+        """Whether the filter's object is walking off the floor through an entry region: its centre is
+        in one, it moves at ≥ ``exit_speed`` and the centre ``exit_lookahead_s`` ahead is off the
+        walkable floor. Nobody can be beyond the floor's edge, so what the column still reads there
+        is somebody else (in front of the door on the same line of sight), not the object."""
+        cfg = self.config
+        if cfg.exit_lookahead_s <= 0 or not self.scene.entry_regions:
+            return False
+        tr = f.track
+        v = np.array([tr.vx, tr.vy])
+        if float(np.hypot(*v)) < cfg.exit_speed:
+            return False
+        here = np.array([[tr.x, tr.y]])
+        if self.scene.entry_region_index(here)[0] < 0:
+            return False
+        return not bool(self._walkable(here + cfg.exit_lookahead_s * v)[0])
 
     # ------------------------------------------------------------------ detection filters
     def _update_detector(self, d: _Filter, t: float) -> None:

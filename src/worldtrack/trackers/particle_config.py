@@ -184,6 +184,14 @@ class ParticleConfig:
         σ of the jitter of detection particles (0.15).
     end_after_s : float, s
         A tracking filter ends once its share has stayed ≤ β this long (paper: at once, 0; 0.3).
+    exit_lookahead_s, exit_speed, exit_hold_s
+        Leaving through an exit (not in the paper): a tracking filter whose centre is in an entry
+        region, moving at ≥ ``exit_speed`` (0.3 m/s), with its centre ``exit_lookahead_s`` ahead
+        (0.2 s) off the walkable floor, ends at once — its object is walking off the known floor,
+        and what its column reads there next is whoever stands in front of the door on the same
+        line of sight. Its last image box stays explained for the detection filters for
+        ``exit_hold_s`` (0.5 s), so the object still showing at the floor's edge is not detected
+        again. ``exit_lookahead_s = 0`` turns this off (the paper preset: tracks end only by β).
     split, split_distance, split_dip, split_min_mass, split_frames
         Split a filter whose particles form two lumps on the floor at least ``split_distance`` apart
         (0.35 m), with a valley of at most ``split_dip`` (0.5) times the lower peak and at least
@@ -237,6 +245,9 @@ class ParticleConfig:
     detection_reseed: float = 0.2
     detection_noise: float = 0.15
     end_after_s: float = 0.3
+    exit_lookahead_s: float = 0.2
+    exit_speed: float = 0.3
+    exit_hold_s: float = 0.5
     split: bool = True
     split_distance: float = 0.35
     split_dip: float = 0.5
@@ -256,7 +267,7 @@ class ParticleConfig:
                    foot_samples=0, head_samples=0, pixel_weights=False, top_sigma=0.0, shadows="object", explain="detection",
                    occlusion=False, appearance_weight=0.0, surface_offset=0.0,
                    split=False, merge=False,
-                   end_after_s=0.0)
+                   end_after_s=0.0, exit_lookahead_s=0.0)
         try:
             return replace(base, **overrides)
         except TypeError as e:
@@ -282,7 +293,7 @@ class ParticleConfig:
             if not _number(getattr(self, name)) or not getattr(self, name) > 0:
                 raise bad(name, "a positive number")
         for name in ("gamma", "top_sigma", "height_spread", "noise_h", "noise_xy", "noise_z", "box_margin", "surface_offset", "occlusion_margin", "exclusion_depth", "detection_noise", "entry_margin",
-                     "end_after_s", "likelihood_power", "column_radius", "appearance_weight"):
+                     "end_after_s", "exit_lookahead_s", "exit_speed", "exit_hold_s", "likelihood_power", "column_radius", "appearance_weight"):
             if not _number(getattr(self, name)) or not getattr(self, name) >= 0:
                 raise bad(name, "a number ≥ 0")
         for name, lo, hi, what in (("alpha", 0, 1, "(0, 1)"), ("hit_rate_object", 0, 1, "(0, 1)"),
