@@ -301,7 +301,7 @@ class ParticleTracker:
         owners = occluders = None
         if explain_tracks:
             centres = [f.xyz[:, :2].mean(axis=0) for f in self.filters]
-            boxes = self._boxes(self.filters, centres, cfg.box_margin)
+            boxes = self._boxes([f.track for f in self.filters], centres, cfg.box_margin)
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
             if cfg.occlusion:
                 occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
@@ -330,18 +330,13 @@ class ParticleTracker:
         # the line of sight), so the object just handed over does not fire the fresh detection
         # filter again even where its track sits at the wrong depth.
         if cfg.explain != "none" and self.detectors:
-            boxes = self._boxes(self.filters, [f.centre for f in self.filters], cfg.box_margin,
-                                cfg.exclusion_depth)
             # Objects that just left through an exit may still show at the floor's edge: their
             # last boxes stay explained for ``exit_hold_s``.
             self._leaving = [(tr, t0) for tr, t0 in self._leaving if t - t0 <= cfg.exit_hold_s]
-            if self._leaving:
-                xy = np.array([[tr.x, tr.y] for tr, _ in self._leaving])
-                widths = np.array([tr.width for tr, _ in self._leaving])
-                heights = np.array([tr.height for tr, _ in self._leaving])
-                for cid, cl in self._cams.items():
-                    boxes[cid] = list(boxes[cid]) + list(image_boxes(cl.camera, xy, widths, heights, cfg.box_margin,
-                                                                     cfg.exclusion_depth))
+            left = [tr for tr, _ in self._leaving]
+            boxes = self._boxes([f.track for f in self.filters] + left,
+                                [f.centre for f in self.filters] + [np.array([tr.x, tr.y]) for tr in left],
+                                cfg.box_margin, cfg.exclusion_depth)
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
         for d in self.detectors:
             self._move_detector(d, dt)
@@ -380,12 +375,12 @@ class ParticleTracker:
             out[cid] = hit if cfg.likelihood == "column" else thresholded_difference(np.where(hit == 1, F, 0), cfg.gamma)
         return out
 
-    def _boxes(self, filters: list[_Filter], centres: list[np.ndarray], margin: float,
+    def _boxes(self, tracks: list[Track], centres: list[np.ndarray], margin: float,
                depth: float = 0.0) -> dict[str, list[Box | None]]:
-        """Per camera, each filter's object box in the image at ``centres`` (see :func:`image_box`)."""
+        """Per camera, each track's object box in the image at ``centres`` (see :func:`image_boxes`)."""
         xy = np.array(centres, dtype=float).reshape(-1, 2)
-        widths = np.array([f.track.width for f in filters], dtype=float)
-        heights = np.array([f.track.height for f in filters], dtype=float)
+        widths = np.array([tr.width for tr in tracks], dtype=float)
+        heights = np.array([tr.height for tr in tracks], dtype=float)
         return {cid: image_boxes(cl.camera, xy, widths, heights, margin, depth) for cid, cl in self._cams.items()}
 
     def likelihood(self, xyz: np.ndarray, images: Mapping[str, np.ndarray],
@@ -478,7 +473,7 @@ class ParticleTracker:
         fs = [f for f in self.filters if f.likely is not None and f.likely.mean() > 0.5]
         if not fs:
             return
-        boxes = self._boxes(self.filters, [f.centre for f in self.filters], cfg.box_margin)
+        boxes = self._boxes([f.track for f in self.filters], [f.centre for f in self.filters], cfg.box_margin)
         index = {id(f): i for i, f in enumerate(self.filters)}
         for cid, hit in images.items():
             cl = self._cams[cid]
@@ -723,7 +718,7 @@ class ParticleTracker:
         """
         cfg = self.config
         fs = self.filters
-        boxes = self._boxes(fs, [f.centre for f in fs], 0.0)
+        boxes = self._boxes([f.track for f in fs], [f.centre for f in fs], 0.0)
         close_now = set()
         for i in range(len(fs)):
             for j in range(i + 1, len(fs)):
