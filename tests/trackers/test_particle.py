@@ -616,3 +616,14 @@ def test_exit_rule_needs_an_entry_region_and_outward_motion():
         assert tracker._left_through_exit(f) is leaving, (x, vx, vy)
     tr.x, tr.vx = -2.85, -1.0
     assert not ParticleTracker(scene, tracker.foregrounds, ParticleConfig.paper())._left_through_exit(f)
+
+
+def test_tracks_held_after_an_exit_are_forgotten_after_the_hold_even_without_detection():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene, births="none")
+    tracker.init_track(-1.0, 3.0)
+    out = run(tracker, scene, bgs, lambda t: [(-1.0 - 1.0 * t, 3.0)] if t < 1.95 else [], 21)
+    assert not out[-1][2] and len(tracker._leaving) == 1      # ended at the edge, held
+    for k in range(21, 29):                                   # 0.8 s later: past exit_hold_s
+        tracker.step({"cam": bgs["cam"]}, k / FPS)
+    assert tracker._leaving == []

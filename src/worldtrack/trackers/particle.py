@@ -290,6 +290,7 @@ class ParticleTracker:
         if self._last_t is not None and t < self._last_t:
             raise InputError(f"particle tracker: time went backwards ({t} s after {self._last_t} s)")
         dt = 0.0 if self._last_t is None else t - self._last_t
+        self._leaving = [(tr, t0) for tr, t0 in self._leaving if t - t0 <= cfg.exit_hold_s]
         images = self._images(frames)
         self._last_t = t
         if not images:
@@ -332,7 +333,6 @@ class ParticleTracker:
         if cfg.explain != "none" and self.detectors:
             # Objects that just left through an exit may still show at the floor's edge: their
             # last boxes stay explained for ``exit_hold_s``.
-            self._leaving = [(tr, t0) for tr, t0 in self._leaving if t - t0 <= cfg.exit_hold_s]
             left = [tr for tr, _ in self._leaving]
             boxes = self._boxes([f.track for f in self.filters] + left,
                                 [f.centre for f in self.filters] + [np.array([tr.x, tr.y]) for tr in left],
