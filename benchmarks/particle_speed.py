@@ -12,9 +12,9 @@ Measured, with the median over frames after a warm-up:
 * ms per frame for K = 1, 2, 5, 10, 20 objects, and the per-object cost
   ``(time(K) − time(0)) / K``, as a ratio to one ``cv2.createBackgroundSubtractorMOG2().apply`` on a
   640×480 frame measured in the same run (target ≤ 0.2);
-* the likelihood alone for one tracking filter of 500 particles, called as ``step`` calls it
-  (``ParticleTracker.likelihood``) for each configuration, and the bare line-column kernel against
-  its NumPy reference.
+* the likelihood alone for one tracking filter of 500 particles (``ParticleTracker.likelihood``;
+  ``step`` makes one such call for all its tracking filters together, of which this is the case of
+  one filter) for each configuration, and the bare line-column kernel against its NumPy reference.
 
 Configurations: ``paper`` (500 particles, a line column of 20 heights, weights ∝ count, shadows
 count as object) and ``default`` (500 particles, a 3-line column of 20 heights with 2 samples below
@@ -130,9 +130,9 @@ def main() -> int:
             print(f"{name:8s} K={k:2d}: {1000 * t:7.2f} ms/frame, {1000 * po:.3f} ms/object "
                   f"= {po / mog2:.3f} MOG2", file=sys.stderr)
 
-    # The likelihood alone: one tracking filter of 500 particles about one person, as step() calls
-    # ParticleTracker.likelihood (the image it reads, the filter's own box among the track boxes
-    # when explaining away, the particles' heights).
+    # The likelihood alone: one tracking filter of 500 particles about one person, read as step()
+    # reads its tracking filters with ParticleTracker.likelihood (the image it reads, the filter's
+    # own box among the track boxes when explaining away, the particles' heights).
     person = people_at(1, 0)
     img = render(cam, bg, person, rng)
     xy = person + rng.normal(0, 0.2, (500, 2))
@@ -168,7 +168,7 @@ def main() -> int:
     text = (f"One MOG2 apply on {W}x{H}: {1000 * mog2:.2f} ms (the reference). {summary}.\n\n"
             f"Per frame, independent of the objects:\n\n{t1}\n\nTracking (median over {FRAMES - 3} frames; "
             f"per object = (ms/frame(K) − ms/frame(0)) / K):\n\n{t2}\n\nThe likelihood alone (one filter's "
-            f"500 particles, as step calls it; default: 20 heights + 2 below + 2 above, 3 lines):\n\n{t3}\n")
+            f"500 particles, as step reads them; default: 20 heights + 2 below + 2 above, 3 lines):\n\n{t3}\n")
     print(text)
     path = write_result("particle_speed", "Particle tracker (seed 004): speed",
                         "Command: `.venv/bin/python benchmarks/particle_speed.py`\n\n" + text)

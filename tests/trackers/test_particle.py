@@ -23,12 +23,12 @@ from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_e
 from worldtrack.io.sources import Frame
 from worldtrack.scene import scene_from_dict
 from worldtrack.trackers import make_tracker
-from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box
+from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box, image_boxes
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, hit_image,
                                                      occluder_layers, owner_image, point_values_reference,
                                                      hit_labels, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, polygon_distance,
-                                                   stratified_resample, systematic_resample)
+from worldtrack.trackers.particle_sampling import (FloorRegion, _lookup, bimodal_split, polygon_distance,
+                                                   splittable, stratified_resample, systematic_resample)
 
 from _render import texture  # tests/trackers/_render.py
 
@@ -122,6 +122,88 @@ def test_column_kernel_agrees_with_reference(dist, radius, px_scale):
         # Ties between tops (equal scores up to rounding) may resolve either way.
         assert same.mean() > 0.999
         assert seen.sum() > 1000 and counts.max() > 10  # the test exercises real hits
+
+
+def test_kernels_read_each_particle_with_its_own_filters_box():
+    """The particles of three filters in one call (interleaved): each particle reads with its own
+    filter's box and occluder index — the same as one call per filter, and as the references."""
+    cam = make_scene().cameras["cam"]
+    rng = np.random.default_rng(4)
+    hit = (cv2.GaussianBlur(rng.random((H, W)).astype(np.float32), (0, 0), 4) > 0.5).astype(np.uint8)
+    hit[(hit == 1) & (rng.random((H, W)) < 0.2)] = 2
+    F = thresholded_difference(rng.uniform(0, 100, (H, W)).astype(np.float32), 30.0)
+    boxes = [(40, 120, 30, 200), (100, 180, 0, 120), None]
+    owner = owner_image((H, W), boxes)
+    occluders = occluder_layers((H, W), boxes, [2.0, 4.5, 3.0])
+    n = 3000
+    xy = np.column_stack([rng.uniform(-2.5, 2.5, n), rng.uniform(0.5, 6.0, n)])
+    xyz = np.column_stack([xy, rng.uniform(0.0, 2.0, n)])
+    which = rng.integers(0, 3, n)
+    hs = np.concatenate([[-0.2, -0.1], np.arange(20) * 0.1, [2.0, 2.1]])
+    args = dict(on=2.77, off=-1.56, k_min=10, radius=0.1, below=-2.77, n_below=2, n_above=2, owner=owner,
+                tops=rng.uniform(1.4, 2.0, n), top_sigma=0.1, occluders=occluders, margin=0.3)
+    cl = CameraLikelihood(cam)
+    batched = cl.column(hit, xy, hs, box=boxes, me=[0, 1, 2], which=which, **args)
+    one_by_one = [np.zeros_like(a) for a in batched]
+    point, point_one = cl.point(F, xyz, owner, boxes, which), [np.zeros(n), np.zeros(n, dtype=bool)]
+    for f in range(3):
+        sel = which == f
+        part = cl.column(hit, xy[sel], hs, box=boxes[f], me=f, **{**args, "tops": args["tops"][sel]})
+        for a, b in zip(one_by_one, part):
+            a[sel] = b
+        for a, b in zip(point_one, cl.point(F, xyz[sel], owner, boxes[f])):
+            a[sel] = b
+    for a, b in zip(batched, one_by_one):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(point, point_one):
+        np.testing.assert_array_equal(a, b)
+    reference = column_counts_reference(cam, hit, xy, hs, box=boxes, me=[0, 1, 2], which=which, **args)
+    for i in (0, 3):                                                    # counts, seen
+        np.testing.assert_array_equal(batched[i], reference[i])
+    np.testing.assert_allclose(batched[1], reference[1], rtol=0, atol=1e-9)
+    for a, b in zip(point, point_values_reference(cam, F, xyz, owner, boxes, which)):
+        np.testing.assert_array_equal(a, b)
+    # The boxes matter: read with the wrong filters' boxes, many particles score otherwise.
+    wrong = cl.column(hit, xy, hs, box=boxes, me=[0, 1, 2], which=(which + 1) % 3, **args)
+    assert (wrong[1] != batched[1]).sum() > 100
+    assert (cl.point(F, xyz, owner, boxes, (which + 1) % 3)[0] != point[0]).sum() > 100
+
+
+def test_batched_likelihood_equals_one_call_per_filter():
+    """``step`` reads all tracking filters in one likelihood call: the same values as one call per
+    filter with its own box, occluder index and colours (three people who stood apart long enough
+    for each filter to learn its colours; then the third stands behind the second)."""
+    scene = make_scene(entry=False)
+    apart = [(-1.5, 3.0), (0.0, 2.5), (1.5, 3.5)]
+    tracker, bgs = tracker_for(scene, births="none")
+    for i, (x, y) in enumerate(apart, start=1):
+        tracker.init_track(x, y, track_id=i)
+    run(tracker, scene, bgs, lambda t: apart, 6)
+    fs = sorted(tracker.filters, key=lambda f: f.track.id)
+    assert len(fs) == 3 and all(f.colours["cam"].hist is not None for f in fs)
+    people = apart[:2] + [(0.0, 4.5)]
+    fs[2].xyz = fs[2].xyz + [-1.5, 1.0, 0.0]
+    images = tracker._images({"cam": Frame(render(scene.camera("cam"), bgs["cam"], people,
+                                                  np.random.default_rng(7)), 1.0, 10)})
+    centres = [f.xyz[:, :2].mean(axis=0) for f in fs]
+    boxes = tracker._boxes([f.track for f in fs], centres, tracker.config.box_margin)
+    owners = {"cam": owner_image((H, W), boxes["cam"])}
+    occluders = {"cam": occluder_layers((H, W), boxes["cam"], scene.camera("cam").floor_rays(np.array(centres))[1])}
+    xyz, h = np.concatenate([f.xyz for f in fs]), np.concatenate([f.h for f in fs])
+    which = np.repeat(np.arange(3), [len(f.xyz) for f in fs])
+    batched = tracker.likelihood(xyz, images, owners, boxes, h, occluders, [0, 1, 2], [f.colours for f in fs], which)
+    for i, f in enumerate(fs):
+        one = tracker.likelihood(f.xyz, images, owners, {"cam": boxes["cam"][i]}, f.h, occluders, i, f.colours)
+        for a, b in zip(batched, one):
+            np.testing.assert_array_equal(a[which == i], b)
+    u0, u1, v0, v1 = boxes["cam"][2]
+    assert occluders["cam"].depth_for(2)[v0:v1, u0:u1].min() < 4.0      # the third is behind the second
+    # Each filter's own colours and box count: swapping either changes the values.
+    colours = [f.colours for f in fs]
+    for swapped in (tracker.likelihood(xyz, images, owners, boxes, h, occluders, [0, 1, 2], colours[::-1], which),
+                    tracker.likelihood(xyz, images, owners, {"cam": boxes["cam"][::-1]}, h, occluders, [2, 1, 0],
+                                       colours, which)):
+        assert not np.array_equal(swapped[0], batched[0])
 
 
 def test_occluder_layers_keep_the_two_nearest_boxes():
@@ -422,6 +504,49 @@ def test_systematic_resampling_copies_floor_or_ceil_of_n_w():
     np.testing.assert_allclose(s / 100000, w / w.sum(), atol=0.003)
 
 
+def test_resampling_rows_is_resampling_each_row():
+    """F filters' weights as rows: each row resampled on its own, with the same random numbers as
+    one call per row; the lookup is ``searchsorted(side="right")`` (zero weights never drawn)."""
+    rng = np.random.default_rng(1)
+    W = rng.random((6, 40)) ** 4
+    W[:, ::3] = 0.0                                                     # ties in the cumulative weights
+    W[2] = 0.0
+    W[2, 7] = 1.0                                                       # one particle takes all
+    for resample in (systematic_resample, stratified_resample):
+        rows = resample(W, 40, np.random.default_rng(9))
+        r = np.random.default_rng(9)
+        np.testing.assert_array_equal(rows, [resample(w, 40, r) for w in W])
+        assert rows.shape == (6, 40) and np.all(rows[2] == 7) and not np.any(rows % 3 == 0)
+    u = (np.random.default_rng(2).random((6, 1)) + np.arange(40)) / 40
+    c = np.cumsum(W, axis=1) / W.sum(axis=1, keepdims=True)
+    expected = [np.minimum(np.searchsorted(cr, ur, side="right"), 39) for cr, ur in zip(c, u)]
+    np.testing.assert_array_equal(systematic_resample(W, 40, np.random.default_rng(2)), expected)
+    # A point on a cumulative weight falls after it (side="right"), past the last one stays in range.
+    np.testing.assert_array_equal(_lookup(np.ones((1, 4)), np.array([[0.0, 0.25, 0.5, 0.75, 1.0]])),
+                                  [[0, 1, 2, 3, 3]])
+
+
+def test_splittable_is_the_first_test_of_bimodal_split():
+    rng = np.random.default_rng(0)
+    clouds = []
+    for k in range(60):
+        gap = rng.uniform(0.0, 0.8)
+        n1 = int(rng.integers(50, 450))
+        lumps = np.vstack([rng.normal([0, 0], rng.uniform(0.03, 0.15), (n1, 2)),
+                           rng.normal([gap, 0], rng.uniform(0.03, 0.15), (500 - n1, 2))])
+        clouds.append(lumps @ [[0.6, 0.8], [-0.8, 0.6]])                # along a slanted axis
+    wide = splittable(np.array(clouds), 0.35, 0.2)
+    split = np.array([bimodal_split(c, 0.35, 0.5, 0.2) is not None for c in clouds])
+    assert wide.any() and not wide.all() and split.any()
+    assert not np.any(split & ~wide)                                    # never rules out a split
+    # Wide: the std along the principal axis is at least d·sqrt(m(1 − m)).
+    sd = np.sqrt([np.linalg.eigvalsh(np.cov(c.T, bias=True))[-1] for c in clouds])
+    bound = 0.35 * np.sqrt(0.2 * 0.8)
+    clear = np.abs(sd - bound) > 1e-9
+    np.testing.assert_array_equal(wide[clear], (sd >= bound)[clear])
+    assert not splittable(np.zeros((2, 7, 2)), 0.35, 0.2).any()          # too few particles
+
+
 def test_bimodal_split_finds_two_lumps_not_one_long_cloud():
     rng = np.random.default_rng(0)
     two = np.vstack([rng.normal([0, 0], 0.06, (250, 2)), rng.normal([0.6, 0], 0.06, (250, 2))])
@@ -486,6 +611,25 @@ def test_image_box_covers_the_person():
     u0, u1, v0, v1 = image_box(cam, 0.5, 3.0, WIDTH, HEIGHT, 0.0)
     assert u0 <= xs.min() + 1 and u1 >= xs.max() and v0 <= ys.min() + 1 and v1 >= ys.max()
     assert (u1 - u0) < 1.3 * (xs.max() - xs.min() + 1)
+
+
+OVERHEAD = {"id": "cam", "image_size": [W, H], "position": [0, 2.999, 4], "look_at": [0, 3, 0], "hfov_deg": 70}
+
+
+@pytest.mark.parametrize("spec", [CAM, dict(CAM, distortion=[-0.2, 0.05, 0.001, -0.002, 0.0]), OVERHEAD])
+def test_box_kernel_agrees_with_image_boxes(spec):
+    cam = make_scene(cameras=(spec,)).cameras["cam"]
+    rng = np.random.default_rng(6)
+    xy = np.column_stack([rng.uniform(-8, 8, 3000), rng.uniform(-4, 12, 3000)])   # in view, out, behind
+    xy[:2] = cam.centre[:2]                                                      # at the camera's foot
+    widths, heights = rng.uniform(0.3, 0.6, len(xy)), rng.uniform(1.0, 2.0, len(xy))
+    cl = CameraLikelihood(cam)
+    for margin, depth in ((0.0, 0.0), (0.05, 0.0), (0.05, 0.5)):
+        plain = image_boxes(cam, xy, widths, heights, margin, depth)
+        assert cl.boxes(xy, widths, heights, margin, depth) == plain
+        assert 100 < sum(b is None for b in plain) < len(xy) - 100
+        assert sum(b is not None and (b[0] == 0 or b[1] == W) for b in plain) > 50     # clipped at the edges
+        assert plain[0] is not None or spec is not OVERHEAD                            # seen at the foot
 
 
 def test_image_box_with_depth_covers_the_object_nearer_and_farther():
@@ -605,17 +749,18 @@ def test_exit_rule_needs_an_entry_region_and_outward_motion():
     scene = make_scene()
     tracker, _ = tracker_for(scene)
     tracker.init_track(-2.85, 3.0)
-    f = tracker.filters[0]
-    tr = f.track
+    tr = tracker.filters[0].track
     for (x, vx, vy), leaving in (((-2.85, -1.0, 0.0), True),    # in the door, walking off the edge
                                  ((-2.85, 1.0, 0.0), False),    # in the door, walking in
                                  ((-2.85, -0.2, 0.0), False),   # too slow to be walking out
                                  ((-2.5, -1.0, 0.0), False),    # 0.2 s ahead still on the floor
                                  ((2.85, 1.0, 0.0), False)):    # off the right edge, no entry region there
         tr.x, tr.vx, tr.vy = x, vx, vy
-        assert tracker._left_through_exit(f) is leaving, (x, vx, vy)
+        assert tracker._left_through_exit([tr]).tolist() == [leaving], (x, vx, vy)
     tr.x, tr.vx = -2.85, -1.0
-    assert not ParticleTracker(scene, tracker.foregrounds, ParticleConfig.paper())._left_through_exit(f)
+    assert tracker._left_through_exit([tr, tr]).tolist() == [True, True]      # several tracks at once
+    paper = ParticleTracker(scene, tracker.foregrounds, ParticleConfig.paper())
+    assert paper._left_through_exit([tr]).tolist() == [False]
 
 
 def test_tracks_held_after_an_exit_are_forgotten_after_the_hold_even_without_detection():

@@ -14,7 +14,7 @@ from test_particle import CAM, COLOURS, FLOOR, make_scene, render, run, tracker_
 
 from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
                                                      SAT_BINS, ColourModel, colour_bins, colour_bins_reference,
-                                                     column_bins, column_bins_reference)
+                                                     colour_log_ratio, column_bins, column_bins_reference)
 from worldtrack.io.sources import Frame  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.trackers.particle_likelihood import CameraLikelihood  # noqa: E402
@@ -60,6 +60,21 @@ def test_colour_penalty_hits_foreign_colours_only():
     absent = math.log(EPSILON / (1 + EPSILON))
     np.testing.assert_allclose(lr, [0.0, 2 * absent, absent, 0.0])       # own colour: 0, never a reward
     assert np.all(lr <= 0.0)
+
+
+def test_colour_log_ratio_of_several_models_is_each_models():
+    rng = np.random.default_rng(2)
+    models = [ColourModel(), None, ColourModel(), ColourModel()]
+    models[0].learn(rng.integers(0, 6, 50), 1.0)
+    models[2].learn(rng.integers(20, N_BINS, 50), 1.0)                  # models[3]: nothing learnt
+    bins = rng.integers(-1, N_BINS, (400, 6))
+    which = rng.integers(0, 4, 400)
+    batched = colour_log_ratio(models, bins, which)
+    for f, m in enumerate(models):
+        expected = m.log_ratio(bins[which == f]) if m is not None else 0.0
+        np.testing.assert_array_equal(batched[which == f], expected)
+    assert batched[which == 0].min() < 0 and batched[which == 2].min() < 0 and np.all(batched[which == 1] == 0)
+    assert not np.array_equal(colour_log_ratio(models[::-1], bins, which), batched)
 
 
 def test_column_bins_read_the_colour_of_object_pixels_on_the_column():

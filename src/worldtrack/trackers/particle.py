@@ -17,6 +17,11 @@ One particle filter per object, in world coordinates (metres, Z up). Every frame
    own extent: z drawn uniformly below the top each column sees (see below), and in x and y a
    disc of the person's width, ``σ_x² = var(x) + (width/4)²``.
 
+The tracking filters go through these steps together: each holds ``particles`` particles, so their
+arrays stack to (filters, particles, …), one likelihood call per camera reads the particles of all
+of them (each with its own filter's box, occluder index and colours) and one resampling call draws
+every filter's particles from its own weights. The detection filters share one likelihood call too.
+
 New objects are found by **detection filters** (§3.2): particles scattered uniformly over each entry
 region (in a scene without entry regions, over the walkable floor in view). A detection filter is a
 particle filter too and concentrates on what enters; when the share of its *likely* particles
@@ -64,7 +69,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -73,10 +78,11 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
-from worldtrack.trackers.particle_appearance import ColourModel, column_bins
+from worldtrack.trackers.particle_appearance import ColourModel, colour_log_ratio, column_bins
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
-from worldtrack.trackers.particle_sampling import FloorRegion, bimodal_split, polygon_distance, resampler
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, polygon_distance, resampler,
+                                                   splittable)
 
 Box = tuple[int, int, int, int]
 
@@ -262,7 +268,7 @@ class ParticleTracker:
         h, w = self.scene.people.size_of(track_id or 0)
         tr = self.position_map.add(x, y, h, w, mode="tracking", time=t, track_id=track_id)
         f = _Filter(xyz, np.zeros((n, 3)), track=tr, h=self._draw_heights(n, h))
-        self._update_region(f, t)
+        self._update_region([f], t)
         self.filters.append(f)
         return tr
 
@@ -296,34 +302,31 @@ class ParticleTracker:
         if not images:
             return self.tracks
 
-        for f in self.filters:
-            self._predict(f, dt)
-        explain_tracks = cfg.explain == "all"
-        owners = occluders = None
-        if explain_tracks:
-            centres = [f.xyz[:, :2].mean(axis=0) for f in self.filters]
-            boxes = self._boxes([f.track for f in self.filters], centres, cfg.box_margin)
-            owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
-            if cfg.occlusion:
-                occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
-                                                  self._cams[cid].camera.floor_rays(np.reshape(centres, (-1, 2)))[1],
-                                                  self._layers.get(cid))
-                             for cid, img in images.items()}
-                self._layers.update(occluders)
-        for i, f in enumerate(self.filters):
-            f.logpi, f.likely, f.col_h = self.likelihood(
-                f.xyz, images, owners, {cid: boxes[cid][i] for cid in images} if explain_tracks else None, f.h,
-                occluders, i, f.colours)
-        for f in list(self.filters):
-            self._update_tracking(f, t)
+        # The tracking filters, all at once: they hold ``particles`` particles each, so their
+        # arrays stack to (filters, particles, ...) and one likelihood call per camera reads them all.
+        fs = list(self.filters)
+        if fs:
+            self._predict(fs, dt)
+            owners = boxes = occluders = None
+            if cfg.explain == "all" and len(fs) > 1:      # a lone filter has nothing to explain away
+                centres = _mean(_stack(fs, "xyz")[:, :, :2])
+                boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
+                owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
+                if cfg.occlusion:
+                    occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
+                                                      self._cams[cid].camera.floor_rays(centres)[1],
+                                                      self._layers.get(cid))
+                                 for cid, img in images.items()}
+                    self._layers.update(occluders)
+            self._observe(fs, images, owners, boxes, occluders)
+            self._update_tracking(fs, t)
         if cfg.appearance_weight > 0:
             self._learn_colours(images)
 
         # Splits and merges first, so a filter that just split into two objects hides both of them
         # from the detection filters below (otherwise the second object is also "detected").
         if cfg.split:
-            for f in list(self.filters):
-                self._maybe_split(f, t)
+            self._split(t)
         if cfg.merge:
             self._merge()
 
@@ -338,11 +341,12 @@ class ParticleTracker:
                                 [f.centre for f in self.filters] + [np.array([tr.x, tr.y]) for tr in left],
                                 cfg.box_margin, cfg.exclusion_depth)
             owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
-        for d in self.detectors:
-            self._move_detector(d, dt)
-            d.logpi, d.likely, d.col_h = self.likelihood(d.xyz, images, owners if cfg.explain != "none" else None,
-                                                         None, d.h)
-            self._update_detector(d, t)
+        if self.detectors:
+            for d in self.detectors:
+                self._move_detector(d, dt)
+            self._observe(self.detectors, images, owners if cfg.explain != "none" else None)
+            for d in self.detectors:
+                self._update_detector(d, t)
 
         for f in self.filters:
             f.track.age_frames += 1
@@ -377,19 +381,23 @@ class ParticleTracker:
 
     def _boxes(self, tracks: list[Track], centres: list[np.ndarray], margin: float,
                depth: float = 0.0) -> dict[str, list[Box | None]]:
-        """Per camera, each track's object box in the image at ``centres`` (see :func:`image_boxes`)."""
+        """Per camera, each track's object box in the image at ``centres`` (:func:`image_boxes`, by
+        its kernel :meth:`CameraLikelihood.boxes`)."""
         xy = np.array(centres, dtype=float).reshape(-1, 2)
         widths = np.array([tr.width for tr in tracks], dtype=float)
         heights = np.array([tr.height for tr in tracks], dtype=float)
-        return {cid: image_boxes(cl.camera, xy, widths, heights, margin, depth) for cid, cl in self._cams.items()}
+        return {cid: cl.boxes(xy, widths, heights, margin, depth) for cid, cl in self._cams.items()}
 
     def likelihood(self, xyz: np.ndarray, images: Mapping[str, np.ndarray],
                    owners: Mapping[str, np.ndarray] | None = None,
                    boxes: Mapping[str, Box | None] | None = None,
                    h: np.ndarray | None = None, occluders: Mapping[str, object] | None = None,
-                   me: int = -1, colours: Mapping[str, ColourModel] | None = None
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   me: int | Sequence[int] = -1, colours: Mapping[str, ColourModel] | None = None,
+                   which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Log-likelihood of particles, summed over the cameras that see them.
+
+        The particles of one filter, or (``which``) of several filters in one call: the kernels
+        read each particle with its own filter's box, occluder index and colours.
 
         Parameters
         ----------
@@ -407,6 +415,9 @@ class ParticleTracker:
         colours : {camera_id: ColourModel}, optional — the object's learnt colours: each particle
             adds ``appearance_weight`` times the colour log-ratio of its colour column (see
             :mod:`~worldtrack.trackers.particle_appearance`)
+        which : (N,) int, optional — each particle's filter, 0 … F − 1, for the particles of F
+            filters: then ``boxes`` maps each camera to a sequence of F boxes (or None), ``me`` is a
+            sequence of F indices and ``colours`` a sequence of F mappings (or None), one per filter
 
         Returns
         -------
@@ -421,6 +432,12 @@ class ParticleTracker:
         """
         cfg = self.config
         n = len(xyz)
+        if which is None:               # one filter: the case of F = 1
+            which = np.zeros(n, dtype=np.int64)
+            boxes = {cid: [b] for cid, b in boxes.items()} if boxes is not None else None
+            me, colours = [me], [colours]
+        if colours is None:
+            colours = [None] * len(me)
         logpi = np.zeros(n)
         n_seen = np.zeros(n, dtype=np.int32)
         likely = np.ones(n, dtype=bool)
@@ -430,7 +447,7 @@ class ParticleTracker:
             for cid, img in images.items():
                 cl = self._cams[cid]
                 owner = owners.get(cid) if owners is not None else None
-                box = boxes.get(cid) if boxes is not None else None
+                box = boxes.get(cid) if boxes is not None else [None] * len(me)
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz[:, :2], cl)
                     counts, ratio, top, seen = cl.column(img, surface, self._column, self._on, self._off,
@@ -438,7 +455,7 @@ class ParticleTracker:
                                                          self._n_above, owner, box, h, self._top_sigma,
                                                          self._px_scale[cid],
                                                          occluders.get(cid) if occluders is not None else None, me,
-                                                         cfg.occlusion_margin)
+                                                         cfg.occlusion_margin, which)
                     if cfg.weighting == "count":
                         lv = np.log(counts / S)
                         col += np.where(seen, counts * cfg.dz, 0.0)
@@ -446,12 +463,12 @@ class ParticleTracker:
                         lv = ratio
                         col += np.where(seen, self._column[top], 0.0)
                     ok = counts >= cfg.likely_count
-                    model = colours.get(cid) if colours else None
-                    if model is not None and model.hist is not None and cid in self._frames:
-                        lv = lv + cfg.appearance_weight * model.log_ratio(
-                            column_bins(cl, self._frames[cid], img, surface))
+                    if cid in self._frames:
+                        models = [c.get(cid) if c else None for c in colours]
+                        lv = lv + cfg.appearance_weight * self._colour_penalty(cl, self._frames[cid], img, surface,
+                                                                               models, which)
                 else:
-                    values, seen = cl.point(img, xyz, owner, box)
+                    values, seen = cl.point(img, xyz, owner, box, which)
                     lv = np.log(values / F_MAX)
                     ok = values > 0
                 logpi += np.where(seen, lv, 0.0)
@@ -463,6 +480,19 @@ class ParticleTracker:
         logpi = np.where(valid, logpi, -np.inf)
         return logpi, likely & valid, col / np.maximum(n_seen, 1)
 
+    @staticmethod
+    def _colour_penalty(cl: CameraLikelihood, frame: np.ndarray, hit: np.ndarray, surface: np.ndarray,
+                        models: list[ColourModel | None], which: np.ndarray) -> np.ndarray:
+        """(N,) colour log-ratio of each particle's colour column (≤ 0) under its filter's model,
+        0 for the particles of filters that have learnt nothing (their columns are not read)."""
+        learnt = np.array([m is not None and m.hist is not None for m in models], dtype=bool)
+        out = np.zeros(len(surface))
+        if not learnt.any():
+            return out
+        rows = np.flatnonzero(learnt[which])
+        out[rows] = colour_log_ratio(models, column_bins(cl, frame, hit, surface[rows]), which[rows])
+        return out
+
     def _learn_colours(self, images: Mapping[str, np.ndarray]) -> None:
         """Teach each filter the colours on its column, in the cameras where its box overlaps no other's.
 
@@ -470,24 +500,28 @@ class ParticleTracker:
         object samples only; filters with fewer than half their particles likely learn nothing.
         """
         cfg = self.config
-        fs = [f for f in self.filters if f.likely is not None and f.likely.mean() > 0.5]
-        if not fs:
+        fs = self.filters
+        learners = np.array([f.likely is not None and f.likely.mean() > 0.5 for f in fs], dtype=bool)
+        if not learners.any():
             return
-        boxes = self._boxes([f.track for f in self.filters], [f.centre for f in self.filters], cfg.box_margin)
-        index = {id(f): i for i, f in enumerate(self.filters)}
+        centres = np.array([f.centre for f in fs], dtype=float).reshape(-1, 2)
+        widths = np.array([f.track.width for f in fs], dtype=float)
+        boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
         for cid, hit in images.items():
             cl = self._cams[cid]
-            bs = boxes[cid]
-            for f in fs:
-                i = index[id(f)]
-                if bs[i] is None or any(j != i and b is not None and _overlap(bs[i], b) > 0 for j, b in enumerate(bs)):
-                    continue
-                centre = self._near_surface(f.centre[None, :], cl)
-                along, _ = cl.camera.floor_rays(centre)
-                across = np.array([-along[0, 1], along[0, 0]]) * 0.25 * f.track.width
-                xy = np.vstack([centre, centre + across, centre - across])
-                f.colours.setdefault(cid, ColourModel()).learn(
-                    column_bins(cl, self._frames[cid], hit, xy), cfg.appearance_rate)
+            ov = _overlaps(boxes[cid])
+            np.fill_diagonal(ov, 0.0)
+            apart = np.array([b is not None for b in boxes[cid]], dtype=bool) & ~(ov > 0).any(axis=1)
+            idx = np.flatnonzero(learners & apart)
+            if not len(idx):
+                continue
+            centre = self._near_surface(centres[idx], cl)
+            along, _ = cl.camera.floor_rays(centre)
+            across = np.column_stack([-along[:, 1], along[:, 0]]) * (0.25 * widths[idx])[:, None]
+            xy = np.stack([centre, centre + across, centre - across], axis=1).reshape(-1, 2)
+            bins = column_bins(cl, self._frames[cid], hit, xy).reshape(len(idx), -1)
+            for i, b in zip(idx, bins):
+                fs[i].colours.setdefault(cid, ColourModel()).learn(b, cfg.appearance_rate)
 
     def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
         """Where a camera's column stands for particles at ``xy`` (N, 2): ``surface_offset`` m nearer to it."""
@@ -498,33 +532,40 @@ class ParticleTracker:
         return xy - r * along
 
     # ------------------------------------------------------------------ prediction
-    def _predict(self, f: _Filter, dt: float) -> None:
-        """Eqs. 1–2 in real time: ``x_t = x_{t−1} + v·dt + w``, ``w ~ N(0, σ²·dt)``."""
+    def _predict(self, fs: list[_Filter], dt: float) -> None:
+        """Eqs. 1–2 in real time, for tracking filters ``fs`` at once: ``x_t = x_{t−1} + v·dt + w``,
+        ``w ~ N(0, σ²·dt)``; and the random walk of the particles' heights."""
         cfg = self.config
         if dt <= 0:
             return
-        n = len(f.xyz)
-        step = self.rng.standard_normal((n, 3)) * (np.array([cfg.noise_xy, cfg.noise_xy, cfg.noise_z]) * math.sqrt(dt))
+        old = _stack(fs, "xyz")
+        step = self.rng.standard_normal(old.shape) * (np.array([cfg.noise_xy, cfg.noise_xy, cfg.noise_z])
+                                                      * math.sqrt(dt))
         if cfg.velocity == "particle":
-            step += f.v * dt
+            step += _stack(fs, "v") * dt
         elif cfg.velocity == "object":
-            step[:, :2] += f.V * dt
-        old = f.xyz
-        f.xyz = old + step
+            step[..., :2] += np.array([f.V for f in fs])[:, None, :] * dt
+        xyz = old + step
         if cfg.likelihood == "point":
-            f.xyz[:, 2] = _reflect(f.xyz[:, 2], 0.0, cfg.max_height)
+            xyz[..., 2] = _reflect(xyz[..., 2], 0.0, cfg.max_height)
+        h = self._jitter_heights(_stack(fs, "h"), dt)
+        for f, x, hh in zip(fs, xyz, h):
+            f.xyz, f.h = x, hh
         if cfg.velocity == "particle":
             # v_t = (x_t − x_{t−1}) / dt, each particle's velocity for the next frame (eq. 2).
-            f.v = (f.xyz - old) / dt
-            _clip_speed(f.v, cfg.max_speed)
-        self._jitter_heights(f, dt)
+            v = (xyz - old) / dt
+            _clip_speed(v, cfg.max_speed)
+            for f, vv in zip(fs, v):
+                f.v = vv
 
-    def _jitter_heights(self, f: _Filter, dt: float) -> None:
-        """Random walk of the particles' object heights, ``noise_h·√dt``, kept in [min_height, max_height]."""
+    def _jitter_heights(self, h: np.ndarray, dt: float) -> np.ndarray:
+        """Particles' object heights ``h`` (any shape) after a random walk of ``noise_h·√dt``, kept
+        in [min_height, max_height]."""
         cfg = self.config
-        if self._top_sigma > 0 and cfg.noise_h > 0 and dt > 0 and len(f.h):
-            f.h = _reflect(f.h + self.rng.standard_normal(len(f.h)) * (cfg.noise_h * math.sqrt(dt)),
-                           cfg.min_height, cfg.max_height)
+        if self._top_sigma > 0 and cfg.noise_h > 0 and dt > 0 and h.size:
+            return _reflect(h + self.rng.standard_normal(h.shape) * (cfg.noise_h * math.sqrt(dt)),
+                            cfg.min_height, cfg.max_height)
+        return h
 
     def _draw_heights(self, n: int, centre: float | None = None) -> np.ndarray:
         """(n,) object heights ~ N(centre, height_spread²) in [min_height, max_height] (default centre:
@@ -543,7 +584,7 @@ class ParticleTracker:
         keep = self._resample(self._weights(d.logw), n, self.rng)
         d.xyz, d.h = d.xyz[keep], d.h[keep]
         d.xyz[:, :2] += self.rng.standard_normal((n, 2)) * (cfg.detection_noise * math.sqrt(max(dt, 0.0)))
-        self._jitter_heights(d, dt)
+        d.h = self._jitter_heights(d.h, dt)
         fresh = (self.rng.random(n) < cfg.detection_reseed) | ~d.region.contains(d.xyz[:, :2])
         k = int(fresh.sum())
         if k:
@@ -556,86 +597,135 @@ class ParticleTracker:
 
     # ------------------------------------------------------------------ tracking filters
     def _weights(self, logpi: np.ndarray) -> np.ndarray:
-        """Eq. 8 up to its sum (the resampler normalises): ``g ∝ π^κ``; uniform if every π is 0."""
-        m = logpi.max() if len(logpi) else -np.inf
-        if not np.isfinite(m):
-            return np.ones(len(logpi))
-        return np.exp(self.config.likelihood_power * (logpi - m))
+        """Eq. 8 up to its sum (the resampler normalises), along the last axis of ``logpi`` (one row
+        per filter): ``g ∝ π^κ``; uniform in a row whose every π is 0."""
+        if logpi.shape[-1] == 0:
+            return np.ones(logpi.shape)
+        m = logpi.max(axis=-1, keepdims=True)
+        finite = np.isfinite(m)
+        return np.where(finite, np.exp(self.config.likelihood_power * (logpi - np.where(finite, m, 0.0))), 1.0)
+
+    def _resampled(self, parts: dict[str, np.ndarray], weights: np.ndarray, n: int) -> dict[str, np.ndarray]:
+        """The particles of F filters resampled to ``n`` each in proportion to ``weights`` (F, M).
+
+        ``parts`` maps each per-particle field to its (F, M, ...) array; returns them (F, n, ...).
+        With the column likelihood each particle's z is then drawn uniformly below the top its column
+        sees (the column does not depend on z), so that the particles fill the object (the box's z
+        extent)."""
+        idx = self._resample(weights, n, self.rng)
+        flat = (idx + weights.shape[1] * np.arange(len(idx))[:, None]).ravel()
+        out = {name: a.reshape((-1,) + a.shape[2:]).take(flat, axis=0).reshape(idx.shape + a.shape[2:])
+               for name, a in parts.items()}
+        if self.config.likelihood == "column":
+            out["xyz"][..., 2] = self.rng.random(idx.shape) * out["col_h"]
+        return out
 
     def _resample_filter(self, f: _Filter, weights: np.ndarray, n: int) -> None:
-        f.take(self._resample(weights, n, self.rng))
-        if self.config.likelihood == "column":
-            # The column does not depend on z: put each particle's z uniformly below the top its
-            # column sees, so that the particles fill the object (the box's z extent).
-            f.xyz[:, 2] = self.rng.random(n) * f.col_h
+        """:meth:`_resampled` of one filter, in place."""
+        parts = {name: getattr(f, name)[None] for name in PARTICLE_FIELDS if getattr(f, name) is not None}
+        for name, a in self._resampled(parts, weights[None], n).items():
+            setattr(f, name, a[0])
 
-    def _update_tracking(self, f: _Filter, t: float) -> None:
-        """Share of likely particles (end at ≤ β), weights (eq. 8), resampling, object region."""
+    def _observe(self, fs: list[_Filter], images: Mapping[str, np.ndarray],
+                 owners: Mapping[str, np.ndarray] | None = None,
+                 boxes: Mapping[str, list[Box | None]] | None = None,
+                 occluders: Mapping[str, object] | None = None) -> None:
+        """This frame's observation (``logpi, likely, col_h``) of filters ``fs``, in one likelihood call.
+
+        ``boxes`` and ``occluders`` (optional) are of the filters' objects in the order of ``fs``."""
+        sizes = [len(f.xyz) for f in fs]
+        out = self.likelihood(np.concatenate([f.xyz for f in fs]), images, owners, boxes,
+                              np.concatenate([f.h for f in fs]), occluders, np.arange(len(fs)),
+                              [f.colours for f in fs], np.repeat(np.arange(len(fs)), sizes))
+        ends = np.cumsum(sizes).tolist()
+        for name, a in zip(("logpi", "likely", "col_h"), out):
+            for f, start, end in zip(fs, [0] + ends, ends):
+                setattr(f, name, a[start:end])
+
+    def _update_tracking(self, fs: list[_Filter], t: float) -> None:
+        """Share of likely particles (end at ≤ β), weights (eq. 8), resampling and object region of
+        the tracking filters ``fs`` (equal particle counts), at once."""
         cfg = self.config
-        share = float(f.likely.mean())
-        if share <= cfg.beta:
-            if f.low_since is None:
-                f.low_since = t
-            if t - f.low_since >= cfg.end_after_s:
+        parts = {name: _stack(fs, name) for name in PARTICLE_FIELDS if getattr(fs[0], name) is not None}
+        shares = parts["likely"].mean(axis=1).tolist()
+        resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
+        kept = []
+        for i, (f, share) in enumerate(zip(fs, shares)):
+            if share <= cfg.beta:
+                if f.low_since is None:
+                    f.low_since = t
+                if t - f.low_since >= cfg.end_after_s:
+                    self._end(f)
+                    continue
+            else:
+                f.low_since = None
+                f.track.last_seen = t
+            for name, a in resampled.items():
+                setattr(f, name, a[i])
+            f.track.score = share
+            kept.append(f)
+        if not kept:
+            return
+        self._update_region(kept, t)
+        for f, leaving in zip(kept, self._left_through_exit([f.track for f in kept])):
+            if leaving:
+                self._leaving.append((f.track, t))
                 self._end(f)
-                return
-        else:
-            f.low_since = None
-            f.track.last_seen = t
-        self._resample_filter(f, self._weights(f.logpi), cfg.particles)
-        f.track.score = share
-        self._update_region(f, t)
-        if self._left_through_exit(f):
-            self._leaving.append((f.track, t))
-            self._end(f)
 
-    def _update_region(self, f: _Filter, t: float) -> None:
-        """Object region (eqs. 9–10) and the track's fields, from the resampled particles."""
+    def _update_region(self, fs: list[_Filter], t: float) -> None:
+        """Object region (eqs. 9–10) and the track's fields, from the resampled particles, of filters
+        ``fs`` at once (equal particle counts)."""
         cfg = self.config
-        tr = f.track
-        centre = f.xyz.mean(axis=0)
-        sd = f.xyz.std(axis=0)
-        prev, f.centre = f.centre, centre[:2].copy()
+        centre, sd = _mean_sd(_stack(fs, "xyz"))
         if cfg.velocity == "object":
-            if prev is not None and f.t_update is not None and t > f.t_update:
+            V = np.array([f.V for f in fs], dtype=float).reshape(-1, 2)
+            prev = np.array([(np.nan, np.nan) if f.centre is None else f.centre for f in fs], dtype=float)
+            since = np.array([np.nan if f.t_update is None else t - f.t_update for f in fs])
+            moved = np.isfinite(prev[:, 0]) & (since > 0)
+            if moved.any():
                 a = cfg.velocity_smoothing
-                f.V = (1 - a) * f.V + a * (f.centre - prev) / (t - f.t_update)
-                _clip_speed(f.V[None, :], cfg.max_speed)
-            V = f.V
+                V[moved] = (1 - a) * V[moved] + a * (centre[moved, :2] - prev[moved]) / since[moved, None]
+                _clip_speed(V, cfg.max_speed)
         elif cfg.velocity == "particle":
-            V = f.v[:, :2].mean(axis=0)
+            V = _mean(_stack(fs, "v")[..., :2])
         else:
-            V = np.zeros(2)
-        f.t_update = t
-        tr.x, tr.y = float(centre[0]), float(centre[1])
-        tr.vx, tr.vy = float(V[0]), float(V[1])
-        tr.sigma = float(math.sqrt(0.5 * (sd[0] ** 2 + sd[1] ** 2)))
+            V = np.zeros((len(fs), 2))
+        sigma = np.sqrt(0.5 * (sd[:, 0] ** 2 + sd[:, 1] ** 2))
+        heights = None
         if cfg.likelihood == "column" and self._top_sigma > 0:
-            tr.height = float(f.h.mean())
-        elif cfg.likelihood == "column" and f.col_h is not None:
-            tr.height = float(f.col_h.mean())
+            heights = _stack(fs, "h").mean(axis=1)
+        elif cfg.likelihood == "column" and all(f.col_h is not None for f in fs):
+            heights = _stack(fs, "col_h").mean(axis=1)
         if cfg.likelihood == "column" and cfg.weighting == "ratio":
             # The particles are the object's axis on the floor; the object fills a disc of radius
             # width/2 round it (per-axis variance r²/4), as its z fills the height below the top.
-            sd[:2] = np.hypot(sd[:2], 0.25 * tr.width)
-        tr.extra.update(z=float(centre[2]), sx=float(sd[0]), sy=float(sd[1]), sz=float(sd[2]))
+            widths = np.array([f.track.width for f in fs], dtype=float)
+            sd[:, :2] = np.hypot(sd[:, :2], 0.25 * widths[:, None])
+        floor_centre = centre[:, :2].copy()
+        rows = zip(fs, floor_centre, V, centre.tolist(), V.tolist(), sd.tolist(), sigma.tolist(),
+                   heights.tolist() if heights is not None else [None] * len(fs))
+        for f, c, v, (x, y, z), (vx, vy), (sx, sy, sz), s, height in rows:
+            f.centre, f.t_update = c, t
+            if cfg.velocity == "object":
+                f.V = v
+            tr = f.track
+            tr.x, tr.y, tr.vx, tr.vy, tr.sigma = x, y, vx, vy, s
+            if height is not None:
+                tr.height = height
+            tr.extra.update(z=z, sx=sx, sy=sy, sz=sz)
 
-    def _left_through_exit(self, f: _Filter) -> bool:
-        """Whether the filter's object is walking off the floor through an entry region: its centre is
-        in one, it moves at ≥ ``exit_speed`` and the centre ``exit_lookahead_s`` ahead is off the
-        walkable floor. Nobody can be beyond the floor's edge, so what the column still reads there
-        is somebody else (in front of the door on the same line of sight), not the object."""
+    def _left_through_exit(self, tracks: list[Track]) -> np.ndarray:
+        """(F,) bool: whether each track's object is walking off the floor through an entry region: its
+        centre is in one, it moves at ≥ ``exit_speed`` and the centre ``exit_lookahead_s`` ahead is off
+        the walkable floor. Nobody can be beyond the floor's edge, so what the column still reads
+        there is somebody else (in front of the door on the same line of sight), not the object."""
         cfg = self.config
-        if cfg.exit_lookahead_s <= 0 or not self.scene.entry_regions:
-            return False
-        tr = f.track
-        v = np.array([tr.vx, tr.vy])
-        if float(np.hypot(*v)) < cfg.exit_speed:
-            return False
-        here = np.array([[tr.x, tr.y]])
-        if self.scene.entry_region_index(here)[0] < 0:
-            return False
-        return not bool(self._walkable(here + cfg.exit_lookahead_s * v)[0])
+        if cfg.exit_lookahead_s <= 0 or not self.scene.entry_regions or not tracks:
+            return np.zeros(len(tracks), dtype=bool)
+        here = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
+        v = np.array([[tr.vx, tr.vy] for tr in tracks], dtype=float)
+        return ((np.hypot(v[:, 0], v[:, 1]) >= cfg.exit_speed) & (self.scene.entry_region_index(here) >= 0)
+                & ~self._walkable(here + cfg.exit_lookahead_s * v))
 
     # ------------------------------------------------------------------ detection filters
     def _update_detector(self, d: _Filter, t: float) -> None:
@@ -662,7 +752,7 @@ class ParticleTracker:
         tr.height, tr.width = self.scene.people.size_of(tr.id)
         tr.score = score
         f.track = tr
-        self._update_region(f, t)
+        self._update_region([f], t)
         self.filters.append(f)
 
     def _lumps(self, xyz: np.ndarray, idx: np.ndarray, depth: int) -> list[np.ndarray]:
@@ -685,19 +775,29 @@ class ParticleTracker:
         if side is None:
             return None
         h, w = self.scene.people.height, self.scene.people.width
-        a, b = xy[~side].mean(axis=0), xy[side].mean(axis=0)
+        lumps = np.array([xy[~side].mean(axis=0), xy[side].mean(axis=0)])
         for cl in self._cams.values():
-            p = image_box(cl.camera, a[0], a[1], w, h, 0.0)
-            q = image_box(cl.camera, b[0], b[1], w, h, 0.0)
+            p, q = cl.boxes(lumps, w, h, 0.0)
             if p is not None and q is not None and _overlap(p, q) < cfg.merge_overlap:
                 return side
         return None
 
     # ------------------------------------------------------------------ split and merge
-    def _maybe_split(self, f: _Filter, t: float) -> None:
-        """Split a filter whose particles have been two lumps for ``split_frames`` frames."""
+    def _split(self, t: float) -> None:
+        """:meth:`_maybe_split` every tracking filter; the cheap first test of the two-lump check
+        (:func:`~worldtrack.trackers.particle_sampling.splittable`) for all of them at once."""
         cfg = self.config
-        side = self._two_objects(f.xyz[:, :2])
+        fs = list(self.filters)
+        if fs:
+            wide = splittable(_stack(fs, "xyz")[:, :, :2], cfg.split_distance, cfg.split_min_mass)
+            for f, w in zip(fs, wide.tolist()):
+                self._maybe_split(f, t, w)
+
+    def _maybe_split(self, f: _Filter, t: float, wide: bool = True) -> None:
+        """Split a filter whose particles have been two lumps for ``split_frames`` frames (``wide``
+        False: its cloud failed :func:`~worldtrack.trackers.particle_sampling.splittable`, one lump)."""
+        cfg = self.config
+        side = self._two_objects(f.xyz[:, :2]) if wide else None
         f.split_count = f.split_count + 1 if side is not None else 0
         if f.split_count < cfg.split_frames:
             return
@@ -707,7 +807,7 @@ class ParticleTracker:
         f.take(np.flatnonzero(keep))
         for g in (f, new):
             self._resample_filter(g, np.ones(len(g.xyz)), cfg.particles)
-        self._update_region(f, t)
+        self._update_region([f], t)
         self._new_track(new, t, score=f.track.score)
 
     def _merge(self) -> None:
@@ -718,14 +818,18 @@ class ParticleTracker:
         """
         cfg = self.config
         fs = self.filters
+        if len(fs) < 2:
+            self._close = {}
+            return
         boxes = self._boxes([f.track for f in fs], [f.centre for f in fs], 0.0)
+        ov = np.array([_overlaps(b) for b in boxes.values()]).reshape(len(boxes), len(fs), len(fs))
+        both = ~np.isnan(ov)                                  # (camera, i, j): the camera sees both
+        apart = both & ~(ov >= cfg.merge_overlap)
+        close = both.any(axis=0) & ~apart.any(axis=0)
         close_now = set()
-        for i in range(len(fs)):
-            for j in range(i + 1, len(fs)):
-                both = [(b[i], b[j]) for b in boxes.values() if b[i] is not None and b[j] is not None]
-                if both and all(_overlap(p, q) >= cfg.merge_overlap for p, q in both):
-                    a, b = fs[i].track.id, fs[j].track.id
-                    close_now.add((min(a, b), max(a, b)))
+        for i, j in zip(*np.nonzero(np.triu(close, 1))):
+            a, b = fs[i].track.id, fs[j].track.id
+            close_now.add((min(a, b), max(a, b)))
         self._close = {k: self._close.get(k, 0) + 1 for k in close_now}
         by_id = {f.track.id: f for f in fs}
         for (ia, ib), n in list(self._close.items()):
@@ -749,6 +853,10 @@ def image_boxes(camera: Camera, xy: np.ndarray, widths: np.ndarray, heights: np.
     each side of the object across the line of sight, from ``−margin`` to ``height + margin``
     (metres); with ``depth > 0``, of the rectangles at the object and ``depth`` (m) nearer and
     farther along the line of sight together.
+
+    Written plainly with :meth:`Camera.project`; the tracker uses the Numba kernel of the same,
+    :meth:`CameraLikelihood.boxes <worldtrack.trackers.particle_likelihood.CameraLikelihood.boxes>`
+    (~8× faster for a few objects; the tests check that they agree).
     """
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     k = len(xy)
@@ -768,18 +876,13 @@ def image_boxes(camera: Camera, xy: np.ndarray, widths: np.ndarray, heights: np.
     corners[..., 0, 2] = -margin
     corners[..., 1, 2] = top[:, None, None]
     uv = camera.project(corners.reshape(k, -1, 3))
-    ok = np.isfinite(uv).all(axis=2)
-    lo = np.floor(np.where(ok[..., None], uv, np.inf).min(axis=1) + 0.5)
-    hi = np.floor(np.where(ok[..., None], uv, -np.inf).max(axis=1) + 0.5) + 1
-    out: list[Box | None] = []
-    for i in range(k):
-        if not ok[i].any():
-            out.append(None)
-            continue
-        u0, v0 = max(int(lo[i, 0]), 0), max(int(lo[i, 1]), 0)
-        u1, v1 = min(int(hi[i, 0]), camera.width), min(int(hi[i, 1]), camera.height)
-        out.append((u0, u1, v0, v1) if u0 < u1 and v0 < v1 else None)
-    return out
+    ok = np.isfinite(uv).all(axis=2, keepdims=True)
+    # Clipped to the image: a box wholly outside it (or with no corner in front of the camera,
+    # lo = inf, hi = −inf) ends up empty.
+    size = (camera.width, camera.height)
+    lo = np.clip(np.floor(np.where(ok, uv, np.inf).min(axis=1) + 0.5), 0, size).astype(int).tolist()
+    hi = np.clip(np.floor(np.where(ok, uv, -np.inf).max(axis=1) + 0.5) + 1, 0, size).astype(int).tolist()
+    return [(u0, u1, v0, v1) if u0 < u1 and v0 < v1 else None for (u0, v0), (u1, v1) in zip(lo, hi)]
 
 
 def image_box(camera: Camera, x: float, y: float, width: float, height: float, margin: float,
@@ -788,13 +891,38 @@ def image_box(camera: Camera, x: float, y: float, width: float, height: float, m
     return image_boxes(camera, np.array([[x, y]]), np.array([width]), np.array([height]), margin, depth)[0]
 
 
+def _overlaps(boxes: list[Box | None]) -> np.ndarray:
+    """(K, K) intersection of each pair of pixel boxes over the smaller one's area; NaN where either
+    is None."""
+    b = np.array([(np.nan,) * 4 if x is None else x for x in boxes], dtype=float).reshape(-1, 4)
+    w = np.minimum(b[:, None, 1], b[None, :, 1]) - np.maximum(b[:, None, 0], b[None, :, 0])
+    h = np.minimum(b[:, None, 3], b[None, :, 3]) - np.maximum(b[:, None, 2], b[None, :, 2])
+    area = (b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2])
+    with np.errstate(invalid="ignore"):
+        return np.where((w > 0) & (h > 0), w * h, 0.0) / np.minimum(area[:, None], area[None, :])
+
+
 def _overlap(p: Box, q: Box) -> float:
     """Intersection of two pixel boxes over the smaller one's area."""
-    w = min(p[1], q[1]) - max(p[0], q[0])
-    h = min(p[3], q[3]) - max(p[2], q[2])
-    if w <= 0 or h <= 0:
-        return 0.0
-    return w * h / min((p[1] - p[0]) * (p[3] - p[2]), (q[1] - q[0]) * (q[3] - q[2]))
+    return float(_overlaps([p, q])[0, 1])
+
+
+def _stack(fs: list[_Filter], name: str) -> np.ndarray:
+    """(F, N, ...) the per-particle array ``name`` of filters holding N particles each."""
+    return np.stack([getattr(f, name) for f in fs])
+
+
+def _mean(x: np.ndarray) -> np.ndarray:
+    """Mean over the particles of each filter, ``x`` (F, N, C) → (F, C), as a matrix product
+    (NumPy's reduction over the middle axis of an (F, N, 3) array is ~25× slower)."""
+    return np.full(x.shape[1], 1.0 / x.shape[1]) @ x
+
+
+def _mean_sd(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_mean` and the standard deviation over the particles of each filter, two (F, C)."""
+    mean = _mean(x)
+    d = x - mean[:, None, :]
+    return mean, np.sqrt(_mean(d * d))
 
 
 def _background_image(fg: object) -> np.ndarray | None:
@@ -816,8 +944,8 @@ def _reflect(z: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 def _clip_speed(v: np.ndarray, max_speed: float) -> None:
-    """Scale rows of ``v`` (N, ≥ 2) whose floor speed exceeds ``max_speed`` (in place)."""
-    s = np.hypot(v[:, 0], v[:, 1])
+    """Scale the velocities in ``v`` (..., ≥ 2) whose floor speed exceeds ``max_speed`` (in place)."""
+    s = np.hypot(v[..., 0], v[..., 1])
     over = s > max_speed
     if over.any():
         v[over, :2] *= (max_speed / s[over])[:, None]

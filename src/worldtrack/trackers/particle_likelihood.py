@@ -48,6 +48,7 @@ check that they agree exactly.
 from __future__ import annotations
 
 import math
+from typing import Sequence
 
 import cv2
 import numpy as np
@@ -319,10 +320,13 @@ class Occluders(tuple):
         self.filled = []            # the boxes written into the layers (cleared on reuse)
         return self
 
-    def depth_for(self, me: int) -> np.ndarray:
-        """(H, W): the depth of the nearest box over each pixel other than box ``me``'s (inf where none)."""
+    def depth_for(self, me, iv=slice(None), iu=slice(None)) -> np.ndarray:
+        """The depth of the nearest box other than box ``me``'s over pixels ``(iv, iu)`` (inf where none).
+
+        Default: over the whole image, (H, W). ``me`` an int, or an array of box indices that
+        broadcasts against the pixel indices ``iv, iu`` (one per pixel read)."""
         near1, id1, near2 = self
-        return np.where(id1 == me, near2, near1)
+        return np.where(id1[iv, iu] == me, near2[iv, iu], near1[iv, iu])
 
 
 #: No occluders: reading by depth disabled.
@@ -335,55 +339,104 @@ def column_heights(max_height: float, dz: float) -> np.ndarray:
     return np.arange(T + 1, dtype=float) * dz
 
 
+def filter_rows(box, me: int | Sequence[int], which: np.ndarray | None,
+                n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernels' per-filter arguments for ``n`` particles of one or more filters.
+
+    Parameters
+    ----------
+    box : one filter's box ``(u0, u1, v0, v1)`` or None; with ``which``, a sequence of F of them
+        (or None for none)
+    me : int — the filter's index among the occluders' boxes; with ``which``, a sequence of F (or
+        one int for all)
+    which : (n,) int, optional — each particle's filter (0 … F − 1); None: all of one filter
+    n : int
+
+    Returns
+    -------
+    boxes : (F, 4) int64 — :data:`NO_BOX` for None
+    mes : (F,) int64
+    which : (n,) int64
+    """
+    if which is None:
+        box, me, which = [box], [me], np.zeros(n, dtype=np.int64)
+    elif box is None:
+        box = [None] * (len(me) if np.ndim(me) else int(np.max(which, initial=-1)) + 1)
+    boxes = np.array([NO_BOX if b is None else b for b in box], dtype=np.int64).reshape(-1, 4)
+    mes = np.array(np.broadcast_to(np.asarray(me, dtype=np.int64), (len(boxes),)))
+    return boxes, mes, np.ascontiguousarray(which, dtype=np.int64)
+
+
 # ---------------------------------------------------------------------------- Numba kernels
+#
+# The kernels read the intrinsics and distortion once per call, as a tuple of scalars (:func:`_lens`),
+# and the column kernel the rotation's entries too: read from the arrays inside the sample loop they
+# are reloaded at every sample (the compiler cannot tell that the output arrays do not alias them),
+# which cost the column kernel about a quarter of its time.
 
 @njit(cache=True, inline="always")
-def _cam_to_uv(cx, cy, cz, K, dist, has_dist):
-    """Camera-frame point → pixel coordinates (u, v) (no rounding, no image test); NaN behind the camera."""
+def _lens(K, dist):
+    """The intrinsics and distortion as scalars: ``(f_x, skew, c_x, f_y, c_y, k1, k2, p1, p2, k3)``."""
+    return K[0, 0], K[0, 1], K[0, 2], K[1, 1], K[1, 2], dist[0], dist[1], dist[2], dist[3], dist[4]
+
+
+@njit(cache=True, inline="always")
+def _cam_to_uv(cx, cy, cz, lens, has_dist):
+    """Camera-frame point → pixel coordinates (u, v) (no rounding, no image test); NaN behind the camera.
+
+    ``lens`` from :func:`_lens`."""
     if not cz > 1e-9:
         return np.nan, np.nan
     x = cx / cz
     y = cy / cz
     if has_dist:
-        k1, k2, p1, p2, k3 = dist[0], dist[1], dist[2], dist[3], dist[4]
+        k1, k2, p1, p2, k3 = lens[5], lens[6], lens[7], lens[8], lens[9]
         r2 = x * x + y * y
         radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
         xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
         yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
         x, y = xd, yd
-    return K[0, 0] * x + K[0, 1] * y + K[0, 2], K[1, 1] * y + K[1, 2]
+    return lens[0] * x + lens[1] * y + lens[2], lens[3] * y + lens[4]
 
 
 @njit(cache=True, inline="always")
-def _pixel_index(u, v, W, H):
-    """Nearest pixel (iu, iv) of (u, v), or (−1, −1) outside the image (or NaN)."""
-    if not (u >= -0.5 and u < W - 0.5 and v >= -0.5 and v < H - 0.5):
-        return -1, -1
-    return int(math.floor(u + 0.5)), int(math.floor(v + 0.5))
+def _nearest(c, n):
+    """Nearest pixel index of coordinate ``c`` along an image axis of ``n`` pixels, −1 outside (or NaN)."""
+    if not (c >= -0.5 and c < n - 0.5):
+        return -1
+    return int(math.floor(c + 0.5))
 
 
 @njit(cache=True, inline="always")
-def _cam_to_pixel(cx, cy, cz, K, dist, has_dist, W, H):
-    """Camera-frame point → integer pixel (iu, iv), or (−1, −1) if behind the camera or outside the image.
+def _to_pixel(px, py, pz, R, t, lens, has_dist, W, H):
+    """World point → integer pixel (iu, iv), or (−1, −1) if behind the camera or outside the image.
 
-    The arithmetic of :meth:`Camera.project` after ``R·p + t``, then rounding to the nearest pixel centre.
-    """
-    u, v = _cam_to_uv(cx, cy, cz, K, dist, has_dist)
-    return _pixel_index(u, v, W, H)
-
-
-@njit(cache=True, inline="always")
-def _to_pixel(px, py, pz, R, t, K, dist, has_dist, W, H):
-    """World point → integer pixel (iu, iv), or (−1, −1) (see :func:`_cam_to_pixel`)."""
+    The arithmetic of :meth:`Camera.project`, then rounding to the nearest pixel centre."""
     cx = R[0, 0] * px + R[0, 1] * py + R[0, 2] * pz + t[0]
     cy = R[1, 0] * px + R[1, 1] * py + R[1, 2] * pz + t[1]
     cz = R[2, 0] * px + R[2, 1] * py + R[2, 2] * pz + t[2]
-    return _cam_to_pixel(cx, cy, cz, K, dist, has_dist, W, H)
+    u, v = _cam_to_uv(cx, cy, cz, lens, has_dist)
+    iu, iv = _nearest(u, W), _nearest(v, H)
+    if iu < 0 or iv < 0:
+        return -1, -1
+    return iu, iv
+
+
+@njit(cache=True, inline="always")
+def _line_offset(j, d):
+    """Offset (pixels) of a cylinder's line ``j``: 0 the centre, 1 left, 2 right, ``d`` to the side."""
+    return 0.0 if j == 0 else (-d if j == 1 else d)
+
+
+@njit(cache=True, inline="always")
+def _box(boxes, f):
+    """Row ``f`` of ``boxes`` (F, 4) as a tuple ``(u0, u1, v0, v1)``."""
+    return boxes[f, 0], boxes[f, 1], boxes[f, 2], boxes[f, 3]
 
 
 @njit(cache=True, inline="always")
 def _others(owner, box, iu, iv):
-    """True if pixel (iu, iv) lies in the box of an object other than the filter's own."""
+    """True if pixel (iu, iv) lies in the box of an object other than ``box`` (the filter's own)."""
     n = owner[iv, iu]
     if n == 0:
         return False
@@ -403,11 +456,11 @@ def _occluded(near1, id1, near2, me, iu, iv, depth, margin):
 @njit(cache=True)
 def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray,
                   dist: np.ndarray, has_dist: bool, radius: float, hit: np.ndarray,
-                  owner: np.ndarray, box: np.ndarray, near1: np.ndarray, id1: np.ndarray, near2: np.ndarray,
-                  me: int, centre: np.ndarray, margin: float, on: float, off: float, below: float, n_below: int,
-                  n_above: int, k_min: int, tops: np.ndarray, top_sigma: float, px_scale: float, counts: np.ndarray,
-                  ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
-    """Height-column likelihood of every particle for one camera, in place.
+                  owner: np.ndarray, boxes: np.ndarray, which: np.ndarray, near1: np.ndarray, id1: np.ndarray,
+                  near2: np.ndarray, mes: np.ndarray, centre: np.ndarray, margin: float, on: float, off: float,
+                  below: float, n_below: int, n_above: int, k_min: int, tops: np.ndarray, top_sigma: float,
+                  px_scale: float, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
+    """Height-column likelihood of the particles of one or more filters for one camera, in place.
 
     Parameters
     ----------
@@ -419,12 +472,13 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     radius : float, metres — 0: a line of points (the paper); > 0: a thin cylinder (module docstring)
     hit : (H, W) uint8 — 1 object, 0 background, 2 no evidence (:func:`hit_image`, :func:`hit_labels`)
     owner : (H, W) uint8 — number of object boxes over each pixel (:func:`owner_image`)
-    box : (4,) int64 — the filter's own object box ``(u0, u1, v0, v1)``, or :data:`NO_BOX`
+    boxes : (F, 4) int64 — each filter's own object box ``(u0, u1, v0, v1)``, or :data:`NO_BOX`
+    which : (N,) int64 — each particle's filter, a row of ``boxes`` and ``mes``
     near1, id1, near2 : :func:`occluder_layers` of the same boxes, or the empty arrays of
         :data:`NO_OCCLUDERS`. With them, a sample in another object's box whose object is nearer
         to the camera than the particle by more than ``margin`` is *occluded*: no evidence (label 2)
         instead of background
-    me : int — the filter's own index in the boxes of ``near1, id1, near2``
+    mes : (F,) int64 — each filter's own index in the boxes of ``near1, id1, near2``
     centre : (2,) float64, metres — the camera centre's floor position (depths are floor distances)
     margin : float, metres
     on, off, below : float — log-ratio terms for a sample on / off the object, and for a ring sample
@@ -446,12 +500,16 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     S = heights.shape[0]
     last = S - n_above - 1
     k_min = max(k_min, n_below)
-    fx = K[0, 0]
+    lens = _lens(K, dist)
+    fx = lens[0]
+    r02, r12, r22 = R[0, 2], R[1, 2], R[2, 2]
     label = np.zeros(S, dtype=np.uint8)
     us = np.zeros(S)
     vs = np.zeros(S)
     wt = np.ones(S)
     for i in range(xy.shape[0]):
+        box = _box(boxes, which[i])
+        me = mes[which[i]]
         depth = math.hypot(xy[i, 0] - centre[0], xy[i, 1] - centre[1])
         # Camera-frame coordinates of the floor point; the column is linear in z.
         b0 = R[0, 0] * xy[i, 0] + R[0, 1] * xy[i, 1] + t[0]
@@ -460,27 +518,38 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
         s = False
         for k in range(S):
             z = heights[k]
-            cz = b2 + R[2, 2] * z
-            u, v = _cam_to_uv(b0 + R[0, 2] * z, b1 + R[1, 2] * z, cz, K, dist, has_dist)
+            cz = b2 + r22 * z
+            u, v = _cam_to_uv(b0 + r02 * z, b1 + r12 * z, cz, lens, has_dist)
             us[k] = u
             vs[k] = v
             lab = 0
-            # The centre, then (cylinder) the pixels ``radius`` to the left and right at this depth:
-            # object if any reads object, else no evidence if any reads so.
-            d = fx * radius / cz if radius > 0.0 and cz > 1e-9 else 0.0
-            for j in range(3 if d > 0.0 else 1):
-                iu, iv = _pixel_index(u + (0.0 if j == 0 else (-d if j == 1 else d)), v, W, H)
-                if iu >= 0:
-                    s = True
-                    if not _others(owner, box, iu, iv):
+            iv = _nearest(v, H)
+            if iv >= 0:
+                # The centre, then (cylinder) the pixels ``radius`` to the left and right at this
+                # depth: object if any reads object, else no evidence if any reads so — as a pixel
+                # in the box of a nearer object does (looked up last, only if nothing else decides).
+                d = fx * radius / cz if radius > 0.0 else 0.0
+                lines = 3 if d > 0.0 else 1
+                others = 0                                  # bit j: line j is in another's box
+                for j in range(lines):
+                    iu = _nearest(u + _line_offset(j, d), W)
+                    if iu >= 0:
+                        s = True
+                        if _others(owner, box, iu, iv):
+                            others |= 1 << j
+                            continue
                         p = hit[iv, iu]
                         if p == 1:
                             lab = 1
                             break
                         if p == 2:
                             lab = 2
-                    elif _occluded(near1, id1, near2, me, iu, iv, depth, margin):
-                        lab = 2
+                if lab == 0 and others:
+                    for j in range(lines):
+                        if (others >> j) & 1 and _occluded(near1, id1, near2, me, _nearest(u + _line_offset(j, d), W),
+                                                           iv, depth, margin):
+                            lab = 2
+                            break
             label[k] = lab
         if px_scale > 0.0:
             for k in range(S):
@@ -545,7 +614,7 @@ def _sample_length(us, vs, k):
 
 @njit(cache=True)
 def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, dist: np.ndarray,
-                 has_dist: bool, F: np.ndarray, owner: np.ndarray, box: np.ndarray,
+                 has_dist: bool, F: np.ndarray, owner: np.ndarray, boxes: np.ndarray, which: np.ndarray,
                  values: np.ndarray, seen: np.ndarray) -> None:
     """Point likelihood π_i = F(u, v) at each particle's own projection (eq. 7), in place.
 
@@ -553,17 +622,67 @@ def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, d
     ----------
     xyz : (N, 3) float64, metres
     F : (H, W) float32 — background difference with ``F ≤ γ`` set to 0 (:func:`thresholded_difference`)
-    owner, box : as in :func:`column_counts`
+    owner, boxes, which : as in :func:`column_counts`
     values : (N,) float64 — out: F at the particle, 0 outside the image or in another object's box
     seen : (N,) bool — out: the particle projects into the image
     """
     H, W = F.shape
+    lens = _lens(K, dist)
     for i in range(xyz.shape[0]):
-        iu, iv = _to_pixel(xyz[i, 0], xyz[i, 1], xyz[i, 2], R, t, K, dist, has_dist, W, H)
+        iu, iv = _to_pixel(xyz[i, 0], xyz[i, 1], xyz[i, 2], R, t, lens, has_dist, W, H)
         values[i] = 0.0
         seen[i] = iu >= 0
-        if iu >= 0 and not _others(owner, box, iu, iv):
+        if iu >= 0 and not _others(owner, _box(boxes, which[i]), iu, iv):
             values[i] = F[iv, iu]
+
+
+@njit(cache=True)
+def box_pixels(xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: float, depth: float,
+               R: np.ndarray, t: np.ndarray, K: np.ndarray, dist: np.ndarray, has_dist: bool, centre: np.ndarray,
+               floor_direction: np.ndarray, W: int, H: int, out: np.ndarray) -> None:
+    """Pixel boxes of objects standing at ``xy`` (K, 2), in place: the kernel of
+    :func:`~worldtrack.trackers.particle.image_boxes` (see there; tested equal to it).
+
+    Parameters
+    ----------
+    xy : (K, 2) float64, metres; widths, heights : (K,) float64, metres
+    margin, depth : float, metres
+    R, t, K, dist, has_dist : the camera, as in :func:`column_counts`
+    centre : (2,) float64 — the camera's foot point; floor_direction : (2,) float64 — its
+        :attr:`~worldtrack.geometry.camera.Camera.floor_direction`
+    W, H : int — image size
+    out : (K, 4) int64 — out: ``(u0, u1, v0, v1)``, all −1 where the box is empty (out of view)
+    """
+    lens = _lens(K, dist)
+    shifts = (0.0, -depth, depth)
+    for i in range(xy.shape[0]):
+        # The line of sight on the floor (as Camera.floor_rays) and across it.
+        dx, dy = xy[i, 0] - centre[0], xy[i, 1] - centre[1]
+        n = math.hypot(dx, dy)
+        ax, ay = (dx / n, dy / n) if n > 1e-9 else (floor_direction[0], floor_direction[1])
+        hw = 0.5 * widths[i] + margin
+        lo_u, lo_v, hi_u, hi_v = np.inf, np.inf, -np.inf, -np.inf
+        for a in range(3 if depth > 0.0 else 1):
+            for side in (-1.0, 1.0):
+                px = xy[i, 0] + shifts[a] * ax + side * hw * -ay
+                py = xy[i, 1] + shifts[a] * ay + side * hw * ax
+                for pz in (-margin, heights[i] + margin):
+                    u, v = _cam_to_uv(R[0, 0] * px + R[0, 1] * py + R[0, 2] * pz + t[0],
+                                      R[1, 0] * px + R[1, 1] * py + R[1, 2] * pz + t[1],
+                                      R[2, 0] * px + R[2, 1] * py + R[2, 2] * pz + t[2], lens, has_dist)
+                    if math.isfinite(u) and math.isfinite(v):
+                        lo_u, hi_u = min(lo_u, u), max(hi_u, u)
+                        lo_v, hi_v = min(lo_v, v), max(hi_v, v)
+        # Clipped to the image: a box wholly outside it (or with no corner in front of the
+        # camera) ends up empty.
+        u0 = min(max(np.floor(lo_u + 0.5), 0.0), W)
+        v0 = min(max(np.floor(lo_v + 0.5), 0.0), H)
+        u1 = min(max(np.floor(hi_u + 0.5) + 1.0, 0.0), W)
+        v1 = min(max(np.floor(hi_v + 0.5) + 1.0, 0.0), H)
+        if u0 < u1 and v0 < v1:
+            out[i, 0], out[i, 1], out[i, 2], out[i, 3] = int(u0), int(u1), int(v0), int(v1)
+        else:
+            out[i, 0], out[i, 1], out[i, 2], out[i, 3] = -1, -1, -1, -1
 
 
 # ---------------------------------------------------------------------------- NumPy references
@@ -587,12 +706,13 @@ def _pixels(camera: Camera, points: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return iu, iv, inside
 
 
-def _readable(owner: np.ndarray | None, box, iu: np.ndarray, iv: np.ndarray) -> np.ndarray:
-    """False where a pixel lies in another object's box."""
+def _readable(owner: np.ndarray | None, boxes: np.ndarray, iu: np.ndarray, iv: np.ndarray) -> np.ndarray:
+    """False where a pixel lies in another object's box; ``boxes`` (N, 4) is the own box of the
+    particle each row of ``iu, iv`` (N, ...) belongs to."""
     if owner is None:
         return np.ones(iu.shape, dtype=bool)
-    box = NO_BOX if box is None else np.asarray(box)
-    own = (iu >= box[0]) & (iu < box[1]) & (iv >= box[2]) & (iv < box[3])
+    b = boxes.reshape((len(boxes),) + (1,) * (iu.ndim - 1) + (4,))
+    own = (iu >= b[..., 0]) & (iu < b[..., 1]) & (iv >= b[..., 2]) & (iv < b[..., 3])
     return owner[iv, iu].astype(int) <= own
 
 
@@ -601,8 +721,10 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
                             below: float = 0.0, n_below: int = 0, n_above: int = 0,
                             owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
                             top_sigma: float = 0.0, px_scale: float = 0.0, occluders: Occluders | None = None,
-                            me: int = -1, margin: float = 0.0):
+                            me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None):
     """:func:`column_counts` written plainly: every (particle, height) point through :meth:`Camera.project`.
+
+    ``box``, ``me`` and ``which`` as in :meth:`CameraLikelihood.column`.
 
     Returns
     -------
@@ -613,6 +735,8 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
     """
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     n, s = len(xy), len(heights)
+    boxes, mes, which = filter_rows(box, me, which, n)
+    own_box, own_index = boxes[which], mes[which][:, None]
     uv, depth = camera.project(column_points(xy, heights), return_depth=True)
     hits = np.zeros((n, s), dtype=bool)
     unsure = np.zeros((n, s), dtype=bool)
@@ -626,13 +750,13 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         inside = camera.in_image(uo) & np.isfinite(uo).all(axis=-1)
         iu = np.where(inside, np.floor(np.nan_to_num(uo[..., 0]) + 0.5), 0).astype(np.int64)
         iv = np.where(inside, np.floor(np.nan_to_num(uo[..., 1]) + 0.5), 0).astype(np.int64)
-        readable = inside & _readable(owner, box, iu, iv)
+        readable = inside & _readable(owner, own_box, iu, iv)
         hits |= readable & (hit[iv, iu] == 1)
         unsure |= readable & (hit[iv, iu] == 2)
         if occluders is not None and occluders[0].size:
             # In a nearer object's box: occluded, no evidence.
             particle_depth = camera.floor_rays(xy)[1][:, None]
-            unsure |= inside & ~readable & (occluders.depth_for(me)[iv, iu] < particle_depth - margin)
+            unsure |= inside & ~readable & (occluders.depth_for(own_index, iv, iu) < particle_depth - margin)
         seen |= inside.any(axis=1)
     unsure &= ~hits
     if px_scale > 0:
@@ -663,10 +787,12 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
 
 
 def point_values_reference(camera: Camera, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
-                           box=None) -> tuple[np.ndarray, np.ndarray]:
+                           box=None, which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`point_values` written plainly: F at each particle's projection, and ``seen``."""
-    iu, iv, inside = _pixels(camera, np.asarray(xyz, dtype=float).reshape(-1, 3))
-    ok = inside & _readable(owner, box, iu, iv)
+    xyz = np.asarray(xyz, dtype=float).reshape(-1, 3)
+    boxes, _, which = filter_rows(box, -1, which, len(xyz))
+    iu, iv, inside = _pixels(camera, xyz)
+    ok = inside & _readable(owner, boxes[which], iu, iv)
     return np.where(ok, F[iv, iu], 0.0).astype(float), inside
 
 
@@ -689,39 +815,57 @@ class CameraLikelihood:
         self.has_dist = bool(camera.has_distortion)
         self.no_owner = np.zeros((camera.height, camera.width), dtype=np.uint8)
         self.centre = np.ascontiguousarray(camera.centre[:2], dtype=np.float64)
+        self.floor_direction = np.ascontiguousarray(camera.floor_direction, dtype=np.float64)
+
+    def boxes(self, xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: float,
+              depth: float = 0.0) -> list[tuple[int, int, int, int] | None]:
+        """:func:`~worldtrack.trackers.particle.image_boxes` of objects at ``xy`` (K, 2) with
+        ``widths, heights`` (K,) — by the kernel :func:`box_pixels`."""
+        xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+        k = len(xy)
+        out = np.empty((k, 4), dtype=np.int64)
+        box_pixels(xy, np.ascontiguousarray(np.broadcast_to(np.asarray(widths, dtype=np.float64), (k,))),
+                   np.ascontiguousarray(np.broadcast_to(np.asarray(heights, dtype=np.float64), (k,))),
+                   float(margin), float(depth), self.R, self.t, self.K, self.dist, self.has_dist, self.centre,
+                   self.floor_direction, self.camera.width, self.camera.height, out)
+        return [tuple(b) if b[0] >= 0 else None for b in out.tolist()]
 
     def column(self, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
                k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
                owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
-               top_sigma: float = 0.0, px_scale: float = 0.0, occluders: "Occluders | None" = None, me: int = -1,
-               margin: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+               top_sigma: float = 0.0, px_scale: float = 0.0, occluders: "Occluders | None" = None,
+               me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`.
 
-        ``occluders`` (:func:`occluder_layers` of the boxes behind ``owner``) with ``me`` (the
-        filter's index among them) and ``margin`` (m): samples behind a nearer object read as no
-        evidence."""
+        ``box`` is the filter's own box among those behind ``owner``; ``occluders``
+        (:func:`occluder_layers` of those boxes) with ``me`` (the filter's index among them) and
+        ``margin`` (m): samples behind a nearer object read as no evidence. The particles of
+        several filters in one call: ``which`` (N,) int, each particle's filter 0 … F − 1, with
+        ``box`` and ``me`` sequences of F (:func:`filter_rows`)."""
         xy = np.ascontiguousarray(xy, dtype=np.float64)
         n = len(xy)
+        boxes, mes, which = filter_rows(box, me, which, n)
         counts = np.empty(n, dtype=np.int32)
         ratio = np.empty(n, dtype=np.float64)
         top = np.empty(n, dtype=np.int32)
         seen = np.empty(n, dtype=np.bool_)
         column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
-                      self.has_dist, float(radius), hit, self.no_owner if owner is None else owner,
-                      NO_BOX if box is None else np.asarray(box, dtype=np.int64),
-                      *(NO_OCCLUDERS if occluders is None else occluders), int(me), self.centre, float(margin),
+                      self.has_dist, float(radius), hit, self.no_owner if owner is None else owner, boxes, which,
+                      *(NO_OCCLUDERS if occluders is None else occluders), mes, self.centre, float(margin),
                       float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
                       np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
                       float(top_sigma) if tops is not None else 0.0, float(px_scale), counts, ratio, top, seen)
         return counts, ratio, top, seen
 
     def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
-              box=None) -> tuple[np.ndarray, np.ndarray]:
-        """(F values (N,) float64, seen (N,) bool) at the points ``xyz`` (N, 3) — eq. 7."""
+              box=None, which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(F values (N,) float64, seen (N,) bool) at the points ``xyz`` (N, 3) — eq. 7; ``box``
+        and ``which`` as in :meth:`column`."""
         xyz = np.ascontiguousarray(xyz, dtype=np.float64)
+        boxes, _, which = filter_rows(box, -1, which, len(xyz))
         values = np.empty(len(xyz), dtype=np.float64)
         seen = np.empty(len(xyz), dtype=np.bool_)
         point_values(xyz, self.R, self.t, self.K, self.dist, self.has_dist, F,
-                     self.no_owner if owner is None else owner,
-                     NO_BOX if box is None else np.asarray(box, dtype=np.int64), values, seen)
+                     self.no_owner if owner is None else owner, boxes, which, values, seen)
         return values, seen

@@ -6,7 +6,8 @@
 * :class:`FloorRegion` — a floor area rasterised once, for scattering detection particles uniformly
   over it (§3.2) and testing whether they are still inside.
 * :func:`bimodal_split` — is a particle cloud two objects side by side? (the paper's open problem of
-  objects that enter together and then part, §6.)
+  objects that enter together and then part, §6.) :func:`splittable` — its cheap first test, for
+  many clouds at once.
 * :func:`polygon_distance` — how far floor points are from an entry region.
 """
 
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
@@ -34,26 +36,55 @@ def systematic_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -
 
     Parameters
     ----------
-    weights : (M,) float, ≥ 0, not all 0
+    weights : (M,) or (F, M) float, ≥ 0, not all 0 in a row — one row per filter, each resampled
+        on its own (with its own uniform number)
     n : int
     rng : numpy.random.Generator
 
     Returns
     -------
-    (n,) int64, sorted
+    (n,) or (F, n) int64, sorted — indices into each row
     """
-    c = np.cumsum(weights, dtype=float)
-    c /= c[-1]
-    u = (rng.random() + np.arange(n)) / n
-    return np.minimum(np.searchsorted(c, u, side="right"), len(c) - 1)
+    rows = _rows(weights)
+    u = (rng.random((len(rows), 1)) + np.arange(n)) / n
+    return _lookup(rows, u).reshape(np.shape(weights)[:-1] + (n,))
 
 
 def stratified_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
     """As :func:`systematic_resample` with an independent uniform number in each stratum ``[j/n, (j+1)/n)``."""
-    c = np.cumsum(weights, dtype=float)
-    c /= c[-1]
-    u = (rng.random(n) + np.arange(n)) / n
-    return np.minimum(np.searchsorted(c, u, side="right"), len(c) - 1)
+    rows = _rows(weights)
+    u = (rng.random((len(rows), n)) + np.arange(n)) / n
+    return _lookup(rows, u).reshape(np.shape(weights)[:-1] + (n,))
+
+
+def _rows(weights: np.ndarray) -> np.ndarray:
+    """``weights`` (M,) or (F, M) as (F, M) float."""
+    w = np.asarray(weights, dtype=float)
+    return w.reshape(-1, w.shape[-1])
+
+
+def _lookup(weights: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """(F, n) the index in each row of ``weights`` (F, M) where its sorted points ``u`` (F, n) in
+    [0, 1) fall in the normalised cumulative weights: ``searchsorted(c, u, side="right")`` per row,
+    capped at M − 1, found by one linear merge of each row's sorted points and weights (a
+    ``searchsorted`` of all rows at once costs ~5× more)."""
+    c = np.cumsum(weights, axis=1)
+    c /= c[:, -1:]
+    out = np.empty(u.shape, dtype=np.int64)
+    _merge_sorted(c, np.ascontiguousarray(u), out)
+    return out
+
+
+@njit(cache=True)
+def _merge_sorted(c, u, out):
+    """Per row: the number of ``c`` values ≤ each ``u`` value (both ascending), at most M − 1, in place."""
+    m = c.shape[1]
+    for f in range(c.shape[0]):
+        j = 0
+        for k in range(u.shape[1]):
+            while j < m and c[f, j] <= u[f, k]:
+                j += 1
+            out[f, k] = min(j, m - 1)
 
 
 def resampler(name: str) -> Callable[[np.ndarray, int, np.random.Generator], np.ndarray]:
@@ -153,18 +184,13 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
         Which side of the valley each particle is on; ``None`` for a single object.
     """
     xy = np.asarray(xy, dtype=float)
-    n = len(xy)
-    if n < 8:
+    if len(xy) < 8:
         return None
-    c = xy - xy.mean(axis=0)
-    sxx, syy, sxy = float(c[:, 0] @ c[:, 0]) / n, float(c[:, 1] @ c[:, 1]) / n, float(c[:, 0] @ c[:, 1]) / n
-    # Largest eigenvalue of the 2×2 covariance and its eigenvector (the principal axis).
-    half = 0.5 * (sxx - syy)
-    lam = 0.5 * (sxx + syy) + np.hypot(half, sxy)
-    # Two lumps d apart holding m and 1 − m of the particles have a std of at least d·sqrt(m(1 − m))
-    # along the axis joining them: a narrower cloud cannot be split.
-    if np.sqrt(max(lam, 0.0)) < min_separation * np.sqrt(min_mass * (1 - min_mass)):
+    c, (sxx, syy, sxy, lam) = _principal(xy[None])
+    c, sxx, syy, sxy, lam = c[0], float(sxx[0]), float(syy[0]), float(sxy[0]), float(lam[0])
+    if not _wide_enough(lam, min_separation, min_mass):
         return None
+    # The principal axis: the eigenvector of the covariance's largest eigenvalue.
     axis = np.array([sxy, lam - sxx]) if abs(sxy) > 1e-15 else (np.array([1.0, 0.0]) if sxx >= syy
                                                                    else np.array([0.0, 1.0]))
     axis /= np.linalg.norm(axis)
@@ -195,6 +221,42 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
     if min(m, 1 - m) < min_mass:
         return None
     return side
+
+
+def splittable(xy: np.ndarray, min_separation: float, min_mass: float) -> np.ndarray:
+    """Which of F clouds :func:`bimodal_split` could split at all: the cheap test it starts with
+    (at least 8 particles, wide enough along the principal axis), for many clouds at once.
+
+    Parameters
+    ----------
+    xy : (F, N, 2) float, metres
+    min_separation, min_mass : as in :func:`bimodal_split`
+
+    Returns
+    -------
+    (F,) bool — False: :func:`bimodal_split` returns None for that cloud
+    """
+    xy = np.asarray(xy, dtype=float)
+    if xy.shape[1] < 8:
+        return np.zeros(len(xy), dtype=bool)
+    return _wide_enough(_principal(xy)[1][3], min_separation, min_mass)
+
+
+def _principal(xy: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """The clouds ``xy`` (F, N, 2) centred, and per cloud the covariance ``sxx, syy, sxy`` and its
+    largest eigenvalue (the variance along the principal axis), each (F,), m²."""
+    w = np.full(xy.shape[1], 1.0 / xy.shape[1])
+    c = xy - (w @ xy)[:, None, :]
+    cov = c.transpose(0, 2, 1) @ (c * w[:, None])
+    sxx, syy, sxy = cov[:, 0, 0], cov[:, 1, 1], cov[:, 0, 1]
+    return c, (sxx, syy, sxy, 0.5 * (sxx + syy) + np.hypot(0.5 * (sxx - syy), sxy))
+
+
+def _wide_enough(lam, min_separation: float, min_mass: float):
+    """Two lumps d apart holding m and 1 − m of the particles have a std of at least d·sqrt(m(1 − m))
+    along the axis joining them: a cloud of principal variance ``lam`` narrower than that cannot be
+    split."""
+    return np.sqrt(np.maximum(lam, 0.0)) >= min_separation * np.sqrt(min_mass * (1 - min_mass))
 
 
 def polygon_distance(xy: ArrayLike, ring: ArrayLike) -> np.ndarray:
