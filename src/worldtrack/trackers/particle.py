@@ -81,8 +81,8 @@ from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_appearance import ColourModel, colour_log_ratio, column_bins
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, polygon_distance, resampler,
-                                                   splittable)
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, polygon_distance,
+                                                   resampler, splittable)
 
 Box = tuple[int, int, int, int]
 
@@ -309,7 +309,7 @@ class ParticleTracker:
             self._predict(fs, dt)
             owners = boxes = occluders = None
             if cfg.explain == "all" and len(fs) > 1:      # a lone filter has nothing to explain away
-                centres = _mean(_stack(fs, "xyz")[:, :, :2])
+                centres = cloud_mean(_stack(fs, "xyz")[:, :, :2])
                 boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
                 owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
                 if cfg.occlusion:
@@ -687,7 +687,7 @@ class ParticleTracker:
                 V[moved] = (1 - a) * V[moved] + a * (centre[moved, :2] - prev[moved]) / since[moved, None]
                 _clip_speed(V, cfg.max_speed)
         elif cfg.velocity == "particle":
-            V = _mean(_stack(fs, "v")[..., :2])
+            V = cloud_mean(_stack(fs, "v")[..., :2])
         else:
             V = np.zeros((len(fs), 2))
         sigma = np.sqrt(0.5 * (sd[:, 0] ** 2 + sd[:, 1] ** 2))
@@ -912,17 +912,11 @@ def _stack(fs: list[_Filter], name: str) -> np.ndarray:
     return np.stack([getattr(f, name) for f in fs])
 
 
-def _mean(x: np.ndarray) -> np.ndarray:
-    """Mean over the particles of each filter, ``x`` (F, N, C) → (F, C), as a matrix product
-    (NumPy's reduction over the middle axis of an (F, N, 3) array is ~25× slower)."""
-    return np.full(x.shape[1], 1.0 / x.shape[1]) @ x
-
-
 def _mean_sd(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_mean` and the standard deviation over the particles of each filter, two (F, C)."""
-    mean = _mean(x)
+    """:func:`~worldtrack.trackers.particle_sampling.cloud_mean` and the standard deviation over the particles of each filter, two (F, C)."""
+    mean = cloud_mean(x)
     d = x - mean[:, None, :]
-    return mean, np.sqrt(_mean(d * d))
+    return mean, np.sqrt(cloud_mean(d * d))
 
 
 def _background_image(fg: object) -> np.ndarray | None:
