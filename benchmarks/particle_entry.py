@@ -14,13 +14,18 @@ For each tracker configuration and scenario seed this prints, from ``worldtrack.
 * box contains centre: the share of matched frames whose box ``(x, y, z) ± (sx, sy, sz)`` holds the
   true body centre ``(x, y, height / 2)``.
 
+Every scenario seed runs with each tracker seed (``ParticleConfig.seed``, default 0 and 1): the
+tracker's random draws alone move these figures by about as much as many a change does, so the
+table gives each figure's mean over all runs ± its spread over tracker seeds.
+
 Configurations: ``paper-column`` and ``paper-point`` (the method as published:
 ``ParticleConfig.paper`` with ``likelihood="column"`` / ``"point"``) and ``default-column`` /
 ``default-point`` (with worldtrack's extensions).
 
 Usage::
 
-    .venv/bin/python benchmarks/particle_entry.py                  # 3 seeds, 320x240, all configs
+    .venv/bin/python benchmarks/particle_entry.py                  # 3 seeds × 2 tracker seeds, 320x240, all configs
+    .venv/bin/python benchmarks/particle_entry.py --seeds 0 1 2 3 4 5 --tracker-seeds 0 1 2 --configs default-column --jobs 2
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 --configs default-column
     .venv/bin/python benchmarks/particle_entry.py --set gamma=30 --set alpha=0.4
 
@@ -199,9 +204,48 @@ COLUMNS = [("people", "people"), ("tracks_per_person", "tracks/person"), ("one_t
            ("box_pct", "box holds centre %"), ("recall", "recall"), ("mota", "MOTA"), ("idf1", "IDF1")]
 
 
+def summarise(results: list[dict], keys: list[str]) -> dict[str, tuple[float, float]]:
+    """Mean over every run and the spread over tracker seeds, per figure.
+
+    Parameters
+    ----------
+    results : list of dict — one per (scenario seed, tracker seed) run, each with a ``tracker_seed``
+        and the figures ``keys``
+    keys : the figures to summarise
+
+    Returns
+    -------
+    {key: (mean, spread)} — ``mean`` over all runs (NaNs ignored); ``spread`` the standard
+    deviation, over tracker seeds, of the mean over scenario seeds (0 with one tracker seed): how
+    much the figure moves with the tracker's random draws alone, the noise a change must beat
+    """
+    out = {}
+    seeds = sorted({r["tracker_seed"] for r in results})
+    for k in keys:
+        per = [float(np.nanmean([r[k] for r in results if r["tracker_seed"] == s])) for s in seeds]
+        out[k] = (float(np.nanmean([r[k] for r in results])), float(np.std(per, ddof=1)) if len(per) > 1 else 0.0)
+    return out
+
+
+def _pm(mean: float, spread: float, show_spread: bool) -> str:
+    """``mean ± spread`` as table text (3 significant digits)."""
+    m = f"{mean:.3g}" if abs(mean) < 1000 else f"{mean:.0f}"
+    return f"{m} ± {spread:.2g}" if show_spread else m
+
+
+def _task(job: tuple) -> tuple:
+    """One run: (config name, scenario seed, tracker seed) → (score, given-starts figures, s/frame)."""
+    name, seq, options, tracker_seed, single = job
+    cfg = CONFIGS[name](**{**options, "seed": tracker_seed})
+    pred, spf = run(seq, cfg)
+    return score(seq, pred), (given_starts(seq, cfg) if single else None), spf
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="scenario seeds")
+    p.add_argument("--tracker-seeds", type=int, nargs="+", default=[0, 1],
+                   help="tracker random seeds (ParticleConfig.seed); every scenario seed runs with each")
     p.add_argument("--size", default="320x240")
     p.add_argument("--configs", nargs="+", default=list(CONFIGS), choices=list(CONFIGS))
     p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
@@ -209,6 +253,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--scenario", action="append", default=[], metavar="NAME=VALUE",
                    help="override a scenario option (e.g. shadow_strength=0)")
     p.add_argument("--no-single", action="store_true", help="skip the runs with filters started on the truth")
+    p.add_argument("--jobs", type=int, default=1, help="worker processes (timings are then not comparable)")
+    p.add_argument("--json", default=None, metavar="PATH", help="also write every run's figures as JSON")
     p.add_argument("--name", default="particle_entry", help="result file benchmarks/results/NAME.md")
     p.add_argument("--no-write", action="store_true")
     args = p.parse_args(argv)
@@ -223,45 +269,67 @@ def main(argv: list[str] | None = None) -> int:
         print(f"rendered seed {seed}: {len(seqs[-1].images)} frames in {time.perf_counter() - t0:.1f} s",
               file=sys.stderr)
 
-    rows, per_seed, single_rows = [], [], []
+    jobs = [(name, seq, options, ts, not args.no_single)
+            for name in args.configs for ts in args.tracker_seeds for seq in seqs]
+    if args.jobs > 1:
+        from concurrent.futures import ProcessPoolExecutor
+        with ProcessPoolExecutor(args.jobs) as pool:
+            outs = list(pool.map(_task, jobs))
+    else:
+        outs = [_task(j) for j in jobs]
+
+    show = len(args.tracker_seeds) > 1
+    rows, per_seed, single_rows, dump = [], [], [], []
     for name in args.configs:
         results, singles = [], []
-        for seq in seqs:
-            pred, spf = run(seq, CONFIGS[name](**options))
-            r = score(seq, pred)
+        for (n, seq, _, ts, _), (r, g, spf) in zip(jobs, outs):
+            if n != name:
+                continue
+            r = {**r, "tracker_seed": ts, "seed": seq.seed}
             results.append(r)
-            if not args.no_single:
-                singles.append(given_starts(seq, CONFIGS[name](**options)))
-            per_seed.append([name, seq.seed] + [r[k] for k, _ in COLUMNS] + [1000 * spf])
-            print(f"{name:15s} seed {seq.seed}: " + ", ".join(f"{lab} {r[k]:.3g}" for k, lab in COLUMNS),
-                  file=sys.stderr)
-        mean = {k: (int(np.sum([r[k] for r in results])) if k == "people" else float(np.nanmean([r[k] for r in results])))
-                for k, _ in COLUMNS}
-        rows.append([name] + [mean[k] for k, _ in COLUMNS])
+            if g is not None:
+                singles.append({**g, "tracker_seed": ts})
+            dump.append({"config": name, **r, **(g or {}), "ms_per_frame": 1000 * spf})
+            per_seed.append([name, seq.seed, ts] + [r[k] for k, _ in COLUMNS] + [1000 * spf])
+            print(f"{name:15s} seed {seq.seed} tracker seed {ts}: "
+                  + ", ".join(f"{lab} {r[k]:.3g}" for k, lab in COLUMNS), file=sys.stderr)
+        summ = summarise(results, [k for k, _ in COLUMNS if k != "people"])
+        people = int(np.sum([r["people"] for r in results if r["tracker_seed"] == args.tracker_seeds[0]]))
+        rows.append([name, people] + [_pm(*summ[k], show) for k, _ in COLUMNS if k != "people"])
         if singles:
-            single_rows.append([name] + [float(np.nanmean([r[k] for r in singles])) for k, _ in SINGLE_COLUMNS])
-            print(f"{name:15s} given starts: " + ", ".join(f"{lab} {single_rows[-1][i + 1]:.3g}"
+            ss = summarise(singles, [k for k, _ in SINGLE_COLUMNS])
+            single_rows.append([name] + [_pm(*ss[k], show) for k, _ in SINGLE_COLUMNS])
+            print(f"{name:15s} given starts: " + ", ".join(f"{lab} {single_rows[-1][i + 1]}"
                                                              for i, (_, lab) in enumerate(SINGLE_COLUMNS)),
                   file=sys.stderr)
 
     headers = ["config"] + [lab for _, lab in COLUMNS]
     table = markdown_table(headers, rows)
-    seed_table = markdown_table(["config", "seed"] + [lab for _, lab in COLUMNS] + ["ms/frame"], per_seed)
+    seed_table = markdown_table(["config", "seed", "tracker seed"] + [lab for _, lab in COLUMNS] + ["ms/frame"],
+                                per_seed)
     single_table = markdown_table(["config"] + [lab for _, lab in SINGLE_COLUMNS], single_rows) if single_rows else ""
     cmd = "benchmarks/particle_entry.py " + " ".join(argv if argv is not None else sys.argv[1:])
     print(table)
     if single_table:
         print("\nTracking alone: each person's filter started on the true position, no detection:\n")
         print(single_table)
+    if args.json:
+        import json
+        Path(args.json).write_text(json.dumps(dump, indent=1))
     if not args.no_write:
+        spread = (f"Each figure is the mean over all {len(jobs) // len(args.configs)} runs per configuration "
+                  f"(scenario seeds × tracker seeds {', '.join(map(str, args.tracker_seeds))}) ± the standard "
+                  f"deviation over tracker seeds of the mean over scenario seeds (the tracker's own random "
+                  f"noise; a change must beat it)." if show else
+                  f"Means over scenario seeds, tracker seed {args.tracker_seeds[0]}.")
         body = (f"Command: `.venv/bin/python {cmd.strip()}`\n\nScenario `entry`, {w}x{h}, seeds "
                 f"{', '.join(map(str, args.seeds))}{', ' + str(scen) if scen else ''}; overrides "
                 f"{options or 'none'}. Gate {GATE_M} m; ground truth from {int(VIS_EVAL * 100)} % visible. "
-                f"Means over seeds (people: total).\n\n{table}\n\n"
+                f"{spread} People: total over scenario seeds.\n\n{table}\n\n"
                 + (f"Tracking alone: every person's filter started on the true position when the person is "
                    f"first fully in view (no detection, split or merge); errors of the person's own track "
                    f"over the frames the person is ≥ 50 % visible:\n\n{single_table}\n\n" if single_table else "")
-                + f"Per seed:\n\n{seed_table}\n")
+                + f"Per run:\n\n{seed_table}\n")
         path = write_result(args.name, "Particle tracker (seed 004) on the entry scenario", body)
         print(f"wrote {path}", file=sys.stderr)
     return 0
