@@ -145,13 +145,15 @@ def test_new_person_is_found_and_track_ends_after_leaving_the_view():
     assert len({t[0] for a in alive for t in a}) == 1                      # one id throughout
 
 
-def test_measured_height_of_a_rendered_person():
+@pytest.fixture(scope="module")
+def still_tall_person():
+    """A 1.85 m person standing still, head and feet in view: (camera, per frame (labels, xy, region, box, down))."""
     sc = make_scenario("static-grid", size=(320, 240), frames=170, seed=0, camera="cam1", height=1.85)
     cam = sc.scene.cameras["cam1"]
     fg = make_foregrounds(sc.scene, {"cam1": sc.background("cam1")}, "colour", 20)["cam1"]
     tr = EllipsoidTracker(sc.scene, {"cam1": fg})
     cs, (lo, hi) = tr.cams["cam1"], tr.config.height_range_m
-    measured = []
+    views = []
     for b in sc.render():
         g = b.gt[0]
         if not (g["speed"] == 0 and g["head_cam1"] and g["feet_cam1"]):
@@ -162,11 +164,35 @@ def test_measured_height_of_a_rendered_person():
         region = _form_mask(ring[0], box[0], cs.grid, cam.has_distortion)
         u0, u1, v0, v1 = box[0]
         down = cs.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
-        measured.append(measure_height(cam, fg.labels(b.views["cam1"].image), cs.occ, xy[0], region, tuple(box[0]),
-                                       height_range_m=(lo, hi), down=down))
+        views.append((fg.labels(b.views["cam1"].image), xy[0], region, tuple(box[0]), down))
+    return cam, cs, (lo, hi), views
+
+
+def test_measured_height_of_a_rendered_person(still_tall_person):
+    cam, cs, height_range, views = still_tall_person
+    measured = [measure_height(cam, labels, cs.occ, xy, region, box, height_range_m=height_range, down=down)
+                for labels, xy, region, box, down in views]
     ok = [h for h in measured if h is not None]
     assert len(ok) >= 5
     assert abs(np.median(ok) - 1.85) < 0.05
+
+
+def test_height_measured_for_a_track_off_along_the_line_of_sight_only(still_tall_person):
+    # A tall person tracked with a short model sits too deep along the camera's line of sight:
+    # the feet are then 0.6 m from the track, which max_depth_offset_m allows along the ray only.
+    cam, cs, height_range, views = still_tall_person
+    def heights(shift_along: float, shift_across: float, **kw):
+        out = []
+        for labels, xy, region, box, down in views:
+            ray = (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
+            moved = xy + shift_along * ray + shift_across * np.array([-ray[1], ray[0]])
+            out.append(measure_height(cam, labels, cs.occ, moved, region, box, height_range_m=height_range,
+                                      down=down, **kw))
+        return [h for h in out if h is not None]
+    assert heights(0.6, 0.0) == []                                      # the old 0.4 m limit everywhere
+    deep = heights(0.6, 0.0, max_depth_offset_m=1.0)
+    assert len(deep) >= 5 and abs(np.median(deep) - 1.85) < 0.05       # measured from the image alone
+    assert heights(0.0, 0.6, max_depth_offset_m=1.0) == []              # across the ray: somebody else
 
 
 def test_compiled_rounds_equal_the_python_rounds(crossing):

@@ -51,6 +51,8 @@ from worldtrack.trackers.height import head_ray, measure_height, pixel_clear, tr
 _DUMMY_GRID = np.zeros((1, 1, 2), dtype=np.float32)
 #: Pixels a person must show (in all cameras together) to count as seen, or as its own.
 _MIN_OWN_PIXELS = 40
+#: A person's height is measured in a view where others' ellipses cover at most this share of its region.
+_MAX_COVERED_FOR_HEIGHT = 0.3
 
 
 @dataclass(frozen=True)
@@ -100,6 +102,8 @@ class EllipsoidConfig:
         more than this: the measurement's own scatter (~4 cm) would otherwise add depth error
     height_min_px : int — measure only in views where the person is at least this tall, and
         seen at more than 45° from the vertical
+    height_depth_offset_m : float — in one view, the feet found may be this far from the track
+        along the camera's line of sight (0.4 m across it)
     velocity_smoothing : float — weight of the new velocity measurement (0..1)
     max_speed_mps : float — velocities are clipped to this speed (a running person)
     births : {"anywhere", "entry", "none"} — where new people may appear: anywhere in view, only in
@@ -157,6 +161,7 @@ class EllipsoidConfig:
     height_samples: int = 25
     height_deadband_m: float = 0.05
     height_min_px: int = 60
+    height_depth_offset_m: float = 1.0
     velocity_smoothing: float = 0.5
     max_speed_mps: float = 3.0
     births: str = "anywhere"
@@ -755,9 +760,12 @@ class EllipsoidTracker:
     def _update_heights(self, tracks: list[Track]) -> None:
         """Measure the height of people a camera sees whole and alone; use the running median.
 
-        See :mod:`worldtrack.trackers.height`. Only tracked people whose ellipse (with its ring)
-        overlaps nobody else's in that camera are measured; a person keeps its height when never
-        measured (the scene default, the paper's 1.65 m).
+        See :mod:`worldtrack.trackers.height`. In one camera, a tracked person is measured when
+        others' ellipses cover at most 30 % of its region (the tallest plausible person's ellipse
+        with its ring), on the pixels nobody else covers; the feet found may be up to
+        ``height_depth_offset_m`` from the track along the line of sight (a wrong model height
+        puts it there). A person keeps its height when never measured (the scene default, the
+        paper's 1.65 m).
         """
         cfg = self.config
         tracks = [tr for tr in tracks if tr.id in self.position_map]
@@ -783,10 +791,9 @@ class EllipsoidTracker:
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
             _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws)
             cam = cs.camera
-            if triangulate:
-                # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
-                inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws)
-                owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
+            # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
+            inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws)
+            owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
             for k in due:
                 tr = tracks[k]
                 if not valid[k]:
@@ -799,21 +806,24 @@ class EllipsoidTracker:
                 down = cs.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
                 if down is None:
                     continue
+                mine = owner[v0:v1, u0:u1]
                 if triangulate:
-                    mine = owner[v0:v1, u0:u1]
                     ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b), down)
                     if ray is not None:
                         rays.setdefault(tr.id, []).append(ray)
-                overlap = (valid & (box[:, 0] < b[1]) & (box[:, 1] > b[0]) & (box[:, 2] < b[3]) & (box[:, 3] > b[2]))
-                overlap[k] = False
-                if overlap.any():
+                # Clear enough in this view: others' ellipses cover little of the region; their
+                # pixels are left out of it.
+                free = (mine == k) | (mine == -1)
+                if np.count_nonzero(region & ~free) > _MAX_COVERED_FOR_HEIGHT * np.count_nonzero(region):
                     continue
+                region = region & free
                 # One camera alone: only oblique views that show the person large — from above,
                 # height is neither measurable nor needed; small, it is noise.
                 flat = np.hypot(*(xy[k] - cam.centre[:2]))
                 if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height_min_px:
                     continue
-                h = measure_height(cam, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down)
+                h = measure_height(cam, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
+                                   max_depth_offset_m=cfg.height_depth_offset_m)
                 if h is not None:
                     samples_now.setdefault(tr.id, []).append(h)
         for k, tr in enumerate(tracks):

@@ -21,7 +21,8 @@ from worldtrack.geometry.camera import Camera
 
 def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                    region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
-                   height_range_m: tuple[float, float] = (1.2, 2.2), down: np.ndarray | None = None) -> float | None:
+                   height_range_m: tuple[float, float] = (1.2, 2.2), down: np.ndarray | None = None,
+                   max_depth_offset_m: float | None = None) -> float | None:
     """Height (m) of the person whose foreground lies in ``region`` of ``box``, or None.
 
     Parameters
@@ -32,9 +33,14 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     xy : (2,) — the person's current floor position, metres
     region : (v1 − v0, u1 − u0) bool — where this person's pixels may be (its ellipse and ring)
     box : (u0, u1, v0, v1) — the region's place in the image
-    max_offset_m : float — the measured feet must be this close to ``xy``
+    max_offset_m : float — the measured feet must be this close to ``xy`` across the camera's line
+        of sight (and along it, unless ``max_depth_offset_m`` is given)
     height_range_m : (min, max) — plausible heights
     down : (2,), optional — the image's world-down direction there (computed when not given)
+    max_depth_offset_m : float, optional — the limit along the line of sight. A wrong model height
+        puts a track too deep or too near along the ray (a 1.95 m person tracked with a 1.7 m
+        ellipse 10 m away: ~0.5 m), which is what measuring the height corrects; sideways the
+        feet of somebody else are what is found
 
     Returns
     -------
@@ -52,7 +58,16 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     if not pixel_clear(camera, occ, bottom + 2 * down):
         return None  # feet at the border or on an obstacle's edge
     feet = camera.backproject(bottom[None], 0.0)[0]
-    if not np.isfinite(feet).all() or np.hypot(*(feet[:2] - xy)) > max_offset_m:
+    if not np.isfinite(feet).all():
+        return None
+    # The feet's offset from the track, along the camera's line of sight and across it.
+    off = feet[:2] - np.asarray(xy, dtype=float)
+    ray = feet[:2] - camera.centre[:2]
+    ray = ray / max(float(np.hypot(*ray)), 1e-9)
+    along = abs(float(off @ ray))
+    across = abs(float(off[0] * ray[1] - off[1] * ray[0]))
+    depth_limit = max_offset_m if max_depth_offset_m is None else max_depth_offset_m
+    if across > max_offset_m or along > depth_limit:
         return None
     origin, d = camera.rays(top[None])
     d = d[0]
