@@ -1,0 +1,153 @@
+"""Seed 000 on ``crowd`` with 10 people over many scenario seeds: issue 4's MOTA ≥ 0.90 target.
+
+One seed of a 10-person crowd is a handful of encounters; whether the tracker meets the target
+depends on which ones the seed deals (MOTA ranges over ~0.80–0.94 between seeds with the same
+code). So this renders ``crowd`` (2 corner cameras of the 10 × 8 m hall, 640×480, 80 frames at
+10 frames/s) for several seeds, tracks each with the ellipsoid tracker's default preset and colour
+foreground through :func:`worldtrack.experiment.run_scenario` (gate 0.5 m; people less than 20 %
+visible in every camera are neither required nor forbidden), and reports per seed and overall:
+MOTA, IDF1, false positives, misses, ID switches, mean position error — and what the errors are:
+
+* false positives: ``ghost`` (no person within 1 m: a track left on a wall or in a corner),
+  ``duplicate`` (the nearest person is matched to another track), ``displaced`` (the nearest
+  person, 0.5–1 m away, is matched to no track: one error counted twice, with a miss);
+* misses: ``no track`` (no track within 1 m: not started yet, or ended), ``shared`` (the nearest
+  track is matched to somebody else: two people close together under one track), ``displaced``.
+
+Usage::
+
+    .venv/bin/python benchmarks/crowd_seeds.py                    # seeds 0-9, ~2.5 min
+    .venv/bin/python benchmarks/crowd_seeds.py --seeds 0 1 --set rescue_gain=0.1 --quick
+
+Writes ``benchmarks/results/crowd_seeds.md`` (not with ``--quick`` or ``--set``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import markdown_table, render_images, save_result  # noqa: E402
+
+from worldtrack.eval import evaluate_detailed  # noqa: E402
+from worldtrack.experiment import run_scenario  # noqa: E402
+from worldtrack.io.tracks import TrackTable  # noqa: E402
+from worldtrack.synth import make_scenario  # noqa: E402
+
+SIZE = (640, 480)
+FRAMES = 80
+PEOPLE = 10
+GATE_M = 0.5
+NEAR_M = 1.0          # a track farther than this from every person is a ghost
+TARGET_MOTA = 0.90
+CAUSES = ["fp ghost", "fp duplicate", "fp displaced", "miss no track", "miss shared", "miss displaced"]
+
+
+def error_causes(gt: TrackTable, pred: TrackTable, pairs: dict) -> Counter:
+    """Count false positives and misses by cause (see the module notes).
+
+    Parameters
+    ----------
+    gt, pred : scored ground truth and predictions
+    pairs : ``evaluate_detailed(...).pairs`` — matched (frame, gt_id, pred_id) columns
+    """
+    pred_matched = set(zip(pairs["frame"].tolist(), pairs["pred_id"].tolist()))
+    gt_matched = set(zip(pairs["frame"].tolist(), pairs["gt_id"].tolist()))
+    out: Counter = Counter()
+    for frame in np.unique(np.concatenate([gt.frame, pred.frame])):
+        g = gt.frame == frame
+        p = pred.frame == frame
+        gxy = np.column_stack([gt.x[g], gt.y[g]])
+        pxy = np.column_stack([pred.x[p], pred.y[p]])
+        gid, pid = gt.id[g], pred.id[p]
+        # (G, P) distances; with nobody on one side every distance is "far".
+        d = (np.linalg.norm(gxy[:, None] - pxy[None], axis=2) if len(gxy) and len(pxy)
+             else np.full((len(gxy), len(pxy)), np.inf))
+        for j in range(len(pid)):
+            if (frame, pid[j]) in pred_matched:
+                continue
+            i = int(np.argmin(d[:, j])) if len(gid) else -1
+            if i < 0 or d[i, j] > NEAR_M:
+                out["fp ghost"] += 1
+            elif (frame, gid[i]) in gt_matched:
+                out["fp duplicate"] += 1
+            else:
+                out["fp displaced"] += 1
+        for i in range(len(gid)):
+            if (frame, gid[i]) in gt_matched:
+                continue
+            j = int(np.argmin(d[i])) if len(pid) else -1
+            if j < 0 or d[i, j] > NEAR_M:
+                out["miss no track"] += 1
+            elif (frame, pid[j]) in pred_matched:
+                out["miss shared"] += 1
+            else:
+                out["miss displaced"] += 1
+    return out
+
+
+def run_seed(seed: int, frames: int, people: int, options: dict) -> dict:
+    sc = make_scenario("crowd", size=SIZE, frames=frames, seed=seed, people=people)
+    t0 = time.perf_counter()
+    bundles = render_images(sc)
+    render_s = time.perf_counter() - t0
+    r = run_scenario(sc, bundles=bundles, foreground="colour", gate=GATE_M, **options)
+    m = r.metrics
+    causes = error_causes(r.gt, r.pred, evaluate_detailed(r.gt, r.pred, gate=GATE_M).pairs)
+    return {"seed": seed, "mota": m["mota"], "idf1": m["idf1"], "fp": m["num_false_positives"],
+            "miss": m["num_misses"], "switches": m["num_switches"], "error": r.errors.mean_m,
+            "causes": causes, "fps": r.frames / max(r.seconds, 1e-9), "render_s": render_s}
+
+
+def _value(text: str):
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(text.lower(), text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--seeds", type=int, nargs="+", default=list(range(10)))
+    p.add_argument("--frames", type=int, default=FRAMES)
+    p.add_argument("--people", type=int, default=PEOPLE)
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="an EllipsoidConfig option (e.g. rescue_gain=0.1); results are then only printed")
+    p.add_argument("--quick", action="store_true", help="print only, do not write results/crowd_seeds.md")
+    args = p.parse_args(argv)
+    options = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
+    t0 = time.perf_counter()
+    rows, total = [], Counter()
+    for seed in args.seeds:
+        r = run_seed(seed, args.frames, args.people, options)
+        total += r["causes"]
+        rows.append([seed, r["mota"], r["idf1"], r["fp"], r["miss"], r["switches"], r["error"]]
+                    + [r["causes"][c] for c in CAUSES] + [r["fps"]])
+        print(f"seed {seed}: MOTA {r['mota']:.3f} (fp {r['fp']}, miss {r['miss']}, switches {r['switches']}); "
+              f"rendered in {r['render_s']:.0f} s", file=sys.stderr, flush=True)
+    motas = np.array([row[1] for row in rows])
+    headers = (["seed", "MOTA", "IDF1", "false positives", "misses", "ID switches", "mean error m"]
+               + CAUSES + ["frames/s (step)"])
+    summary = (f"MOTA over {len(motas)} seeds: mean **{motas.mean():.3f}**, median {np.median(motas):.3f}, "
+               f"min {motas.min():.3f}, max {motas.max():.3f}; {int((motas >= TARGET_MOTA).sum())} of "
+               f"{len(motas)} seeds ≥ {TARGET_MOTA} (target). Errors by cause, all seeds: "
+               + ", ".join(f"{c} {total[c]}" for c in CAUSES) + ".")
+    text = (f"`crowd`, {args.people} people, 2 cameras, {SIZE[0]}x{SIZE[1]}, {args.frames} frames; ellipsoid "
+            f"default preset{', options ' + str(options) if options else ''}, colour foreground, gate {GATE_M} m.\n\n"
+            f"{markdown_table(headers, rows)}\n\n{summary}\n")
+    print(text)
+    save_result("crowd_seeds", "Ellipsoid tracker (seed 000) on a 10-person crowd over scenario seeds", text,
+                args.quick or bool(options), time.perf_counter() - t0)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
