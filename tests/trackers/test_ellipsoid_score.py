@@ -154,3 +154,26 @@ def test_ellipse_crop_equals_the_conic_mask(lab, cam_id):
         ca, sa = np.cos(angle[k]), np.sin(angle[k])
         ring = ((du * ca + dv * sa) / (axes[k, 0] + 5)) ** 2 + ((dv * ca - du * sa) / (axes[k, 1] + 5)) ** 2 < 1
         assert ring.sum() > full.sum() and ring[v0:v1, u0:u1].sum() == ring.sum()
+
+
+@pytest.mark.parametrize("cam_id", ["cam1", "cam2"])
+def test_owner_crop_equals_the_owner_map_and_the_masks(lab, cam_id):
+    from worldtrack.trackers.ellipsoid_score import owner_crop, owner_map
+    cam = lab.cameras[cam_id]
+    args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
+    xy = np.array([[-1.0, 1.0], [-0.8, 1.2], [-0.5, 2.0]])    # the first two overlap in both views
+    inner, ring, box, valid = ellipse_forms(*args, xy, np.full(3, 1.65), np.full(3, 0.4), 5.0, 0.1)
+    grid = cam.ideal_pixel_grid if cam.has_distortion else np.zeros((1, 1, 2), np.float32)
+    full = owner_map(cam.height, cam.width, inner, box, valid, grid, cam.has_distortion)
+    # The reference itself, from independently drawn silhouettes: who covers each pixel.
+    masks = np.stack([person_mask(cam, p, 1.65, 0.4).astype(bool) for p in xy])
+    expected = np.where(masks.sum(0) > 1, -2, np.where(masks.any(0), masks.argmax(0), -1))
+    assert (full != expected).sum() <= 6                     # float32 grid vs float64 at the edges
+    assert (full == -2).sum() > 20                            # the overlap is there to be found
+    for k in range(3):
+        u0, u1, v0, v1 = box[k]
+        np.testing.assert_array_equal(owner_crop(box[k], inner, box, valid, grid, cam.has_distortion),
+                                      full[v0:v1, u0:u1])
+    window = np.array([box[0, 0], box[1, 1], box[1, 2], box[0, 3]])   # spans parts of both boxes
+    np.testing.assert_array_equal(owner_crop(window, inner, box, valid, grid, cam.has_distortion),
+                                  full[window[2]:window[3], window[0]:window[1]])

@@ -44,7 +44,7 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.ellipsoid_match import OFFSETS, STAY, run_rounds
-from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, owner_map, score_camera,
+from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, owner_crop, score_camera,
                                                  ternary_real, track_support)
 from worldtrack.trackers.height import head_ray, measure_height, pixel_clear, triangulate_height
 
@@ -791,9 +791,7 @@ class EllipsoidTracker:
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
             _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws)
             cam = cs.camera
-            # Who each pixel belongs to (current ellipses): −1 nobody, −2 several people.
             inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws)
-            owner = owner_map(cam.height, cam.width, inner, ibox, ivalid, cs.grid, cam.has_distortion)
             for k in due:
                 tr = tracks[k]
                 if not valid[k]:
@@ -806,7 +804,8 @@ class EllipsoidTracker:
                 down = cs.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
                 if down is None:
                     continue
-                mine = owner[v0:v1, u0:u1]
+                # Who each pixel of the box belongs to (current ellipses): −1 nobody, −2 several people.
+                mine = owner_crop(b, inner, ibox, ivalid, cs.grid, cam.has_distortion)
                 if triangulate:
                     ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b), down)
                     if ray is not None:

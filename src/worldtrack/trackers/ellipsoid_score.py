@@ -629,8 +629,36 @@ def ellipse_crop(form, box, grid, has_dist):
 
 
 @njit(cache=True)
+def owner_crop(window, inner, box, valid, grid, has_dist):
+    """(v1 − v0, u1 − u0) int32: :func:`owner_map` inside ``window`` = (u0, u1, v0, v1) only.
+
+    ``window`` must lie inside the image (a person's box does). Only the people whose boxes meet
+    it are visited, so the cost is that of the window, not of the image.
+    """
+    u0, u1, v0, v1 = window[0], window[1], window[2], window[3]
+    out = np.full((max(0, v1 - v0), max(0, u1 - u0)), -1, dtype=np.int32)
+    for k in range(inner.shape[0]):
+        if not valid[k]:
+            continue
+        for v in range(max(box[k, 2], v0), min(box[k, 3], v1)):
+            for uu in range(max(box[k, 0], u0), min(box[k, 1], u1)):
+                if has_dist:
+                    x = np.float64(grid[v, uu, 0])
+                    y = np.float64(grid[v, uu, 1])
+                else:
+                    x = np.float64(uu)
+                    y = np.float64(v)
+                if _inside(inner[k], x, y):
+                    out[v - v0, uu - u0] = k if out[v - v0, uu - u0] == -1 else -2
+    return out
+
+
+@njit(cache=True)
 def owner_map(height, width, inner, box, valid, grid, has_dist):
-    """(H, W) int32: index of the one person whose ellipse covers each pixel, −1 nobody, −2 several."""
+    """(H, W) int32: index of the one person whose ellipse covers each pixel, −1 nobody, −2 several.
+
+    The whole-image reference for :func:`owner_crop`.
+    """
     out = np.full((height, width), -1, dtype=np.int32)
     for k in range(inner.shape[0]):
         if not valid[k]:
