@@ -19,6 +19,7 @@ import numpy as np
 
 from worldtrack.errors import InputError
 from worldtrack.foreground.kernels import colour_labels, shadow_like
+from worldtrack.foreground.texture import relabel_cloth
 
 
 #: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
@@ -75,10 +76,16 @@ class StaticBackground:
         Darkest shadow, as a fraction of the background brightness.
     shadow_distortion : float
         Largest colour distortion of a shadow, as a fraction of ``‖B‖`` (RGB distance).
+    shadow_texture_ncc : float or None
+        With ``shadows``: a shadow-like pixel over textured background whose grey levels do not
+        correlate with the background's (NCC at most this over a 5-pixel window) is foreground — a
+        dark garment of the floor's colour hides the floor's pattern, a shadow keeps it (see
+        :mod:`worldtrack.foreground.texture`). None: no texture test.
     """
 
     def __init__(self, background: np.ndarray, threshold: float = 30.0, mode: str = "grey", open_px: int = 0,
-                 shadows: bool = False, shadow_min_ratio: float = 0.45, shadow_distortion: float = 0.08):
+                 shadows: bool = False, shadow_min_ratio: float = 0.45, shadow_distortion: float = 0.08,
+                 shadow_texture_ncc: float | None = None):
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise InputError(f"background: expected an (H, W, 3) uint8 colour image, got {background.shape} "
                              f"{background.dtype}")
@@ -93,6 +100,7 @@ class StaticBackground:
         self.shadows = bool(shadows)
         self.shadow_min_ratio = float(shadow_min_ratio)
         self.shadow_distortion = float(shadow_distortion)
+        self.shadow_texture_ncc = None if shadow_texture_ncc is None else float(shadow_texture_ncc)
         bg = background.astype(np.float32)
         self._bg = bg
         self._bg_norm2 = np.ascontiguousarray(np.maximum(np.einsum("hwc,hwc->hw", bg, bg), 1.0), np.float32)
@@ -112,6 +120,7 @@ class StaticBackground:
 
         A shadow-like change may be a cast shadow or a dark, grey garment over a grey floor;
         trackers that can should treat it as no evidence either way rather than as background.
+        With ``shadow_texture_ncc`` the garments that hide a textured floor are told apart (1).
         """
         self._check(image)
         if self.mode == "grey":
@@ -123,6 +132,8 @@ class StaticBackground:
         else:
             out = colour_labels(np.ascontiguousarray(image), self.background, self._bg_norm2, self.threshold,
                                 self.shadows, self.shadow_min_ratio, self.shadow_distortion)
+        if self.shadows and self.shadow_texture_ncc is not None:
+            relabel_cloth(out, image, self.grey, self.shadow_texture_ncc, candidate=UNSURE)
         return _open_foreground(out, self.kernel)
 
     def mask(self, image: np.ndarray) -> np.ndarray:

@@ -50,10 +50,10 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-import cv2
 import numpy as np
 from numba import njit
 
+from worldtrack.foreground.texture import TEXTURE_MIN_SD, TEXTURE_WINDOW, texture_correlation
 from worldtrack.geometry.camera import Camera
 
 #: Largest possible Euclidean RGB distance, ``sqrt(3)·255``: divides F so that point likelihoods of
@@ -77,11 +77,9 @@ def hit_image(difference: np.ndarray, gamma: float) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(difference) > gamma).view(np.uint8)
 
 
-#: Texture test of shadow candidates: window (pixels), least background contrast (grey-level σ) for
-#: the test to apply, and the normalised cross-correlation at or above which the candidate is a
-#: shadow / below which it is object.
-TEXTURE_WINDOW = 5
-TEXTURE_MIN_SD = 4.0
+#: Texture test of shadow candidates (window and least background contrast from
+#: :mod:`worldtrack.foreground.texture`): the normalised cross-correlation at or above which the
+#: candidate is a shadow / below which it is object.
 TEXTURE_NCC = (0.2, 0.5)
 
 
@@ -150,34 +148,6 @@ def _judge_texture(labels: np.ndarray, image: np.ndarray, background: np.ndarray
     sub, c = labels[box], cand[box]
     sub[c] = judged[c]
     return labels
-
-
-def texture_correlation(image: np.ndarray, background: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
-    """Local normalised cross-correlation of the grey levels of ``image`` and ``background``.
-
-    Parameters
-    ----------
-    image, background : (H, W, 3) uint8 BGR
-    window : int — side of the square window (pixels, odd)
-
-    Returns
-    -------
-    ncc : (H, W) float32 in [−1, 1] (0 where either window is flat)
-    background_sd : (H, W) float32 — the background's grey-level σ in the window
-    """
-    a = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY).astype(np.float32)
-    b = cv2.cvtColor(background, cv2.COLOR_BGR2GRAY).astype(np.float32)
-
-    def mean(x: np.ndarray) -> np.ndarray:
-        return cv2.boxFilter(x, -1, (window, window), borderType=cv2.BORDER_REFLECT)
-
-    ma, mb = mean(a), mean(b)
-    va = np.maximum(mean(a * a) - ma * ma, 0.0)
-    vb = np.maximum(mean(b * b) - mb * mb, 0.0)
-    cov = mean(a * b) - ma * mb
-    denom = np.sqrt(va * vb)
-    ncc = np.where(denom > 1e-3, cov / np.maximum(denom, 1e-3), 0.0).astype(np.float32)
-    return ncc, np.sqrt(vb)
 
 
 @njit(cache=True)
