@@ -918,8 +918,7 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     the image — the bottom for an oblique camera, the end nearest the image centre for one that
     looks straight down. They are back-projected to the floor, unless the blob ends there at the
     image border or on an obstacle (a desk hides the feet): then its other end, the top of the
-    head, is back-projected to the default ``height`` — or, when an obstacle hides the feet and
-    the image border cuts the head, the blob's centroid to half that height.
+    head, is back-projected to the default ``height``.
     """
     cam = cs.camera
     down = cs.down_direction(centroid)
@@ -940,19 +939,11 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
     half = max(1.0, 0.4 * (spread.max() - spread.min()))  # most of the blob's width
     beyond = foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across
-    feet_at_border = not pixel_clear(cam, None, beyond).all()
-    feet_on_obstacle = not feet_at_border and (~pixel_clear(cam, cs.occ, beyond)).mean() > 0.5
-    feet_hidden = feet_at_border or feet_on_obstacle
+    feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, cs.occ, beyond)).mean() > 0.5
     if not feet_hidden:
         p = cam.backproject(foot[None], 0.0)[0]
     elif pixel_clear(cam, None, head - 2 * down):  # the head inside the image
         p = cam.backproject(head[None], height)[0]
-    elif feet_on_obstacle:
-        # Feet behind an obstacle, head past the image border: the blob's centre at half height.
-        # Its depth is a guess, which the matching refines where it can; the track is flagged
-        # ``unmeasurable`` where it cannot. (A blob cut by the border at both ends is left alone:
-        # more of the person comes into view.)
-        p = cam.backproject(np.asarray(centroid, float)[None], 0.5 * height)[0]
     else:
         return None
     return p if np.isfinite(p).all() else None
