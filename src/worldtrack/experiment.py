@@ -75,7 +75,8 @@ def visibility(gt: TrackTable) -> np.ndarray:
 
 
 def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
-                      threshold: float | None = None, cameras: list[str] | None = None, **options):
+                      threshold: float | None = None, cameras: list[str] | None = None,
+                      shadow_texture_ncc: float | None = None, **options):
     """A tracker for a synthetic scenario, its foregrounds made from the scenario's background plates.
 
     Parameters
@@ -85,11 +86,14 @@ def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "defaul
     foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
         the colour threshold defaults to the synthetic world's 20
     cameras : the cameras to track with (default: all)
+    shadow_texture_ncc : the foreground's texture test of shadow-like pixels (default off; see
+        :func:`worldtrack.pipeline.make_foregrounds`)
     """
     if threshold is None and foreground == "colour":
         threshold = SYNTHETIC_COLOUR_THRESHOLD
     cams = list(cameras or scenario.camera_ids)
-    foregrounds = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, foreground, threshold)
+    foregrounds = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, foreground, threshold,
+                                   shadow_texture_ncc=shadow_texture_ncc)
     return make_tracker(method, scenario.scene, foregrounds, preset=preset, **options)
 
 
@@ -132,7 +136,8 @@ def predictions_table(rows) -> TrackTable:
 def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
                  threshold: float | None = None, min_visibility: float = 0.2, gate: float = 0.5,
                  score_rows: Callable[[TrackTable], np.ndarray] | None = None, init_from_gt: bool = False,
-                 cameras: list[str] | None = None, bundles=None, **options) -> ExperimentResult:
+                 cameras: list[str] | None = None, bundles=None, shadow_texture_ncc: float | None = None,
+                 **options) -> ExperimentResult:
     """Track a synthetic scenario and score it.
 
     Parameters
@@ -149,11 +154,12 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
         (the paper's static measurements start from a known person)
     cameras : use only these cameras (default: all)
     bundles : already rendered bundles (to render once and track several ways)
+    shadow_texture_ncc : see :func:`synthetic_tracker`
     """
     if bundles is None:
         bundles = scenario.render()
     cams = list(cameras or scenario.camera_ids)
-    tracker = synthetic_tracker(scenario, method, preset, foreground, threshold, cams, **options)
+    tracker = synthetic_tracker(scenario, method, preset, foreground, threshold, cams, shadow_texture_ncc, **options)
     if init_from_gt and bundles:
         for r in bundles[0].gt:
             tracker.init_track(r["x"], r["y"], track_id=int(r["id"]))
