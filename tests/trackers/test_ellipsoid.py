@@ -264,3 +264,25 @@ def test_two_views_that_agree_confirm_a_new_person_at_once():
     one = _two_camera_scene()
     del one.cameras["c2"]
     assert _first_confirmed_frame(one, confirm_views=2) >= 2           # one view alone: no short cut
+
+
+def test_height_is_no_longer_measured_once_the_samples_are_in(monkeypatch):
+    # A person's height does not change: after ``height_samples`` measurements the median is final.
+    # (The measurement itself is stubbed: this is about when it is asked for.)
+    import worldtrack.trackers.ellipsoid as ell
+    calls = []
+    monkeypatch.setattr(ell, "measure_height", lambda *a, **k: calls.append(1) or 1.8)
+    scene = _lab_scene((320, 240))
+    rng = np.random.default_rng(2)
+    bg = _background(scene, rng)
+    tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"),
+                          EllipsoidConfig(births="none", height_samples=4))
+    tr.init_track(-1.0, 1.5, track_id=1)
+    per_frame = []
+    for i in range(30):
+        before = len(calls)
+        tr.step({"cam": Frame(_frame(scene, bg, [(-1.0, 1.5)], rng), i / 10, i)}, i / 10)
+        per_frame.append(len(calls) - before)
+    assert len(tr._heights[1]) == 4                        # measured, and no more than wanted
+    assert sum(per_frame[:5]) >= 4 and sum(per_frame[-15:]) == 0
+    assert tr.position_map[1].height == pytest.approx(1.8)

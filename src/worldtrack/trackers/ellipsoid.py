@@ -776,8 +776,10 @@ class EllipsoidTracker:
         samples_now: dict[int, list[float]] = {}
         rays: dict[int, list] = {}
         # Every frame until a person has 10 measurements (or 20 frames were tried: someone always
-        # in a group rarely gives one), then one frame in five.
+        # in a group rarely gives one), then one frame in five until ``height_samples`` are in:
+        # a person's height does not change, and the median of that many is final.
         due = [k for k, tr in enumerate(tracks) if tr.mode == "tracking"
+               and len(self._heights.get(tr.id, ())) < cfg.height_samples
                and ((len(self._heights.get(tr.id, ())) < 10 and self._height_tries.get(tr.id, 0) < 20)
                     or (self._frame + tr.id) % 5 == 0)]
         if not due:
