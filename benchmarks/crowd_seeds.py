@@ -6,17 +6,15 @@ code). So this renders ``crowd`` (2 corner cameras of the 10 × 8 m hall, 640×4
 10 frames/s) for several seeds, tracks each with the ellipsoid tracker's default preset and colour
 foreground through :func:`worldtrack.experiment.run_scenario` (gate 0.5 m; people less than 20 %
 visible in every camera are neither required nor forbidden), and reports per seed and overall:
-MOTA, IDF1, false positives, misses, ID switches, mean position error — and what the errors are:
-
-* false positives: ``ghost`` (no person within 1 m: a track left on a wall or in a corner),
-  ``duplicate`` (the nearest person is matched to another track), ``displaced`` (the nearest
-  person, 0.5–1 m away, is matched to no track: one error counted twice, with a miss);
-* misses: ``no track`` (no track within 1 m: not started yet, or ended), ``shared`` (the nearest
-  track is matched to somebody else: two people close together under one track), ``displaced``.
+MOTA, IDF1, false positives, misses, ID switches, mean position error — and what the errors are
+(:func:`worldtrack.eval.error_causes`, 1 m): false positives that are ghosts (no person within 1 m:
+a track left on a wall or in a corner), duplicates or displaced; misses with no track near, under a
+track that is somebody else's (two people close together), or displaced.
 
 Usage::
 
-    .venv/bin/python benchmarks/crowd_seeds.py                    # seeds 0-9, ~2.5 min
+    .venv/bin/python benchmarks/crowd_seeds.py                    # seeds 0-9, ~1.5 min
+    .venv/bin/python benchmarks/crowd_seeds.py --quick            # smoke run: 2 seeds, 40 frames
     .venv/bin/python benchmarks/crowd_seeds.py --seeds 0 1 --set rescue_gain=0.1 --quick
     .venv/bin/python benchmarks/crowd_seeds.py --texture-ncc 0     # the foreground's texture test on
 
@@ -36,7 +34,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, render_images, save_result  # noqa: E402
 
-from worldtrack.eval import evaluate_detailed  # noqa: E402
+from worldtrack.eval import CAUSES, error_causes, evaluate_detailed  # noqa: E402
 from worldtrack.experiment import run_scenario  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
@@ -45,52 +43,7 @@ SIZE = (640, 480)
 FRAMES = 80
 PEOPLE = 10
 GATE_M = 0.5
-NEAR_M = 1.0          # a track farther than this from every person is a ghost
 TARGET_MOTA = 0.90
-CAUSES = ["fp ghost", "fp duplicate", "fp displaced", "miss no track", "miss shared", "miss displaced"]
-
-
-def error_causes(gt: TrackTable, pred: TrackTable, pairs: dict) -> Counter:
-    """Count false positives and misses by cause (see the module notes).
-
-    Parameters
-    ----------
-    gt, pred : scored ground truth and predictions
-    pairs : ``evaluate_detailed(...).pairs`` — matched (frame, gt_id, pred_id) columns
-    """
-    pred_matched = set(zip(pairs["frame"].tolist(), pairs["pred_id"].tolist()))
-    gt_matched = set(zip(pairs["frame"].tolist(), pairs["gt_id"].tolist()))
-    out: Counter = Counter()
-    for frame in np.unique(np.concatenate([gt.frame, pred.frame])):
-        g = gt.frame == frame
-        p = pred.frame == frame
-        gxy = np.column_stack([gt.x[g], gt.y[g]])
-        pxy = np.column_stack([pred.x[p], pred.y[p]])
-        gid, pid = gt.id[g], pred.id[p]
-        # (G, P) distances; with nobody on one side every distance is "far".
-        d = (np.linalg.norm(gxy[:, None] - pxy[None], axis=2) if len(gxy) and len(pxy)
-             else np.full((len(gxy), len(pxy)), np.inf))
-        for j in range(len(pid)):
-            if (frame, pid[j]) in pred_matched:
-                continue
-            i = int(np.argmin(d[:, j])) if len(gid) else -1
-            if i < 0 or d[i, j] > NEAR_M:
-                out["fp ghost"] += 1
-            elif (frame, gid[i]) in gt_matched:
-                out["fp duplicate"] += 1
-            else:
-                out["fp displaced"] += 1
-        for i in range(len(gid)):
-            if (frame, gid[i]) in gt_matched:
-                continue
-            j = int(np.argmin(d[i])) if len(pid) else -1
-            if j < 0 or d[i, j] > NEAR_M:
-                out["miss no track"] += 1
-            elif (frame, pid[j]) in pred_matched:
-                out["miss shared"] += 1
-            else:
-                out["miss displaced"] += 1
-    return out
 
 
 def run_seed(seed: int, frames: int, people: int, options: dict, texture_ncc: float | None = None) -> dict:
@@ -100,7 +53,7 @@ def run_seed(seed: int, frames: int, people: int, options: dict, texture_ncc: fl
     render_s = time.perf_counter() - t0
     r = run_scenario(sc, bundles=bundles, foreground="colour", gate=GATE_M, shadow_texture_ncc=texture_ncc, **options)
     m = r.metrics
-    causes = error_causes(r.gt, r.pred, evaluate_detailed(r.gt, r.pred, gate=GATE_M).pairs)
+    causes = error_causes(r.gt, r.pred, evaluate_detailed(r.gt, r.pred, gate=GATE_M).pairs, near=1.0)
     return {"seed": seed, "mota": m["mota"], "idf1": m["idf1"], "fp": m["num_false_positives"],
             "miss": m["num_misses"], "switches": m["num_switches"], "error": r.errors.mean_m,
             "causes": causes, "fps": r.frames / max(r.seconds, 1e-9), "render_s": render_s}
@@ -117,15 +70,20 @@ def _value(text: str):
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--seeds", type=int, nargs="+", default=list(range(10)))
-    p.add_argument("--frames", type=int, default=FRAMES)
+    p.add_argument("--seeds", type=int, nargs="+", default=None, help="default 0-9 (0 1 with --quick)")
+    p.add_argument("--frames", type=int, default=None, help=f"default {FRAMES} (40 with --quick)")
     p.add_argument("--people", type=int, default=PEOPLE)
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an EllipsoidConfig option (e.g. rescue_gain=0.1); results are then only printed")
     p.add_argument("--texture-ncc", type=float, default=None,
                    help="the foreground's texture test of shadow-like pixels (off by default); results are then only printed")
-    p.add_argument("--quick", action="store_true", help="print only, do not write results/crowd_seeds.md")
+    p.add_argument("--quick", action="store_true",
+                   help="a smoke run (2 seeds, 40 frames unless given); prints only, writes no results file")
     args = p.parse_args(argv)
+    if args.seeds is None:
+        args.seeds = [0, 1] if args.quick else list(range(10))
+    if args.frames is None:
+        args.frames = 40 if args.quick else FRAMES
     options = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
     t0 = time.perf_counter()
     rows, total = [], Counter()
@@ -138,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
               f"rendered in {r['render_s']:.0f} s", file=sys.stderr, flush=True)
     motas = np.array([row[1] for row in rows])
     headers = (["seed", "MOTA", "IDF1", "false positives", "misses", "ID switches", "mean error m"]
-               + CAUSES + ["frames/s (step)"])
+               + list(CAUSES) + ["frames/s (step)"])
     summary = (f"MOTA over {len(motas)} seeds: mean **{motas.mean():.3f}**, median {np.median(motas):.3f}, "
                f"min {motas.min():.3f}, max {motas.max():.3f}; {int((motas >= TARGET_MOTA).sum())} of "
                f"{len(motas)} seeds ≥ {TARGET_MOTA} (target). Errors by cause, all seeds: "

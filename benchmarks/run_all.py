@@ -1,13 +1,14 @@
 """Run every benchmark of issue 5 in turn and print their tables (``make bench``).
 
 Question: all of them at once — seed 000's tables on the synthetic world (``paper_kato``), the three
-trackers on the same frames (``compare_methods``), where a frame's time goes (``speed``) and the
-trackers on real footage (``real_data``). Each runs as its own process (so one's memory and
+trackers on the same frames (``compare_methods``), the 10-person crowd over 10 seeds
+(``crowd_seeds``, issue 4's MOTA target), where a frame's time goes (``speed``) and the trackers on
+real footage (``real_data``). Each runs as its own process (so one's memory and
 compiled kernels do not affect another's timing), one after the other, and writes
 ``benchmarks/results/<name>.md``; their tables go to stdout, progress to stderr.
 
 The budget is 15 minutes on a 2-core machine; the sizes and frame counts of each script are
-chosen for it (see their docstrings); the whole run takes about 6 minutes. ``--quick`` runs every
+chosen for it (see their docstrings); the whole run takes about 8 minutes. ``--quick`` runs every
 script's smoke test (about 1.5 minutes) and writes no result files. The older single-question scripts (``render_speed``,
 ``particle_speed``, ``particle_entry``) are not part of this run; run them by hand.
 
@@ -24,7 +25,7 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-SCRIPTS = ("paper_kato", "compare_methods", "speed", "real_data")
+SCRIPTS = ("paper_kato", "compare_methods", "crowd_seeds", "speed", "real_data")
 BUDGET_S = 15 * 60
 
 
