@@ -808,13 +808,13 @@ class EllipsoidTracker:
                     continue
                 # Who each pixel of the box belongs to (current ellipses): −1 nobody, −2 several people.
                 mine = owner_crop(b, inner, ibox, ivalid, cs.grid, cam.has_distortion)
+                free = (mine == k) | (mine == -1)
                 if triangulate:
-                    ray = head_ray(cam, labels, cs.occ, region & ((mine == k) | (mine == -1)), tuple(b), down)
+                    ray = head_ray(cam, labels, cs.occ, region & free, tuple(b), down)
                     if ray is not None:
                         rays.setdefault(tr.id, []).append(ray)
                 # Clear enough in this view: others' ellipses cover little of the region; their
                 # pixels are left out of it.
-                free = (mine == k) | (mine == -1)
                 if np.count_nonzero(region & ~free) > _MAX_COVERED_FOR_HEIGHT * np.count_nonzero(region):
                     continue
                 region = region & free
