@@ -165,7 +165,7 @@ def test_owner_crop_equals_the_owner_map_and_the_masks(lab, cam_id):
     inner, ring, box, valid = ellipse_forms(*args, xy, np.full(3, 1.65), np.full(3, 0.4), 5.0, 0.1)
     grid = cam.ideal_pixel_grid if cam.has_distortion else np.zeros((1, 1, 2), np.float32)
     full = owner_map(cam.height, cam.width, inner, box, valid, grid, cam.has_distortion)
-    # The reference itself, from independently drawn silhouettes: who covers each pixel.
+    # The reference, from independently drawn silhouettes: who covers each pixel.
     masks = np.stack([person_mask(cam, p, 1.65, 0.4).astype(bool) for p in xy])
     expected = np.where(masks.sum(0) > 1, -2, np.where(masks.any(0), masks.argmax(0), -1))
     assert (full != expected).sum() <= 6                     # float32 grid vs float64 at the edges

@@ -630,10 +630,17 @@ def ellipse_crop(form, box, grid, has_dist):
 
 @njit(cache=True)
 def owner_crop(window, inner, box, valid, grid, has_dist):
-    """(v1 − v0, u1 − u0) int32: :func:`owner_map` inside ``window`` = (u0, u1, v0, v1) only.
+    """Who covers each pixel of ``window`` = (u0, u1, v0, v1): (v1 − v0, u1 − u0) int32, the
+    index of the one person whose ellipse covers the pixel, −1 nobody, −2 several.
 
     ``window`` must lie inside the image (a person's box does). Only the people whose boxes meet
     it are visited, so the cost is that of the window, not of the image.
+
+    Parameters
+    ----------
+    window : (4,) int64
+    inner, box, valid : the people's ellipse forms (N, 5), boxes (N, 4) and validity (N,)
+    grid : (H, W, 2) float32 — ideal coordinates of each pixel (used when ``has_dist``)
     """
     u0, u1, v0, v1 = window[0], window[1], window[2], window[3]
     out = np.full((max(0, v1 - v0), max(0, u1 - u0)), -1, dtype=np.int32)
@@ -653,24 +660,8 @@ def owner_crop(window, inner, box, valid, grid, has_dist):
     return out
 
 
-@njit(cache=True)
-def owner_map(height, width, inner, box, valid, grid, has_dist):
-    """(H, W) int32: index of the one person whose ellipse covers each pixel, −1 nobody, −2 several.
-
-    The whole-image reference for :func:`owner_crop`.
-    """
-    out = np.full((height, width), -1, dtype=np.int32)
-    for k in range(inner.shape[0]):
-        if not valid[k]:
-            continue
-        for v in range(max(box[k, 2], 0), min(box[k, 3], height)):
-            for uu in range(max(box[k, 0], 0), min(box[k, 1], width)):
-                if has_dist:
-                    x = np.float64(grid[v, uu, 0])
-                    y = np.float64(grid[v, uu, 1])
-                else:
-                    x = np.float64(uu)
-                    y = np.float64(v)
-                if _inside(inner[k], x, y):
-                    out[v, uu] = k if out[v, uu] == -1 else -2
-    return out
+def owner_map(height: int, width: int, inner: np.ndarray, box: np.ndarray, valid: np.ndarray, grid: np.ndarray,
+              has_dist: bool) -> np.ndarray:
+    """(H, W) int32: index of the one person whose ellipse covers each pixel, −1 nobody, −2 several
+    (:func:`owner_crop` over the whole image)."""
+    return owner_crop(np.array([0, width, 0, height], dtype=np.int64), inner, box, valid, grid, has_dist)
