@@ -36,7 +36,6 @@ from common import markdown_table, render_images, save_result  # noqa: E402
 
 from worldtrack.eval import CAUSES, error_causes, evaluate_detailed  # noqa: E402
 from worldtrack.experiment import run_scenario  # noqa: E402
-from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 
 SIZE = (640, 480)
