@@ -455,7 +455,8 @@ class ParticleTracker:
                                                          self._n_above, owner, box, h, self._top_sigma,
                                                          self._px_scale[cid],
                                                          occluders.get(cid) if occluders is not None else None, me,
-                                                         cfg.occlusion_margin, which)
+                                                         cfg.occlusion_margin, which,
+                                                         cfg.out_of_view == "unknown")
                     if cfg.weighting == "count":
                         lv = np.log(counts / S)
                         col += np.where(seen, counts * cfg.dz, 0.0)

@@ -36,8 +36,12 @@ cover each pixel (:func:`owner_image`) — and the box of the filter's own objec
 other object's box reads as background. A filter then cannot take over its neighbour's pixels, and a
 detection filter sees only what no track explains.
 
-A sample that projects outside the image, or lies behind the camera, reads background and does not
-make the camera "see" the particle. Pixels are read at the nearest pixel centre (pixel centres at
+A sample that projects outside the image, or lies behind the camera, does not make the camera "see"
+the particle, and it reads background (the paper: the image is all the evidence there is) or, with
+``outside_unknown``, no evidence: it adds ``off`` or nothing to ``ratio``, and is never counted in
+``counts``. (With a cylinder a sample is outside only if none of its three pixels is in the image.)
+A person standing with the feet below the image's bottom edge otherwise loses ``off`` for every
+sample out of view, and the filter drifts away from the camera, to where the whole column is in view. Pixels are read at the nearest pixel centre (pixel centres at
 integer coordinates, the image covering ``−0.5 ≤ u < W − 0.5``, as :class:`Camera` defines).
 
 Each kernel (:func:`column_counts`, :func:`point_values`) has a plain NumPy reference built on
@@ -429,7 +433,8 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                   owner: np.ndarray, boxes: np.ndarray, which: np.ndarray, near1: np.ndarray, id1: np.ndarray,
                   near2: np.ndarray, mes: np.ndarray, centre: np.ndarray, margin: float, on: float, off: float,
                   below: float, n_below: int, n_above: int, k_min: int, tops: np.ndarray, top_sigma: float,
-                  px_scale: float, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray, seen: np.ndarray) -> None:
+                  px_scale: float, outside_unknown: bool, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray,
+                  seen: np.ndarray) -> None:
     """Height-column likelihood of the particles of one or more filters for one camera, in place.
 
     Parameters
@@ -461,7 +466,10 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
         sample's terms are weighted by the image length it stands for times ``px_scale``, so that a
         column counts *pixels* of evidence and a far column, short in the image, does not gain
         from packing more samples into the same pixels
-    counts : (N,) int32 — out: samples ``k·dz``, k = 0 … T, on ``F > γ`` (labels 1 and 2: π_i, eq. 11)
+    outside_unknown : bool — a sample out of the image (none of its pixels in it) or behind the
+        camera adds nothing to ``ratio`` (no evidence) instead of ``off`` (background, the paper)
+    counts : (N,) int32 — out: samples ``k·dz``, k = 0 … T, on ``F > γ`` (labels 1 and 2: π_i, eq. 11);
+        a sample out of the image is never counted
     ratio : (N,) float64 — out: the best log-likelihood ratio
     top : (N,) int32 — out: the index into ``heights`` of the best top
     seen : (N,) bool — out: at least one sample projects into the image
@@ -492,7 +500,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
             u, v = _cam_to_uv(b0 + r02 * z, b1 + r12 * z, cz, lens, has_dist)
             us[k] = u
             vs[k] = v
-            lab = 0
+            lab = 3                                         # out of the image until a pixel is read
             iv = _nearest(v, H)
             if iv >= 0:
                 # The centre, then (cylinder) the pixels ``radius`` to the left and right at this
@@ -505,6 +513,8 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                     iu = _nearest(u + _line_offset(j, d), W)
                     if iu >= 0:
                         s = True
+                        if lab == 3:
+                            lab = 0
                         if _others(owner, box, iu, iv):
                             others |= 1 << j
                             continue
@@ -530,7 +540,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                 base += below * wt[k]
         c = 0
         for k in range(n_below, last + 1):
-            if label[k] != 0:
+            if label[k] == 1 or label[k] == 2:
                 c += 1
         # Ring above the top: the weight of the ``n_above`` samples above index k that read object.
         ring = 0.0
@@ -544,7 +554,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
             lab = label[k]
             if lab == 1:
                 run += on * wt[k]
-            elif lab == 0:
+            elif lab == 0 or (lab == 3 and not outside_unknown):
                 run += off * wt[k]
             if k >= k_min:
                 if k > k_min and n_above > 0:
@@ -691,10 +701,11 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
                             below: float = 0.0, n_below: int = 0, n_above: int = 0,
                             owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
                             top_sigma: float = 0.0, px_scale: float = 0.0, occluders: Occluders | None = None,
-                            me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None):
+                            me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None,
+                            outside_unknown: bool = False):
     """:func:`column_counts` written plainly: every (particle, height) point through :meth:`Camera.project`.
 
-    ``box``, ``me`` and ``which`` as in :meth:`CameraLikelihood.column`.
+    ``box``, ``me``, ``which`` and ``outside_unknown`` as in :meth:`CameraLikelihood.column`.
 
     Returns
     -------
@@ -711,6 +722,7 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
     hits = np.zeros((n, s), dtype=bool)
     unsure = np.zeros((n, s), dtype=bool)
     seen = np.zeros(n, dtype=bool)
+    in_view = np.zeros((n, s), dtype=bool)               # some pixel of the sample is in the image
     offsets = [0.0] if radius <= 0 else [0.0, -1.0, 1.0]
     with np.errstate(divide="ignore", invalid="ignore"):
         d = np.where(depth > 1e-9, camera.K[0, 0] * radius / depth, 0.0)
@@ -728,7 +740,10 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
             particle_depth = camera.floor_rays(xy)[1][:, None]
             unsure |= inside & ~readable & (occluders.depth_for(own_index, iv, iu) < particle_depth - margin)
         seen |= inside.any(axis=1)
+        in_view |= inside
     unsure &= ~hits
+    if outside_unknown:
+        unsure |= ~in_view
     if px_scale > 0:
         # Each sample stands for half the image distance between its neighbours (one at the ends).
         lo = np.maximum(np.arange(s) - 1, 0)
@@ -752,7 +767,7 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         run = run - 0.5 * ((z - np.asarray(tops, dtype=float)[:, None]) / top_sigma) ** 2
     run[:, :max(k_min, n_below)] = -np.inf
     top = np.argmax(run, axis=1)
-    counts = (hits | unsure)[:, n_below:last].sum(axis=1).astype(np.int64)
+    counts = ((hits | unsure) & in_view)[:, n_below:last].sum(axis=1).astype(np.int64)
     return counts, run[np.arange(n), top], top, seen
 
 
@@ -804,15 +819,16 @@ class CameraLikelihood:
                k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
                owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
                top_sigma: float = 0.0, px_scale: float = 0.0, occluders: "Occluders | None" = None,
-               me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+               me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None,
+               outside_unknown: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`.
 
         ``box`` is the filter's own box among those behind ``owner``; ``occluders``
         (:func:`occluder_layers` of those boxes) with ``me`` (the filter's index among them) and
         ``margin`` (m): samples behind a nearer object read as no evidence. The particles of
         several filters in one call: ``which`` (N,) int, each particle's filter 0 … F − 1, with
-        ``box`` and ``me`` sequences of F (:func:`filter_rows`)."""
+        ``box`` and ``me`` sequences of F (:func:`filter_rows`). ``outside_unknown``: samples out
+        of the image are no evidence rather than background (``ParticleConfig.out_of_view``)."""
         xy = np.ascontiguousarray(xy, dtype=np.float64)
         n = len(xy)
         boxes, mes, which = filter_rows(box, me, which, n)
@@ -825,7 +841,8 @@ class CameraLikelihood:
                       *(NO_OCCLUDERS if occluders is None else occluders), mes, self.centre, float(margin),
                       float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
                       np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
-                      float(top_sigma) if tops is not None else 0.0, float(px_scale), counts, ratio, top, seen)
+                      float(top_sigma) if tops is not None else 0.0, float(px_scale), bool(outside_unknown),
+                      counts, ratio, top, seen)
         return counts, ratio, top, seen
 
     def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
