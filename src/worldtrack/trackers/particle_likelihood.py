@@ -41,8 +41,8 @@ the particle, and it reads background (the paper: the image is all the evidence 
 ``outside_unknown``, no evidence: it adds ``off`` or nothing to ``ratio``, and is never counted in
 ``counts``. (With a cylinder a sample is outside only if none of its three pixels is in the image.)
 A person standing with the feet below the image's bottom edge otherwise loses ``off`` for every
-sample out of view, and the filter drifts away from the camera, to where the whole column is in view. Pixels are read at the nearest pixel centre (pixel centres at
-integer coordinates, the image covering ``−0.5 ≤ u < W − 0.5``, as :class:`Camera` defines).
+sample out of view, and the filter drifts away from the camera, to where the whole column is in
+view. Pixels are read at the nearest pixel centre (pixel centres at integer coordinates, the image covering ``−0.5 ≤ u < W − 0.5``, as :class:`Camera` defines).
 
 Each kernel (:func:`column_counts`, :func:`point_values`) has a plain NumPy reference built on
 :meth:`Camera.project` (:func:`column_counts_reference`, :func:`point_values_reference`); the tests
@@ -128,6 +128,8 @@ def hit_labels(image: np.ndarray, background: np.ndarray, gamma: float,
 
 #: Temporary label of shadow candidates before the texture test.
 CANDIDATE = 3
+#: A column sample's label when none of its pixels is in the image (:func:`column_counts`).
+_OUT_OF_VIEW = 3
 
 
 def _judge_texture(labels: np.ndarray, image: np.ndarray, background: np.ndarray, shadow: int,
@@ -500,7 +502,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
             u, v = _cam_to_uv(b0 + r02 * z, b1 + r12 * z, cz, lens, has_dist)
             us[k] = u
             vs[k] = v
-            lab = 3                                         # out of the image until a pixel is read
+            lab = _OUT_OF_VIEW                              # until a pixel in the image is read
             iv = _nearest(v, H)
             if iv >= 0:
                 # The centre, then (cylinder) the pixels ``radius`` to the left and right at this
@@ -513,7 +515,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                     iu = _nearest(u + _line_offset(j, d), W)
                     if iu >= 0:
                         s = True
-                        if lab == 3:
+                        if lab == _OUT_OF_VIEW:
                             lab = 0
                         if _others(owner, box, iu, iv):
                             others |= 1 << j
@@ -554,7 +556,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
             lab = label[k]
             if lab == 1:
                 run += on * wt[k]
-            elif lab == 0 or (lab == 3 and not outside_unknown):
+            elif lab == 0 or (lab == _OUT_OF_VIEW and not outside_unknown):
                 run += off * wt[k]
             if k >= k_min:
                 if k > k_min and n_above > 0:
