@@ -646,7 +646,8 @@ def test_image_box_with_depth_covers_the_object_nearer_and_farther():
 
 @pytest.mark.parametrize("bad", [dict(alpha=1.5), dict(beta=-0.1), dict(particles=0), dict(dz=0),
                                  dict(likelihood="blob"), dict(min_height=2.5), dict(resampling="multinomial"),
-                                 dict(hit_rate_object=0.01)])
+                                 dict(hit_rate_object=0.01), dict(births="lost"), dict(births="entry+anywhere"),
+                                 dict(lost_radius=-1.0), dict(lost_hold_s=float("nan"))])
 def test_bad_configuration_is_an_input_error(bad):
     with pytest.raises(InputError):
         ParticleConfig(**bad)
@@ -659,6 +660,8 @@ def test_user_mistakes_are_input_errors():
         make_tracker("particle", scene, fgs, no_such_option=1)
     with pytest.raises(InputError):
         ParticleTracker(make_scene(entry=False), fgs, ParticleConfig(births="entry"))
+    with pytest.raises(InputError, match="entry\\+lost"):
+        ParticleTracker(make_scene(entry=False), fgs, ParticleConfig(births="entry+lost"))
     tracker = ParticleTracker(scene, fgs)
     with pytest.raises(InputError, match="mode must be 'tracking'"):
         tracker.init_track(0.0, 3.0, mode="capture")
@@ -772,3 +775,65 @@ def test_tracks_held_after_an_exit_are_forgotten_after_the_hold_even_without_det
     for k in range(21, 29):                                   # 0.8 s later: past exit_hold_s
         tracker.step({"cam": bgs["cam"]}, k / FPS)
     assert tracker._leaving == []
+
+
+# ---------------------------------------------------------------------------- lost tracks (births="entry+lost")
+
+def _watches(tracker):
+    return [d for d in tracker.detectors if d.until is not None]
+
+
+def test_a_track_lost_mid_room_is_watched_there_for_lost_hold_s_and_not_after():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene, births="entry+lost", end_after_s=0.0, lost_radius=0.8, lost_hold_s=1.0)
+    assert len(tracker.detectors) == 1 and not _watches(tracker)      # the door's
+    tracker.init_track(1.0, 3.0)
+    out = run(tracker, scene, bgs, lambda t: [(1.0, 3.0)] if t < 0.45 else [], 8)
+    ended = next(k for k, (_, _, tracks) in enumerate(out) if not tracks)
+    assert 5 <= ended <= 6                                            # ended by β once the person is gone
+    (w,) = _watches(tracker)
+    t_end = ended / FPS
+    assert w.until == pytest.approx(t_end + 1.0)
+    # The floor in view within lost_radius of the last position, and only there.
+    last = out[ended - 1][2][0]
+    assert np.hypot(last.x - 1.0, last.y - 3.0) < 0.15
+    pts = w.region.sample(2000, np.random.default_rng(0))
+    d = np.hypot(pts[:, 0] - last.x, pts[:, 1] - last.y)
+    assert d.max() <= 0.8 + 0.05 * np.sqrt(2) and d.min() < 0.1 and w.region.area > 0.8 * np.pi * 0.8 ** 2
+    assert tracker._in_view(pts).all() and w.region.contains([[1.0, 3.0]]).tolist() == [True]
+    k = 8
+    while k / FPS <= t_end + 1.0 + 1e-9:                              # kept for lost_hold_s ...
+        tracker.step({"cam": bgs["cam"]}, k / FPS)
+        assert len(_watches(tracker)) == 1, k
+        k += 1
+    tracker.step({"cam": bgs["cam"]}, k / FPS)                        # ... and none afterwards
+    assert not _watches(tracker) and len(tracker.detectors) == 1
+
+
+@pytest.mark.parametrize("births", ["entry+lost", "entry"])
+def test_a_lost_person_who_shows_again_nearby_is_found_with_entry_lost_only(births):
+    """Gone from the image for 0.4 s mid-room, then standing 0.3 m from the track's last position."""
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene, births=births, end_after_s=0.0)
+    tracker.init_track(1.0, 3.0)
+    out = run(tracker, scene, bgs, lambda t: [(1.0, 3.0)] if t < 0.45 else [] if t < 0.85 else [(1.3, 3.0)], 16)
+    assert not out[7][2]
+    tracks = out[-1][2]
+    if births == "entry":
+        assert not tracks
+        return
+    assert len(tracks) == 1 and tracks[0].id == 2
+    assert np.hypot(tracks[0].x - 1.3, tracks[0].y - 3.0) < 0.15
+    assert not _watches(tracker)                                       # the watch that found it is dropped
+
+
+def test_no_watch_where_an_entry_region_already_watches_or_for_tracks_not_ended_by_beta():
+    scene = make_scene()
+    tracker, bgs = tracker_for(scene, births="entry+lost", end_after_s=0.0)
+    tracker.init_track(-2.3, 3.0)                                     # in the door region, nobody there
+    run(tracker, scene, bgs, lambda t: [], 3)
+    assert not tracker.filters and not _watches(tracker)
+    tracker, bgs = tracker_for(scene, births="entry+lost")
+    tracker.init_track(-1.0, 3.0)                                     # leaves through the exit
+    out = run(tracker, scene, bgs, _walks_out_and_waits(2.25), 22)
+    assert not out[-1][2] and len(tracker._leaving) == 1 and not _watches(tracker)

@@ -47,6 +47,10 @@ Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as p
   once instead of living on with whoever stands in front of the door on its line of sight, and its
   last box stays explained to the detection filters for a moment (``exit_*`` in
   :class:`ParticleConfig`);
+* lost tracks (``births="entry+lost"``): where a tracking filter ended by the β rule away from the
+  entry regions, a detection filter watches the floor round its last position for a while, so an
+  object that stopped showing enough (a person waiting with the feet below the image's edge) is
+  found again when it shows, not only when it comes back to a door;
 * the particles' z: the column does not depend on it, so after resampling each particle's z is
   drawn uniformly below the top its column sees — the particles then fill the object's height.
 
@@ -102,8 +106,10 @@ class _Filter:
     ``xyz`` (P, 3) particle positions (m) and ``v`` (P, 3) their own velocities (m/s); ``V`` (2,)
     the object's floor velocity (m/s); ``centre`` (2,) the floor mean after resampling; ``region``
     the area a detection filter scatters over; ``logw`` a detection filter's log weights of the
-    last frame (None: scatter afresh). ``logpi, likely, col_h`` hold this frame's observation;
-    ``h`` (P,) each particle's object height (m), where its column's top is expected.
+    last frame (None: scatter afresh); ``until`` (s) the time after which a detection filter that
+    watches a lost track's place is dropped (None: kept for good). ``logpi, likely, col_h`` hold
+    this frame's observation; ``h`` (P,) each particle's object height (m), where its column's top
+    is expected.
     """
 
     xyz: np.ndarray
@@ -113,6 +119,7 @@ class _Filter:
     V: np.ndarray = field(default_factory=lambda: np.zeros(2))
     centre: np.ndarray | None = None
     logw: np.ndarray | None = None
+    until: float | None = None
     low_since: float | None = None
     t_update: float | None = None
     split_count: int = 0
@@ -198,6 +205,7 @@ class ParticleTracker:
         self._resample = resampler(cfg.resampling)
         self._walkable = scene.walkable.raster(0.01).contains
         self.filters: list[_Filter] = []
+        self._births = cfg.births if cfg.births != "auto" else ("entry" if scene.entry_regions else "anywhere")
         self.detectors = [_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=r, h=np.zeros(0))
                           for r in self._detection_regions()]
         self._last_t: float | None = None
@@ -211,23 +219,10 @@ class ParticleTracker:
     def _detection_regions(self) -> list[FloorRegion]:
         """Where detection filters scatter: entry regions grown by ``entry_margin``, or all floor; in view."""
         cfg, scene = self.config, self.scene
-        births = cfg.births
-        if births == "auto":
-            births = "entry" if scene.entry_regions else "anywhere"
+        births = self._births
         if births == "none":
             return []
-        walk = scene.walkable.contains
-
-        def in_view(xy: np.ndarray) -> np.ndarray:
-            """Walkable, and a column of ``min_height`` there is inside some camera's image."""
-            seen = np.zeros(len(xy), dtype=bool)
-            for cl in self._cams.values():
-                cam = cl.camera
-                feet = cam.in_image(cam.project(np.column_stack([xy, np.zeros(len(xy))])))
-                head = cam.in_image(cam.project(np.column_stack([xy, np.full(len(xy), cfg.min_height)])))
-                seen |= feet & head
-            return walk(xy) & seen
-
+        in_view = self._in_view
         if births == "anywhere":
             reg = FloorRegion.rasterise("walkable", scene.walkable.bounds, 0.05, in_view)
             if reg.empty:
@@ -235,7 +230,7 @@ class ParticleTracker:
                                  f"{', '.join(self._cams)}")
             return [reg]
         if not scene.entry_regions:
-            raise InputError(f"particle tracker: births='entry' but scene {scene.name!r} has no entry regions")
+            raise InputError(f"particle tracker: births={births!r} but scene {scene.name!r} has no entry regions")
         regions = []
         m = cfg.entry_margin
         for er in scene.entry_regions:
@@ -249,6 +244,18 @@ class ParticleTracker:
             raise InputError(f"particle tracker: no entry region of scene {scene.name!r} is in view of "
                              f"{', '.join(self._cams)} (use births='anywhere')")
         return regions
+
+    def _in_view(self, xy: np.ndarray) -> np.ndarray:
+        """(N,) bool: floor points ``xy`` (N, 2), metres, are walkable and a column of ``min_height``
+        there is inside some camera's image."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        seen = np.zeros(len(xy), dtype=bool)
+        for cl in self._cams.values():
+            cam = cl.camera
+            feet = cam.in_image(cam.project(np.column_stack([xy, np.zeros(len(xy))])))
+            head = cam.in_image(cam.project(np.column_stack([xy, np.full(len(xy), self.config.min_height)])))
+            seen |= feet & head
+        return self.scene.walkable.contains(xy) & seen
 
     # ------------------------------------------------------------------ public
     def init_track(self, x: float, y: float, track_id: int | None = None, mode: str = "tracking",
@@ -297,6 +304,7 @@ class ParticleTracker:
             raise InputError(f"particle tracker: time went backwards ({t} s after {self._last_t} s)")
         dt = 0.0 if self._last_t is None else t - self._last_t
         self._leaving = [(tr, t0) for tr, t0 in self._leaving if t - t0 <= cfg.exit_hold_s]
+        self.detectors = [d for d in self.detectors if d.until is None or t <= d.until]
         images = self._images(frames)
         self._last_t = t
         if not images:
@@ -650,13 +658,14 @@ class ParticleTracker:
         parts = {name: _stack(fs, name) for name in PARTICLE_FIELDS if getattr(fs[0], name) is not None}
         shares = parts["likely"].mean(axis=1).tolist()
         resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
-        kept = []
+        kept, lost = [], []
         for i, (f, share) in enumerate(zip(fs, shares)):
             if share <= cfg.beta:
                 if f.low_since is None:
                     f.low_since = t
                 if t - f.low_since >= cfg.end_after_s:
                     self._end(f)
+                    lost.append(f.track)
                     continue
             else:
                 f.low_since = None
@@ -665,6 +674,7 @@ class ParticleTracker:
                 setattr(f, name, a[i])
             f.track.score = share
             kept.append(f)
+        self._watch_lost(lost, t)
         if not kept:
             return
         self._update_region(kept, t)
@@ -736,8 +746,35 @@ class ParticleTracker:
         if share > cfg.alpha:
             self._spawn(d, np.flatnonzero(d.likely), t)
             d.logw = None
+            if d.until is not None:          # a lost track's watch: found, dropped next frame
+                d.until = -math.inf
             return
         d.logw = d.logpi if np.isfinite(d.logpi).any() else None
+
+    def _watch_lost(self, tracks: list[Track], t: float) -> None:
+        """``births="entry+lost"``: watch where each of ``tracks`` (ended by the β rule at time ``t``,
+        seconds) was last, unless an entry region's detection filter covers that place already.
+
+        The watch is a detection filter over the floor in view within ``lost_radius`` (m) of the
+        track's last ``(x, y)``, kept until ``t + lost_hold_s`` or until it starts a track.
+        """
+        cfg = self.config
+        if self._births != "entry+lost" or not tracks or cfg.lost_radius <= 0 or cfg.lost_hold_s <= 0:
+            return
+        xy = np.array([[tr.x, tr.y] for tr in tracks], dtype=float)
+        covered = np.zeros(len(xy), dtype=bool)
+        for d in self.detectors:
+            if d.until is None:
+                covered |= d.region.contains(xy)
+        r = cfg.lost_radius
+        for k in np.flatnonzero(~covered):
+            c = xy[k]
+            reg = FloorRegion.rasterise(f"lost {tracks[k].id}", (c[0] - r, c[0] + r, c[1] - r, c[1] + r), 0.05,
+                                        lambda p, c=c: (np.hypot(p[:, 0] - c[0], p[:, 1] - c[1]) <= r)
+                                        & self._in_view(p))
+            if not reg.empty:
+                self.detectors.append(_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=reg, h=np.zeros(0),
+                                              until=t + cfg.lost_hold_s))
 
     def _spawn(self, d: _Filter, idx: np.ndarray, t: float) -> None:
         """Start tracking filters from a detection filter's likely particles, one per lump."""
