@@ -761,11 +761,11 @@ class EllipsoidTracker:
         """Measure the height of people a camera sees whole and alone; use the running median.
 
         See :mod:`worldtrack.trackers.height`. In one camera, a tracked person is measured when
-        others' ellipses cover at most 30 % of its region (the tallest plausible person's ellipse
-        with its ring), on the pixels nobody else covers; the feet found may be up to
-        ``height_depth_offset_m`` from the track along the line of sight (a wrong model height
-        puts it there). A person keeps its height when never measured (the scene default, the
-        paper's 1.65 m).
+        others' ellipses cover at most ``_MAX_COVERED_FOR_HEIGHT`` of its region (the tallest
+        plausible person's ellipse with its ring), on the pixels nobody else covers; the feet found
+        may be up to ``height_depth_offset_m`` from the track along the line of sight (a wrong model
+        height puts it there). Measuring stops once ``height_samples`` are in. A person keeps its
+        height when never measured (the scene default, the paper's 1.65 m).
         """
         cfg = self.config
         tracks = [tr for tr in tracks if tr.id in self.position_map]
