@@ -177,3 +177,28 @@ def test_owner_crop_equals_the_owner_map_and_the_masks(lab, cam_id):
     window = np.array([box[0, 0], box[1, 1], box[1, 2], box[0, 3]])   # spans parts of both boxes
     np.testing.assert_array_equal(owner_crop(window, inner, box, valid, grid, cam.has_distortion),
                                   full[window[2]:window[3], window[0]:window[1]])
+
+
+def test_kernel_equals_reference_in_a_crowd_behind_the_desk(lab):
+    # The pinhole kernel sums each row by intervals; rows where the desk hides part of a
+    # candidate fall back to pixel by pixel. Both against the reference, with many overlapping
+    # neighbours (their ellipses and rings cut every row into pieces).
+    cam = lab.cameras["cam1"]
+    occ = lab.occlusion("cam1").floor_distance
+    rng = np.random.default_rng(11)
+    for trial in range(4):
+        truth = np.array([rng.uniform(-1.5, -0.5), rng.uniform(2.3, 3.2)])   # around the desk's back edge
+        mask = np.zeros((cam.height, cam.width), np.uint8)
+        others = truth + rng.uniform(-0.7, 0.7, (6, 2))
+        for p in [truth, *others[:3]]:
+            mask |= person_mask(cam, p, rng.uniform(1.5, 1.9), rng.uniform(0.35, 0.5))
+        mask[rng.random(mask.shape) < 0.05] ^= 1
+        real = ternary_real(mask, 3)
+        cand = truth + rng.normal(0, 0.1, 2) + np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)]) * 0.1
+        for use_ring, target, unexplained in [(True, 0, True), (True, 120, False), (False, 0, True), (True, 60, True)]:
+            num, den, _ = kernel(cam, occ, real, use_ring, cand, others, 3, target, unexplained)
+            rn, rd = score_candidates_reference(cam.P, cam, occ, real, use_ring, cand, 1.65, 0.40, 3,
+                                                others, 1.65, 0.40, target_pixels=target,
+                                                count_unexplained=unexplained)
+            np.testing.assert_array_equal(num, rn)
+            np.testing.assert_array_equal(den, rd)
