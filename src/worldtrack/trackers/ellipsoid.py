@@ -273,6 +273,7 @@ class EllipsoidTracker:
         self._walk_raster = scene.walkable.raster(0.01)
         self._walkable = self._walk_raster.contains
         self._python_rounds = False  # tests switch to the readable rounds to compare
+        self._kernel_args: dict[tuple, tuple] = {}
         self._last_t: float | None = None
         self._frame = 0
         self._close_frames: dict[tuple[int, int], int] = {}
@@ -353,16 +354,9 @@ class EllipsoidTracker:
         if self._python_rounds:
             best_e, best_den = self._rounds_python(use_ring, xy, hs, ws, state, real)
         else:
-            cams = [self.cams[cid] for cid in cids]
             best_e, best_den = run_rounds(
-                xy, hs, ws, n, use_ring,
-                np.stack([cs.camera.P for cs in cams]), np.stack([cs.camera.K for cs in cams]),
-                np.stack([cs.camera.dist for cs in cams]), np.array([cs.camera.has_distortion for cs in cams]),
-                np.array([[cs.camera.width, cs.camera.height] for cs in cams], dtype=np.int64),
-                np.stack([cs.camera.centre for cs in cams]), np.stack([cs.camera.floor_direction for cs in cams]),
-                np.array([float(cs.ring_px) for cs in cams]), cfg.ring_fraction,
-                NumbaList([cs.grid for cs in cams]), NumbaList([cs.occ for cs in cams]),
-                NumbaList([real[cid] for cid in cids]),
+                xy, hs, ws, n, use_ring, *self._kernel_cameras(tuple(cids)), cfg.ring_fraction,
+                *self._kernel_cameras(tuple(cids), lists=True), tuple(real[cid] for cid in cids),
                 *stacked, self._walk_raster.inside, self._walk_raster.origin, self._walk_raster.resolution,
                 cfg.step_m, cfg.min_step_m, cfg.max_step_m, cfg.iterations,
                 cfg.max_iterations, cfg.adaptive_step, cfg.min_gain, cfg.target_pixels,
@@ -384,6 +378,29 @@ class EllipsoidTracker:
             tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
             result[tr.id] = (float(best_e[k]), float(best_den[k]))
         return result
+
+    def _kernel_cameras(self, cids: tuple[str, ...], lists: bool = False) -> tuple:
+        """The cameras ``cids`` as :func:`ellipsoid_match.run_rounds` takes them, built once per set.
+
+        Without ``lists``: stacked P (C, 3, 4), K (C, 3, 3), distortion (C, 5), has-distortion (C,),
+        (width, height) (C, 2), centre (C, 3), floor viewing direction (C, 2), ring width (C,) px.
+        With ``lists``: typed lists of the ideal pixel grids and obstacle floor distances.
+        """
+        key = (cids, lists)
+        if key not in self._kernel_args:
+            cams = [self.cams[cid] for cid in cids]
+            if lists:
+                args = (NumbaList([cs.grid for cs in cams]), NumbaList([cs.occ for cs in cams]))
+            else:
+                args = (np.stack([cs.camera.P for cs in cams]), np.stack([cs.camera.K for cs in cams]),
+                        np.stack([cs.camera.dist for cs in cams]),
+                        np.array([cs.camera.has_distortion for cs in cams]),
+                        np.array([[cs.camera.width, cs.camera.height] for cs in cams], dtype=np.int64),
+                        np.stack([cs.camera.centre for cs in cams]),
+                        np.stack([cs.camera.floor_direction for cs in cams]),
+                        np.array([float(cs.ring_px) for cs in cams]))
+            self._kernel_args[key] = args
+        return self._kernel_args[key]
 
     def _rounds_python(self, use_ring: np.ndarray, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
                        real: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
