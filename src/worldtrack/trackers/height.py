@@ -15,6 +15,7 @@ running median of the measurements differs from it by more than that.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from worldtrack.geometry.camera import Camera
 
@@ -141,26 +142,116 @@ def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray
     return float(p[2])
 
 
+#: Fewer foreground pixels than this in a person's region: no ends are looked for.
+_MIN_PIXELS = 30
+
+
 def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
           down: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Top and bottom (pixels) of the foreground in ``region`` along the image's world-down
-    direction, and that direction; None with fewer than 30 pixels."""
-    u0, u1, v0, v1 = box
-    fg = (labels[v0:v1, u0:u1] == 1) & region
-    vs, us = np.nonzero(fg)
-    if len(vs) < 30:
-        return None
-    us = us + u0
-    vs = vs + v0
-    centre = np.array([us.mean(), vs.mean()])
+    direction, and that direction; None with fewer than ``_MIN_PIXELS`` pixels.
+
+    The ends are the means of the extreme 1 % of the pixels along ``down`` (:func:`extreme_ends`),
+    moved half a pixel outwards.
+    """
+    u0, u1, v0, v1 = (int(b) for b in box)
     if down is None:
-        down = camera.image_down_direction(centre[None])[0]
+        fg = (labels[v0:v1, u0:u1] == 1) & region
+        vs, us = np.nonzero(fg)
+        if len(vs) < _MIN_PIXELS:
+            return None
+        down = camera.image_down_direction(np.array([[us.mean() + u0, vs.mean() + v0]]))[0]
     if not np.isfinite(down).all():
         return None
-    along = (us - centre[0]) * down[0] + (vs - centre[1]) * down[1]
-    n_end = max(1, len(along) // 100)
-    low = np.argpartition(along, n_end - 1)[:n_end]
-    high = np.argpartition(along, len(along) - n_end)[-n_end:]
-    top = np.array([us[low].mean(), vs[low].mean()]) - 0.5 * down
-    bottom = np.array([us[high].mean(), vs[high].mean()]) + 0.5 * down
-    return top, bottom, down
+    n, top, bottom = extreme_ends(labels, region, u0, v0, float(down[0]), float(down[1]))
+    if n < _MIN_PIXELS:
+        return None
+    return top - 0.5 * down, bottom + 0.5 * down, down
+
+
+@njit(cache=True)
+def extreme_ends(labels: np.ndarray, region: np.ndarray, u0: int, v0: int, dx: float,
+                 dy: float) -> tuple[int, np.ndarray, np.ndarray]:
+    """The foreground pixels (``labels == 1``) of ``region`` and their two ends along (dx, dy).
+
+    Parameters
+    ----------
+    labels : (H, W) uint8 — foreground labels of the whole image
+    region : (h, w) bool — where to look, its top-left pixel at (u0, v0) of ``labels``
+    dx, dy : float — unit image direction
+
+    Returns
+    -------
+    n : int — foreground pixels in the region
+    first, last : (2,) float — mean (u, v) of the ``max(1, n // 100)`` pixels lowest / highest
+        along (dx, dy), measured from the pixels' centroid; ties at the cut are taken in row-major
+        order (a stable sort's). NaN when n = 0.
+    """
+    h, w = region.shape
+    us = np.empty(h * w, np.int64)
+    vs = np.empty(h * w, np.int64)
+    n = 0
+    su = 0.0
+    sv = 0.0
+    for r in range(h):
+        for c in range(w):
+            if region[r, c] and labels[v0 + r, u0 + c] == 1:
+                us[n] = u0 + c
+                vs[n] = v0 + r
+                su += u0 + c
+                sv += v0 + r
+                n += 1
+    first = np.full(2, np.nan)
+    last = np.full(2, np.nan)
+    if n == 0:
+        return n, first, last
+    cu = su / n
+    cv = sv / n
+    along = np.empty(n)
+    for i in range(n):
+        along[i] = (us[i] - cu) * dx + (vs[i] - cv) * dy
+    n_end = max(1, n // 100)
+    low_cut = np.partition(along, n_end - 1)[n_end - 1]        # the n_end-th smallest
+    high_cut = np.partition(along, n - n_end)[n - n_end]       # the n_end-th largest
+    for sign in (1.0, -1.0):
+        cut = low_cut if sign > 0 else high_cut
+        # Strictly beyond the cut, then ties in order until n_end are taken.
+        taken = 0
+        tu = 0.0
+        tv = 0.0
+        for i in range(n):
+            if sign * along[i] < sign * cut:
+                tu += us[i]
+                tv += vs[i]
+                taken += 1
+        for i in range(n):
+            if taken >= n_end:
+                break
+            if along[i] == cut:
+                tu += us[i]
+                tv += vs[i]
+                taken += 1
+        out = first if sign > 0 else last
+        out[0] = tu / n_end
+        out[1] = tv / n_end
+    return n, first, last
+
+
+def extreme_ends_reference(labels: np.ndarray, region: np.ndarray, u0: int, v0: int, dx: float,
+                           dy: float) -> tuple[int, np.ndarray, np.ndarray]:
+    """Plain NumPy version of :func:`extreme_ends` (a stable sort instead of selection)."""
+    h, w = region.shape
+    vs, us = np.nonzero((labels[v0:v0 + h, u0:u0 + w] == 1) & region)
+    n = len(us)
+    if n == 0:
+        return 0, np.full(2, np.nan), np.full(2, np.nan)
+    us, vs = us + u0, vs + v0
+    along = (us - us.mean()) * dx + (vs - vs.mean()) * dy
+    n_end = max(1, n // 100)
+    order = np.argsort(along, kind="stable")
+    low = order[:n_end]
+    # The highest: strictly above the n_end-th largest value, then its ties in row-major order.
+    cut = along[order[n - n_end]]
+    above = np.flatnonzero(along > cut)
+    high = np.concatenate([above, np.flatnonzero(along == cut)[:n_end - len(above)]])
+    return n, np.array([us[low].mean(), vs[low].mean()]), np.array([us[high].mean(), vs[high].mean()])
