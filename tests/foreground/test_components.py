@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from worldtrack.foreground.components import blobs, connected_components
+from worldtrack.foreground.components import blob_extent, blob_extent_reference, blobs, connected_components
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -71,3 +71,29 @@ def test_a_shrink_factor_that_would_lose_single_pixels_is_refused():
     assert len(blobs(mask, 1, 22)) == 1          # 255 / 22² rounds to 1: the pixel survives
     with pytest.raises(ValueError, match="at most 22"):
         blobs(mask, 1, 23)
+
+
+@pytest.mark.parametrize("direction", [(0.0, 1.0), (0.6, 0.8), (-0.96, 0.28)])
+def test_blob_extent_equals_the_reference(direction):
+    rng = np.random.default_rng(5)
+    for trial in range(20):
+        blob = rng.random((int(rng.integers(1, 80)), int(rng.integers(1, 50)))) < rng.uniform(0.2, 1.0)
+        u0, v0 = int(rng.integers(0, 300)), int(rng.integers(0, 200))
+        cu, cv = u0 + rng.uniform(0, blob.shape[1]), v0 + rng.uniform(0, blob.shape[0])
+        got = blob_extent(blob, u0, v0, cu, cv, *direction, 50)
+        want = blob_extent_reference(blob, u0, v0, cu, cv, *direction, 50)
+        if not blob.any():
+            assert np.isnan(got).all() and np.isnan(want).all()
+            continue
+        np.testing.assert_array_equal(got[:4], want[:4])
+        np.testing.assert_allclose(got[4:], want[4:], rtol=0, atol=1e-9)   # sums in another order
+
+
+def test_blob_extent_of_a_rectangle():
+    blob = np.zeros((100, 40), bool)
+    blob[10:90, 5:25] = True                       # 1600 pixels, 20 per row: each end is 32 = 1.6 rows
+    along_min, along_max, across_min, across_max, first, last = blob_extent(blob, 100, 50, 115.0, 100.0, 0.0, 1.0, 50)
+    assert (along_min, along_max) == (60 - 100.0, 139 - 100.0)   # rows v = 60 … 139 about v = 100
+    assert (across_min, across_max) == (-(124 - 115.0), -(105 - 115.0))   # across = −du for down = (0, 1)
+    # The top end: row 60 whole (u 105…124) and the first 12 pixels of row 61 (u 105…116).
+    assert first == pytest.approx(-np.mean([*range(105, 125), *range(105, 117)]) + 115.0)

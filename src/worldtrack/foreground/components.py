@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+from numba import njit
 
 
 def connected_components(mask: np.ndarray) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
@@ -87,3 +88,84 @@ def blobs(mask: np.ndarray, min_area: float, factor: int = 1) -> list[tuple[int,
         out.append((area, (x0 + int(c0), y0 + int(r0), int(c1 - c0), int(r1 - r0)), centroid, crop))
     return out
 
+
+
+@njit(cache=True)
+def blob_extent(blob: np.ndarray, u0: int, v0: int, cu: float, cv: float, dx: float, dy: float,
+                end_divisor: int) -> tuple[float, float, float, float, float, float]:
+    """How far a blob reaches along a direction and across it, and where its two ends lie across.
+
+    Parameters
+    ----------
+    blob : (h, w) bool — the blob's pixels, its top-left pixel at (u0, v0) of the image
+    cu, cv : float — the reference point (the blob's centroid), pixels
+    dx, dy : float — unit image direction "along"; "across" is (−dy, dx)
+    end_divisor : int — each end is the ``max(1, n // end_divisor)`` pixels lowest / highest along
+        the direction; ties at the cut are taken in row-major order (a stable sort's)
+
+    Returns
+    -------
+    along_min, along_max, across_min, across_max : float — extremes of the pixels' coordinates
+        relative to (cu, cv), pixels (NaN for an empty blob)
+    across_first, across_last : float — mean across-coordinate of the pixels at the low and the
+        high end along the direction
+    """
+    h, w = blob.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if blob[r, c]:
+                n += 1
+    if n == 0:
+        return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+    along = np.empty(n)
+    across = np.empty(n)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if blob[r, c]:
+                du = (u0 + c) - cu
+                dv = (v0 + r) - cv
+                along[i] = du * dx + dv * dy
+                across[i] = du * -dy + dv * dx
+                i += 1
+    n_end = max(1, n // end_divisor)
+    low_cut = np.partition(along, n_end - 1)[n_end - 1]
+    high_cut = np.partition(along, n - n_end)[n - n_end]
+    means = np.zeros(2)
+    for e in range(2):
+        sign = 1.0 if e == 0 else -1.0
+        cut = low_cut if e == 0 else high_cut
+        taken = 0
+        total = 0.0
+        for i in range(n):
+            if sign * along[i] < sign * cut:
+                total += across[i]
+                taken += 1
+        for i in range(n):
+            if taken >= n_end:
+                break
+            if along[i] == cut:
+                total += across[i]
+                taken += 1
+        means[e] = total / n_end
+    return along.min(), along.max(), across.min(), across.max(), means[0], means[1]
+
+
+def blob_extent_reference(blob: np.ndarray, u0: int, v0: int, cu: float, cv: float, dx: float, dy: float,
+                          end_divisor: int) -> tuple[float, float, float, float, float, float]:
+    """Plain NumPy version of :func:`blob_extent` (a stable sort instead of selection)."""
+    vs, us = np.nonzero(blob)
+    if len(us) == 0:
+        return (np.nan,) * 6
+    du, dv = us + u0 - cu, vs + v0 - cv
+    along = du * dx + dv * dy
+    across = du * -dy + dv * dx
+    n = len(along)
+    n_end = max(1, n // end_divisor)
+    order = np.argsort(along, kind="stable")
+    low = order[:n_end]
+    cut = along[order[n - n_end]]
+    above = np.flatnonzero(along > cut)
+    high = np.concatenate([above, np.flatnonzero(along == cut)[:n_end - len(above)]])
+    return (along.min(), along.max(), across.min(), across.max(), across[low].mean(), across[high].mean())

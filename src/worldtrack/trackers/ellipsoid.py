@@ -39,7 +39,7 @@ import numpy as np
 from numba.typed import List as NumbaList
 
 from worldtrack.foreground.background import Foreground
-from worldtrack.foreground.components import blobs
+from worldtrack.foreground.components import blob_extent, blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
@@ -313,9 +313,11 @@ class EllipsoidTracker:
         tracks = list(self.position_map)
         prev = {tr.id: (tr.x, tr.y) for tr in tracks}
         if cfg.predict and dt > 0:
-            for tr in tracks:
-                if tr.mode == "tracking":
-                    self._move_if_walkable(tr, tr.x + tr.vx * dt, tr.y + tr.vy * dt)
+            moving = [tr for tr in tracks if tr.mode == "tracking"]
+            ahead = np.array([[tr.x + tr.vx * dt, tr.y + tr.vy * dt] for tr in moving]).reshape(-1, 2)
+            for tr, (x, y), ok in zip(moving, ahead, self._walkable(ahead)):
+                if ok:  # a prediction into a wall or a desk stays where it was
+                    tr.x, tr.y = float(x), float(y)
 
         scores = self._match(tracks, real)
         births = self._births(real, t) if cfg.births != "none" else []
@@ -598,10 +600,6 @@ class EllipsoidTracker:
             return None
         d = np.hypot(offsets[ok, 0], offsets[ok, 1])
         return cand[ok][int(np.argmin(d))]
-
-    def _move_if_walkable(self, tr: Track, x: float, y: float) -> None:
-        if self._walkable([[x, y]])[0]:
-            tr.x, tr.y = float(x), float(y)
 
     # ------------------------------------------------------------------ births
     def _births(self, real: dict[str, np.ndarray], t: float) -> list[Track]:
@@ -943,20 +941,15 @@ def _blob_position(cs: _CameraState, blob: np.ndarray, origin: tuple[int, int], 
     down = cs.down_direction(centroid)
     if down is None:
         return None
-    vs, us = np.nonzero(blob)
-    vs = vs + origin[1]
-    us = us + origin[0]
-    along = (us - centroid[0]) * down[0] + (vs - centroid[1]) * down[1]
-    across = np.array([-down[1], down[0]])
-    spread = (us - centroid[0]) * across[0] + (vs - centroid[1]) * across[1]
-    n_end = max(1, len(along) // 50)
-    low = np.argpartition(along, n_end - 1)[:n_end]            # the extreme 2 % at either end
-    high = np.argpartition(along, len(along) - n_end)[-n_end:]
     # The ends: the extreme pixel along ``down``, laterally at the mean of the extreme 2 %.
-    foot = centroid + (along.max() + 0.5) * down + spread[high].mean() * across
-    head = centroid + (along.min() - 0.5) * down + spread[low].mean() * across
+    along_min, along_max, spread_min, spread_max, spread_low, spread_high = blob_extent(
+        blob, int(origin[0]), int(origin[1]), float(centroid[0]), float(centroid[1]), float(down[0]),
+        float(down[1]), 50)
+    across = np.array([-down[1], down[0]])
+    foot = centroid + (along_max + 0.5) * down + spread_high * across
+    head = centroid + (along_min - 0.5) * down + spread_low * across
     # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
-    half = max(1.0, 0.4 * (spread.max() - spread.min()))  # most of the blob's width
+    half = max(1.0, 0.4 * (spread_max - spread_min))  # most of the blob's width
     beyond = foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across
     feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, cs.occ, beyond)).mean() > 0.5
     if not feet_hidden:
