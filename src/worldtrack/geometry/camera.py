@@ -342,8 +342,16 @@ class Camera:
             Unit directions in world coordinates, one per pixel.
         """
         p, lead = _as_points(uv, 2)
-        xy = self.undistort_normalised(self._pixels_to_normalised(p))
-        d = np.column_stack([xy, np.ones(len(xy))]) @ self.R  # Rᵀ·d for each row
+        # Homogeneous normalised coordinates (x, y, 1), filled in place: this is called for a
+        # pixel or two at a time, where every temporary array costs as much as the arithmetic.
+        K = self.K
+        h = np.empty((len(p), 3))
+        h[:, 1] = (p[:, 1] - K[1, 2]) / K[1, 1]
+        h[:, 0] = (p[:, 0] - K[0, 2] - K[0, 1] * h[:, 1]) / K[0, 0]
+        h[:, 2] = 1.0
+        if self.has_distortion:
+            h[:, :2] = self.undistort_normalised(h[:, :2])
+        d = h @ self.R  # Rᵀ·d for each row
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         return self.centre.copy(), d.reshape(lead + (3,))
 
@@ -363,12 +371,13 @@ class Camera:
         """
         origin, d = self.rays(uv)
         d2 = d.reshape(-1, 3)
-        zz = np.broadcast_to(np.asarray(z, dtype=float), d.shape[:-1]).reshape(-1)
+        zz = float(z) if np.ndim(z) == 0 else np.broadcast_to(np.asarray(z, dtype=float), d.shape[:-1]).reshape(-1)
         with np.errstate(divide="ignore", invalid="ignore"):
             s = (zz - origin[2]) / d2[:, 2]
         bad = ~(s > 0) | (np.abs(d2[:, 2]) < 1e-12)
         out = origin + s[:, None] * d2
-        out[bad] = np.nan
+        if bad.any():
+            out[bad] = np.nan
         return out.reshape(d.shape)
 
     def image_down_direction(self, uv: ArrayLike) -> np.ndarray:
