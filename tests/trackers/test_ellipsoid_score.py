@@ -202,3 +202,22 @@ def test_kernel_equals_reference_in_a_crowd_behind_the_desk(lab):
                                                 count_unexplained=unexplained)
             np.testing.assert_array_equal(num, rn)
             np.testing.assert_array_equal(den, rd)
+
+
+@pytest.mark.parametrize("radius", [0, 1, 2, 7, 26])
+def test_within_l1_equals_the_iterated_cross_dilation(radius):
+    from worldtrack.trackers.ellipsoid_score import within_l1, within_l1_reference
+    rng = np.random.default_rng(radius)
+    for trial in range(8):
+        H, W = int(rng.integers(1, 90)), int(rng.integers(1, 120))
+        fg = (rng.random((H, W)) < rng.choice([0.0, 0.002, 0.02, 0.3])).astype(np.uint8)
+        if trial % 2:
+            fg[0, rng.integers(0, W)] = fg[rng.integers(0, H), W - 1] = 1    # on the border
+        out = within_l1(fg, radius)
+        np.testing.assert_array_equal(out, within_l1_reference(fg, radius))
+        assert out.dtype == np.uint8 and out.shape == (H, W)
+    # One pixel: exactly the diamond |du| + |dv| <= radius around it.
+    fg = np.zeros((61, 61), np.uint8)
+    fg[30, 30] = 1
+    v, u = np.mgrid[0:61, 0:61]
+    np.testing.assert_array_equal(within_l1(fg, radius), (np.abs(u - 30) + np.abs(v - 30) <= radius).astype(np.uint8))

@@ -507,10 +507,74 @@ def _near_foreground(fg: np.ndarray, ring_px: int) -> np.ndarray:
     """
     side = 2 * ring_px + 1
     square = cv2.dilate(fg, np.ones((side, side), np.uint8))
-    diag = _octagon_diagonal(ring_px)
+    return (square > 0) & (within_l1(fg, _octagon_diagonal(ring_px)) > 0)
+
+
+def within_l1(fg: np.ndarray, radius: int) -> np.ndarray:
+    """(H, W) uint8: 1 within city-block distance ``radius`` of a non-zero pixel of ``fg`` (uint8).
+
+    The dilation by a diamond, i.e. ``cv2.dilate`` with a 3×3 cross iterated ``radius`` times
+    (:func:`within_l1_reference`), from the separable city-block distance instead: the distance
+    along each column (two compiled passes whose inner loops run along rows, so they vectorise),
+    then the same on the transposed image; capped at ``radius + 1`` in uint8. ~3× faster than
+    the iterated cross at radius 26 (640×480), and independent of the radius.
+    """
+    if radius <= 0:
+        return (fg > 0).astype(np.uint8)
+    if radius >= 255:
+        return within_l1_reference(fg, radius)
+    cap = np.uint8(radius + 1)
+    down = _column_distance(fg, cap)
+    return cv2.transpose(_column_distance_within(cv2.transpose(down), cap, np.uint8(radius)))
+
+
+def within_l1_reference(fg: np.ndarray, radius: int) -> np.ndarray:
+    """:func:`within_l1` as the iterated dilation by a 3×3 cross: the plain version it is tested against."""
+    if radius <= 0:
+        return (fg > 0).astype(np.uint8)
     cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
-    diamond = cv2.dilate(fg, cross, iterations=diag) if diag > 0 else fg
-    return (square > 0) & (diamond > 0)
+    return (cv2.dilate((fg > 0).astype(np.uint8), cross, iterations=radius) > 0).astype(np.uint8)
+
+
+@njit(cache=True)
+def _relax_columns(a: np.ndarray, cap: np.uint8) -> None:
+    """In place: each pixel's value becomes the least of itself and (its column neighbour's + 1),
+    downwards then upwards, never above ``cap`` — a distance along the columns."""
+    H, W = a.shape
+    for y in range(1, H):
+        for x in range(W):
+            v = min(a[y - 1, x], cap - 1) + 1
+            if v < a[y, x]:
+                a[y, x] = v
+    for y in range(H - 2, -1, -1):
+        for x in range(W):
+            v = min(a[y + 1, x], cap - 1) + 1
+            if v < a[y, x]:
+                a[y, x] = v
+
+
+@njit(cache=True)
+def _column_distance(fg: np.ndarray, cap: np.uint8) -> np.ndarray:
+    """(H, W) uint8: distance along the column to the nearest non-zero pixel of ``fg``, capped."""
+    H, W = fg.shape
+    a = np.empty((H, W), np.uint8)
+    for y in range(H):
+        for x in range(W):
+            a[y, x] = 0 if fg[y, x] else cap
+    _relax_columns(a, cap)
+    return a
+
+
+@njit(cache=True)
+def _column_distance_within(a: np.ndarray, cap: np.uint8, radius: np.uint8) -> np.ndarray:
+    """Relax ``a`` along its columns (in place) and return 1 where it is at most ``radius``."""
+    _relax_columns(a, cap)
+    H, W = a.shape
+    out = np.empty((H, W), np.uint8)
+    for y in range(H):
+        for x in range(W):
+            out[y, x] = 1 if a[y, x] <= radius else 0
+    return out
 
 
 def score_candidates_reference(P, camera, occ, real, use_ring, xy, heights, widths, ring_px,
