@@ -6,7 +6,9 @@ One particle filter per object, in world coordinates (metres, Z up). Every frame
 
        x_t = x_{t−1} + v·dt + w,   w ~ N(0, σ²·dt)      (σ in m/√s, dt in seconds)
 
-   with ``v`` each particle's own ``(x_{t−1} − x_{t−2}) / dt`` (the paper) or the object's;
+   with ``v`` the object's (default), each particle's own ``(x_{t−1} − x_{t−2}) / dt`` (the paper)
+   or each particle's own velocity state (``velocity="state"``: constant velocity, walking by
+   ``noise_v``);
 2. **observes** the likelihood π_i of each particle (:mod:`~worldtrack.trackers.particle_likelihood`:
    the height column of eq. 11 or the point of eq. 7, multiplied over the cameras that see the
    particle; 0 off the walkable floor or out of every view) and weights ``g_i = π_i / Σ π`` (eq. 8);
@@ -274,7 +276,7 @@ class ParticleTracker:
                                self.rng.random(n) * cfg.max_height])
         h, w = self.scene.people.size_of(track_id or 0)
         tr = self.position_map.add(x, y, h, w, mode="tracking", time=t, track_id=track_id)
-        f = _Filter(xyz, np.zeros((n, 3)), track=tr, h=self._draw_heights(n, h))
+        f = _Filter(xyz, self._draw_velocities(n), track=tr, h=self._draw_heights(n, h))
         self._update_region([f], t)
         self.filters.append(f)
         return tr
@@ -552,6 +554,15 @@ class ParticleTracker:
                                                       * math.sqrt(dt))
         if cfg.velocity == "particle":
             step += _stack(fs, "v") * dt
+        elif cfg.velocity == "state":
+            # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it.
+            v = _stack(fs, "v")
+            v[..., :2] += self.rng.standard_normal(v[..., :2].shape) * (cfg.noise_v * math.sqrt(dt))
+            v[..., 2] = 0.0
+            _clip_speed(v, cfg.max_speed)
+            step += v * dt
+            for f, vv in zip(fs, v):
+                f.v = vv
         elif cfg.velocity == "object":
             step[..., :2] += np.array([f.V for f in fs])[:, None, :] * dt
         xyz = old + step
@@ -575,6 +586,16 @@ class ParticleTracker:
             return _reflect(h + self.rng.standard_normal(h.shape) * (cfg.noise_h * math.sqrt(dt)),
                             cfg.min_height, cfg.max_height)
         return h
+
+    def _draw_velocities(self, n: int) -> np.ndarray:
+        """(n, 3) velocities (m/s) of a new tracking filter's particles: with ``velocity="state"``
+        ~ N(0, velocity_spread²) on each floor axis (the object's velocity is unknown yet), else 0."""
+        cfg = self.config
+        v = np.zeros((n, 3))
+        if cfg.velocity == "state" and cfg.velocity_spread > 0:
+            v[:, :2] = cfg.velocity_spread * self.rng.standard_normal((n, 2))
+            _clip_speed(v, cfg.max_speed)
+        return v
 
     def _draw_heights(self, n: int, centre: float | None = None) -> np.ndarray:
         """(n,) object heights ~ N(centre, height_spread²) in [min_height, max_height] (default centre:
@@ -697,7 +718,7 @@ class ParticleTracker:
                 a = cfg.velocity_smoothing
                 V[moved] = (1 - a) * V[moved] + a * (centre[moved, :2] - prev[moved]) / since[moved, None]
                 _clip_speed(V, cfg.max_speed)
-        elif cfg.velocity == "particle":
+        elif cfg.velocity in ("particle", "state"):
             V = cloud_mean(_stack(fs, "v")[..., :2])
         else:
             V = np.zeros((len(fs), 2))
@@ -780,7 +801,7 @@ class ParticleTracker:
         """Start tracking filters from a detection filter's likely particles, one per lump."""
         cfg = self.config
         for g in (self._lumps(d.xyz, idx, depth=2) if cfg.split else [idx]):
-            f = d.subset(g, v=np.zeros((len(g), 3)))
+            f = d.subset(g, v=self._draw_velocities(len(g)))
             self._resample_filter(f, self._weights(f.logpi), cfg.particles)
             self._new_track(f, t, score=float(d.likely.mean()))
 

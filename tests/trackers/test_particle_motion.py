@@ -1,0 +1,85 @@
+"""The particle tracker's motion model (``velocity="state"``) and its depth along the line of sight.
+
+Small rendered scenes of :mod:`test_particle` (ellipsoid people over a textured floor, exact ground
+truth); every filter is started on the truth with ``init_track`` and no detection, so what is
+measured is the filter alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from test_particle import FPS, make_scene, run, tracker_for
+
+
+def _errors(out, pid: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Floor errors (m) of track ``pid`` per frame and their components along the camera's line of sight."""
+    err, along = [], []
+    for _, truth, tracks in out:
+        tr = {t.id: t for t in tracks}.get(pid)
+        if tr is None:
+            err.append(np.inf)
+            along.append(np.inf)
+            continue
+        x, y = truth[0][:2]
+        err.append(np.hypot(tr.x - x, tr.y - y))
+        along.append(tr.y - y)               # the camera at (0, −1) looks along +y
+    return np.array(err), np.array(along)
+
+
+def test_state_velocity_moves_each_particle_by_its_own_velocity():
+    """Without noise, x_t = x_{t−1} + v·dt exactly and v persists (constant velocity)."""
+    scene = make_scene(entry=False)
+    tracker, _ = tracker_for(scene, velocity="state", noise_xy=0.0, noise_v=0.0, births="none")
+    tracker.init_track(0.0, 3.0)
+    (f,) = tracker.filters
+    rng = np.random.default_rng(1)
+    v = np.zeros_like(f.v)
+    v[:, :2] = rng.uniform(-1, 1, (len(v), 2))
+    f.v = v.copy()
+    before = f.xyz.copy()
+    tracker._predict([f], 0.1)
+    np.testing.assert_allclose(f.xyz[:, :2], before[:, :2] + 0.1 * v[:, :2], atol=1e-12)
+    np.testing.assert_allclose(f.v, v, atol=1e-12)
+    tracker._predict([f], 0.2)
+    np.testing.assert_allclose(f.xyz[:, :2], before[:, :2] + 0.3 * v[:, :2], atol=1e-12)
+
+
+def test_state_velocity_noise_and_initial_spread():
+    """The velocity walks by noise_v·√dt per step; new filters' velocities spread velocity_spread."""
+    scene = make_scene(entry=False)
+    tracker, _ = tracker_for(scene, velocity="state", noise_xy=0.0, noise_v=1.0, velocity_spread=0.7,
+                             births="none", particles=4000)
+    tracker.init_track(0.0, 3.0)
+    (f,) = tracker.filters
+    assert f.v[:, :2].std(axis=0) == pytest.approx([0.7, 0.7], rel=0.05)
+    assert np.all(f.v[:, 2] == 0)
+    v0 = f.v.copy()
+    tracker._predict([f], 0.25)
+    dv = f.v[:, :2] - v0[:, :2]
+    assert dv.std(axis=0) == pytest.approx([0.5, 0.5], rel=0.05)      # 1.0 m/s/√s · √0.25 s
+    # Other velocity models start from rest and keep no velocity state.
+    t2, _ = tracker_for(scene, births="none")
+    t2.init_track(0.0, 3.0)
+    assert np.all(t2.filters[0].v == 0)
+
+
+def towards_camera(t):
+    """Walks straight at the camera (along its line of sight) at 1 m/s, from 5.5 m to 2.5 m."""
+    return [(0.3, 5.5 - 1.0 * t)]
+
+
+@pytest.mark.parametrize("velocity", ["state", "object"])
+def test_walker_along_the_line_of_sight_is_followed(velocity):
+    """The depth along the line of sight is the column's weak direction; the filter must keep up with
+    a walker coming straight at the camera, started on the truth (no lag building up)."""
+    scene = make_scene(entry=False)
+    tracker, bgs = tracker_for(scene, velocity=velocity, births="none", split=False, merge=False)
+    tracker.init_track(*towards_camera(0.0)[0], track_id=1)
+    out = run(tracker, scene, bgs, towards_camera, int(3.0 * FPS))
+    err, along = _errors(out)
+    assert np.all(np.isfinite(err))
+    assert np.mean(err) < 0.10 and np.max(err) < 0.25
+    vy = [tracks[0].vy for _, _, tracks in out[10:]]
+    assert np.median(vy) == pytest.approx(-1.0, abs=0.25)
