@@ -60,7 +60,7 @@ def test_state_velocity_noise_and_initial_spread():
     dv = f.v[:, :2] - v0[:, :2]
     assert dv.std(axis=0) == pytest.approx([0.5, 0.5], rel=0.05)      # 1.0 m/s/√s · √0.25 s
     # Other velocity models start from rest and keep no velocity state.
-    t2, _ = tracker_for(scene, births="none")
+    t2, _ = tracker_for(scene, births="none", velocity="object")
     t2.init_track(0.0, 3.0)
     assert np.all(t2.filters[0].v == 0)
 

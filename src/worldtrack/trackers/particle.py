@@ -6,9 +6,9 @@ One particle filter per object, in world coordinates (metres, Z up). Every frame
 
        x_t = x_{t−1} + v·dt + w,   w ~ N(0, σ²·dt)      (σ in m/√s, dt in seconds)
 
-   with ``v`` the object's (default), each particle's own ``(x_{t−1} − x_{t−2}) / dt`` (the paper)
-   or each particle's own velocity state (``velocity="state"``: constant velocity, walking by
-   ``noise_v``);
+   with ``v`` each particle's own velocity state (default, ``velocity="state"``: constant
+   velocity, walking by ``noise_v``, which stops while the filter's columns are mostly hidden),
+   each particle's own ``(x_{t−1} − x_{t−2}) / dt`` (the paper) or the object's;
 2. **observes** the likelihood π_i of each particle (:mod:`~worldtrack.trackers.particle_likelihood`:
    the height column of eq. 11 or the point of eq. 7, multiplied over the cameras that see the
    particle; 0 off the walkable floor or out of every view) and weights ``g_i = π_i / Σ π`` (eq. 8);
@@ -111,7 +111,8 @@ class _Filter:
     last frame (None: scatter afresh); ``until`` (s) the time after which a detection filter that
     watches a lost track's place is dropped (None: kept for good). ``logpi, likely, col_h`` hold
     this frame's observation; ``h`` (P,) each particle's object height (m), where its column's top
-    is expected.
+    is expected. ``k_lo`` {camera_id: int}: the lowest column samples that read no evidence for this
+    filter (``common_view``).
     """
 
     xyz: np.ndarray
@@ -130,6 +131,7 @@ class _Filter:
     col_h: np.ndarray | None = None
     h: np.ndarray | None = None
     colours: dict = field(default_factory=dict)
+    k_lo: dict = field(default_factory=dict)
 
     def take(self, idx: np.ndarray) -> None:
         """Keep the particles ``idx`` (with repeats), this frame's observation included."""
@@ -201,7 +203,8 @@ class ParticleTracker:
                                        self.heights[-1] + cfg.dz * np.arange(1, self._n_above + 1)])
         self._k_min = self._n_below + min(cfg.likely_count, len(self.heights) - 1)
         # Pixel weights: a column sample REFERENCE_DEPTH from a camera weighs 1.
-        self._px_scale = {cid: (REFERENCE_DEPTH / (cl.K[1, 1] * cfg.dz) if cfg.pixel_weights else 0.0)
+        self._px_scale = {cid: (REFERENCE_DEPTH / (cl.K[1, 1] * cfg.dz)
+                                if cfg.pixel_weights == "depth" and cfg.weighting == "ratio" else 0.0)
                           for cid, cl in self._cams.items()}
         self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
         self._resample = resampler(cfg.resampling)
@@ -403,7 +406,9 @@ class ParticleTracker:
                    boxes: Mapping[str, Box | None] | None = None,
                    h: np.ndarray | None = None, occluders: Mapping[str, object] | None = None,
                    me: int | Sequence[int] = -1, colours: Mapping[str, ColourModel] | None = None,
-                   which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   which: np.ndarray | None = None,
+                   px_scale: Mapping[str, np.ndarray] | None = None, k_lo: Mapping[str, np.ndarray] | None = None,
+                   hidden: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Log-likelihood of particles, summed over the cameras that see them.
 
         The particles of one filter, or (``which``) of several filters in one call: the kernels
@@ -428,6 +433,13 @@ class ParticleTracker:
         which : (N,) int, optional — each particle's filter, 0 … F − 1, for the particles of F
             filters: then ``boxes`` maps each camera to a sequence of F boxes (or None), ``me`` is a
             sequence of F indices and ``colours`` a sequence of F mappings (or None), one per filter
+        px_scale : {camera_id: (F,) float}, optional — per filter, the pixel-weight scale (1 / pixels,
+            0 = unweighted; :meth:`_filter_pixel_scales`); default the camera's ``pixel_weights="depth"``
+            scale (0 otherwise) for every particle
+        k_lo : {camera_id: (F,) int}, optional — per filter, the lowest column samples that read no
+            evidence (``common_view``); default none
+        hidden : dict, optional — filled with {camera_id: (N,) int}, how many of each particle's
+            lowest column samples are hidden (occluded or out of view)
 
         Returns
         -------
@@ -460,13 +472,14 @@ class ParticleTracker:
                 box = boxes.get(cid) if boxes is not None else [None] * len(me)
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz[:, :2], cl)
-                    counts, ratio, top, seen = cl.column(img, surface, self._column, self._on, self._off,
-                                                         self._k_min, cfg.column_radius, -self._on, self._n_below,
-                                                         self._n_above, owner, box, h, self._top_sigma,
-                                                         self._px_scale[cid],
-                                                         occluders.get(cid) if occluders is not None else None, me,
-                                                         cfg.occlusion_margin, which,
-                                                         cfg.out_of_view == "unknown")
+                    counts, ratio, top, seen, hid = cl.column(
+                        img, surface, self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
+                        self._n_below, self._n_above, owner, box, h, self._top_sigma,
+                        self._px_scale[cid] if px_scale is None else px_scale[cid],
+                        occluders.get(cid) if occluders is not None else None, me, cfg.occlusion_margin, which,
+                        cfg.out_of_view == "unknown", k_lo[cid] if k_lo is not None else 0, return_hidden=True)
+                    if hidden is not None:
+                        hidden[cid] = hid
                     if cfg.weighting == "count":
                         lv = np.log(counts / S)
                         col += np.where(seen, counts * cfg.dz, 0.0)
@@ -557,7 +570,8 @@ class ParticleTracker:
         elif cfg.velocity == "state":
             # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it.
             v = _stack(fs, "v")
-            v[..., :2] += self.rng.standard_normal(v[..., :2].shape) * (cfg.noise_v * math.sqrt(dt))
+            scale = cfg.noise_v * math.sqrt(dt) * self._coasting(fs)[:, None, None]
+            v[..., :2] += self.rng.standard_normal(v[..., :2].shape) * scale
             v[..., 2] = 0.0
             _clip_speed(v, cfg.max_speed)
             step += v * dt
@@ -577,6 +591,17 @@ class ParticleTracker:
             _clip_speed(v, cfg.max_speed)
             for f, vv in zip(fs, v):
                 f.v = vv
+
+    def _coasting(self, fs: list[_Filter]) -> np.ndarray:
+        """(F,) factor of the velocity walk of filters ``fs``: ``1 − hidden / coast_hidden`` clipped to
+        [0, 1], ``hidden`` the share of column samples hidden (``k_lo``) in the camera that sees
+        most of the object; 1 with ``coast_hidden = 0``."""
+        cfg = self.config
+        if cfg.coast_hidden <= 0:
+            return np.ones(len(fs))
+        n = len(self._column)
+        hidden = np.array([min(f.k_lo.values(), default=0) for f in fs], dtype=float) / n
+        return np.clip(1.0 - hidden / cfg.coast_hidden, 0.0, 1.0)
 
     def _jitter_heights(self, h: np.ndarray, dt: float) -> np.ndarray:
         """Particles' object heights ``h`` (any shape) after a random walk of ``noise_h·√dt``, kept
@@ -663,14 +688,51 @@ class ParticleTracker:
         """This frame's observation (``logpi, likely, col_h``) of filters ``fs``, in one likelihood call.
 
         ``boxes`` and ``occluders`` (optional) are of the filters' objects in the order of ``fs``."""
+        cfg = self.config
         sizes = [len(f.xyz) for f in fs]
+        tracking = fs[0].track is not None
+        scales = k_lo = hidden = None
+        if cfg.pixel_weights in ("filter", "hidden") and cfg.weighting == "ratio" and tracking:
+            scales = self._filter_pixel_scales(cloud_mean(_stack(fs, "xyz")[:, :, :2]), images)
+            if cfg.pixel_weights == "hidden":
+                # Only where the lower body was hidden last frame (above the foot samples).
+                for cid in scales:
+                    scales[cid] = np.where([f.k_lo.get(cid, 0) > self._n_below for f in fs], scales[cid], 0.0)
+        if ((cfg.common_view > 0 or cfg.coast_hidden > 0 or cfg.pixel_weights == "hidden")
+                and cfg.likelihood == "column" and tracking):
+            hidden = {}
+            if cfg.common_view > 0 and cfg.weighting == "ratio":
+                k_lo = {cid: np.array([f.k_lo.get(cid, 0) for f in fs], dtype=np.int64) for cid in images}
         out = self.likelihood(np.concatenate([f.xyz for f in fs]), images, owners, boxes,
                               np.concatenate([f.h for f in fs]), occluders, np.arange(len(fs)),
-                              [f.colours for f in fs], np.repeat(np.arange(len(fs)), sizes))
+                              [f.colours for f in fs], np.repeat(np.arange(len(fs)), sizes), scales, k_lo, hidden)
+        if hidden:
+            # Next frame's k_lo: the share ``common_view`` of the filter's columns see every sample
+            # from there up (tracking filters hold equal particle counts).
+            for cid, hid in hidden.items():
+                lo = np.quantile(hid.reshape(len(fs), -1), cfg.common_view or 0.5, axis=1, method="higher")
+                for f, v in zip(fs, lo.tolist()):
+                    f.k_lo[cid] = int(v)
         ends = np.cumsum(sizes).tolist()
         for name, a in zip(("logpi", "likely", "col_h"), out):
             for f, start, end in zip(fs, [0] + ends, ends):
                 setattr(f, name, a[start:end])
+
+    def _filter_pixel_scales(self, centres: np.ndarray, cameras) -> dict[str, np.ndarray]:
+        """``pixel_weights="filter"``: per camera, (F,) 1 / the mean image length (pixels) of a body
+        sample of the column at each of ``centres`` (F, 2), metres; 0 where it does not project."""
+        out = {}
+        top = float(self.heights[-1])
+        for cid in cameras:
+            cl = self._cams[cid]
+            xy = self._near_surface(centres, cl)
+            ends = np.concatenate([np.column_stack([xy, np.zeros(len(xy))]),
+                                   np.column_stack([xy, np.full(len(xy), top)])])
+            uv = cl.camera.project(ends).reshape(2, len(xy), 2)
+            length = np.hypot(*(uv[1] - uv[0]).T) / (len(self.heights) - 1)
+            ok = np.isfinite(length) & (length > 0)
+            out[cid] = np.where(ok, 1.0 / np.where(ok, length, 1.0), 0.0)
+        return out
 
     def _update_tracking(self, fs: list[_Filter], t: float) -> None:
         """Share of likely particles (end at ≤ β), weights (eq. 8), resampling and object region of

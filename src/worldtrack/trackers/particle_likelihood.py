@@ -130,6 +130,7 @@ def hit_labels(image: np.ndarray, background: np.ndarray, gamma: float,
 CANDIDATE = 3
 #: A column sample's label when none of its pixels is in the image (:func:`column_counts`).
 _OUT_OF_VIEW = 3
+_OCCLUDED = 4          # in the box of a nearer object: no evidence, like 2
 
 
 def _judge_texture(labels: np.ndarray, image: np.ndarray, background: np.ndarray, shadow: int,
@@ -343,6 +344,17 @@ def filter_rows(box, me: int | Sequence[int], which: np.ndarray | None,
     return boxes, mes, np.ascontiguousarray(which, dtype=np.int64)
 
 
+def _per_filter_int(v: int | Sequence[int], f: int) -> np.ndarray:
+    """(F,) int64 of one value for all ``f`` filters or one per filter."""
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=np.int64), (f,)))
+
+
+def pixel_scales(px_scale: float | Sequence[float], f: int) -> np.ndarray:
+    """(F,) float64 pixel-weight scales (1 / pixels) of ``f`` filters from one scale for all or one
+    per filter (0: unweighted samples)."""
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(px_scale, dtype=np.float64), (f,)))
+
+
 # ---------------------------------------------------------------------------- Numba kernels
 #
 # The kernels read the intrinsics and distortion once per call, as a tuple of scalars (:func:`_lens`),
@@ -435,8 +447,8 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                   owner: np.ndarray, boxes: np.ndarray, which: np.ndarray, near1: np.ndarray, id1: np.ndarray,
                   near2: np.ndarray, mes: np.ndarray, centre: np.ndarray, margin: float, on: float, off: float,
                   below: float, n_below: int, n_above: int, k_min: int, tops: np.ndarray, top_sigma: float,
-                  px_scale: float, outside_unknown: bool, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray,
-                  seen: np.ndarray) -> None:
+                  px_scale: np.ndarray, outside_unknown: bool, k_lo: np.ndarray, counts: np.ndarray,
+                  ratio: np.ndarray, top: np.ndarray, seen: np.ndarray, hidden: np.ndarray) -> None:
     """Height-column likelihood of the particles of one or more filters for one camera, in place.
 
     Parameters
@@ -464,17 +476,22 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     k_min : int — the top is searched from index ``k_min`` of ``heights`` up to ``S − n_above − 1``
     tops, top_sigma : (N,) float64 and float, metres — with ``top_sigma > 0`` each particle's own
         object height: a top at height z adds the log prior ``−(z − tops[i])² / (2·top_sigma²)``
-    px_scale : float, 1 / pixels — 0: every sample weighs 1 (the paper's samples); > 0: each
-        sample's terms are weighted by the image length it stands for times ``px_scale``, so that a
-        column counts *pixels* of evidence and a far column, short in the image, does not gain
-        from packing more samples into the same pixels
+    px_scale : (F,) float64, 1 / pixels — per filter, 0: every sample weighs 1 (the paper's
+        samples); > 0: each sample's terms are weighted by the image length it stands for times
+        ``px_scale``, so that a column counts *pixels* of evidence and a far column, short in the
+        image, does not gain from packing more samples into the same pixels
     outside_unknown : bool — a sample out of the image (none of its pixels in it) or behind the
         camera adds nothing to ``ratio`` (no evidence) instead of ``off`` (background, the paper)
+    k_lo : (F,) int64 — per filter, the samples ``heights[:k_lo]`` read no evidence in ``ratio`` (not
+        in ``counts``): the columns of a filter whose lower part is hidden (behind a nearer object,
+        below the image's edge) are scored on the samples they all see
     counts : (N,) int32 — out: samples ``k·dz``, k = 0 … T, on ``F > γ`` (labels 1 and 2: π_i, eq. 11);
         a sample out of the image is never counted
     ratio : (N,) float64 — out: the best log-likelihood ratio
     top : (N,) int32 — out: the index into ``heights`` of the best top
     seen : (N,) bool — out: at least one sample projects into the image
+    hidden : (N,) int32 — out: how many of the lowest samples, from ``heights[0]`` up, are hidden —
+        occluded, or out of view with ``outside_unknown``
     """
     H, W = hit.shape
     S = heights.shape[0]
@@ -490,6 +507,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     for i in range(xy.shape[0]):
         box = _box(boxes, which[i])
         me = mes[which[i]]
+        ps = px_scale[which[i]]
         depth = math.hypot(xy[i, 0] - centre[0], xy[i, 1] - centre[1])
         # Camera-frame coordinates of the floor point; the column is linear in z.
         b0 = R[0, 0] * xy[i, 0] + R[0, 1] * xy[i, 1] + t[0]
@@ -530,20 +548,31 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                     for j in range(lines):
                         if (others >> j) & 1 and _occluded(near1, id1, near2, me, _nearest(u + _line_offset(j, d), W),
                                                            iv, depth, margin):
-                            lab = 2
+                            lab = _OCCLUDED
                             break
             label[k] = lab
-        if px_scale > 0.0:
+        if ps > 0.0:
             for k in range(S):
-                wt[k] = _sample_length(us, vs, k) * px_scale
+                wt[k] = _sample_length(us, vs, k) * ps
+        else:
+            for k in range(S):
+                wt[k] = 1.0
+        c = 0
+        for k in range(n_below, last + 1):
+            if label[k] == 1 or label[k] == 2 or label[k] == _OCCLUDED:
+                c += 1
+        # Hidden from the bottom up: occluded, or out of view when that is no evidence.
+        hb = 0
+        while hb < S and (label[hb] == _OCCLUDED or (label[hb] == _OUT_OF_VIEW and outside_unknown)):
+            hb += 1
+        hidden[i] = hb
+        # The samples below ``k_lo`` of the particle's filter read no evidence.
+        for k in range(min(k_lo[which[i]], S)):
+            label[k] = 2
         base = 0.0
         for k in range(n_below):
             if label[k] == 1:
                 base += below * wt[k]
-        c = 0
-        for k in range(n_below, last + 1):
-            if label[k] == 1 or label[k] == 2:
-                c += 1
         # Ring above the top: the weight of the ``n_above`` samples above index k that read object.
         ring = 0.0
         for k in range(k_min + 1, min(k_min + n_above, S - 1) + 1):
@@ -702,12 +731,15 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
                             on: float = 1.0, off: float = -1.0, k_min: int = 0, radius: float = 0.0,
                             below: float = 0.0, n_below: int = 0, n_above: int = 0,
                             owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
-                            top_sigma: float = 0.0, px_scale: float = 0.0, occluders: Occluders | None = None,
+                            top_sigma: float = 0.0, px_scale: float | Sequence[float] = 0.0,
+                            occluders: Occluders | None = None,
                             me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None,
-                            outside_unknown: bool = False):
+                            outside_unknown: bool = False, k_lo: int | Sequence[int] = 0,
+                            return_hidden: bool = False):
     """:func:`column_counts` written plainly: every (particle, height) point through :meth:`Camera.project`.
 
-    ``box``, ``me``, ``which`` and ``outside_unknown`` as in :meth:`CameraLikelihood.column`.
+    ``box``, ``me``, ``which``, ``px_scale``, ``outside_unknown``, ``k_lo`` and ``return_hidden`` as in
+    :meth:`CameraLikelihood.column`.
 
     Returns
     -------
@@ -715,16 +747,19 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
     ratio : (N,) float — the best log-likelihood ratio
     top : (N,) int64 — index into ``heights`` of the best top
     seen : (N,) bool — some sample projects into the image
+    hidden : (N,) int64, with ``return_hidden`` — how many lowest samples are hidden
     """
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     n, s = len(xy), len(heights)
     boxes, mes, which = filter_rows(box, me, which, n)
     own_box, own_index = boxes[which], mes[which][:, None]
+    scale = pixel_scales(px_scale, len(boxes))[which][:, None]
     uv, depth = camera.project(column_points(xy, heights), return_depth=True)
     hits = np.zeros((n, s), dtype=bool)
     unsure = np.zeros((n, s), dtype=bool)
     seen = np.zeros(n, dtype=bool)
     in_view = np.zeros((n, s), dtype=bool)               # some pixel of the sample is in the image
+    occluded = np.zeros((n, s), dtype=bool)              # some pixel in a nearer object's box
     offsets = [0.0] if radius <= 0 else [0.0, -1.0, 1.0]
     with np.errstate(divide="ignore", invalid="ignore"):
         d = np.where(depth > 1e-9, camera.K[0, 0] * radius / depth, 0.0)
@@ -740,20 +775,26 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         if occluders is not None and occluders[0].size:
             # In a nearer object's box: occluded, no evidence.
             particle_depth = camera.floor_rays(xy)[1][:, None]
-            unsure |= inside & ~readable & (occluders.depth_for(own_index, iv, iu) < particle_depth - margin)
+            occluded |= inside & ~readable & (occluders.depth_for(own_index, iv, iu) < particle_depth - margin)
         seen |= inside.any(axis=1)
         in_view |= inside
+    occluded &= ~hits & ~unsure
+    unsure |= occluded
     unsure &= ~hits
+    hid = occluded | (~in_view if outside_unknown else False)
+    hidden = np.where(hid.all(axis=1), s, np.argmin(hid, axis=1))
     if outside_unknown:
         unsure |= ~in_view
-    if px_scale > 0:
-        # Each sample stands for half the image distance between its neighbours (one at the ends).
-        lo = np.maximum(np.arange(s) - 1, 0)
-        hi = np.minimum(np.arange(s) + 1, s - 1)
-        length = np.hypot(*(uv[:, hi] - uv[:, lo]).transpose(2, 0, 1)) / (hi - lo)
-        weight = np.nan_to_num(length, nan=0.0) * px_scale
-    else:
-        weight = np.ones((n, s))
+    counts = ((hits | unsure) & in_view)[:, n_below:s - n_above].sum(axis=1).astype(np.int64)
+    # The samples below each filter's k_lo read no evidence.
+    cut = np.arange(s)[None, :] < _per_filter_int(k_lo, len(boxes))[which][:, None]
+    hits, unsure = hits & ~cut, unsure | cut
+    # Each sample stands for half the image distance between its neighbours (one at the ends).
+    lo = np.maximum(np.arange(s) - 1, 0)
+    hi = np.minimum(np.arange(s) + 1, s - 1)
+    with np.errstate(invalid="ignore"):
+        length = np.nan_to_num(np.hypot(*(uv[:, hi] - uv[:, lo]).transpose(2, 0, 1)) / (hi - lo), nan=0.0)
+    weight = np.where(scale > 0, length * scale, 1.0)
     last = s - n_above                                   # one past the highest possible top
     terms = np.where(hits, on, np.where(unsure, 0.0, off)) * weight
     terms[:, :n_below] = np.where(hits[:, :n_below], below, 0.0) * weight[:, :n_below]
@@ -769,8 +810,8 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         run = run - 0.5 * ((z - np.asarray(tops, dtype=float)[:, None]) / top_sigma) ** 2
     run[:, :max(k_min, n_below)] = -np.inf
     top = np.argmax(run, axis=1)
-    counts = ((hits | unsure) & in_view)[:, n_below:last].sum(axis=1).astype(np.int64)
-    return counts, run[np.arange(n), top], top, seen
+    out = counts, run[np.arange(n), top], top, seen
+    return out + (hidden,) if return_hidden else out
 
 
 def point_values_reference(camera: Camera, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
@@ -820,17 +861,22 @@ class CameraLikelihood:
     def column(self, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
                k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
                owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
-               top_sigma: float = 0.0, px_scale: float = 0.0, occluders: "Occluders | None" = None,
-               me: int | Sequence[int] = -1, margin: float = 0.0, which: np.ndarray | None = None,
-               outside_unknown: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+               top_sigma: float = 0.0, px_scale: float | Sequence[float] = 0.0,
+               occluders: "Occluders | None" = None, me: int | Sequence[int] = -1, margin: float = 0.0,
+               which: np.ndarray | None = None, outside_unknown: bool = False,
+               k_lo: int | Sequence[int] = 0, return_hidden: bool = False) -> tuple[np.ndarray, ...]:
         """(counts, ratio, top, seen) of the height columns at ``xy`` (N, 2); see :func:`column_counts`.
 
         ``box`` is the filter's own box among those behind ``owner``; ``occluders``
         (:func:`occluder_layers` of those boxes) with ``me`` (the filter's index among them) and
         ``margin`` (m): samples behind a nearer object read as no evidence. The particles of
         several filters in one call: ``which`` (N,) int, each particle's filter 0 … F − 1, with
-        ``box`` and ``me`` sequences of F (:func:`filter_rows`). ``outside_unknown``: samples out
-        of the image are no evidence rather than background (``ParticleConfig.out_of_view``)."""
+        ``box`` and ``me`` sequences of F (:func:`filter_rows`). ``px_scale``: one pixel-weight
+        scale (1 / pixels, 0 = unweighted) for all particles or one per filter. ``outside_unknown``:
+        samples out of the image are no evidence rather than background
+        (``ParticleConfig.out_of_view``). ``k_lo``: for all particles or per filter, the samples
+        ``heights[:k_lo]`` read no evidence in ``ratio``. ``return_hidden``: also return
+        :func:`column_counts`' ``hidden`` (N,) int32, the number of lowest samples hidden."""
         xy = np.ascontiguousarray(xy, dtype=np.float64)
         n = len(xy)
         boxes, mes, which = filter_rows(box, me, which, n)
@@ -838,14 +884,15 @@ class CameraLikelihood:
         ratio = np.empty(n, dtype=np.float64)
         top = np.empty(n, dtype=np.int32)
         seen = np.empty(n, dtype=np.bool_)
+        hidden = np.empty(n, dtype=np.int32)
         column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
                       self.has_dist, float(radius), hit, self.no_owner if owner is None else owner, boxes, which,
                       *(NO_OCCLUDERS if occluders is None else occluders), mes, self.centre, float(margin),
                       float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
                       np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
-                      float(top_sigma) if tops is not None else 0.0, float(px_scale), bool(outside_unknown),
-                      counts, ratio, top, seen)
-        return counts, ratio, top, seen
+                      float(top_sigma) if tops is not None else 0.0, pixel_scales(px_scale, len(boxes)),
+                      bool(outside_unknown), _per_filter_int(k_lo, len(boxes)), counts, ratio, top, seen, hidden)
+        return (counts, ratio, top, seen, hidden) if return_hidden else (counts, ratio, top, seen)
 
     def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
               box=None, which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
