@@ -144,7 +144,7 @@ class ParticleConfig:
         hit_rate_background``. With the foot samples this is a ring round the column (seed 000's
         −1 ring in column form): a column that stands on a body farther along the line of sight
         and stops short inside it hits both, so depth comes from the head as well as the feet (2).
-    pixel_weights : {"none", "depth", "filter"}
+    pixel_weights : {"none", "depth", "filter", "hidden"}
         With ``ratio``: weight each column sample by the image length it stands for, so the ratio
         counts pixels of evidence. Samples are evenly spaced in height, not in the image:
         unweighted (``none``, the paper), a column farther along the line of sight — shorter in the
