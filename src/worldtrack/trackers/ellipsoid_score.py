@@ -329,22 +329,17 @@ def _row_span(f, v):
 @njit(cache=True, inline="always")
 def _span_indices(lo, hi, us, stride, n):
     """Sampled columns ``us + i·stride`` (i < n) strictly inside the open interval (lo, hi): the
-    index range [i0, i1) (empty when i0 ≥ i1), found arithmetically and then checked with the
-    same float comparisons as a pixel-by-pixel test."""
+    index range [i0, i1) (empty when i0 ≥ i1).
+
+    Exact in integers: a column u is > lo when u ≥ ⌊lo⌋ + 1 and < hi when u < ⌈hi⌉, the same
+    answers as comparing the float coordinate pixel by pixel.
+    """
     if not lo < hi:
         return 0, 0
-    flo = min(max((lo - us) / stride, -1.0), n + 1.0)
-    fhi = min(max((hi - us) / stride, -1.0), n + 1.0)
-    i0 = min(max(int(math.floor(flo)) + 1, 0), n)
-    while i0 > 0 and np.float64(us + (i0 - 1) * stride) > lo:
-        i0 -= 1
-    while i0 < n and not np.float64(us + i0 * stride) > lo:
-        i0 += 1
-    i1 = min(max(int(math.ceil(fhi)), 0), n)
-    while i1 > 0 and not np.float64(us + (i1 - 1) * stride) < hi:
-        i1 -= 1
-    while i1 < n and np.float64(us + i1 * stride) < hi:
-        i1 += 1
+    first = int(math.floor(min(max(lo, -1e9), 1e9))) + 1    # the first column > lo
+    end = int(math.ceil(min(max(hi, -1e9), 1e9)))           # the first column ≥ hi
+    i0 = min(max(-((us - first) // stride), 0), n)          # ⌈(first − us) / stride⌉
+    i1 = min(max(-((us - end) // stride), 0), n)
     return i0, max(i0, i1)
 
 
@@ -357,9 +352,10 @@ def _pixels_by_rows(occ, real, use_ring, count_unexplained, c_inner, c_ring, c_b
     terms depend on the candidate only through whether the candidate's ellipse or ring covers it,
     so each row is read once: the terms without the candidate (the others' joint image) and,
     as running sums along the row, how much they change where a candidate's ellipse or ring
-    lies. A candidate then costs two interval lookups per row instead of a test per pixel —
-    unless an obstacle nearer than the candidate hides part of the row, where its pixels are
-    visited one by one. Sums are identical to visiting every pixel for every candidate.
+    lies. A candidate then costs two interval lookups per row instead of a test per pixel, plus
+    a correction at each pixel of its interval where an obstacle nearer than it hides it (those
+    keep their terms without the candidate). Sums are identical to visiting every pixel for
+    every candidate (:func:`score_candidates_reference`).
     """
     C = c_inner.shape[0]
     M = near.shape[0]
@@ -447,8 +443,11 @@ def _pixels_by_rows(occ, real, use_ring, count_unexplained, c_inner, c_ring, c_b
                     num[c] += rg_n[b1] - rg_n[b0]
                     den[c] += rg_d[b1] - rg_d[b0]
             # Pixels where an obstacle nearer than the candidate hides it keep their base terms.
-            for h in range(n_hiding):
+            start, stop = min(a0, b0) if b0 < b1 else a0, max(a1, b1)
+            for h in range(np.searchsorted(hiding[:n_hiding], start), n_hiding):
                 i = hiding[h]
+                if i >= stop:
+                    break
                 if o_row[i] >= c_dist[c]:
                     continue
                 if a0 <= i < a1:
