@@ -37,3 +37,21 @@ def test_extreme_ends_of_a_rectangle_are_its_top_and_bottom_rows():
     np.testing.assert_allclose(bottom, [99.5, 248.5])  # rows 248 and 249
     n, _, _ = extreme_ends(labels, np.zeros((300, 200), bool), 0, 0, 0.0, 1.0)
     assert n == 0
+
+
+def test_pixel_clear_equals_the_reference():
+    from worldtrack.geometry.camera import Camera
+    from worldtrack.trackers.height import pixel_clear, pixel_clear_reference
+    cam = Camera.look_at("c", 64, 48, [0.0, -5.0, 3.0], [0.0, 0.0, 0.0], hfov_deg=60.0)
+    occ = np.full((48, 64), np.inf, np.float32)
+    occ[30:, 10:40] = 4.0                                     # an obstacle in the lower left
+    rng = np.random.default_rng(2)
+    p = rng.uniform([-3, -3], [67, 51], (500, 2))
+    p[:50] = np.round(p[:50]) + 0.5                            # exact halves round to even
+    for grid in (None, occ):
+        got = pixel_clear(cam, grid, p)
+        np.testing.assert_array_equal(got, pixel_clear_reference(cam, grid, p))
+        assert got.shape == (500,) and 0 < got.sum() < 500
+        np.testing.assert_array_equal(pixel_clear(cam, grid, p.reshape(50, 10, 2)), got.reshape(50, 10))
+        assert pixel_clear(cam, grid, p[7]) == got[7]            # one point: a scalar
+    assert not pixel_clear(cam, occ, np.array([20.0, 40.0])) and pixel_clear(cam, None, np.array([20.0, 40.0]))

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import Mapping, NamedTuple
 
 import cv2
@@ -591,9 +592,7 @@ class EllipsoidTracker:
         """
         if self._walkable([xy])[0]:
             return np.asarray(xy, float)
-        g = np.arange(-radius, radius + 1e-9, 0.05)
-        offsets = np.array([(a, b) for a in g for b in g])
-        offsets = offsets[np.hypot(offsets[:, 0], offsets[:, 1]) <= radius]
+        offsets = _disc_offsets(radius)
         cand = xy + offsets
         ok = self._walkable(cand)
         if not ok.any():
@@ -980,6 +979,16 @@ def _ray_direction(cam: Camera, xy: np.ndarray) -> np.ndarray:
     """Unit floor direction of the camera's ray through floor point ``xy`` — the direction along
     which one camera cannot tell depth — or the optical axis's for a point right below the camera."""
     return cam.floor_rays(xy, min_distance=0.3)[0]
+
+
+@lru_cache(maxsize=8)
+def _disc_offsets(radius: float) -> np.ndarray:
+    """(K, 2) floor offsets (m) on a 5 cm grid within ``radius`` of the origin, row by row."""
+    g = np.arange(-radius, radius + 1e-9, 0.05)
+    offsets = np.array([(a, b) for a in g for b in g])
+    offsets = offsets[np.hypot(offsets[:, 0], offsets[:, 1]) <= radius]
+    offsets.setflags(write=False)
+    return offsets
 
 
 def _disc(radius: int) -> np.ndarray:
