@@ -97,3 +97,13 @@ def test_blob_extent_of_a_rectangle():
     assert (across_min, across_max) == (-(124 - 115.0), -(105 - 115.0))   # across = −du for down = (0, 1)
     # The top end: row 60 whole (u 105…124) and the first 12 pixels of row 61 (u 105…116).
     assert first == pytest.approx(-np.mean([*range(105, 125), *range(105, 117)]) + 115.0)
+
+
+def test_extreme_indices_take_ties_in_index_order():
+    from worldtrack.foreground.components import extreme_indices
+    values = np.array([3.0, 1.0, 2.0, 1.0, 5.0, 1.0, 5.0, 0.0])
+    assert extreme_indices(values, 3, True).tolist() == [7, 1, 3]       # 0, then the first two 1s
+    assert extreme_indices(values, 1, False).tolist() == [4]            # the first of the two 5s
+    assert extreme_indices(values, 3, False).tolist() == [4, 6, 0]      # both 5s, then the 3
+    order = np.argsort(values, kind="stable")
+    assert sorted(extreme_indices(values, 5, True).tolist()) == sorted(order[:5].tolist())

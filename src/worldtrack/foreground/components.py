@@ -130,26 +130,36 @@ def blob_extent(blob: np.ndarray, u0: int, v0: int, cu: float, cv: float, dx: fl
                 across[i] = du * -dy + dv * dx
                 i += 1
     n_end = max(1, n // end_divisor)
-    low_cut = np.partition(along, n_end - 1)[n_end - 1]
-    high_cut = np.partition(along, n - n_end)[n - n_end]
     means = np.zeros(2)
     for e in range(2):
-        sign = 1.0 if e == 0 else -1.0
-        cut = low_cut if e == 0 else high_cut
-        taken = 0
         total = 0.0
-        for i in range(n):
-            if sign * along[i] < sign * cut:
-                total += across[i]
-                taken += 1
-        for i in range(n):
-            if taken >= n_end:
-                break
-            if along[i] == cut:
-                total += across[i]
-                taken += 1
+        for i in extreme_indices(along, n_end, e == 0):
+            total += across[i]
         means[e] = total / n_end
     return along.min(), along.max(), across.min(), across.max(), means[0], means[1]
+
+
+@njit(cache=True)
+def extreme_indices(values: np.ndarray, count: int, lowest: bool) -> np.ndarray:
+    """Indices of the ``count`` lowest (or highest) of ``values`` (1 ≤ count ≤ len): those strictly
+    beyond the cut in index order, then the ties at the cut in index order until ``count`` — the
+    set a stable sort puts first (or, for the ties, last), found by one selection (O(n))."""
+    n = values.shape[0]
+    cut = np.partition(values, count - 1)[count - 1] if lowest else np.partition(values, n - count)[n - count]
+    sign = 1.0 if lowest else -1.0
+    out = np.empty(count, np.int64)
+    taken = 0
+    for i in range(n):
+        if sign * values[i] < sign * cut:
+            out[taken] = i
+            taken += 1
+    for i in range(n):
+        if taken >= count:
+            break
+        if values[i] == cut:
+            out[taken] = i
+            taken += 1
+    return out
 
 
 def blob_extent_reference(blob: np.ndarray, u0: int, v0: int, cu: float, cv: float, dx: float, dy: float,

@@ -488,22 +488,10 @@ def ternary_real(labels: np.ndarray, ring_px: int) -> np.ndarray:
     # the square where some column within ring_px has it within ring_px, within the diamond where
     # the city-block distance is within diag. Both along the rows, on the transposed distances.
     crop = np.ascontiguousarray(labels[v0:v1, u0:u1])
-    down = _column_distance_of_label(crop, np.uint8(m))
+    down = _column_distance(crop, np.uint8(m), 1)
     near = cv2.transpose(_octagon_from_column_distance(cv2.transpose(down), np.uint8(m), ring_px, diag))
     _mark_ring(out[v0:v1, u0:u1], crop, near)
     return out
-
-
-@njit(cache=True)
-def _column_distance_of_label(labels: np.ndarray, cap: np.uint8) -> np.ndarray:
-    """(H, W) uint8: distance along the column to the nearest pixel labelled 1, capped at ``cap``."""
-    H, W = labels.shape
-    a = np.empty((H, W), np.uint8)
-    for y in range(H):
-        for x in range(W):
-            a[y, x] = 0 if labels[y, x] == 1 else cap
-    _relax_columns(a, cap)
-    return a
 
 
 @njit(cache=True)
@@ -582,7 +570,7 @@ def within_l1(fg: np.ndarray, radius: int) -> np.ndarray:
     if radius >= 255:
         return within_l1_reference(fg, radius)
     cap = np.uint8(radius + 1)
-    down = _column_distance(fg, cap)
+    down = _column_distance(np.ascontiguousarray(fg != 0), cap, True)
     return cv2.transpose(_column_distance_within(cv2.transpose(down), cap, np.uint8(radius)))
 
 
@@ -612,13 +600,14 @@ def _relax_columns(a: np.ndarray, cap: np.uint8) -> None:
 
 
 @njit(cache=True)
-def _column_distance(fg: np.ndarray, cap: np.uint8) -> np.ndarray:
-    """(H, W) uint8: distance along the column to the nearest non-zero pixel of ``fg``, capped."""
-    H, W = fg.shape
+def _column_distance(image: np.ndarray, cap: np.uint8, value) -> np.ndarray:
+    """(H, W) uint8: distance along the column to the nearest pixel of ``image`` equal to
+    ``value``, capped at ``cap``."""
+    H, W = image.shape
     a = np.empty((H, W), np.uint8)
     for y in range(H):
         for x in range(W):
-            a[y, x] = 0 if fg[y, x] else cap
+            a[y, x] = 0 if image[y, x] == value else cap
     _relax_columns(a, cap)
     return a
 

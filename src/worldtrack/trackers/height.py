@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from worldtrack.foreground.components import extreme_indices
 from worldtrack.geometry.camera import Camera
 
 
@@ -244,27 +245,12 @@ def extreme_ends(labels: np.ndarray, region: np.ndarray, u0: int, v0: int, dx: f
     for i in range(n):
         along[i] = (us[i] - cu) * dx + (vs[i] - cv) * dy
     n_end = max(1, n // 100)
-    low_cut = np.partition(along, n_end - 1)[n_end - 1]        # the n_end-th smallest
-    high_cut = np.partition(along, n - n_end)[n - n_end]       # the n_end-th largest
-    for sign in (1.0, -1.0):
-        cut = low_cut if sign > 0 else high_cut
-        # Strictly beyond the cut, then ties in order until n_end are taken.
-        taken = 0
+    for out, lowest in ((first, True), (last, False)):
         tu = 0.0
         tv = 0.0
-        for i in range(n):
-            if sign * along[i] < sign * cut:
-                tu += us[i]
-                tv += vs[i]
-                taken += 1
-        for i in range(n):
-            if taken >= n_end:
-                break
-            if along[i] == cut:
-                tu += us[i]
-                tv += vs[i]
-                taken += 1
-        out = first if sign > 0 else last
+        for i in extreme_indices(along, n_end, lowest):
+            tu += us[i]
+            tv += vs[i]
         out[0] = tu / n_end
         out[1] = tv / n_end
     return n, first, last
