@@ -83,3 +83,37 @@ def test_walker_along_the_line_of_sight_is_followed(velocity):
     assert np.mean(err) < 0.10 and np.max(err) < 0.25
     vy = [tracks[0].vy for _, _, tracks in out[10:]]
     assert np.median(vy) == pytest.approx(-1.0, abs=0.25)
+
+
+def test_velocity_walk_kernel_equals_numpy_reference():
+    """The compiled velocity walk (``velocity="state"``) gives the NumPy code's values bit for bit,
+    clipped speeds, stopped walks (scale 0) and the vertical component included."""
+    from worldtrack.trackers.particle_sampling import velocity_walk, velocity_walk_reference
+
+    rng = np.random.default_rng(3)
+    for f, n in ((1, 7), (6, 500)):
+        v = rng.normal(0, 1.5, (f, n, 3))
+        a = rng.standard_normal((f, n, 2))
+        step = rng.normal(0, 0.05, (f, n, 3))
+        scale = rng.uniform(0, 0.4, f)
+        scale[0] = 0.0
+        v1, s1, v2, s2 = v.copy(), step.copy(), v.copy(), step.copy()
+        velocity_walk(v1, a, scale, 2.5, 0.1, s1)
+        velocity_walk_reference(v2, a, scale, 2.5, 0.1, s2)
+        assert (np.hypot(v2[..., 0], v2[..., 1]) >= 2.5 - 1e-12).any()     # some speeds were clipped
+        np.testing.assert_array_equal(v1, v2)
+        np.testing.assert_array_equal(s1, s2)
+
+
+@pytest.mark.parametrize("q", [0.5, 0.3, 0.1, 0.9, 1.0, 0.0])
+def test_quantile_rank_picks_what_np_quantile_higher_picks(q):
+    """``k_lo`` is the per-filter order statistic at :func:`_quantile_rank` (np.partition), which is
+    the value ``np.quantile(..., method="higher")`` returns."""
+    from worldtrack.trackers.particle import _quantile_rank
+
+    rng = np.random.default_rng(5)
+    for f, n in ((1, 1), (4, 500), (3, 37)):
+        hid = rng.integers(0, 27, (f, n)).astype(np.int32)
+        r = _quantile_rank(n, q)
+        np.testing.assert_array_equal(np.partition(hid, r, axis=1)[:, r],
+                                      np.quantile(hid, q, axis=1, method="higher"))

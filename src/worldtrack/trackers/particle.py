@@ -73,6 +73,7 @@ Example
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
@@ -88,7 +89,7 @@ from worldtrack.trackers.particle_appearance import ColourModel, colour_log_rati
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, polygon_distance,
-                                                   resampler, splittable)
+                                                   resampler, splittable, velocity_walk)
 
 Box = tuple[int, int, int, int]
 
@@ -320,7 +321,7 @@ class ParticleTracker:
         fs = list(self.filters)
         if fs:
             self._predict(fs, dt)
-            owners = boxes = occluders = None
+            owners = boxes = occluders = centres = None
             if cfg.explain == "all" and len(fs) > 1:      # a lone filter has nothing to explain away
                 centres = cloud_mean(_stack(fs, "xyz")[:, :, :2])
                 boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
@@ -331,7 +332,7 @@ class ParticleTracker:
                                                       self._layers.get(cid))
                                  for cid, img in images.items()}
                     self._layers.update(occluders)
-            self._observe(fs, images, owners, boxes, occluders)
+            self._observe(fs, images, owners, boxes, occluders, centres)
             self._update_tracking(fs, t)
         if cfg.appearance_weight > 0:
             self._learn_colours(images)
@@ -570,11 +571,9 @@ class ParticleTracker:
         elif cfg.velocity == "state":
             # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it.
             v = _stack(fs, "v")
-            scale = cfg.noise_v * math.sqrt(dt) * self._coasting(fs)[:, None, None]
-            v[..., :2] += self.rng.standard_normal(v[..., :2].shape) * scale
-            v[..., 2] = 0.0
-            _clip_speed(v, cfg.max_speed)
-            step += v * dt
+            scale = cfg.noise_v * math.sqrt(dt) * self._coasting(fs)
+            velocity_walk(v, self.rng.standard_normal(v.shape[:2] + (2,)), scale, float(cfg.max_speed),
+                          float(dt), step)
             for f, vv in zip(fs, v):
                 f.v = vv
         elif cfg.velocity == "object":
@@ -684,20 +683,28 @@ class ParticleTracker:
     def _observe(self, fs: list[_Filter], images: Mapping[str, np.ndarray],
                  owners: Mapping[str, np.ndarray] | None = None,
                  boxes: Mapping[str, list[Box | None]] | None = None,
-                 occluders: Mapping[str, object] | None = None) -> None:
+                 occluders: Mapping[str, object] | None = None, centres: np.ndarray | None = None) -> None:
         """This frame's observation (``logpi, likely, col_h``) of filters ``fs``, in one likelihood call.
 
-        ``boxes`` and ``occluders`` (optional) are of the filters' objects in the order of ``fs``."""
+        ``boxes`` and ``occluders`` (optional) are of the filters' objects in the order of ``fs``;
+        ``centres`` (optional, (F, 2)) their particles' mean floor positions, if already at hand."""
         cfg = self.config
         sizes = [len(f.xyz) for f in fs]
         tracking = fs[0].track is not None
         scales = k_lo = hidden = None
         if cfg.pixel_weights in ("filter", "hidden") and cfg.weighting == "ratio" and tracking:
-            scales = self._filter_pixel_scales(cloud_mean(_stack(fs, "xyz")[:, :, :2]), images)
             if cfg.pixel_weights == "hidden":
-                # Only where the lower body was hidden last frame (above the foot samples).
-                for cid in scales:
-                    scales[cid] = np.where([f.k_lo.get(cid, 0) > self._n_below for f in fs], scales[cid], 0.0)
+                # Only where the lower body was hidden last frame (above the foot samples); the
+                # scales are not computed at all while no filter is hidden (then all 0).
+                use = {cid: np.array([f.k_lo.get(cid, 0) > self._n_below for f in fs]) for cid in images}
+                if any(u.any() for u in use.values()):
+                    scales = self._filter_pixel_scales(self._centres(fs, centres), images)
+                    for cid in scales:
+                        scales[cid] = np.where(use[cid], scales[cid], 0.0)
+                else:
+                    scales = {cid: np.zeros(len(fs)) for cid in images}
+            else:
+                scales = self._filter_pixel_scales(self._centres(fs, centres), images)
         if ((cfg.common_view > 0 or cfg.coast_hidden > 0 or cfg.pixel_weights == "hidden")
                 and cfg.likelihood == "column" and tracking):
             hidden = {}
@@ -709,14 +716,22 @@ class ParticleTracker:
         if hidden:
             # Next frame's k_lo: the share ``common_view`` of the filter's columns see every sample
             # from there up (tracking filters hold equal particle counts).
+            # (np.quantile(..., method="higher") of each row, as the order statistic it picks.)
+            n = len(fs[0].xyz)
+            rank = _quantile_rank(n, cfg.common_view or 0.5)
             for cid, hid in hidden.items():
-                lo = np.quantile(hid.reshape(len(fs), -1), cfg.common_view or 0.5, axis=1, method="higher")
+                lo = np.partition(hid.reshape(len(fs), n), rank, axis=1)[:, rank]
                 for f, v in zip(fs, lo.tolist()):
-                    f.k_lo[cid] = int(v)
+                    f.k_lo[cid] = v
         ends = np.cumsum(sizes).tolist()
         for name, a in zip(("logpi", "likely", "col_h"), out):
             for f, start, end in zip(fs, [0] + ends, ends):
                 setattr(f, name, a[start:end])
+
+    @staticmethod
+    def _centres(fs: list[_Filter], centres: np.ndarray | None) -> np.ndarray:
+        """(F, 2) the mean floor position of each filter's particles (``centres`` if given)."""
+        return cloud_mean(_stack(fs, "xyz")[:, :, :2]) if centres is None else centres
 
     def _filter_pixel_scales(self, centres: np.ndarray, cameras) -> dict[str, np.ndarray]:
         """``pixel_weights="filter"``: per camera, (F,) 1 / the mean image length (pixels) of a body
@@ -1026,6 +1041,13 @@ def _overlaps(boxes: list[Box | None]) -> np.ndarray:
 def _overlap(p: Box, q: Box) -> float:
     """Intersection of two pixel boxes over the smaller one's area."""
     return float(_overlaps([p, q])[0, 1])
+
+
+@functools.lru_cache(maxsize=16)
+def _quantile_rank(n: int, q: float) -> int:
+    """The 0-based rank of the order statistic that ``np.quantile(x, q, method="higher")`` returns
+    for ``n`` values (so ``np.partition`` can pick it without the quantile machinery)."""
+    return int(np.quantile(np.arange(n), q, method="higher"))
 
 
 def _stack(fs: list[_Filter], name: str) -> np.ndarray:

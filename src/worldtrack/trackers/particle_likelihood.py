@@ -504,10 +504,12 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     us = np.zeros(S)
     vs = np.zeros(S)
     wt = np.ones(S)
+    weighted = False                                        # wt holds a weighted particle's lengths
     for i in range(xy.shape[0]):
         box = _box(boxes, which[i])
         me = mes[which[i]]
         ps = px_scale[which[i]]
+        hb = 0                                              # hidden samples from the bottom up so far
         depth = math.hypot(xy[i, 0] - centre[0], xy[i, 1] - centre[1])
         # Camera-frame coordinates of the floor point; the column is linear in z.
         b0 = R[0, 0] * xy[i, 0] + R[0, 1] * xy[i, 1] + t[0]
@@ -551,21 +553,22 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
                             lab = _OCCLUDED
                             break
             label[k] = lab
+            # Hidden from the bottom up: occluded, or out of view when that is no evidence.
+            if hb == k and (lab == _OCCLUDED or (lab == _OUT_OF_VIEW and outside_unknown)):
+                hb = k + 1
+        hidden[i] = hb
         if ps > 0.0:
             for k in range(S):
                 wt[k] = _sample_length(us, vs, k) * ps
-        else:
+            weighted = True
+        elif weighted:
             for k in range(S):
                 wt[k] = 1.0
+            weighted = False
         c = 0
         for k in range(n_below, last + 1):
             if label[k] == 1 or label[k] == 2 or label[k] == _OCCLUDED:
                 c += 1
-        # Hidden from the bottom up: occluded, or out of view when that is no evidence.
-        hb = 0
-        while hb < S and (label[hb] == _OCCLUDED or (label[hb] == _OUT_OF_VIEW and outside_unknown)):
-            hb += 1
-        hidden[i] = hb
         # The samples below ``k_lo`` of the particle's filter read no evidence.
         for k in range(min(k_lo[which[i]], S)):
             label[k] = 2

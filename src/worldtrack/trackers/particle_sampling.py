@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -240,6 +241,50 @@ def splittable(xy: np.ndarray, min_separation: float, min_mass: float) -> np.nda
     if xy.shape[1] < 8:
         return np.zeros(len(xy), dtype=bool)
     return _wide_enough(_principal(xy)[1][3], min_separation, min_mass)
+
+
+# ---------------------------------------------------------------------------- motion
+
+@njit(cache=True)
+def velocity_walk(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: float, dt: float,
+                  step: np.ndarray) -> None:
+    """``velocity="state"``'s prediction of F filters, in place (one compiled pass instead of five
+    NumPy passes over strided views; equal to :func:`velocity_walk_reference`).
+
+    v : (F, N, 3) float64 — the particles' velocities (m/s); out: ``v + a·scale`` on the floor axes,
+        0 vertically, floor speeds above ``max_speed`` scaled down to it
+    a : (F, N, 2) float64 — standard normal draws of the walk
+    scale : (F,) float64 — per filter, the walk's σ·√dt (m/s)
+    step : (F, N, 3) float64 — the particles' moves (m); out: ``step + v·dt`` with the new ``v``
+    """
+    for f in range(v.shape[0]):
+        sc = scale[f]
+        for i in range(v.shape[1]):
+            v0 = v[f, i, 0] + a[f, i, 0] * sc
+            v1 = v[f, i, 1] + a[f, i, 1] * sc
+            s = math.hypot(v0, v1)
+            if s > max_speed:
+                r = max_speed / s
+                v0 *= r
+                v1 *= r
+            v[f, i, 0] = v0
+            v[f, i, 1] = v1
+            v[f, i, 2] = 0.0
+            step[f, i, 0] += v0 * dt
+            step[f, i, 1] += v1 * dt
+            step[f, i, 2] += 0.0 * dt
+
+
+def velocity_walk_reference(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: float, dt: float,
+                            step: np.ndarray) -> None:
+    """:func:`velocity_walk` in NumPy (the tracker's former code), in place."""
+    v[..., :2] += a * np.asarray(scale)[:, None, None]
+    v[..., 2] = 0.0
+    s = np.hypot(v[..., 0], v[..., 1])
+    over = s > max_speed
+    if over.any():
+        v[over, :2] *= (max_speed / s[over])[:, None]
+    step += v * dt
 
 
 def cloud_mean(x: np.ndarray) -> np.ndarray:
