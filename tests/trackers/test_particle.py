@@ -812,11 +812,12 @@ def test_a_track_lost_mid_room_is_watched_there_for_lost_hold_s_and_not_after():
     assert not _watches(tracker) and len(tracker.detectors) == 1
 
 
-@pytest.mark.parametrize("births", ["entry+lost", "entry"])
-def test_a_lost_person_who_shows_again_nearby_is_found_with_entry_lost_only(births):
-    """Gone from the image for 0.4 s mid-room, then standing 0.3 m from the track's last position."""
+@pytest.mark.parametrize("births, same_id", [("entry+lost", True), ("entry+lost", False), ("entry", True)])
+def test_a_lost_person_who_shows_again_nearby_is_found_with_entry_lost_only(births, same_id):
+    """Gone from the image for 0.4 s mid-room, then standing 0.3 m from the track's last position:
+    found again under the lost track's id (``lost_same_id``) or a new one."""
     scene = make_scene()
-    tracker, bgs = tracker_for(scene, births=births, end_after_s=0.0)
+    tracker, bgs = tracker_for(scene, births=births, end_after_s=0.0, lost_same_id=same_id)
     tracker.init_track(1.0, 3.0)
     out = run(tracker, scene, bgs, lambda t: [(1.0, 3.0)] if t < 0.45 else [] if t < 0.85 else [(1.3, 3.0)], 16)
     assert not out[7][2]
@@ -824,7 +825,7 @@ def test_a_lost_person_who_shows_again_nearby_is_found_with_entry_lost_only(birt
     if births == "entry":
         assert not tracks
         return
-    assert len(tracks) == 1 and tracks[0].id == 2
+    assert len(tracks) == 1 and tracks[0].id == (1 if same_id else 2)
     assert np.hypot(tracks[0].x - 1.3, tracks[0].y - 3.0) < 0.15
     assert not _watches(tracker)                                       # the watch that found it is dropped
 
@@ -839,3 +840,15 @@ def test_no_watch_where_an_entry_region_already_watches_or_for_tracks_not_ended_
     tracker.init_track(-1.0, 3.0)                                     # leaves through the exit
     out = run(tracker, scene, bgs, _walks_out_and_waits(2.25), 22)
     assert not out[-1][2] and len(tracker._leaving) == 1 and not _watches(tracker)
+
+
+def test_by_default_a_scene_with_entry_regions_watches_lost_tracks_and_the_paper_does_not():
+    scene = make_scene()
+    for cfg, watched in ((ParticleConfig(), True), (ParticleConfig.paper(), False)):
+        tracker, bgs = tracker_for(scene, **{k: getattr(cfg, k) for k in ("births", "lost_hold_s", "lost_same_id")},
+                                   end_after_s=0.0)
+        tracker.init_track(1.0, 3.0)
+        run(tracker, scene, bgs, lambda t: [(1.0, 3.0)] if t < 0.45 else [], 8)
+        assert not tracker.filters and len(_watches(tracker)) == int(watched)
+    tracker, _ = tracker_for(make_scene(entry=False))
+    assert tracker._births == "anywhere"

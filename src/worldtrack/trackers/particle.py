@@ -49,10 +49,11 @@ Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as p
   once instead of living on with whoever stands in front of the door on its line of sight, and its
   last box stays explained to the detection filters for a moment (``exit_*`` in
   :class:`ParticleConfig`);
-* lost tracks (``births="entry+lost"``): where a tracking filter ended by the β rule away from the
-  entry regions, a detection filter watches the floor round its last position for a while, so an
-  object that stopped showing enough (a person waiting with the feet below the image's edge) is
-  found again when it shows, not only when it comes back to a door;
+* lost tracks (``births="entry+lost"``, the default where the scene has entry regions): where a
+  tracking filter ended by the β rule away from the entry regions, a detection filter watches the
+  floor round its last position for a while, so an object that stopped showing enough (a person
+  with the feet below the image's edge, or out of the image for a few seconds) is found again,
+  under its old id, when it shows, not only when it comes back to a door;
 * the particles' z: the column does not depend on it, so after resampling each particle's z is
   drawn uniformly below the top its column sees — the particles then fill the object's height.
 
@@ -124,6 +125,7 @@ class _Filter:
     centre: np.ndarray | None = None
     logw: np.ndarray | None = None
     until: float | None = None
+    lost_id: int | None = None
     low_since: float | None = None
     t_update: float | None = None
     split_count: int = 0
@@ -211,7 +213,7 @@ class ParticleTracker:
         self._resample = resampler(cfg.resampling)
         self._walkable = scene.walkable.raster(0.01).contains
         self.filters: list[_Filter] = []
-        self._births = cfg.births if cfg.births != "auto" else ("entry" if scene.entry_regions else "anywhere")
+        self._births = cfg.births if cfg.births != "auto" else ("entry+lost" if scene.entry_regions else "anywhere")
         self.detectors = [_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=r, h=np.zeros(0))
                           for r in self._detection_regions()]
         self._last_t: float | None = None
@@ -872,19 +874,24 @@ class ParticleTracker:
                                         & self._in_view(p))
             if not reg.empty:
                 self.detectors.append(_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=reg, h=np.zeros(0),
-                                              until=t + cfg.lost_hold_s))
+                                              until=t + cfg.lost_hold_s, lost_id=tracks[k].id))
 
     def _spawn(self, d: _Filter, idx: np.ndarray, t: float) -> None:
         """Start tracking filters from a detection filter's likely particles, one per lump."""
         cfg = self.config
-        for g in (self._lumps(d.xyz, idx, depth=2) if cfg.split else [idx]):
+        lumps = self._lumps(d.xyz, idx, depth=2) if cfg.split else [idx]
+        # A lost track's watch (``lost_same_id``): its biggest lump is that object found again.
+        same = (d.lost_id if cfg.lost_same_id and d.lost_id is not None and d.lost_id not in self.position_map
+                else None)
+        big = max(range(len(lumps)), key=lambda i: len(lumps[i]))
+        for i, g in enumerate(lumps):
             f = d.subset(g, v=self._draw_velocities(len(g)))
             self._resample_filter(f, self._weights(f.logpi), cfg.particles)
-            self._new_track(f, t, score=float(d.likely.mean()))
+            self._new_track(f, t, score=float(d.likely.mean()), track_id=same if i == big else None)
 
-    def _new_track(self, f: _Filter, t: float, score: float) -> None:
+    def _new_track(self, f: _Filter, t: float, score: float, track_id: int | None = None) -> None:
         c = f.xyz.mean(axis=0)
-        tr = self.position_map.add(c[0], c[1], mode="tracking", time=t)
+        tr = self.position_map.add(c[0], c[1], mode="tracking", time=t, track_id=track_id)
         tr.height, tr.width = self.scene.people.size_of(tr.id)
         tr.score = score
         f.track = tr
