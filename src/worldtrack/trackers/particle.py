@@ -113,8 +113,10 @@ class _Filter:
     last frame (None: scatter afresh); ``until`` (s) the time after which a detection filter that
     watches a lost track's place is dropped (None: kept for good). ``logpi, likely, col_h`` hold
     this frame's observation; ``h`` (P,) each particle's object height (m), where its column's top
-    is expected. ``k_lo`` {camera_id: int}: the lowest column samples that read no evidence for this
-    filter (``common_view``).
+    is expected. ``k_lo`` {camera_id: int}: how many of the lowest column samples of this filter's
+    particles were hidden (occluded or out of view) last frame, as an order statistic over them (the
+    ``common_view`` share, else the median); read by ``pixel_weights="hidden"``, ``coast_hidden``
+    and, as the samples that read no evidence, by ``common_view``.
     """
 
     xyz: np.ndarray
