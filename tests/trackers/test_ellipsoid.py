@@ -14,7 +14,8 @@ from worldtrack.pipeline import make_foregrounds
 from worldtrack.scene import scene_from_dict
 from worldtrack.synth import make_scenario
 from worldtrack.trackers import make_tracker
-from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker, _form_mask
+from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker, _form_mask, _ray_direction
+from worldtrack.trackers.ellipsoid_score import ternary_real
 from worldtrack.trackers.height import measure_height
 
 
@@ -286,3 +287,36 @@ def test_height_is_no_longer_measured_once_the_samples_are_in(monkeypatch):
     assert len(tr._heights[1]) == 4                        # measured, and no more than wanted
     assert sum(per_frame[:5]) >= 4 and sum(per_frame[-15:]) == 0
     assert tr.position_map[1].height == pytest.approx(1.8)
+
+
+def test_new_person_is_placed_along_the_line_of_sight_of_the_camera_that_proposed_them():
+    # A blob's foot point is uncertain along the ray of the camera whose blob it is: the birth
+    # search runs along that ray. Along the other camera's ray the same guess stays 0.15 m off.
+    scene = _two_camera_scene((320, 240))
+    rng = np.random.default_rng(3)
+    bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
+    person = np.array([-1.0, 1.2])
+    cen, rad = q.person_ellipsoid([person], 1.65, 0.4)
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig())
+    real = {}
+    for cid, cam in scene.cameras.items():
+        img = bgs[cid].copy()
+        img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
+        labels = tracker.cams[cid].foreground.labels(np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8))
+        tracker.last_labels[cid], tracker.last_masks[cid] = labels, (labels == 1).astype(np.uint8)
+        real[cid] = ternary_real(labels, tracker.cams[cid].ring_px)
+    # Births say which camera's blob each proposal came from.
+    born = tracker._births(real, 0.0)
+    assert born and all(b.extra["seen_by"] in scene.cameras for b in born)
+    for b in born:
+        tracker.position_map.remove(b.id)
+    for proposer, other in (("c1", "c2"), ("c2", "c1")):
+        guess = person + 0.9 * _ray_direction(scene.camera(proposer), person)
+        errors = {}
+        for seen_by in (proposer, other):
+            new = tracker.position_map.add(*guess, mode="capture", tentative=True)
+            new.extra["seen_by"] = seen_by
+            tracker._match([new], real)
+            errors[seen_by] = np.hypot(new.x - person[0], new.y - person[1])
+            tracker.position_map.remove(new.id)
+        assert errors[proposer] < 0.03 and errors[other] > 0.1, errors

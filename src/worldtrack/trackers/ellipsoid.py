@@ -352,7 +352,7 @@ class EllipsoidTracker:
         if cfg.birth_search_m > 0:
             for k, tr in enumerate(tracks):
                 if tr.mode == "capture" and tr.age_frames == 0:
-                    self._search_new(k, xy, hs, ws, state, real)
+                    self._search_new(k, xy, hs, ws, state, real, tr.extra.pop("seen_by", None))
         use_ring = np.array([tr.mode != "capture" for tr in tracks])
         if self._python_rounds:
             best_e, best_den = self._rounds_python(use_ring, xy, hs, ws, state, real)
@@ -458,15 +458,21 @@ class EllipsoidTracker:
         return e, den, cand, forms, ok
 
     def _search_new(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
-                    real: dict[str, np.ndarray]) -> None:
+                    real: dict[str, np.ndarray], seen_by: str | None = None) -> None:
         """Place a just-proposed person by a coarse grid search before the 9-candidate steps.
 
-        A blob's foot point is uncertain mostly along the viewing direction (feet lost in a hole of
-        the mask, two people merged), so candidates spread ±``birth_search_m`` along the axes of
-        the camera that sees the person largest, 0.1 m apart, scored over every camera.
+        A blob's foot point is uncertain mostly along the line of sight of the camera the blob
+        was found in (``seen_by``: feet lost in a hole of the mask, two people merged, a head
+        back-projected at the default height), so candidates spread ±``birth_search_m`` along that
+        camera's ray through the guess and ±0.2 m across it, 0.1 m apart, scored over every
+        camera. Without ``seen_by``, the ray of the camera that sees the guess largest.
         """
         cfg = self.config
-        d = self._axes(k, state, xy, along_ray=True)
+        if seen_by in self.cams:
+            ray = _ray_direction(self.cams[seen_by].camera, xy[k])
+            d = ray, np.array([-ray[1], ray[0]])
+        else:
+            d = self._axes(k, state, xy, along_ray=True)
         along = np.arange(-cfg.birth_search_m, cfg.birth_search_m + 1e-9, 0.1)
         across = np.array([-0.2, -0.1, 0.0, 0.1, 0.2])
         grid = np.array([(a, c) for a in along for c in across])
@@ -639,17 +645,18 @@ class EllipsoidTracker:
                 expected = _visible_pixels(cs, pxy, h0, w0)
                 if expected <= 0 or area < cfg.min_blob_fraction * expected:
                     continue
-                proposals.append(pxy)
+                proposals.append((pxy, cid))
         if not proposals:
             return []
         if cfg.births == "entry" and self._frame > 0 and self.scene.entry_regions:
-            proposals = [p for p in proposals if self.scene.entry_region_index([p])[0] >= 0]
+            proposals = [(p, cid) for p, cid in proposals if self.scene.entry_region_index([p])[0] >= 0]
         # Each proposal is already clear of the existing people; keep the proposals apart too.
         new: list[Track] = []
-        for p in proposals:
+        for p, cid in proposals:
             if any(np.hypot(*(np.array([b.x, b.y]) - p)) < cfg.min_separation_m for b in new):
                 continue
             tr = self.position_map.add(p[0], p[1], h0, w0, mode="capture", time=t, tentative=True)
+            tr.extra["seen_by"] = cid
             new.append(tr)
         return new
 
