@@ -464,19 +464,19 @@ class EllipsoidTracker:
         A blob's foot point is uncertain mostly along the line of sight of the camera the blob
         was found in (``seen_by``: feet lost in a hole of the mask, two people merged, a head
         back-projected at the default height), so candidates spread ±``birth_search_m`` along that
-        camera's ray through the guess and ±0.2 m across it, 0.1 m apart, scored over every
-        camera. Without ``seen_by``, the ray of the camera that sees the guess largest.
+        camera's ray through the guess and ±0.2 m across it, 0.1 m apart — and likewise along the
+        ray of the camera that sees the guess largest (the only one without ``seen_by``) — all
+        scored over every camera.
         """
         cfg = self.config
+        axes = [self._axes(k, state, xy, along_ray=True)]
         if seen_by in self.cams:
             ray = _ray_direction(self.cams[seen_by].camera, xy[k])
-            d = ray, np.array([-ray[1], ray[0]])
-        else:
-            d = self._axes(k, state, xy, along_ray=True)
+            axes.append((ray, np.array([-ray[1], ray[0]])))
         along = np.arange(-cfg.birth_search_m, cfg.birth_search_m + 1e-9, 0.1)
         across = np.array([-0.2, -0.1, 0.0, 0.1, 0.2])
         grid = np.array([(a, c) for a in along for c in across])
-        cand = xy[k] + grid[:, :1] * d[0] + grid[:, 1:] * d[1]
+        cand = np.concatenate([xy[k] + grid[:, :1] * d[0] + grid[:, 1:] * d[1] for d in axes])
         cand = cand[self._walkable(cand)]
         if len(cand) == 0:
             return
