@@ -349,10 +349,10 @@ class EllipsoidTracker:
         stacked = [np.stack(a) for a in zip(*(self.cams[cid].forms(xy, hs, ws) for cid in cids))]
         # Per camera, views into the stacked arrays: updates through either are shared.
         state = {cid: _Forms(*(a[c] for a in stacked)) for c, cid in enumerate(cids)}
-        if cfg.birth_search_m > 0:
-            for k, tr in enumerate(tracks):
-                if tr.mode == "capture" and tr.age_frames == 0:
-                    self._search_new(k, xy, hs, ws, state, real, tr.extra.pop("seen_by", None))
+        for k, tr in enumerate(tracks):
+            seen_by = tr.extra.pop("seen_by", None)  # births' note for this search only
+            if cfg.birth_search_m > 0 and tr.mode == "capture" and tr.age_frames == 0:
+                self._search_new(k, xy, hs, ws, state, real, seen_by)
         use_ring = np.array([tr.mode != "capture" for tr in tracks])
         if self._python_rounds:
             best_e, best_den = self._rounds_python(use_ring, xy, hs, ws, state, real)
@@ -472,7 +472,8 @@ class EllipsoidTracker:
         axes = [self._axes(k, state, xy, along_ray=True)]
         if seen_by in self.cams:
             ray = _ray_direction(self.cams[seen_by].camera, xy[k])
-            axes.append((ray, np.array([-ray[1], ray[0]])))
+            if not np.allclose(ray, axes[0][0]):  # the same camera: nothing new to search
+                axes.append((ray, np.array([-ray[1], ray[0]])))
         along = np.arange(-cfg.birth_search_m, cfg.birth_search_m + 1e-9, 0.1)
         across = np.array([-0.2, -0.1, 0.0, 0.1, 0.2])
         grid = np.array([(a, c) for a in along for c in across])
