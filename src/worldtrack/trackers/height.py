@@ -217,9 +217,9 @@ def extreme_ends(labels: np.ndarray, region: np.ndarray, u0: int, v0: int, dx: f
     Returns
     -------
     n : int — foreground pixels in the region
-    first, last : (2,) float — mean (u, v) of the ``max(1, n // 100)`` pixels lowest / highest
-        along (dx, dy), measured from the pixels' centroid; ties at the cut are taken in row-major
-        order (a stable sort's). NaN when n = 0.
+    first, last : (2,) float — image coordinates (u, v), the mean of the ``max(1, n // 100)``
+        pixels lowest / highest along (dx, dy) (their coordinate along it taken from the pixels'
+        centroid); ties at the cut are taken in row-major order (a stable sort's). NaN when n = 0.
     """
     h, w = region.shape
     us = np.empty(h * w, np.int64)

@@ -697,18 +697,15 @@ class ParticleTracker:
         tracking = fs[0].track is not None
         scales = k_lo = hidden = None
         if cfg.pixel_weights in ("filter", "hidden") and cfg.weighting == "ratio" and tracking:
-            if cfg.pixel_weights == "hidden":
-                # Only where the lower body was hidden last frame (above the foot samples); the
-                # scales are not computed at all while no filter is hidden (then all 0).
-                use = {cid: np.array([f.k_lo.get(cid, 0) > self._n_below for f in fs]) for cid in images}
-                if any(u.any() for u in use.values()):
-                    scales = self._filter_pixel_scales(self._centres(fs, centres), images)
-                    for cid in scales:
-                        scales[cid] = np.where(use[cid], scales[cid], 0.0)
-                else:
-                    scales = {cid: np.zeros(len(fs)) for cid in images}
+            # "hidden": only where the lower body was hidden last frame (above the foot samples).
+            use = ({cid: np.array([f.k_lo.get(cid, 0) > self._n_below for f in fs]) for cid in images}
+                   if cfg.pixel_weights == "hidden" else None)
+            if use is not None and not any(u.any() for u in use.values()):
+                scales = {cid: np.zeros(len(fs)) for cid in images}   # nobody hidden: no scales to compute
             else:
                 scales = self._filter_pixel_scales(self._centres(fs, centres), images)
+                if use is not None:
+                    scales = {cid: np.where(use[cid], s, 0.0) for cid, s in scales.items()}
         if ((cfg.common_view > 0 or cfg.coast_hidden > 0 or cfg.pixel_weights == "hidden")
                 and cfg.likelihood == "column" and tracking):
             hidden = {}

@@ -272,7 +272,6 @@ def velocity_walk(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: fl
             v[f, i, 2] = 0.0
             step[f, i, 0] += v0 * dt
             step[f, i, 1] += v1 * dt
-            step[f, i, 2] += 0.0 * dt
 
 
 def velocity_walk_reference(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: float, dt: float,
