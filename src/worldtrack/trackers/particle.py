@@ -36,7 +36,8 @@ Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as p
 
 * objects that enter together and then part (§6's future work): a filter whose particles have become
   two lumps on the floor is split into two tracks, a detection filter that fires on two lumps starts
-  two, and filters that settle on one object are merged;
+  two, and filters that settle on one object are merged (after a longer wait if they stand apart on
+  the floor, one behind the other in the image: two people passing);
 * explaining away: pixels inside another tracked object's image box read as background, so a filter
   cannot take over a neighbour that shows more foreground, and a detection filter sees only what no
   track explains; where that object stands nearer to the camera they read as occluded (no
@@ -49,6 +50,9 @@ Beyond the paper (on by default; :meth:`ParticleConfig.paper` is the method as p
   once instead of living on with whoever stands in front of the door on its line of sight, and its
   last box stays explained to the detection filters for a moment (``exit_*`` in
   :class:`ParticleConfig`);
+* doors out of view: an entry region that the cameras do not see (or see in part) is entered into
+  view across the view's edge, so its detection filter also covers the floor in view next to the
+  floor out of view near the door (``entry_reach``);
 * lost tracks (``births="entry+lost"``, the default where the scene has entry regions): where a
   tracking filter ended by the β rule away from the entry regions, a detection filter watches the
   floor round its last position for a while, so an object that stopped showing enough (a person
@@ -80,6 +84,7 @@ from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
@@ -245,15 +250,39 @@ class ParticleTracker:
         m = cfg.entry_margin
         for er in scene.entry_regions:
             p = er.polygon
-            bounds = (p[:, 0].min() - m, p[:, 0].max() + m, p[:, 1].min() - m, p[:, 1].max() + m)
-            reg = FloorRegion.rasterise(er.name, bounds, 0.02,
-                                        lambda xy, p=p: (polygon_distance(xy, p) <= m) & in_view(xy))
+            near = self._unseen_near(p)
+            grow = m + (cfg.entry_reach if near is not None else 0.0)
+            bounds = (p[:, 0].min() - grow, p[:, 0].max() + grow, p[:, 1].min() - grow, p[:, 1].max() + grow)
+
+            def test(xy: np.ndarray, p: np.ndarray = p, near=near) -> np.ndarray:
+                close = polygon_distance(xy, p) <= m
+                if near is not None:                 # where the door's floor comes into view
+                    close |= np.isfinite(near.query(xy, distance_upper_bound=m + 1e-9)[0])
+                return close & in_view(xy)
+
+            reg = FloorRegion.rasterise(er.name, bounds, 0.02, test)
             if not reg.empty:
                 regions.append(reg)
         if not regions:
             raise InputError(f"particle tracker: no entry region of scene {scene.name!r} is in view of "
                              f"{', '.join(self._cams)} (use births='anywhere')")
         return regions
+
+    def _unseen_near(self, polygon: np.ndarray, cell: float = 0.05) -> "cKDTree | None":
+        """The walkable floor out of every view within ``entry_reach`` of an entry region's
+        ``polygon`` (a grid of ``cell`` m), as a KD-tree of cell centres; None if there is none
+        or ``entry_reach`` is 0."""
+        reach = self.config.entry_reach
+        if reach <= 0:
+            return None
+        p = polygon
+        bounds = (p[:, 0].min() - reach, p[:, 0].max() + reach, p[:, 1].min() - reach, p[:, 1].max() + reach)
+        unseen = FloorRegion.rasterise("unseen", bounds, cell, lambda xy: (polygon_distance(xy, p) <= reach)
+                                       & self.scene.walkable.contains(xy) & ~self._in_view(xy))
+        if unseen.empty:
+            return None
+        j, i = np.nonzero(unseen.raster.inside)
+        return cKDTree(unseen.origin + (np.column_stack([i, j]) + 0.5) * cell)
 
     def _in_view(self, xy: np.ndarray) -> np.ndarray:
         """(N,) bool: floor points ``xy`` (N, 2), metres, are walkable and a column of ``min_height``
@@ -968,14 +997,18 @@ class ParticleTracker:
         both = ~np.isnan(ov)                                  # (camera, i, j): the camera sees both
         apart = both & ~(ov >= cfg.merge_overlap)
         close = both.any(axis=0) & ~apart.any(axis=0)
-        close_now = set()
+        c = np.array([f.centre for f in fs], dtype=float)
+        far = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1]) > cfg.merge_distance
+        close_now, frames = set(), {}
         for i, j in zip(*np.nonzero(np.triu(close, 1))):
             a, b = fs[i].track.id, fs[j].track.id
             close_now.add((min(a, b), max(a, b)))
+            # One behind the other on the floor: two people passing, unless it lasts.
+            frames[(min(a, b), max(a, b))] = cfg.merge_far_frames if far[i, j] else cfg.merge_frames
         self._close = {k: self._close.get(k, 0) + 1 for k in close_now}
         by_id = {f.track.id: f for f in fs}
         for (ia, ib), n in list(self._close.items()):
-            if n >= cfg.merge_frames and ia in by_id and ib in by_id:
+            if n >= frames[(ia, ib)] and ia in by_id and ib in by_id:
                 a, b = by_id[ia], by_id[ib]
                 self._end(b if (b.track.born, b.track.id) > (a.track.born, a.track.id) else a)
                 del self._close[(ia, ib)]
