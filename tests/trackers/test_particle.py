@@ -27,8 +27,9 @@ from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, hit_image,
                                                      occluder_layers, owner_image, point_values_reference,
                                                      hit_labels, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, _lookup, bimodal_split, polygon_distance,
-                                                   splittable, stratified_resample, systematic_resample)
+from worldtrack.trackers.particle_sampling import (FloorRegion, _lookup, _valley, _valley_reference, bimodal_split,
+                                                   polygon_distance, splittable, stratified_resample,
+                                                   systematic_resample)
 
 from _render import texture  # tests/trackers/_render.py
 
@@ -605,6 +606,22 @@ def test_splittable_is_the_first_test_of_bimodal_split():
     clear = np.abs(sd - bound) > 1e-9
     np.testing.assert_array_equal(wide[clear], (sd >= bound)[clear])
     assert not splittable(np.zeros((2, 7, 2)), 0.35, 0.2).any()          # too few particles
+
+
+def test_valley_kernel_agrees_with_reference():
+    rng = np.random.default_rng(4)
+    found = 0
+    for k in range(300):
+        gap = rng.uniform(0.0, 0.8)
+        n1 = int(rng.integers(5, 400))
+        s = np.concatenate([rng.normal(0.0, rng.uniform(0.03, 0.2), n1),
+                            rng.normal(gap, rng.uniform(0.03, 0.2), 500 - n1)])
+        lo = s.min()
+        for args in ((0.04, 0.05, 0.35, 0.5), (0.02, 0.03, 0.2, 0.8)):
+            a, b = _valley(s, lo, *args), _valley_reference(s, lo, *args)
+            assert a == b
+            found += a >= 0
+    assert 50 < found < 550                  # both outcomes are exercised
 
 
 def test_bimodal_split_finds_two_lumps_not_one_long_cloud():

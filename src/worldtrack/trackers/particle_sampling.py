@@ -196,8 +196,73 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
                                                                    else np.array([0.0, 1.0]))
     axis /= np.linalg.norm(axis)
     s = c @ axis
-    lo, hi = s.min(), s.max()
-    nb = int(np.ceil((hi - lo) / bin_m)) + 1
+    lo = s.min()
+    valley = _valley(s, lo, bin_m, smooth_m, min_separation, max_dip)
+    if valley < 0:
+        return None
+    side = s > lo + (valley + 0.5) * bin_m
+    m = side.mean()
+    if min(m, 1 - m) < min_mass:
+        return None
+    return side
+
+
+@njit(cache=True)
+def _valley(s: np.ndarray, lo: float, bin_m: float, smooth_m: float, min_separation: float,
+            max_dip: float) -> int:
+    """The valley bin between the two peaks of the smoothed histogram of ``s`` (N,) metres, from
+    ``lo`` in ``bin_m`` bins; −1 if there are no two peaks ``min_separation`` apart with a valley at
+    most ``max_dip`` times the lower. The compiled kernel of :func:`bimodal_split` (the NumPy calls
+    on these ~20-bin arrays cost more than the work); :func:`_valley_reference` is the same in NumPy."""
+    nb = int(math.ceil((s.max() - lo) / bin_m)) + 1
+    h = np.zeros(nb)
+    for v in s:
+        h[min(int((v - lo) / bin_m), nb - 1)] += 1.0
+    r = max(1, int(math.ceil(3 * smooth_m / bin_m)))
+    kernel = np.empty(2 * r + 1)
+    for k in range(2 * r + 1):
+        kernel[k] = math.exp(-0.5 * (((k - r) * bin_m) / smooth_m) ** 2)
+    hs = np.zeros(nb)
+    for i in range(nb):                      # np.convolve(np.pad(h, r), kernel, "valid")
+        acc = 0.0
+        for k in range(2 * r + 1):
+            j = i + r - k
+            if 0 <= j < nb:
+                acc += h[j] * kernel[k]
+        hs[i] = acc
+    p1, n_peaks = -1, 0
+    for i in range(nb):
+        left = hs[i - 1] if i > 0 else -1.0
+        right = hs[i + 1] if i < nb - 1 else -1.0
+        if hs[i] >= left and hs[i] > right and hs[i] > 0:
+            n_peaks += 1
+            if p1 < 0 or hs[i] > hs[p1]:
+                p1 = i
+    if n_peaks < 2:
+        return -1
+    p2 = -1
+    for i in range(nb):
+        left = hs[i - 1] if i > 0 else -1.0
+        right = hs[i + 1] if i < nb - 1 else -1.0
+        if hs[i] >= left and hs[i] > right and hs[i] > 0 and abs(i - p1) * bin_m >= min_separation:
+            if p2 < 0 or hs[i] > hs[p2]:
+                p2 = i
+    if p2 < 0:
+        return -1
+    a, b = min(p1, p2), max(p1, p2)
+    valley = a
+    for i in range(a, b + 1):
+        if hs[i] < hs[valley]:
+            valley = i
+    if hs[valley] > max_dip * min(hs[p1], hs[p2]):
+        return -1
+    return valley
+
+
+def _valley_reference(s: np.ndarray, lo: float, bin_m: float, smooth_m: float, min_separation: float,
+                      max_dip: float) -> int:
+    """:func:`_valley` in NumPy."""
+    nb = int(np.ceil((s.max() - lo) / bin_m)) + 1
     h = np.bincount(np.minimum(((s - lo) / bin_m).astype(np.int64), nb - 1), minlength=nb).astype(float)
     r = max(1, int(np.ceil(3 * smooth_m / bin_m)))
     kx = np.arange(-r, r + 1) * bin_m
@@ -207,21 +272,17 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
     right = np.concatenate([hs[1:], [-1.0]])
     peaks = np.flatnonzero((hs >= left) & (hs > right) & (hs > 0))
     if len(peaks) < 2:
-        return None
+        return -1
     p1 = peaks[np.argmax(hs[peaks])]
     far = peaks[np.abs(peaks - p1) * bin_m >= min_separation]
     if len(far) == 0:
-        return None
+        return -1
     p2 = far[np.argmax(hs[far])]
     a, b = min(p1, p2), max(p1, p2)
     valley = a + int(np.argmin(hs[a:b + 1]))
     if hs[valley] > max_dip * min(hs[p1], hs[p2]):
-        return None
-    side = s > lo + (valley + 0.5) * bin_m
-    m = side.mean()
-    if min(m, 1 - m) < min_mass:
-        return None
-    return side
+        return -1
+    return valley
 
 
 def splittable(xy: np.ndarray, min_separation: float, min_mass: float) -> np.ndarray:
