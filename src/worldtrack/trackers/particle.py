@@ -254,7 +254,7 @@ class ParticleTracker:
             grow = m + (cfg.entry_reach if near is not None else 0.0)
             bounds = (p[:, 0].min() - grow, p[:, 0].max() + grow, p[:, 1].min() - grow, p[:, 1].max() + grow)
 
-            def test(xy: np.ndarray, p: np.ndarray = p, near=near) -> np.ndarray:
+            def test(xy: np.ndarray, p: np.ndarray = p, near: "cKDTree | None" = near) -> np.ndarray:
                 close = polygon_distance(xy, p) <= m
                 if near is not None:                 # where the door's floor comes into view
                     close |= np.isfinite(near.query(xy, distance_upper_bound=m + 1e-9)[0])
@@ -982,7 +982,9 @@ class ParticleTracker:
         self._new_track(new, t, score=f.track.score)
 
     def _merge(self) -> None:
-        """End the younger of two filters that have stayed on one object for ``merge_frames`` frames.
+        """End the younger of two filters that have stayed on one object for ``merge_frames`` frames
+        (``merge_far_frames`` while their centres stand more than ``merge_distance`` apart on the
+        floor: one behind the other, which two people passing also are for a moment).
 
         On one object: their image boxes (:func:`image_box`) overlap by at least ``merge_overlap``
         (intersection over the smaller box) in every camera that sees both.
