@@ -169,18 +169,20 @@ def _entry_tracks(person: TrackTable, pred: TrackTable, pairs: dict, gid: int, s
     first frame fully in view), the distinct tracks matched to the person plus the unmatched tracks
     within the gate of the person (a duplicate the matching left over), each counted from 3 frames on.
     """
-    frames = np.arange(start, start + window + 1)
-    m = (pairs["gt_id"] == gid) & np.isin(pairs["frame"], frames)
-    ids, cnt = np.unique(pairs["pred_id"][m], return_counts=True)
-    count = {int(i): int(c) for i, c in zip(ids, cnt)}
+    in_window = lambda f: (f >= start) & (f <= start + window)   # noqa: E731
+    m = (pairs["gt_id"] == gid) & in_window(pairs["frame"])
+    ids = [pairs["pred_id"][m]]
+    # Unmatched tracks in the window within the gate of the person.
     matched = set(zip(pairs["frame"].astype(int).tolist(), pairs["pred_id"].astype(int).tolist()))
-    where = {int(f): (x, y) for f, x, y in zip(person.frame, person.x, person.y)}
-    for f, i, x, y in zip(pred.frame, pred.id, pred.x, pred.y):
-        f, i = int(f), int(i)
-        if start <= f <= start + window and (f, i) not in matched and f in where \
-                and np.hypot(x - where[f][0], y - where[f][1]) <= GATE_M:
-            count[i] = count.get(i, 0) + 1
-    return sum(c >= 3 for c in count.values())
+    rows = np.flatnonzero(in_window(pred.frame))
+    rows = rows[[(int(pred.frame[r]), int(pred.id[r])) not in matched for r in rows]]
+    here = np.full((start + window + 1, 2), np.nan)
+    sel = in_window(person.frame)
+    here[person.frame[sel].astype(int)] = np.column_stack([person.x[sel], person.y[sel]])
+    at = here[pred.frame[rows].astype(int)]
+    ids.append(pred.id[rows][np.hypot(pred.x[rows] - at[:, 0], pred.y[rows] - at[:, 1]) <= GATE_M])
+    _, counts = np.unique(np.concatenate(ids).astype(int), return_counts=True)
+    return int((counts >= 3).sum())
 
 
 def given_starts(seq: Sequence, config: ParticleConfig) -> dict:

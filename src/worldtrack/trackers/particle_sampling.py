@@ -230,23 +230,22 @@ def _valley(s: np.ndarray, lo: float, bin_m: float, smooth_m: float, min_separat
             if 0 <= j < nb:
                 acc += h[j] * kernel[k]
         hs[i] = acc
-    p1, n_peaks = -1, 0
+    peaks = np.empty(nb, np.int64)
+    n_peaks, p1 = 0, -1
     for i in range(nb):
         left = hs[i - 1] if i > 0 else -1.0
         right = hs[i + 1] if i < nb - 1 else -1.0
         if hs[i] >= left and hs[i] > right and hs[i] > 0:
+            peaks[n_peaks] = i
             n_peaks += 1
             if p1 < 0 or hs[i] > hs[p1]:
                 p1 = i
     if n_peaks < 2:
         return -1
     p2 = -1
-    for i in range(nb):
-        left = hs[i - 1] if i > 0 else -1.0
-        right = hs[i + 1] if i < nb - 1 else -1.0
-        if hs[i] >= left and hs[i] > right and hs[i] > 0 and abs(i - p1) * bin_m >= min_separation:
-            if p2 < 0 or hs[i] > hs[p2]:
-                p2 = i
+    for i in peaks[:n_peaks]:
+        if abs(i - p1) * bin_m >= min_separation and (p2 < 0 or hs[i] > hs[p2]):
+            p2 = i
     if p2 < 0:
         return -1
     a, b = min(p1, p2), max(p1, p2)
