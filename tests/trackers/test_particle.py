@@ -462,6 +462,11 @@ def test_filters_one_behind_the_other_on_the_floor_are_merged_only_if_it_lasts()
     assert frames_to_merge((0.1, 4.0), merge_far_frames=9) == 9
     assert frames_to_merge((0.1, 4.0), merge_distance=np.inf) == 3   # boxes alone (the former rule)
     assert frames_to_merge((1.0, 3.0)) is None                 # side by side: boxes apart
+    # Beyond ``merge_depth`` from the camera the distance that counts as one object grows with it:
+    # the pair stands 4 and 5 m from the camera, 1 m apart: one object when merge_depth is 2 m
+    # (0.6 m × 4.5 / 2 = 1.35 m), still one behind the other when it is 4 m (0.6 m × 4.5 / 4 = 0.68 m).
+    assert frames_to_merge((0.1, 4.0), merge_depth=2.0) == 3
+    assert frames_to_merge((0.1, 4.0), merge_depth=4.0) == 6
 
 
 def test_a_door_out_of_view_is_watched_where_its_floor_comes_into_view():
@@ -725,7 +730,8 @@ def test_image_box_with_depth_covers_the_object_nearer_and_farther():
                                  dict(likelihood="blob"), dict(min_height=2.5), dict(resampling="multinomial"),
                                  dict(hit_rate_object=0.01), dict(births="lost"), dict(births="entry+anywhere"),
                                  dict(lost_radius=-1.0), dict(lost_hold_s=float("nan")), dict(merge_distance=0.0),
-                                 dict(merge_distance=float("nan")), dict(merge_far_frames=0), dict(entry_reach=-1.0)])
+                                 dict(merge_distance=float("nan")), dict(merge_far_frames=0), dict(entry_reach=-1.0),
+                                 dict(merge_depth=0.0), dict(merge_depth=float("nan"))])
 def test_bad_configuration_is_an_input_error(bad):
     with pytest.raises(InputError):
         ParticleConfig(**bad)

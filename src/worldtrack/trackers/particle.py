@@ -1000,7 +1000,7 @@ class ParticleTracker:
         apart = both & ~(ov >= cfg.merge_overlap)
         close = both.any(axis=0) & ~apart.any(axis=0)
         c = np.array([f.centre for f in fs], dtype=float)
-        far = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1]) > cfg.merge_distance
+        far = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1]) > self._merge_distances(c)
         close_now, frames = set(), {}
         for i, j in zip(*np.nonzero(np.triu(close, 1))):
             a, b = fs[i].track.id, fs[j].track.id
@@ -1014,6 +1014,17 @@ class ParticleTracker:
                 a, b = by_id[ia], by_id[ib]
                 self._end(b if (b.track.born, b.track.id) > (a.track.born, a.track.id) else a)
                 del self._close[(ia, ib)]
+
+    def _merge_distances(self, centres: np.ndarray) -> np.ndarray:
+        """(F, F) metres: how far apart on the floor two filters' centres (F, 2) may be and still
+        count as one object for ``_merge``: ``merge_distance``, grown in proportion to the pair's
+        floor distance from the nearest camera beyond ``merge_depth`` (one camera's depth error
+        grows with distance; at 30 m a duplicate of one person stands a metre behind it)."""
+        cfg = self.config
+        cams = np.array([cl.camera.centre[:2] for cl in self._cams.values()], dtype=float).reshape(-1, 2)
+        depth = np.min(np.hypot(centres[:, None, 0] - cams[None, :, 0], centres[:, None, 1] - cams[None, :, 1]), axis=1)
+        pair = 0.5 * (depth[:, None] + depth[None, :])
+        return cfg.merge_distance * np.maximum(1.0, pair / cfg.merge_depth)
 
     def _end(self, f: _Filter) -> None:
         if f in self.filters:

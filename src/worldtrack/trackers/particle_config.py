@@ -328,7 +328,7 @@ class ParticleConfig:
         (0.35 m), with a valley of at most ``split_dip`` (0.5) times the lower peak and at least
         ``split_min_mass`` (0.2) of the particles on each side, for ``split_frames`` (2)
         consecutive frames; a detection filter that fires on two lumps starts two tracks.
-    merge, merge_overlap, merge_frames, merge_distance, merge_far_frames
+    merge, merge_overlap, merge_frames, merge_distance, merge_far_frames, merge_depth
         End the younger of two filters whose image boxes overlap by at least ``merge_overlap``
         (intersection over the smaller box, 0.6) in every camera that sees both, for
         ``merge_frames`` (3) consecutive frames, or ``merge_far_frames`` (6) if their centres are
@@ -340,6 +340,11 @@ class ParticleConfig:
         people, MOTA 0.889 → 0.883, IDF1 0.859 → 0.861 (``merge_distance = inf``: the former
         rule). It costs on PETS 2009 S2.L1 (3 seeds; people 25–35 m away, where one camera's depth
         is uncertain by more than 0.6 m): MOTA 0.866 ± 0.032 → 0.817 ± 0.030 with the exit change.
+    merge_depth
+        Beyond this floor distance from the nearest camera (10 m), ``merge_distance`` grows in
+        proportion to the distance: one camera's depth error grows with it, and at 30 m duplicate
+        filters of one person stand a metre apart. PETS 2009 S2.L1 (3 seeds): MOTA 0.817 ± 0.030
+        → 0.882 ± 0.017, IDF1 0.497 both. The entry scenario's room is within 10 m of its camera.
     seed : int
         Seed of the tracker's random generator: same seed and input, same tracks.
     """
@@ -406,6 +411,7 @@ class ParticleConfig:
     merge_frames: int = 3
     merge_distance: float = 0.6
     merge_far_frames: int = 6
+    merge_depth: float = 10.0
     seed: int = 0
 
     @classmethod
@@ -472,6 +478,9 @@ class ParticleConfig:
         if not isinstance(self.merge_distance, (int, float, np.integer, np.floating)) or isinstance(
                 self.merge_distance, bool) or math.isnan(self.merge_distance) or not self.merge_distance > 0:
             raise bad("merge_distance", "a positive number of metres (inf: boxes alone)")
+        if not isinstance(self.merge_depth, (int, float, np.integer, np.floating)) or isinstance(
+                self.merge_depth, bool) or math.isnan(self.merge_depth) or not self.merge_depth > 0:
+            raise bad("merge_depth", "a positive number of metres (inf: merge_distance at every depth)")
         if not _number(self.merge_overlap) or not 0 < self.merge_overlap <= 1:
             raise bad("merge_overlap", "a share in (0, 1]")
         if self.velocity_smoothing > 1:
