@@ -198,6 +198,8 @@ class ParticleTracker:
                 raise InputError(f"particle tracker: shadows={cfg.shadows!r} needs the background image of {cid}'s "
                                  "foreground model (use a static background, or set shadows='object')")
         self._cams = {cid: CameraLikelihood(scene.camera(cid)) for cid in self.foregrounds}
+        # (C, 2) metres: the cameras' floor positions, for the depth-scaled merge distance.
+        self._camera_floor = np.array([cl.camera.centre[:2] for cl in self._cams.values()], dtype=float).reshape(-1, 2)
         self._floor: dict[str, np.ndarray] = {}
         if cfg.shadows != "object":
             walk = scene.walkable.raster(0.01)
@@ -1021,7 +1023,7 @@ class ParticleTracker:
         floor distance from the nearest camera beyond ``merge_depth`` (one camera's depth error
         grows with distance; at 30 m a duplicate of one person stands a metre behind it)."""
         cfg = self.config
-        cams = np.array([cl.camera.centre[:2] for cl in self._cams.values()], dtype=float).reshape(-1, 2)
+        cams = self._camera_floor
         depth = np.min(np.hypot(centres[:, None, 0] - cams[None, :, 0], centres[:, None, 1] - cams[None, :, 1]), axis=1)
         pair = 0.5 * (depth[:, None] + depth[None, :])
         return cfg.merge_distance * np.maximum(1.0, pair / cfg.merge_depth)

@@ -475,12 +475,11 @@ class ParticleConfig:
             raise bad("detection_reseed", "a share in [0, 1]")
         if not _number(self.appearance_rate) or not 0 < self.appearance_rate <= 1:
             raise bad("appearance_rate", "a weight in (0, 1]")
-        if not isinstance(self.merge_distance, (int, float, np.integer, np.floating)) or isinstance(
-                self.merge_distance, bool) or math.isnan(self.merge_distance) or not self.merge_distance > 0:
-            raise bad("merge_distance", "a positive number of metres (inf: boxes alone)")
-        if not isinstance(self.merge_depth, (int, float, np.integer, np.floating)) or isinstance(
-                self.merge_depth, bool) or math.isnan(self.merge_depth) or not self.merge_depth > 0:
-            raise bad("merge_depth", "a positive number of metres (inf: merge_distance at every depth)")
+        for name, infinite in (("merge_distance", "boxes alone"), ("merge_depth", "merge_distance at every depth")):
+            value = getattr(self, name)
+            if (not isinstance(value, (int, float, np.integer, np.floating)) or isinstance(value, bool)
+                    or math.isnan(value) or not value > 0):
+                raise bad(name, f"a positive number of metres (inf: {infinite})")
         if not _number(self.merge_overlap) or not 0 < self.merge_overlap <= 1:
             raise bad("merge_overlap", "a share in (0, 1]")
         if self.velocity_smoothing > 1:
