@@ -3,7 +3,7 @@
 import cv2
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from worldtrack.geometry.camera import Camera, normalise_projection
@@ -58,6 +58,7 @@ def test_undistort_matches_opencv_and_inverts_distort():
 
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 10_000), z=st.floats(0.0, 1.8))
+@example(seed=1326, z=0.0)  # a corner pixel where the fixed-point undistortion alone stops 2e-6 px short
 def test_backproject_then_project_round_trip(seed, z):
     rng = np.random.default_rng(seed)
     cam = random_camera(rng)
