@@ -69,6 +69,26 @@ def test_backproject_then_project_round_trip(seed, z):
     np.testing.assert_allclose(cam.project(world[ok]), uv[ok], atol=1e-6)
 
 
+def test_pixels_beyond_the_lens_fold_have_no_ray():
+    """Barrel distortion k1 = −0.45 folds back at r_f = 1/sqrt(3·0.45) ≈ 0.861 (normalised), where
+    r·(1 + k1·r²) peaks at ≈ 0.574: pixels farther out have no ray. Undistortion gives them none
+    (76 % of this wide image), and no point it returns lies beyond the fold — the final Newton
+    refinement, run on every pixel, would find roots on the far branch for some of them."""
+    k1 = -0.45
+    cam = Camera.look_at("fold", 640, 480, (0, -4, 3), (0, 0, 0.5), hfov_deg=100, dist=[k1, 0, 0, 0, 0])
+    r_fold = np.sqrt(1 / (3 * -k1))
+    rd_max = r_fold * (1 + k1 * r_fold ** 2)
+    v, u = np.mgrid[0:480, 0:640]
+    pixels = np.column_stack([u.ravel(), v.ravel()]).astype(float)
+    rd = np.hypot(*cam._pixels_to_normalised(pixels).T)
+    ideal = cam.undistort_pixels(pixels)
+    ok = np.isfinite(ideal).all(axis=1)
+    assert not (ok & (rd > rd_max + 1e-6)).any()                      # no ray beyond the fold
+    assert (ok | (rd > rd_max - 1e-3)).all()                          # every pixel inside it has one
+    assert np.hypot(*cam._pixels_to_normalised(ideal[ok]).T).max() <= r_fold
+    np.testing.assert_allclose(cam.distort_pixels(ideal[ok]), pixels[ok], atol=1e-6)
+
+
 def test_backproject_above_horizon_is_nan_and_behind_camera_projects_nan():
     cam = Camera.look_at("c", 640, 480, position=(0, 0, 2), target=(0, 10, 2), hfov_deg=60)  # horizontal
     top = cam.backproject([[320, 10]], 0.0)  # looking above the horizon: never reaches the floor

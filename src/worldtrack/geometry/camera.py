@@ -284,23 +284,28 @@ class Camera:
             if not change > tol:
                 break
         out = np.stack([x, y], axis=1)
-        # Near the corners of a strongly distorted lens the iteration converges slowly and can
-        # stop 1e-8 short (a millionth of a pixel that a round trip shows): two Newton steps on
-        # the residual, with the 2×2 Jacobian by central differences, finish it.
-        h = 1e-7
-        for _ in range(2):
-            residual = self.distort_normalised(out) - xy_distorted
-            jx = (self.distort_normalised(out + [h, 0.0]) - self.distort_normalised(out - [h, 0.0])) / (2 * h)
-            jy = (self.distort_normalised(out + [0.0, h]) - self.distort_normalised(out - [0.0, h])) / (2 * h)
-            det = jx[:, 0] * jy[:, 1] - jy[:, 0] * jx[:, 1]
-            with np.errstate(invalid="ignore", divide="ignore"):
-                step = np.stack([(jy[:, 1] * residual[:, 0] - jy[:, 0] * residual[:, 1]) / det,
-                                 (jx[:, 0] * residual[:, 1] - jx[:, 1] * residual[:, 0]) / det], axis=1)
-            out = np.where(np.isfinite(step), out - step, out)
         # Pixels beyond the lens's monotonic range have no ray: the iteration then settles on
         # a point that does not distort back to the pixel. Mark those NaN.
         bad = np.abs(self.distort_normalised(out) - xy_distorted).max(axis=1) > 1e-7
         out[bad] = np.nan
+        # Near the corners of a strongly distorted lens the iteration converges slowly and can
+        # stop 1e-8 short (a millionth of a pixel that a round trip shows): two Newton steps on
+        # the residual, with the 2×2 Jacobian by central differences, finish it — for the points
+        # that have a ray only (from a pixel beyond the fold, Newton would find a root on the
+        # lens's far, non-monotonic branch).
+        good = np.flatnonzero(~bad)
+        p, target = out[good], xy_distorted[good]
+        h = 1e-7
+        for _ in range(2):
+            residual = self.distort_normalised(p) - target
+            jx = (self.distort_normalised(p + [h, 0.0]) - self.distort_normalised(p - [h, 0.0])) / (2 * h)
+            jy = (self.distort_normalised(p + [0.0, h]) - self.distort_normalised(p - [0.0, h])) / (2 * h)
+            det = jx[:, 0] * jy[:, 1] - jy[:, 0] * jx[:, 1]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                step = np.stack([(jy[:, 1] * residual[:, 0] - jy[:, 0] * residual[:, 1]) / det,
+                                 (jx[:, 0] * residual[:, 1] - jx[:, 1] * residual[:, 0]) / det], axis=1)
+            p = np.where(np.isfinite(step), p - step, p)
+        out[good] = p
         return out
 
     def _normalised_to_pixels(self, xy: np.ndarray) -> np.ndarray:
