@@ -71,6 +71,7 @@ GATE_M = 0.5
 VIS_EVAL = 0.3      # ground truth rows count from this visible share on
 SIDE_BY_SIDE_M = 0.8
 ENTRY_WINDOW_S = 2.0  # "on entering": from fully in view, while a pair walks in together
+ENTRY_FRAMES = 5      # the issue's "within 5 frames of being fully in view"
 
 
 @dataclass
@@ -145,14 +146,14 @@ def score(seq: Sequence, pred: TrackTable) -> dict:
         tracks.append(int((cnt >= 3).sum()))
         first = P["frame"][m].min() if m.any() else None
         lat.append(np.inf if first is None else max(0, int(first) - int(full.min())))
-        entry_one.append(lat[-1] <= 5 and _entry_tracks(sel, pred, P, gid, int(full.min()), window) == 1)
+        entry_one.append(lat[-1] <= ENTRY_FRAMES and _entry_tracks(sel, pred, P, gid, int(full.min()), window) == 1)
     out["entry_one_pct"] = 100.0 * float(np.mean(entry_one)) if entry_one else float("nan")
     out["people"] = len(tracks)
     out["tracks_per_person"] = float(np.mean(tracks)) if tracks else float("nan")
     out["one_track_pct"] = 100.0 * float(np.mean(np.array(tracks) == 1)) if tracks else float("nan")
     lat = np.array(lat, dtype=float)
     out["latency_max"] = float(lat.max()) if len(lat) else float("nan")
-    out["latency_le5_pct"] = 100.0 * float(np.mean(lat <= 5)) if len(lat) else float("nan")
+    out["latency_le5_pct"] = 100.0 * float(np.mean(lat <= ENTRY_FRAMES)) if len(lat) else float("nan")
     # Side by side: both people of a close pair matched to different tracks.
     both, total = 0, 0
     for f in np.unique(gt.frame):
@@ -178,9 +179,10 @@ def _pairs_split_on_entry(gt: TrackTable, pairs: dict, full_at: dict[int, int], 
 
     A pair enters side by side when both become fully in view (``full_at``: frame) at most
     ``within`` frames apart and stand less than ``SIDE_BY_SIDE_M`` apart at the later of the two
-    frames. It is split on entry when, within 5 frames of that frame, both are matched (``pairs``:
-    :func:`evaluate_detailed`'s) to two different tracks in the same frame — the issue's "people
-    entering side by side 0.5 m apart get separate tracks". Returns (pairs split, pairs).
+    frames. It is split on entry when, within ``ENTRY_FRAMES`` (5) of that frame, both are
+    matched (``pairs``: :func:`evaluate_detailed`'s) to two different tracks in the same frame —
+    the issue's "people entering side by side 0.5 m apart get separate tracks". Returns
+    (pairs split, pairs).
     """
     where = {(int(f), int(i)): (x, y) for f, i, x, y in zip(gt.frame, gt.id, gt.x, gt.y)}
     match = {(int(f), int(g)): int(p) for f, g, p in zip(pairs["frame"], pairs["gt_id"], pairs["pred_id"])}
@@ -195,7 +197,7 @@ def _pairs_split_on_entry(gt: TrackTable, pairs: dict, full_at: dict[int, int], 
                 continue
             total += 1
             split += any((f, a) in match and (f, b) in match and match[(f, a)] != match[(f, b)]
-                         for f in range(f0, f0 + 6))
+                         for f in range(f0, f0 + ENTRY_FRAMES + 1))
     return split, total
 
 
