@@ -19,7 +19,7 @@ def _walk(frames: int, people: dict[int, tuple[float, float]]) -> TrackTable:
 
 
 def _pairs(matches: list[tuple[int, int, int]]) -> dict:
-    f, g, p = (np.array(c, dtype=int) for c in zip(*matches)) if matches else (np.zeros(0, int),) * 3
+    f, g, p = (np.array(c, dtype=int) for c in zip(*matches))
     return {"frame": f, "gt_id": g, "pred_id": p}
 
 

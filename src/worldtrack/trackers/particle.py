@@ -254,7 +254,7 @@ class ParticleTracker:
             p = er.polygon
             near = self._unseen_near(p)
             grow = m + (cfg.entry_reach if near is not None else 0.0)
-            bounds = (p[:, 0].min() - grow, p[:, 0].max() + grow, p[:, 1].min() - grow, p[:, 1].max() + grow)
+            bounds = _grown_bounds(p, grow)
 
             def test(xy: np.ndarray, p: np.ndarray = p, near: "cKDTree | None" = near) -> np.ndarray:
                 close = polygon_distance(xy, p) <= m
@@ -278,7 +278,7 @@ class ParticleTracker:
         if reach <= 0:
             return None
         p = polygon
-        bounds = (p[:, 0].min() - reach, p[:, 0].max() + reach, p[:, 1].min() - reach, p[:, 1].max() + reach)
+        bounds = _grown_bounds(p, reach)
         unseen = FloorRegion.rasterise("unseen", bounds, cell, lambda xy: (polygon_distance(xy, p) <= reach)
                                        & self.scene.walkable.contains(xy) & ~self._in_view(xy))
         if unseen.empty:
@@ -1079,6 +1079,12 @@ def image_box(camera: Camera, x: float, y: float, width: float, height: float, m
               depth: float = 0.0) -> Box | None:
     """:func:`image_boxes` of one object."""
     return image_boxes(camera, np.array([[x, y]]), np.array([width]), np.array([height]), margin, depth)[0]
+
+
+def _grown_bounds(polygon: np.ndarray, margin: float) -> tuple[float, float, float, float]:
+    """(x0, x1, y0, y1) metres: the bounding box of ``polygon`` (N, 2) grown by ``margin`` on each side."""
+    (x0, y0), (x1, y1) = polygon.min(axis=0), polygon.max(axis=0)
+    return (x0 - margin, x1 + margin, y0 - margin, y1 + margin)
 
 
 def _overlaps(boxes: list[Box | None]) -> np.ndarray:
