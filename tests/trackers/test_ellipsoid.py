@@ -226,6 +226,22 @@ def test_two_head_rays_from_different_sides_give_the_height():
     assert triangulate_height(rays, np.array([2.0, 3.0])) is None
 
 
+def test_head_rays_through_two_different_heads_give_no_height():
+    from worldtrack.trackers.height import triangulate_height
+    # Camera 1 sees this person's head (1.70 m); camera 2's "top" is a taller person's 0.3 m
+    # behind, at 1.95 m. The rays still have a nearest point, 6 cm off each ray, at a wrong height.
+    c1, c2 = np.array([0.0, 0.0, 3.5]), np.array([4.0, 0.5, 3.2])
+    mine, theirs = np.array([1.0, 2.0, 1.70]), np.array([0.8, 2.2, 1.95])
+    rays = [(c1, (mine - c1) / np.linalg.norm(mine - c1)), (c2, (theirs - c2) / np.linalg.norm(theirs - c2))]
+    h = triangulate_height(rays, np.array([1.0, 2.0]))
+    assert h is not None and abs(h - 1.70) > 0.1  # without the gate: accepted, and wrong
+    assert triangulate_height(rays, np.array([1.0, 2.0]), max_ray_gap_m=0.03) is None
+    # Rays that do meet (up to 1 cm of pixel noise) still give the height.
+    near = mine + np.array([0.0, 0.0, 0.01])
+    good = [rays[0], (c2, (near - c2) / np.linalg.norm(near - c2))]
+    assert triangulate_height(good, np.array([1.0, 2.0]), max_ray_gap_m=0.03) == pytest.approx(1.705, abs=0.01)
+
+
 def _two_camera_scene(size=(160, 120)):
     """The lab's two cameras (the paper's positions), looking at the same floor."""
     w, h = size

@@ -147,13 +147,25 @@ def pixel_clear_reference(camera: Camera, occ: np.ndarray | None, p: np.ndarray)
 
 def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray, max_offset_m: float = 0.5,
                        min_angle_deg: float = 25.0,
-                       height_range_m: tuple[float, float] = (1.2, 2.2)) -> float | None:
+                       height_range_m: tuple[float, float] = (1.2, 2.2),
+                       max_ray_gap_m: float = float("inf")) -> float | None:
     """Height of the point nearest to the head rays of several cameras, or None.
 
     Two cameras looking from different directions pin the top of the head in 3-D without the
     feet: the least-squares point closest to all rays. None when the rays' directions on the
-    floor differ by less than ``min_angle_deg`` (nearly parallel rays pin nothing), or the point
-    is more than ``max_offset_m`` from the person's floor position ``xy``.
+    floor differ by less than ``min_angle_deg`` (nearly parallel rays pin nothing), the point
+    is more than ``max_offset_m`` from the person's floor position ``xy``, or some ray passes
+    farther than ``max_ray_gap_m`` from it: rays through the tops of two different heads (one
+    view's top of the region is a taller person's behind) still have a nearest point, at the
+    wrong height.
+
+    Parameters
+    ----------
+    rays : list of (origin (3,), unit direction (3,)) — head rays, metres
+    xy : (2,) — the person's floor position, metres
+    max_offset_m, max_ray_gap_m : float, metres
+    min_angle_deg : float, degrees
+    height_range_m : (min, max) metres — plausible heights
     """
     if len(rays) < 2:
         return None
@@ -172,6 +184,8 @@ def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray
     p = np.linalg.solve(A, b)
     lo, hi = height_range_m
     if np.hypot(*(p[:2] - xy)) > max_offset_m or not lo <= p[2] <= hi:
+        return None
+    if max(np.linalg.norm((np.eye(3) - np.outer(d, d)) @ (p - o)) for o, d in rays) > max_ray_gap_m:
         return None
     return float(p[2])
 
