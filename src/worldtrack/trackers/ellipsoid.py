@@ -856,11 +856,11 @@ class EllipsoidTracker:
                     samples_now.setdefault(tr.id, []).append(h)
         for k, tr in enumerate(tracks):
             # Two views of the head from different sides beat any single view.
-            h3 = triangulate_height(rays.get(tr.id, []), xy[k], height_range_m=(lo, hi),
-                                    max_ray_gap_m=cfg.height_ray_gap_m)
+            head_rays = rays.get(tr.id, [])
+            h3 = triangulate_height(head_rays, xy[k], height_range_m=(lo, hi), max_ray_gap_m=cfg.height_ray_gap_m)
             if h3 is not None:
                 new = [h3]
-            elif len(rays.get(tr.id, [])) >= 2:
+            elif len(head_rays) >= 2:
                 # Head rays from two views or more that give no height (they miss each other, or
                 # meet off the person or outside the plausible range): some view's "head" is most
                 # likely somebody else's, and that view's single-camera measurement would be no

@@ -175,17 +175,13 @@ def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray
     spread = max(np.degrees(np.arccos(np.clip(abs(a @ b), -1, 1))) for i, a in enumerate(flat) for b in flat[i + 1:])
     if spread < min_angle_deg:
         return None
-    A = np.zeros((3, 3))
-    b = np.zeros(3)
-    for o, d in rays:
-        M = np.eye(3) - np.outer(d, d)  # projects onto the plane normal to the ray
-        A += M
-        b += M @ o
-    p = np.linalg.solve(A, b)
+    # Each ray's projector onto the plane normal to it: M·(p − o) is p's offset from the ray.
+    normal = [np.eye(3) - np.outer(d, d) for _, d in rays]
+    p = np.linalg.solve(sum(normal), sum(M @ o for M, (o, _) in zip(normal, rays)))
     lo, hi = height_range_m
     if np.hypot(*(p[:2] - xy)) > max_offset_m or not lo <= p[2] <= hi:
         return None
-    if max(np.linalg.norm((np.eye(3) - np.outer(d, d)) @ (p - o)) for o, d in rays) > max_ray_gap_m:
+    if max(np.linalg.norm(M @ (p - o)) for M, (o, _) in zip(normal, rays)) > max_ray_gap_m:
         return None
     return float(p[2])
 
