@@ -344,3 +344,42 @@ def test_new_person_is_placed_along_the_line_of_sight_of_the_camera_that_propose
             tracker.position_map.remove(new.id)
     assert errors["c1", "c1"] < 0.03 and errors["c2", "c2"] < 0.03, errors
     assert max(errors["c1", None], errors["c2", None]) > 0.1, errors   # the proposer's ray is what finds it
+
+
+def _heights_measured(monkeypatch, heads: dict) -> list[float]:
+    """Height samples of one person seen by both lab cameras over 5 frames, with each camera's
+    head ray stubbed to pass through ``heads[camera id]`` (None: no head found in that view) and
+    the single-view measurement stubbed to 1.50 m."""
+    import worldtrack.trackers.ellipsoid as ell
+
+    def head_ray(cam, *args, **kwargs):
+        head = heads[cam.id]
+        return None if head is None else (cam.centre, (head - cam.centre) / np.linalg.norm(head - cam.centre))
+
+    monkeypatch.setattr(ell, "head_ray", head_ray)
+    monkeypatch.setattr(ell, "measure_height", lambda *a, **k: 1.50)
+    scene = _two_camera_scene((320, 240))
+    rng = np.random.default_rng(5)
+    bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
+    tr = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(births="none"))
+    tr.init_track(-1.0, 1.2, track_id=1)
+    cen, rad = q.person_ellipsoid([[-1.0, 1.2]], 1.65, 0.4)
+    for i in range(5):
+        frames = {}
+        for cid, cam in scene.cameras.items():
+            img = bgs[cid].copy()
+            img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
+            frames[cid] = Frame(np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8), i / 10, i)
+        tr.step(frames, i / 10)
+    return tr._heights.get(1, [])
+
+
+def test_head_rays_that_miss_each_other_give_no_height_that_frame(monkeypatch):
+    mine, theirs = np.array([-1.0, 1.2, 1.70]), np.array([-1.15, 1.45, 1.95])
+    agree = _heights_measured(monkeypatch, {"c1": mine, "c2": mine})
+    assert len(agree) == 5 and np.allclose(agree, 1.70, atol=0.02)       # triangulated, every frame
+    # c2's "head" is a taller person's behind: no triangulated height, and no single-view one either.
+    assert _heights_measured(monkeypatch, {"c1": mine, "c2": theirs}) == []
+    # One head ray only: the single-view measurement is what there is.
+    one = _heights_measured(monkeypatch, {"c1": mine, "c2": None})
+    assert len(one) >= 1 and np.allclose(one, 1.50)
