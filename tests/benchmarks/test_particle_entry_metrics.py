@@ -1,4 +1,4 @@
-"""The entry benchmark's side-by-side figure counts what the issue asks: pairs split on entry."""
+"""The entry benchmark's figures count what they say: pairs split on entry, and where the error is."""
 
 import sys
 from pathlib import Path
@@ -6,7 +6,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from particle_entry import _pairs_split_on_entry  # noqa: E402
+from types import SimpleNamespace  # noqa: E402
+
+from particle_entry import _pairs_split_on_entry, error_breakdown  # noqa: E402
 
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 
@@ -40,3 +42,30 @@ def test_people_entering_apart_in_place_or_time_are_not_a_pair():
     assert _pairs_split_on_entry(gt, pairs, {1: 0, 2: 0}, within=10) == (0, 0)    # 0.9 m apart
     assert _pairs_split_on_entry(gt, pairs, {1: 0, 3: 11}, within=10) == (0, 0)   # 1.1 s apart
     assert _pairs_split_on_entry(gt, pairs, {1: 0, 3: 10}, within=10) == (1, 1)
+
+
+def _table(rows: list[tuple[int, int, float, float]]) -> TrackTable:
+    a = np.array(rows, dtype=float)
+    return TrackTable.from_arrays(a[:, 0].astype(int), a[:, 1].astype(int), a[:, 2], a[:, 3])
+
+
+def test_error_breakdown_splits_the_error_along_and_across_the_line_of_sight_and_by_situation():
+    # Camera at the origin. Person 1 walks along +x at 1 m/s (10 frames/s), alone; person 2 stands
+    # at (0, 4) with person 3 0.5 m beside it.
+    seq = SimpleNamespace(scenario=SimpleNamespace(fps=10.0, scene=SimpleNamespace(
+        cameras={"cam": SimpleNamespace(centre=np.array([0.0, 0.0, 3.0]))})))
+    gt = _table([(f, 1, 3.0 + 0.1 * f, 0.0) for f in range(3)] + [(f, 2, 0.0, 4.0) for f in range(3)]
+                + [(f, 3, 0.5, 4.0) for f in range(3)])
+    # Track of 1 at frame 1: 0.3 m too far along its line of sight (+x), 0.4 m across (+y).
+    # Track of 2 at frame 1: 0.1 m across its line of sight (−x).
+    pred = _table([(1, 7, 3.1 + 0.3, 0.4), (1, 8, -0.1, 4.0)])
+    q = np.array([1, 4])          # gt rows: person 1 and person 2 at frame 1
+    j = np.array([0, 1])
+    out = error_breakdown(seq, gt, gt, pred, j, q)
+    assert np.isclose(out["err_along_m"], 0.15)              # (0.3 + 0) / 2
+    assert np.isclose(out["err_across_m"], 0.25)             # (0.4 + 0.1) / 2
+    assert np.isclose(out["err_alone_m"], 0.5)               # person 1 only: hypot(0.3, 0.4)
+    assert np.isclose(out["err_near_m"], 0.1)                # person 2, 0.5 m from person 3
+    assert np.isclose(out["near_pct"], 50.0)
+    assert np.isclose(out["err_walking_m"], 0.5)             # 1 m/s
+    assert np.isclose(out["err_standing_m"], 0.1)
