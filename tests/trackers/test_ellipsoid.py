@@ -254,6 +254,17 @@ def _two_camera_scene(size=(160, 120)):
     })
 
 
+def _ellipsoid_frames(scene, bgs: dict, cen: np.ndarray, rad: np.ndarray, rng, i: int) -> dict:
+    """Frame ``i`` (10 frames/s) of every camera: its background with the ellipsoid ``cen, rad``
+    drawn green, plus pixel noise (σ 3)."""
+    frames = {}
+    for cid, cam in scene.cameras.items():
+        img = bgs[cid].copy()
+        img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
+        frames[cid] = Frame(np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8), i / 10, i)
+    return frames
+
+
 def _first_confirmed_frame(scene, confirm_views: int) -> int | None:
     rng = np.random.default_rng(3)
     bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
@@ -262,12 +273,7 @@ def _first_confirmed_frame(scene, confirm_views: int) -> int | None:
     # held frames (or the two views) confirm.
     cen, rad = q.person_ellipsoid([[-1.0, 1.2]], 1.45, 0.3)
     for i in range(8):
-        frames = {}
-        for cid, cam in scene.cameras.items():
-            img = bgs[cid].copy()
-            img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
-            frames[cid] = Frame(np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8), i / 10, i)
-        tracks = tr.step(frames, i / 10)
+        tracks = tr.step(_ellipsoid_frames(scene, bgs, cen, rad, rng, i), i / 10)
         if tracks:
             assert len(tracks) == 1 and np.hypot(tracks[0].x + 1.0, tracks[0].y - 1.2) < 0.15
             return i
@@ -365,12 +371,7 @@ def _heights_measured(monkeypatch, heads: dict) -> list[float]:
     tr.init_track(-1.0, 1.2, track_id=1)
     cen, rad = q.person_ellipsoid([[-1.0, 1.2]], 1.65, 0.4)
     for i in range(5):
-        frames = {}
-        for cid, cam in scene.cameras.items():
-            img = bgs[cid].copy()
-            img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
-            frames[cid] = Frame(np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8), i / 10, i)
-        tr.step(frames, i / 10)
+        tr.step(_ellipsoid_frames(scene, bgs, cen, rad, rng, i), i / 10)
     return tr._heights.get(1, [])
 
 
