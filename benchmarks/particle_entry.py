@@ -206,18 +206,21 @@ def error_breakdown(seq: Sequence, gt_all: TrackTable, gt: TrackTable, pred: Tra
     along = np.abs((err * ray).sum(axis=1))
     across = np.abs(err[:, 0] * ray[:, 1] - err[:, 1] * ray[:, 0])
     dist = np.hypot(err[:, 0], err[:, 1])
-    # Nearest other person in the same frame (all ground truth, seen or not), and own floor speed.
+    # Nearest other person in the same frame (all ground truth, seen or not): one distance matrix
+    # per frame, not a scan of the whole table per pair.
+    frames, ids = gt.frame[q], gt.id[q]
     nearest = np.full(len(q), np.inf)
+    for f in np.unique(frames):
+        mine, others = np.flatnonzero(frames == f), np.flatnonzero(gt_all.frame == f)
+        d = np.hypot(gxy[mine, None, 0] - gt_all.x[others][None], gxy[mine, None, 1] - gt_all.y[others][None])
+        d[ids[mine, None] == gt_all.id[others][None]] = np.inf      # not oneself
+        nearest[mine] = d.min(axis=1, initial=np.inf)
+    # Own floor speed: the mean step to the frames before and after, where the person is in them.
+    where = {(int(f), int(i)): (x, y) for f, i, x, y in zip(gt_all.frame, gt_all.id, gt_all.x, gt_all.y)}
     speed = np.zeros(len(q))
-    for k, row in enumerate(q):
-        f, pid = gt.frame[row], gt.id[row]
-        same = (gt_all.frame == f) & (gt_all.id != pid)
-        if same.any():
-            nearest[k] = float(np.min(np.hypot(gt_all.x[same] - gt.x[row], gt_all.y[same] - gt.y[row])))
-        mine = np.flatnonzero((gt_all.id == pid) & (np.abs(gt_all.frame - f) == 1))
-        if len(mine):
-            steps = np.hypot(gt_all.x[mine] - gt.x[row], gt_all.y[mine] - gt.y[row])
-            speed[k] = float(steps.mean()) * seq.scenario.fps
+    for k, (f, i, (x, y)) in enumerate(zip(frames.tolist(), ids.tolist(), gxy)):
+        steps = [np.hypot(*(np.subtract(where[(f + s, i)], (x, y)))) for s in (-1, 1) if (f + s, i) in where]
+        speed[k] = float(np.mean(steps)) * seq.scenario.fps if steps else 0.0
 
     def mean(mask: np.ndarray) -> float:
         return float(dist[mask].mean()) if mask.any() else nan

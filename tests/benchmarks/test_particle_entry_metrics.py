@@ -69,3 +69,15 @@ def test_error_breakdown_splits_the_error_along_and_across_the_line_of_sight_and
     assert np.isclose(out["near_pct"], 50.0)
     assert np.isclose(out["err_walking_m"], 0.5)             # 1 m/s
     assert np.isclose(out["err_standing_m"], 0.1)
+
+
+def test_error_breakdown_counts_only_neighbours_in_the_same_frame():
+    seq = SimpleNamespace(scenario=SimpleNamespace(fps=10.0, scene=SimpleNamespace(
+        cameras={"cam": SimpleNamespace(centre=np.array([0.0, 0.0, 3.0]))})))
+    # Person 2 stands at (0, 4) in frames 0-2; person 3 stands beside it only in frame 2.
+    gt = _table([(f, 2, 0.0, 4.0) for f in range(3)] + [(2, 3, 0.5, 4.0)])
+    pred = _table([(1, 8, -0.1, 4.0), (2, 8, -0.2, 4.0)])
+    out = error_breakdown(seq, gt, gt, pred, np.array([0, 1]), np.array([1, 2]))
+    assert np.isclose(out["err_alone_m"], 0.1)               # frame 1: nobody else there
+    assert np.isclose(out["err_near_m"], 0.2)                # frame 2: person 3 0.5 m away
+    assert np.isclose(out["err_standing_m"], 0.15)
