@@ -10,8 +10,8 @@ from worldtrack.geometry.rotation import rotation_angle_deg
 from worldtrack.scene import load_scene, scene_from_dict
 from worldtrack.synth import list_scenarios, make_scenario, scenario_parameters
 from worldtrack.synth import scenes
-from worldtrack.synth.bodies import (HEAD, L_FOREARM, L_UPPER_ARM, PARTS_PER_PERSON, R_FOREARM,
-                                     R_UPPER_ARM)
+from worldtrack.synth.bodies import (HEAD, L_FOOT, L_FOREARM, L_UPPER_ARM, PARTS_PER_PERSON, R_FOOT,
+                                     R_FOREARM, R_UPPER_ARM)
 from worldtrack.synth.scenarios import CAM1_GRID, CAM2_GRID
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
@@ -55,6 +55,30 @@ def test_bad_names_and_parameters_are_input_errors():
     with pytest.raises(InputError, match="camera"):
         make_scenario("static-grid", camera="cam3")
     assert "passing" in scenario_parameters("two-crossing")
+
+
+def test_limb_swing_zero_makes_walkers_glide_on_the_same_paths():
+    walk = make_scenario("two-crossing", size=(64, 48), seed=3)
+    glide = make_scenario("two-crossing", size=(64, 48), seed=3, limb_swing=0.0)
+    frame = walk.n_frames // 2
+    for a, b in zip(walk.people, glide.people):
+        np.testing.assert_array_equal(a.track.xy, b.track.xy)
+        assert a.track.speed[frame] > 0.5 and a.track.amplitude[frame] > 0.3
+        assert not b.track.amplitude.any()
+
+    def stride(sc):
+        """How far (m) each walker's feet are apart along the heading at ``frame``."""
+        people, parts = sc.pose_people(frame)
+        centre = parts.centre.reshape(len(people), PARTS_PER_PERSON, 3)
+        yaw = np.array([p.track.yaw[frame] for p in people])
+        apart = centre[:, L_FOOT, :2] - centre[:, R_FOOT, :2]
+        return np.abs(apart[:, 0] * np.cos(yaw) + apart[:, 1] * np.sin(yaw))
+
+    # Walking, one foot is ahead of the other; gliding they stay side by side, as standing.
+    assert stride(walk).max() > 0.3
+    assert stride(glide).max() < 0.02
+    with pytest.raises(InputError, match="limb_swing: expected a value in \\[0, 1.5\\], got -1"):
+        make_scenario("two-crossing", limb_swing=-1.0)
 
 
 @pytest.mark.parametrize("camera, grid", [("cam1", CAM1_GRID), ("cam2", CAM2_GRID)])

@@ -53,6 +53,9 @@ class Common:
     white_balance : "auto" or "fixed"
     light_steps : tuple of (time_s, level) — the room light switches to ``level`` (relative) at
         ``time_s`` seconds, e.g. ((5.0, 0.6),) dims it by 40 % five seconds in
+    limb_swing : float in [0, 1.5] — scale of the walking limb swing (legs and arms); 0 makes walkers
+        glide with the limbs held as when standing, for ablations: how much of a tracker's error
+        the gait causes (the paths, speeds and everything else stay the same)
     """
 
     fps: float = 10.0
@@ -64,6 +67,7 @@ class Common:
     vignetting: float = 0.12
     white_balance: str = "auto"
     light_steps: tuple = ()
+    limb_swing: float = 1.0
 
 
 _REGISTRY: dict[str, Callable[..., Scenario]] = {}
@@ -133,6 +137,9 @@ def make_scenario(name: str, size: tuple[int, int] | str | None = None, frames: 
         raise InputError(f"seed: expected a non-negative integer, got {seed!r}")
     sc = fn(int(seed), common, size=parse_size(size) if size is not None else None,
             frames=int(frames) if frames is not None else None, **own_kw)
+    if common.limb_swing != 1.0:
+        for person in sc.people:
+            person.track.amplitude = person.track.amplitude * float(common.limb_swing)
     sc.params = {"scenario": name, "seed": int(seed), "size": list(_first_size(sc)), "frames": sc.n_frames,
                  **{f.name: getattr(common, f.name) for f in fields(Common)}, **own, **own_kw}
     return sc
@@ -166,6 +173,8 @@ def _check_common(c: Common) -> None:
     for k in ("noise", "blur", "light_drift", "vignetting"):
         if getattr(c, k) < 0:
             raise InputError(f"{k}: expected a value ≥ 0, got {getattr(c, k)}")
+    if not 0 <= c.limb_swing <= 1.5:
+        raise InputError(f"limb_swing: expected a value in [0, 1.5], got {c.limb_swing}")
     if not 0 <= c.shadow_strength <= 1:
         raise InputError(f"shadow_strength: expected a value in [0, 1], got {c.shadow_strength}")
     if c.reflection is not None and not 0 <= c.reflection <= 1:
