@@ -37,6 +37,8 @@ Usage::
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 1 2 3 4 5 --tracker-seeds 0 1 2 --configs default-column --jobs 2
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 --configs default-column
     .venv/bin/python benchmarks/particle_entry.py --set gamma=30 --set alpha=0.4
+    .venv/bin/python benchmarks/particle_entry.py --scenario limb_swing=0 --configs default-column --no-single
+        # walkers glide (no leg or arm swing): the error the gait causes is the difference
 
 Writes ``benchmarks/results/particle_entry.md``.
 """
