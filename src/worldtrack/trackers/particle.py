@@ -85,6 +85,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 from scipy.spatial import cKDTree
+from scipy.spatial.distance import cdist
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
@@ -1002,7 +1003,7 @@ class ParticleTracker:
         apart = both & ~(ov >= cfg.merge_overlap)
         close = both.any(axis=0) & ~apart.any(axis=0)
         c = np.array([f.centre for f in fs], dtype=float)
-        far = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1]) > self._merge_distances(c)
+        far = cdist(c, c) > self._merge_distances(c)
         close_now, frames = set(), {}
         for i, j in zip(*np.nonzero(np.triu(close, 1))):
             a, b = fs[i].track.id, fs[j].track.id
@@ -1023,8 +1024,7 @@ class ParticleTracker:
         floor distance from the nearest camera beyond ``merge_depth`` (one camera's depth error
         grows with distance; at 30 m a duplicate of one person stands a metre behind it)."""
         cfg = self.config
-        cams = self._camera_floor
-        depth = np.min(np.hypot(centres[:, None, 0] - cams[None, :, 0], centres[:, None, 1] - cams[None, :, 1]), axis=1)
+        depth = cdist(centres, self._camera_floor).min(axis=1)
         pair = 0.5 * (depth[:, None] + depth[None, :])
         return cfg.merge_distance * np.maximum(1.0, pair / cfg.merge_depth)
 

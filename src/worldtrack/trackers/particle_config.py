@@ -476,9 +476,7 @@ class ParticleConfig:
         if not _number(self.appearance_rate) or not 0 < self.appearance_rate <= 1:
             raise bad("appearance_rate", "a weight in (0, 1]")
         for name, infinite in (("merge_distance", "boxes alone"), ("merge_depth", "merge_distance at every depth")):
-            value = getattr(self, name)
-            if (not isinstance(value, (int, float, np.integer, np.floating)) or isinstance(value, bool)
-                    or math.isnan(value) or not value > 0):
+            if not _number(getattr(self, name), allow_inf=True) or not getattr(self, name) > 0:
                 raise bad(name, f"a positive number of metres (inf: {infinite})")
         if not _number(self.merge_overlap) or not 0 < self.merge_overlap <= 1:
             raise bad("merge_overlap", "a share in (0, 1]")
@@ -503,5 +501,8 @@ class ParticleConfig:
         return max(1, int(math.ceil(self.min_height / self.dz - 1e-9)))
 
 
-def _number(v: object) -> bool:
-    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) and math.isfinite(v)
+def _number(v: object, allow_inf: bool = False) -> bool:
+    """Whether ``v`` is a real number (not a bool), finite unless ``allow_inf`` (never NaN)."""
+    if not isinstance(v, (int, float, np.integer, np.floating)) or isinstance(v, bool):
+        return False
+    return not math.isnan(v) if allow_inf else math.isfinite(v)
