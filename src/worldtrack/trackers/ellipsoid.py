@@ -377,9 +377,9 @@ class EllipsoidTracker:
                 # searching again: the same line of sight a frame later rarely holds a new answer.
                 failing = tr.frames_low > 0 and self._frame >= tr.extra.get("rescue_after", 0)
                 if tr.mode == "tracking" and (failing or periodic):
-                    e = self._rescue(k, xy, hs, ws, state, real, best_e[k], best_den[k])
-                    if e is not None:
-                        best_e[k] = e
+                    found = self._rescue(k, xy, hs, ws, state, real)
+                    if found is not None:
+                        best_e[k], best_den[k] = found
                     elif failing:
                         tr.extra["rescue_after"] = self._frame + cfg.rescue_retry_frames
         for k, tr in enumerate(tracks):
@@ -497,13 +497,17 @@ class EllipsoidTracker:
         _keep(state, forms, k, b)
 
     def _rescue(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
-                real: dict[str, np.ndarray], e_here: float, den_here: float) -> float | None:
+                real: dict[str, np.ndarray]) -> tuple[float, float] | None:
         """Search the viewing line ±``rescue_search_m`` for a clearly better place (by ``rescue_gain``).
 
         The 9-candidate steps climb E locally and cannot cross what is not walkable: a track that
         settled behind the wrong row of desks — E has a second peak along the viewing direction
         there — stays. Run on a track whose support is failing, and on each track every
         ``rescue_every`` frames; never onto somebody else (``min_separation_m``).
+
+        The current place is scored in the same call as the candidates: E depends on the pixels
+        visited (the union of the candidates' boxes, on a stride that keeps ``target_pixels``), so
+        only scores from one call compare. Returns (E, denominator) of the new place, or None.
         """
         cfg = self.config
         along = np.arange(-cfg.rescue_search_m, cfg.rescue_search_m + 1e-9, 0.15)
@@ -516,21 +520,24 @@ class EllipsoidTracker:
         if len(others):
             dist = np.min(np.linalg.norm(cand[:, None, :] - others[None, :, :], axis=2), axis=1)
             ok &= dist >= cfg.min_separation_m
-        cand = cand[ok]
-        if len(cand) == 0:
+        if not ok.any():
             return None
+        cand = np.vstack([xy[k], cand[ok]])                   # row 0: where the person is now
         e, den, forms = self._score_candidates(k, cand, np.full(len(cand), hs[k]), np.full(len(cand), ws[k]),
                                                state, real, use_ring=True)
+        e_here = float(e[0]) if np.isfinite(e[0]) else 0.0  # not in view where it is: nothing to keep
+        num_here = e_here * den[0]
+        e[0] = -np.inf
         # E is a ratio: a place where less of the person is in view (past the image border) can
         # score higher on less evidence. A move must also raise the net matched evidence Σ sim·real.
         with np.errstate(invalid="ignore"):
-            e[~(np.where(np.isfinite(e), e, 0.0) * den >= e_here * den_here)] = -np.inf
+            e[~(np.where(np.isfinite(e), e, 0.0) * den >= num_here)] = -np.inf
         b = int(np.argmax(e))
         if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue_gain:
             return None
         xy[k] = cand[b]
         _keep(state, forms, k, b)
-        return float(e[b])
+        return float(e[b]), float(den[b])
 
     def _ray_directions(self, k: int, state: dict, xy: np.ndarray) -> list[np.ndarray]:
         """Unit floor directions of the rays from each camera that sees person ``k`` through its
