@@ -311,10 +311,14 @@ def test_height_is_no_longer_measured_once_the_samples_are_in(monkeypatch):
     assert tr.position_map[1].height == pytest.approx(1.8)
 
 
-def _one_person_seen(scene, bgs: dict, person: np.ndarray, rng) -> tuple[EllipsoidTracker, dict, dict]:
-    """A default tracker that has just read one frame of a 1.65 x 0.4 m ellipsoid standing at
-    ``person``: the tracker (foreground labels and masks set), the images and the ternary real
-    images, per camera."""
+def _one_person_seen(seed: int) -> tuple:
+    """The lab's two cameras (320x240, noise backgrounds) and a default tracker that has just read
+    one frame of a 1.65 x 0.4 m ellipsoid standing at (-1.0, 1.2): ``scene, person, backgrounds,
+    tracker`` (foreground labels and masks set), the images and the ternary real images, per camera."""
+    scene = _two_camera_scene((320, 240))
+    rng = np.random.default_rng(seed)
+    bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
+    person = np.array([-1.0, 1.2])
     cen, rad = q.person_ellipsoid([person], 1.65, 0.4)
     tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig())
     real, images = {}, {}
@@ -325,18 +329,14 @@ def _one_person_seen(scene, bgs: dict, person: np.ndarray, rng) -> tuple[Ellipso
         labels = tracker.cams[cid].foreground.labels(images[cid])
         tracker.last_labels[cid], tracker.last_masks[cid] = labels, (labels == 1).astype(np.uint8)
         real[cid] = ternary_real(labels, tracker.cams[cid].ring_px)
-    return tracker, images, real
+    return scene, person, bgs, tracker, images, real
 
 
 def test_rescue_brings_a_track_off_along_a_line_of_sight_back_and_leaves_a_right_one():
     # A track 0.9 m off along one camera's line of sight is searched back along the seeing
     # cameras' lines to the person; a track on the person stays (no candidate beats its own place
     # scored on the same pixels by ``rescue_gain``).
-    scene = _two_camera_scene((320, 240))
-    rng = np.random.default_rng(5)
-    bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
-    person = np.array([-1.0, 1.2])
-    tracker, _, real = _one_person_seen(scene, bgs, person, rng)
+    scene, person, _, tracker, _, real = _one_person_seen(seed=5)
     cids = list(real)
 
     def rescue(at):
@@ -359,11 +359,7 @@ def test_new_person_is_placed_along_the_line_of_sight_of_the_camera_that_propose
     # A blob's foot point is uncertain along the ray of the camera whose blob it is: the birth
     # search runs along that ray (and the ray of the camera that sees the guess largest). Along the
     # largest camera's ray alone, a guess off along the other camera's ray stays 0.15 m off.
-    scene = _two_camera_scene((320, 240))
-    rng = np.random.default_rng(3)
-    bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
-    person = np.array([-1.0, 1.2])
-    tracker, images, real = _one_person_seen(scene, bgs, person, rng)
+    scene, person, bgs, tracker, images, real = _one_person_seen(seed=3)
     # Births say which camera's blob each proposal came from; the note is gone once matched, with
     # or without the search (it is not a column of the output).
     born = tracker._births(real, 0.0)
