@@ -525,13 +525,12 @@ class EllipsoidTracker:
         cand = np.vstack([xy[k], cand[ok]])                   # row 0: where the person is now
         e, den, forms = self._score_candidates(k, cand, np.full(len(cand), hs[k]), np.full(len(cand), ws[k]),
                                                state, real, use_ring=True)
-        e_here = float(e[0]) if np.isfinite(e[0]) else 0.0  # not in view where it is: nothing to keep
-        num_here = e_here * den[0]
-        e[0] = -np.inf
+        num = np.where(np.isfinite(e), e, 0.0) * den          # Σ sim·real (0 where not in view)
+        e_here = float(e[0]) if np.isfinite(e[0]) else 0.0
         # E is a ratio: a place where less of the person is in view (past the image border) can
-        # score higher on less evidence. A move must also raise the net matched evidence Σ sim·real.
-        with np.errstate(invalid="ignore"):
-            e[~(np.where(np.isfinite(e), e, 0.0) * den >= num_here)] = -np.inf
+        # score higher on less evidence. A move must also raise the net matched evidence.
+        e[num < num[0]] = -np.inf
+        e[0] = -np.inf
         b = int(np.argmax(e))
         if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue_gain:
             return None
