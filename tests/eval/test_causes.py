@@ -28,3 +28,34 @@ def test_a_perfect_tracker_has_no_errors_to_sort():
     gt = TrackTable.from_arrays(frame=[0, 1], id=[1, 1], x=[0.0, 0.1], y=[0.0, 0.0])
     counts = error_causes(gt, gt, evaluate_detailed(gt, gt, gate=0.5).pairs)
     assert sum(counts.values()) == 0
+
+
+def _overhead_pair():
+    """Two cameras 5 m up looking straight down, 4 m apart, 90° across: a camera sees feet up to 5 m
+    and a 1.6 m head up to 3.4 m to either side of it along x."""
+    from worldtrack.geometry.camera import Camera
+
+    return [Camera.look_at(c, 640, 480, [x, 0.0, 5.0], [x, 0.0, 0.0], hfov_deg=90.0) for c, x in (("a", 0.0), ("b", 4.0))]
+
+
+def test_a_camera_sees_a_place_only_when_it_sees_both_feet_and_head():
+    from worldtrack.eval import views_of
+
+    # x = 3.3: head 3.3 m from camera a's axis (inside its 3.4 m); x = 3.5: feet in view, head not.
+    views = views_of([2.0, 3.3, 3.5, -2.0, 20.0], [0.0] * 5, _overhead_pair())
+    assert views.tolist() == [2, 2, 1, 1, 0]
+
+
+def test_errors_are_sorted_by_the_views_of_the_place():
+    from worldtrack.eval import errors_by_views
+
+    gt = TrackTable.from_arrays(frame=[0, 0, 0], id=[1, 2, 3], x=[2.0, -2.0, 20.0], y=[0.0, 0.0, 0.0])
+    # Track 1 on person 1 (both cameras see them); track 2 2 m beside person 2 (camera a only); person 3
+    # is out of every view and has no track.
+    pred = TrackTable.from_arrays(frame=[0, 0], id=[1, 2], x=[2.1, -2.0], y=[0.0, 2.0])
+    pairs = evaluate_detailed(gt, pred, gate=0.5).pairs
+    assert errors_by_views(gt, pred, pairs, _overhead_pair()) == {
+        0: {"people": 1, "misses": 1, "tracks": 0, "false positives": 0},
+        1: {"people": 1, "misses": 1, "tracks": 1, "false positives": 1},
+        2: {"people": 1, "misses": 0, "tracks": 1, "false positives": 0},
+    }

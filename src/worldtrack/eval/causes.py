@@ -9,13 +9,19 @@ unmatched. With the matched pairs of :func:`worldtrack.eval.evaluate_detailed`, 
 * miss (a person matched to no track) is ``no track`` when no track is within ``near`` metres,
   ``shared`` when the nearest track is matched to somebody else (two people close together under
   one track), and ``displaced`` otherwise.
+
+:func:`errors_by_views` sorts the same errors by how many cameras see the place: with one camera a
+person's distance along its line of sight rests on their height alone.
 """
 
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Iterable
 
 import numpy as np
+
+from worldtrack.geometry.camera import Camera
 
 from worldtrack.io.tracks import TrackTable
 
@@ -63,3 +69,60 @@ def error_causes(gt: TrackTable, pred: TrackTable, pairs: dict, near: float = 1.
             else:
                 out["miss shared" if (frame, pid[j]) in pred_matched else "miss displaced"] += 1
     return out
+
+
+def views_of(x: np.ndarray, y: np.ndarray, cameras: Iterable[Camera], head_z: float = 1.6) -> np.ndarray:
+    """How many of ``cameras`` see a person standing at each floor point, feet and head.
+
+    Parameters
+    ----------
+    x, y : (N,) metres — floor points
+    cameras : the cameras
+    head_z : metres — a camera sees the person when both ``(x, y, 0)`` and ``(x, y, head_z)`` are in
+        front of it and project inside its image
+
+    Returns
+    -------
+    (N,) int — the number of cameras
+    """
+    x, y = np.asarray(x, float).reshape(-1), np.asarray(y, float).reshape(-1)
+    count = np.zeros(len(x), dtype=int)
+    for cam in cameras:
+        sees = np.ones(len(x), dtype=bool)
+        for z in (0.0, head_z):
+            uv, depth = cam.project(np.column_stack([x, y, np.full(len(x), z)]), return_depth=True)
+            sees &= (depth > 0) & cam.in_image(uv)
+        count += sees
+    return count
+
+
+def errors_by_views(gt: TrackTable, pred: TrackTable, pairs: dict, cameras: Iterable[Camera],
+                    head_z: float = 1.6) -> dict[int, dict[str, int]]:
+    """People, misses, tracks and false positives by how many cameras see the place (:func:`views_of`).
+
+    Parameters
+    ----------
+    gt, pred, pairs : as :func:`error_causes`
+    cameras : the scene's cameras
+    head_z : metres
+
+    Returns
+    -------
+    {views: {"people": …, "misses": …, "tracks": …, "false positives": …}} — person rows and their
+    misses by the views of the person's true place, track rows and their false positives by the
+    views of the track's place; one key per number of views that occurs
+    """
+    cameras = list(cameras)
+    frames = np.asarray(pairs["frame"]).tolist()
+    gt_matched = set(zip(frames, np.asarray(pairs["gt_id"]).tolist()))
+    pred_matched = set(zip(frames, np.asarray(pairs["pred_id"]).tolist()))
+    out: dict[int, dict[str, int]] = {}
+    for table, matched, total, wrong in ((gt, gt_matched, "people", "misses"),
+                                         (pred, pred_matched, "tracks", "false positives")):
+        views = views_of(table.x, table.y, cameras, head_z)
+        hit = np.array([key in matched for key in zip(table.frame.tolist(), table.id.tolist())], dtype=bool)
+        for v in np.unique(views).tolist():
+            row = out.setdefault(int(v), {"people": 0, "misses": 0, "tracks": 0, "false positives": 0})
+            row[total] += int((views == v).sum())
+            row[wrong] += int(((views == v) & ~hit).sum())
+    return dict(sorted(out.items()))
