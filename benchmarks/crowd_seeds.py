@@ -3,10 +3,10 @@
 One seed of a 10-person crowd is a handful of encounters; whether the tracker meets the target
 depends on which ones the seed deals (MOTA ranges over ~0.80–0.94 between seeds with the same
 code). So this renders ``crowd`` (2 cameras in opposite corners of the 10 × 8 m hall, facing each other;
-640×480, 80 frames at
-10 frames/s) for several seeds, tracks each with the ellipsoid tracker's default preset and colour
-foreground through :func:`worldtrack.experiment.run_scenario` (gate 0.5 m; people less than 20 %
-visible in every camera are neither required nor forbidden), and reports per seed and overall:
+640×480, 80 frames at 10 frames/s) for several seeds, tracks each with the ellipsoid tracker's
+default preset and colour foreground through :func:`worldtrack.experiment.run_scenario` (gate
+0.5 m; people less than 20 % visible in every camera are neither required nor forbidden), and
+reports per seed and overall:
 MOTA, IDF1, false positives, misses, ID switches, mean position error — and what the errors are
 (:func:`worldtrack.eval.error_causes`, 1 m): false positives that are ghosts (no person within 1 m:
 a track left on a wall or in a corner), duplicates or displaced; misses with no track near, under a
