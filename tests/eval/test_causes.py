@@ -1,6 +1,7 @@
 """Sorting false positives and misses by cause."""
 
-from worldtrack.eval import CAUSES, error_causes, evaluate_detailed
+from worldtrack.eval import CAUSES, error_causes, errors_by_views, evaluate_detailed, views_of
+from worldtrack.geometry.camera import Camera
 from worldtrack.io.tracks import TrackTable
 
 
@@ -33,22 +34,16 @@ def test_a_perfect_tracker_has_no_errors_to_sort():
 def _overhead_pair():
     """Two cameras 5 m up looking straight down, 4 m apart, 90° across: a camera sees feet up to 5 m
     and a 1.6 m head up to 3.4 m to either side of it along x."""
-    from worldtrack.geometry.camera import Camera
-
     return [Camera.look_at(c, 640, 480, [x, 0.0, 5.0], [x, 0.0, 0.0], hfov_deg=90.0) for c, x in (("a", 0.0), ("b", 4.0))]
 
 
 def test_a_camera_sees_a_place_only_when_it_sees_both_feet_and_head():
-    from worldtrack.eval import views_of
-
     # x = 3.3: head 3.3 m from camera a's axis (inside its 3.4 m); x = 3.5: feet in view, head not.
     views = views_of([2.0, 3.3, 3.5, -2.0, 20.0], [0.0] * 5, _overhead_pair())
     assert views.tolist() == [2, 2, 1, 1, 0]
 
 
 def test_errors_are_sorted_by_the_views_of_the_place():
-    from worldtrack.eval import errors_by_views
-
     gt = TrackTable.from_arrays(frame=[0, 0, 0], id=[1, 2, 3], x=[2.0, -2.0, 20.0], y=[0.0, 0.0, 0.0])
     # Track 1 on person 1 (both cameras see them); track 2 2 m beside person 2 (camera a only); person 3
     # is out of every view and has no track.

@@ -22,7 +22,6 @@ from collections.abc import Iterable
 import numpy as np
 
 from worldtrack.geometry.camera import Camera
-
 from worldtrack.io.tracks import TrackTable
 
 #: The causes, in the order tables list them.
@@ -85,14 +84,10 @@ def views_of(x: np.ndarray, y: np.ndarray, cameras: Iterable[Camera], head_z: fl
     -------
     (N,) int — the number of cameras
     """
-    x, y = np.asarray(x, float).reshape(-1), np.asarray(y, float).reshape(-1)
-    count = np.zeros(len(x), dtype=int)
+    xy = np.column_stack([np.asarray(x, float).reshape(-1), np.asarray(y, float).reshape(-1)])
+    count = np.zeros(len(xy), dtype=int)
     for cam in cameras:
-        sees = np.ones(len(x), dtype=bool)
-        for z in (0.0, head_z):
-            uv, depth = cam.project(np.column_stack([x, y, np.full(len(x), z)]), return_depth=True)
-            sees &= (depth > 0) & cam.in_image(uv)
-        count += sees
+        count += cam.sees_standing(xy, head_z)
     return count
 
 

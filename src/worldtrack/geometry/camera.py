@@ -421,6 +421,16 @@ class Camera:
               & (v >= -0.5 + margin) & (v < self.height - 0.5 - margin))
         return ok.reshape(lead)
 
+    def sees_standing(self, xy: ArrayLike, height: float) -> np.ndarray:
+        """(N,) bool: a person ``height`` metres tall standing at floor points ``xy`` (N, 2), metres,
+        has feet and head in front of the camera and inside its image."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        sees = np.ones(len(xy), dtype=bool)
+        for z in (0.0, height):
+            uv, depth = self.project(np.column_stack([xy, np.full(len(xy), z)]), return_depth=True)
+            sees &= (depth > 0) & self.in_image(uv)
+        return sees
+
     # ------------------------------------------------------------------ variants
     def scaled(self, factor: float) -> "Camera":
         """The same camera for an image resized by ``factor`` (e.g. 0.625 for 768→480 px).

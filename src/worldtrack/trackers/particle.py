@@ -293,10 +293,7 @@ class ParticleTracker:
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         seen = np.zeros(len(xy), dtype=bool)
         for cl in self._cams.values():
-            cam = cl.camera
-            feet = cam.in_image(cam.project(np.column_stack([xy, np.zeros(len(xy))])))
-            head = cam.in_image(cam.project(np.column_stack([xy, np.full(len(xy), self.config.min_height)])))
-            seen |= feet & head
+            seen |= cl.camera.sees_standing(xy, self.config.min_height)
         return self.scene.walkable.contains(xy) & seen
 
     # ------------------------------------------------------------------ public
