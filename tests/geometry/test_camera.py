@@ -159,3 +159,12 @@ def test_floor_rays_point_from_the_foot_point():
     near, _ = cam.floor_rays(np.array([1.1, -2.0]), min_distance=0.3)       # too near to trust
     np.testing.assert_allclose(near, cam.floor_direction)
     np.testing.assert_allclose(cam.floor_distance([[4.0, 2.0, 1.7]]), [5.0])
+
+
+def test_a_camera_sees_a_standing_person_only_with_feet_and_head_in_front_of_it_and_in_the_image():
+    # Horizontal camera 1 m up looking along +y, 60° across: 4:3 image, so ±22.8° vertically.
+    cam = Camera.look_at("c", 640, 480, position=(0, 0, 1), target=(0, 10, 1), hfov_deg=60)
+    # 5 m ahead: feet 11.3° down, head (1.7 m) 8.0° up; 1.5 m ahead: feet 33.7° down, out of the
+    # image; 5 m behind: the mirror image of "5 m ahead" would fall in the image, but it is behind.
+    sees = cam.sees_standing([[0, 5], [0, 1.5], [0, -5]], 1.7)
+    assert sees.tolist() == [True, False, False]

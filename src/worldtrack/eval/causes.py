@@ -28,6 +28,11 @@ from worldtrack.io.tracks import TrackTable
 CAUSES = ("fp ghost", "fp duplicate", "fp displaced", "miss no track", "miss shared", "miss displaced")
 
 
+def _matched(pairs: dict, column: str) -> set[tuple[int, int]]:
+    """The (frame, id) keys of ``column`` ("gt_id" or "pred_id") in the matched ``pairs``."""
+    return set(zip(np.asarray(pairs["frame"]).tolist(), np.asarray(pairs[column]).tolist()))
+
+
 def error_causes(gt: TrackTable, pred: TrackTable, pairs: dict, near: float = 1.0) -> Counter:
     """Count false positives and misses by cause (see the module notes).
 
@@ -41,8 +46,7 @@ def error_causes(gt: TrackTable, pred: TrackTable, pairs: dict, near: float = 1.
     -------
     Counter keyed by :data:`CAUSES`
     """
-    pred_matched = set(zip(np.asarray(pairs["frame"]).tolist(), np.asarray(pairs["pred_id"]).tolist()))
-    gt_matched = set(zip(np.asarray(pairs["frame"]).tolist(), np.asarray(pairs["gt_id"]).tolist()))
+    pred_matched, gt_matched = _matched(pairs, "pred_id"), _matched(pairs, "gt_id")
     out: Counter = Counter({c: 0 for c in CAUSES})
     for frame in np.unique(np.concatenate([gt.frame, pred.frame])).tolist():
         g, p = gt.frame == frame, pred.frame == frame
@@ -108,12 +112,9 @@ def errors_by_views(gt: TrackTable, pred: TrackTable, pairs: dict, cameras: Iter
     views of the track's place; one key per number of views that occurs
     """
     cameras = list(cameras)
-    frames = np.asarray(pairs["frame"]).tolist()
-    gt_matched = set(zip(frames, np.asarray(pairs["gt_id"]).tolist()))
-    pred_matched = set(zip(frames, np.asarray(pairs["pred_id"]).tolist()))
     out: dict[int, dict[str, int]] = {}
-    for table, matched, total, wrong in ((gt, gt_matched, "people", "misses"),
-                                         (pred, pred_matched, "tracks", "false positives")):
+    for table, matched, total, wrong in ((gt, _matched(pairs, "gt_id"), "people", "misses"),
+                                         (pred, _matched(pairs, "pred_id"), "tracks", "false positives")):
         views = views_of(table.x, table.y, cameras, head_z)
         hit = np.array([key in matched for key in zip(table.frame.tolist(), table.id.tolist())], dtype=bool)
         for v in np.unique(views).tolist():

@@ -423,13 +423,11 @@ class Camera:
 
     def sees_standing(self, xy: ArrayLike, height: float) -> np.ndarray:
         """(N,) bool: a person ``height`` metres tall standing at floor points ``xy`` (N, 2), metres,
-        has feet and head in front of the camera and inside its image."""
+        has feet and head in front of the camera and inside its image (:meth:`project` gives NaN,
+        which no image holds, for points behind it)."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        sees = np.ones(len(xy), dtype=bool)
-        for z in (0.0, height):
-            uv, depth = self.project(np.column_stack([xy, np.full(len(xy), z)]), return_depth=True)
-            sees &= (depth > 0) & self.in_image(uv)
-        return sees
+        feet_and_head = np.concatenate([np.column_stack([xy, np.full(len(xy), z)]) for z in (0.0, height)])
+        return self.in_image(self.project(feet_and_head)).reshape(2, -1).all(axis=0)
 
     # ------------------------------------------------------------------ variants
     def scaled(self, factor: float) -> "Camera":
