@@ -239,75 +239,141 @@ def owner_image(shape: tuple[int, int], boxes) -> np.ndarray:
     return out
 
 
+def read_codes(hit: np.ndarray, owner: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) uint8 what :func:`column_counts` reads per pixel: the label of ``hit`` (0, 1, 2; any
+    other value reads as 0, background) in bits 0–1 and the box count of ``owner`` (saturated at
+    63, which reads the same: more than one box) in bits 2–7.
+
+    Parameters
+    ----------
+    hit : (H, W) uint8 — :func:`hit_image` or :func:`hit_labels`
+    owner : (H, W) uint8 — :func:`owner_image`
+    out : (H, W) uint8, optional — written in place and returned
+    """
+    hit = np.ascontiguousarray(hit, dtype=np.uint8)
+    owner = np.ascontiguousarray(owner, dtype=np.uint8)
+    if out is None:
+        out = np.empty(hit.shape, dtype=np.uint8)
+    _read_codes(hit, owner, out)
+    return out
+
+
+@njit(cache=True)
+def _read_codes(hit, owner, out):
+    for v in range(hit.shape[0]):
+        for u in range(hit.shape[1]):
+            h = hit[v, u]
+            out[v, u] = (h if h <= 2 else 0) | (min(owner[v, u], 63) << 2)
+
+
 def occluder_layers(shape: tuple[int, int], boxes, depths, out: "Occluders | None" = None) -> "Occluders":
     """Per pixel, the nearest and second-nearest of ``boxes`` that cover it, for depth-ordered reading.
 
     Parameters
     ----------
     shape : (H, W)
-    boxes : sequence of ``(u0, u1, v0, v1)`` pixel ranges or None, one per tracked object
+    boxes : sequence of ``(u0, u1, v0, v1)`` pixel ranges or None, one per tracked object (fewer
+        than 32767)
     depths : sequence of float, metres — each object's floor distance from the camera
     out : Occluders, optional — an earlier result to reuse: only the boxes it holds are cleared
-        (allocating three full frames every frame cost ~1 ms at 640×480)
+        (allocating full frames every frame cost ~1 ms at 640×480)
 
     Returns
     -------
-    Occluders — ``near1`` (H, W) float64, the depth of the nearest box over each pixel (inf where
-    none), ``id1`` (H, W) int32 its index in ``boxes`` (−1 where none), ``near2`` (H, W) float64 the
-    depth of the second nearest (inf where fewer than two)
+    Occluders — per pixel the indices of the two nearest boxes (``pairs``) and each box's depth
+    (``depths``); read as layers: ``near1`` (H, W) float64, the depth of the nearest box over each
+    pixel (inf where none), ``id1`` (H, W) int32 its index in ``boxes`` (−1 where none), ``near2``
+    (H, W) float64 the depth of the second nearest (inf where fewer than two)
     """
-    if out is None or out[0].shape != tuple(shape):
-        out = Occluders(np.full(shape, np.inf), np.full(shape, -1, dtype=np.int32), np.full(shape, np.inf))
-    near1, id1, near2 = out
+    if len(boxes) >= _MAX_BOXES:
+        raise ValueError(f"occluder_layers: at most {_MAX_BOXES - 1} boxes, got {len(boxes)}")
+    if out is None or out.pairs.shape != tuple(shape):
+        out = Occluders(np.zeros(shape, dtype=np.int32), np.full(1, np.inf))
     for u0, u1, v0, v1 in out.filled:               # clear last use's boxes only (no full-frame pass)
-        near1[v0:v1, u0:u1] = np.inf
-        near2[v0:v1, u0:u1] = np.inf
-        id1[v0:v1, u0:u1] = -1
+        out.pairs[v0:v1, u0:u1] = 0
     given = [k for k, b in enumerate(boxes) if b is not None]
     out.filled = [boxes[k] for k in given]
+    out.depths = np.full(len(boxes) + 1, np.inf)
     if given:
-        _fill_layers(near1, id1, near2, np.array([boxes[k] for k in given], dtype=np.int64).reshape(-1, 4),
-                     np.array(given, dtype=np.int32), np.array([depths[k] for k in given], dtype=np.float64))
+        ids = np.array(given, dtype=np.int32)
+        out.depths[ids + 1] = [depths[k] for k in given]
+        _fill_layers(out.pairs, out.depths, np.array([boxes[k] for k in given], dtype=np.int64).reshape(-1, 4), ids)
     return out
 
 
+#: Box indices of :func:`occluder_layers` are stored plus one in 16 bits (0: none).
+_MAX_BOXES = 32767
+
+
 @njit(cache=True)
-def _fill_layers(near1, id1, near2, boxes, ids, depths):
-    """Insert each box ``(u0, u1, v0, v1)`` with its id and depth into the two nearest layers, in place."""
-    H, W = near1.shape
+def _fill_layers(pairs, depths, boxes, ids):
+    """Insert each box ``(u0, u1, v0, v1)`` with its index into the two nearest layers ``pairs``, in
+    place; ``depths`` (B + 1,) the boxes' depths by index + 1 (``depths[0] = inf``, no box)."""
+    H, W = pairs.shape
     for j in range(boxes.shape[0]):
-        d = depths[j]
+        k = ids[j] + 1
+        d = depths[k]
         for v in range(max(boxes[j, 2], 0), min(boxes[j, 3], H)):
             for u in range(max(boxes[j, 0], 0), min(boxes[j, 1], W)):
-                if d < near1[v, u]:
-                    near2[v, u] = near1[v, u]
-                    near1[v, u] = d
-                    id1[v, u] = ids[j]
-                elif d < near2[v, u]:
-                    near2[v, u] = d
+                p = pairs[v, u]
+                first = p & 0xFFFF
+                if d < depths[first]:                   # nearest: the old nearest becomes second
+                    pairs[v, u] = k | (first << 16)
+                elif d < depths[p >> 16]:
+                    pairs[v, u] = first | (k << 16)
 
 
-class Occluders(tuple):
-    """``(near1, id1, near2)`` of :func:`occluder_layers`; :data:`NO_OCCLUDERS` when there are none."""
+class Occluders:
+    """The two nearest boxes over each pixel, as :func:`occluder_layers` makes them;
+    :data:`NO_OCCLUDERS` when there are none.
 
-    def __new__(cls, near1: np.ndarray, id1: np.ndarray, near2: np.ndarray):
-        self = super().__new__(cls, (np.ascontiguousarray(near1, dtype=np.float64),
-                                     np.ascontiguousarray(id1, dtype=np.int32),
-                                     np.ascontiguousarray(near2, dtype=np.float64)))
-        self.filled = []            # the boxes written into the layers (cleared on reuse)
-        return self
+    Attributes
+    ----------
+    pairs : (H, W) int32 — ``(i1 + 1) | (i2 + 1) << 16`` with i1 the index of the nearest box over the
+        pixel and i2 that of the second nearest (0 for none): what the column kernel reads, one
+        4-byte word per pixel
+    depths : (B + 1,) float64, metres — ``depths[i + 1]`` the depth of box i, ``depths[0] = inf``
+    filled : list — the boxes written into ``pairs`` (cleared on reuse)
+
+    The layers as arrays (:attr:`near1`, :attr:`id1`, :attr:`near2`, also what iterating gives) are
+    made from these when asked for.
+    """
+
+    def __init__(self, pairs: np.ndarray, depths: np.ndarray):
+        self.pairs = np.ascontiguousarray(pairs, dtype=np.int32)
+        self.depths = np.ascontiguousarray(depths, dtype=np.float64)
+        self.filled = []            # the boxes written into ``pairs`` (cleared on reuse)
+
+    @property
+    def near1(self) -> np.ndarray:
+        """(H, W) float64 the depth of the nearest box over each pixel (inf where none)."""
+        return self.depths[self.pairs & 0xFFFF]
+
+    @property
+    def id1(self) -> np.ndarray:
+        """(H, W) int32 the index of the nearest box over each pixel (−1 where none)."""
+        return (self.pairs & 0xFFFF) - 1
+
+    @property
+    def near2(self) -> np.ndarray:
+        """(H, W) float64 the depth of the second-nearest box over each pixel (inf where fewer than two)."""
+        return self.depths[self.pairs >> 16]
+
+    def __iter__(self):
+        return iter((self.near1, self.id1, self.near2))
 
     def depth_for(self, me, iv=slice(None), iu=slice(None)) -> np.ndarray:
         """The depth of the nearest box other than box ``me``'s over pixels ``(iv, iu)`` (inf where none).
 
         Default: over the whole image, (H, W). ``me`` an int, or an array of box indices that
         broadcasts against the pixel indices ``iv, iu`` (one per pixel read)."""
-        near1, id1, near2 = self
-        return np.where(id1[iv, iu] == me, near2[iv, iu], near1[iv, iu])
+        p = self.pairs[iv, iu]
+        first = p & 0xFFFF
+        return self.depths[np.where(first - 1 == me, p >> 16, first)]
 
 
 #: No occluders: reading by depth disabled.
-NO_OCCLUDERS = Occluders(np.zeros((0, 0)), np.zeros((0, 0), dtype=np.int32), np.zeros((0, 0)))
+NO_OCCLUDERS = Occluders(np.zeros((0, 0), dtype=np.int32), np.full(1, np.inf))
 
 
 def column_heights(max_height: float, dz: float) -> np.ndarray:
@@ -411,21 +477,15 @@ def _to_pixel(px, py, pz, R, t, lens, has_dist, W, H):
 
 
 @njit(cache=True, inline="always")
-def _line_offset(j, d):
-    """Offset (pixels) of a cylinder's line ``j``: 0 the centre, 1 left, 2 right, ``d`` to the side."""
-    return 0.0 if j == 0 else (-d if j == 1 else d)
-
-
-@njit(cache=True, inline="always")
 def _box(boxes, f):
     """Row ``f`` of ``boxes`` (F, 4) as a tuple ``(u0, u1, v0, v1)``."""
     return boxes[f, 0], boxes[f, 1], boxes[f, 2], boxes[f, 3]
 
 
 @njit(cache=True, inline="always")
-def _others(owner, box, iu, iv):
-    """True if pixel (iu, iv) lies in the box of an object other than ``box`` (the filter's own)."""
-    n = owner[iv, iu]
+def _others(n, box, iu, iv):
+    """True if pixel (iu, iv), covered by ``n`` object boxes, lies in the box of an object other than
+    ``box`` (the filter's own)."""
     if n == 0:
         return False
     own = 1 if (box[0] <= iu < box[1] and box[2] <= iv < box[3]) else 0
@@ -433,22 +493,42 @@ def _others(owner, box, iu, iv):
 
 
 @njit(cache=True, inline="always")
-def _occluded(near1, id1, near2, me, iu, iv, depth, margin):
+def _occluded(pairs, depths, me, iu, iv, depth, margin):
     """True if the nearest other object's box over pixel (iu, iv) is nearer than ``depth − margin``."""
-    if near1.shape[0] == 0:
+    if pairs.shape[0] == 0:
         return False
-    d = near2[iv, iu] if id1[iv, iu] == me else near1[iv, iu]
+    p = pairs[iv, iu]
+    first = p & 0xFFFF
+    d = depths[p >> 16] if first - 1 == me else depths[first]
     return d < depth - margin
+
+
+@njit(cache=True, inline="always")
+def _read_line(codes, box, iu, iv, lab):
+    """Read one line's pixel (iu, iv) of a column sample whose label so far is ``lab`` (not 1).
+
+    Returns the new label — ``_OUT_OF_VIEW`` until a pixel in the image is read, then 1 if this
+    pixel reads object, 2 if it reads no evidence, else unchanged (0 once in the image) — and
+    whether the pixel lies in another object's box (then its label is not read)."""
+    if iu < 0:
+        return lab, False
+    if lab == _OUT_OF_VIEW:
+        lab = 0
+    c = codes[iv, iu]
+    if _others(c >> 2, box, iu, iv):
+        return lab, True
+    p = c & 3
+    return (p if p == 1 or p == 2 else lab), False
 
 
 @njit(cache=True)
 def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray,
-                  dist: np.ndarray, has_dist: bool, radius: float, hit: np.ndarray,
-                  owner: np.ndarray, boxes: np.ndarray, which: np.ndarray, near1: np.ndarray, id1: np.ndarray,
-                  near2: np.ndarray, mes: np.ndarray, centre: np.ndarray, margin: float, on: float, off: float,
-                  below: float, n_below: int, n_above: int, k_min: int, tops: np.ndarray, top_sigma: float,
-                  px_scale: np.ndarray, outside_unknown: bool, k_lo: np.ndarray, counts: np.ndarray,
-                  ratio: np.ndarray, top: np.ndarray, seen: np.ndarray, hidden: np.ndarray) -> None:
+                  dist: np.ndarray, has_dist: bool, radius: float, codes: np.ndarray, boxes: np.ndarray,
+                  which: np.ndarray, pairs: np.ndarray, depths: np.ndarray, mes: np.ndarray, centre: np.ndarray,
+                  margin: float, on: float, off: float, below: float, n_below: int, n_above: int, k_min: int,
+                  tops: np.ndarray, top_sigma: float, px_scale: np.ndarray, outside_unknown: bool,
+                  k_lo: np.ndarray, counts: np.ndarray, ratio: np.ndarray, top: np.ndarray, seen: np.ndarray,
+                  hidden: np.ndarray) -> None:
     """Height-column likelihood of the particles of one or more filters for one camera, in place.
 
     Parameters
@@ -459,15 +539,16 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     R, t, K, dist : the camera's rotation (3, 3), translation (3,), intrinsics (3, 3), distortion (5,)
     has_dist : bool — apply the distortion model
     radius : float, metres — 0: a line of points (the paper); > 0: a thin cylinder (module docstring)
-    hit : (H, W) uint8 — 1 object, 0 background, 2 no evidence (:func:`hit_image`, :func:`hit_labels`)
-    owner : (H, W) uint8 — number of object boxes over each pixel (:func:`owner_image`)
+    codes : (H, W) uint8 — per pixel the label in bits 0–1 (1 object, 0 background, 2 no evidence:
+        :func:`hit_image`, :func:`hit_labels`) and in bits 2–7 how many object boxes cover it
+        (:func:`owner_image`, up to 63): :func:`read_codes`, one byte read per pixel instead of two
     boxes : (F, 4) int64 — each filter's own object box ``(u0, u1, v0, v1)``, or :data:`NO_BOX`
     which : (N,) int64 — each particle's filter, a row of ``boxes`` and ``mes``
-    near1, id1, near2 : :func:`occluder_layers` of the same boxes, or the empty arrays of
-        :data:`NO_OCCLUDERS`. With them, a sample in another object's box whose object is nearer
-        to the camera than the particle by more than ``margin`` is *occluded*: no evidence (label 2)
-        instead of background
-    mes : (F,) int64 — each filter's own index in the boxes of ``near1, id1, near2``
+    pairs, depths : :class:`Occluders` ``pairs`` (H, W) int32 and ``depths`` (B + 1,) float64 of the
+        same boxes (:func:`occluder_layers`), or those of :data:`NO_OCCLUDERS`. With them, a sample
+        in another object's box whose object is nearer to the camera than the particle by more than
+        ``margin`` is *occluded*: no evidence (label 2) instead of background
+    mes : (F,) int64 — each filter's own index in the boxes of ``pairs, depths``
     centre : (2,) float64, metres — the camera centre's floor position (depths are floor distances)
     margin : float, metres
     on, off, below : float — log-ratio terms for a sample on / off the object, and for a ring sample
@@ -493,7 +574,7 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
     hidden : (N,) int32 — out: how many of the lowest samples, from ``heights[0]`` up, are hidden —
         occluded, or out of view with ``outside_unknown``
     """
-    H, W = hit.shape
+    H, W = codes.shape
     S = heights.shape[0]
     last = S - n_above - 1
     k_min = max(k_min, n_below)
@@ -526,32 +607,28 @@ def column_counts(xy: np.ndarray, heights: np.ndarray, R: np.ndarray, t: np.ndar
             iv = _nearest(v, H)
             if iv >= 0:
                 # The centre, then (cylinder) the pixels ``radius`` to the left and right at this
-                # depth: object if any reads object, else no evidence if any reads so — as a pixel
-                # in the box of a nearer object does (looked up last, only if nothing else decides).
-                d = fx * radius / cz if radius > 0.0 else 0.0
-                lines = 3 if d > 0.0 else 1
-                others = 0                                  # bit j: line j is in another's box
-                for j in range(lines):
-                    iu = _nearest(u + _line_offset(j, d), W)
-                    if iu >= 0:
-                        s = True
-                        if lab == _OUT_OF_VIEW:
-                            lab = 0
-                        if _others(owner, box, iu, iv):
-                            others |= 1 << j
-                            continue
-                        p = hit[iv, iu]
-                        if p == 1:
-                            lab = 1
-                            break
-                        if p == 2:
-                            lab = 2
-                if lab == 0 and others:
-                    for j in range(lines):
-                        if (others >> j) & 1 and _occluded(near1, id1, near2, me, _nearest(u + _line_offset(j, d), W),
-                                                           iv, depth, margin):
-                            lab = _OCCLUDED
-                            break
+                # depth, until one reads object: object if any reads object, else no evidence if
+                # any reads so — as a pixel in the box of a nearer object does (looked up last,
+                # only if nothing else decides).
+                iu0 = _nearest(u, W)
+                lab, o0 = _read_line(codes, box, iu0, iv, lab)
+                o1 = o2 = False
+                iu1 = iu2 = -1
+                if lab != 1 and radius > 0.0:
+                    d = fx * radius / cz
+                    if d > 0.0:
+                        iu1 = _nearest(u - d, W)
+                        lab, o1 = _read_line(codes, box, iu1, iv, lab)
+                        if lab != 1:
+                            iu2 = _nearest(u + d, W)
+                            lab, o2 = _read_line(codes, box, iu2, iv, lab)
+                if lab == 0 and (o0 or o1 or o2):
+                    if ((o0 and _occluded(pairs, depths, me, iu0, iv, depth, margin))
+                            or (o1 and _occluded(pairs, depths, me, iu1, iv, depth, margin))
+                            or (o2 and _occluded(pairs, depths, me, iu2, iv, depth, margin))):
+                        lab = _OCCLUDED
+                if lab != _OUT_OF_VIEW:
+                    s = True
             label[k] = lab
             # Hidden from the bottom up: occluded, or out of view when that is no evidence.
             if hb == k and (lab == _OCCLUDED or (lab == _OUT_OF_VIEW and outside_unknown)):
@@ -646,7 +723,7 @@ def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, d
         iu, iv = _to_pixel(xyz[i, 0], xyz[i, 1], xyz[i, 2], R, t, lens, has_dist, W, H)
         values[i] = 0.0
         seen[i] = iu >= 0
-        if iu >= 0 and not _others(owner, _box(boxes, which[i]), iu, iv):
+        if iu >= 0 and not _others(owner[iv, iu], _box(boxes, which[i]), iu, iv):
             values[i] = F[iv, iu]
 
 
@@ -700,6 +777,30 @@ def box_pixels(xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: 
 
 
 # ---------------------------------------------------------------------------- NumPy references
+
+def read_codes_reference(hit: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """:func:`read_codes` in NumPy."""
+    label = np.where(hit <= 2, hit, 0).astype(np.uint8)
+    return label | (np.minimum(owner, 63).astype(np.uint8) << 2)
+
+
+def occluder_layers_reference(shape: tuple[int, int], boxes, depths) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`occluder_layers` as plain layers ``(near1, id1, near2)``: the boxes taken nearest first
+    (the earlier one first among equal depths; boxes of NaN or infinite depth never), each pixel keeps
+    the first two that cover it."""
+    near1, near2 = np.full(shape, np.inf), np.full(shape, np.inf)
+    id1 = np.full(shape, -1, dtype=np.int32)
+    given = [k for k, b in enumerate(boxes) if b is not None and float(depths[k]) < math.inf]
+    for k in sorted(given, key=lambda k: float(depths[k])):      # sorted() is stable
+        u0, u1, v0, v1 = boxes[k]
+        first = np.zeros(shape, dtype=bool)
+        first[v0:v1, u0:u1] = True
+        second = first & (id1 >= 0) & np.isinf(near2)
+        first &= id1 < 0
+        near1[first], id1[first] = depths[k], k
+        near2[second] = depths[k]
+    return near1, id1, near2
+
 
 def column_points(xy: np.ndarray, heights: np.ndarray) -> np.ndarray:
     """(N, S, 3) world points of vertical columns: floor positions ``xy`` (N, 2) at ``heights`` (S,), metres."""
@@ -775,7 +876,7 @@ def column_counts_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, hei
         readable = inside & _readable(owner, own_box, iu, iv)
         hits |= readable & (hit[iv, iu] == 1)
         unsure |= readable & (hit[iv, iu] == 2)
-        if occluders is not None and occluders[0].size:
+        if occluders is not None and occluders.pairs.size:
             # In a nearer object's box: occluded, no evidence.
             particle_depth = camera.floor_rays(xy)[1][:, None]
             occluded |= inside & ~readable & (occluders.depth_for(own_index, iv, iu) < particle_depth - margin)
@@ -845,6 +946,7 @@ class CameraLikelihood:
         self.dist = np.ascontiguousarray(camera.dist, dtype=np.float64)
         self.has_dist = bool(camera.has_distortion)
         self.no_owner = np.zeros((camera.height, camera.width), dtype=np.uint8)
+        self._codes: np.ndarray | None = None     # read_codes' output, reused call to call
         self.centre = np.ascontiguousarray(camera.centre[:2], dtype=np.float64)
         self.floor_direction = np.ascontiguousarray(camera.floor_direction, dtype=np.float64)
 
@@ -888,9 +990,16 @@ class CameraLikelihood:
         top = np.empty(n, dtype=np.int32)
         seen = np.empty(n, dtype=np.bool_)
         hidden = np.empty(n, dtype=np.int32)
+        if owner is None:
+            codes = hit                             # labels 0, 1, 2 are the codes of pixels in no box
+        else:
+            if self._codes is None or self._codes.shape != hit.shape:
+                self._codes = np.empty(hit.shape, dtype=np.uint8)
+            codes = read_codes(hit, owner, self._codes)
+        occ = NO_OCCLUDERS if occluders is None else occluders
         column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
-                      self.has_dist, float(radius), hit, self.no_owner if owner is None else owner, boxes, which,
-                      *(NO_OCCLUDERS if occluders is None else occluders), mes, self.centre, float(margin),
+                      self.has_dist, float(radius), codes, boxes, which, occ.pairs, occ.depths, mes, self.centre,
+                      float(margin),
                       float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
                       np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
                       float(top_sigma) if tops is not None else 0.0, pixel_scales(px_scale, len(boxes)),

@@ -1,0 +1,80 @@
+"""The particle tracker's compiled kernels against their plain references, for the per-frame images
+the column kernel reads: the combined label-and-owner codes and the two nearest occluders.
+
+Uses the small scene of ``test_particle.py``.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, occluder_layers,
+                                                     occluder_layers_reference, owner_image, read_codes,
+                                                     read_codes_reference)
+
+from test_particle import CAM, H, W, make_scene
+
+
+def test_read_codes_agrees_with_reference():
+    rng = np.random.default_rng(0)
+    hit = rng.integers(0, 5, (H, W), dtype=np.uint8)          # 3 and 4 are no labels: background
+    owner = rng.integers(0, 256, (H, W), dtype=np.uint8)
+    codes = read_codes(hit, owner)
+    np.testing.assert_array_equal(codes, read_codes_reference(hit, owner))
+    np.testing.assert_array_equal(codes & 3, np.where(hit <= 2, hit, 0))
+    np.testing.assert_array_equal(codes >> 2, np.minimum(owner, 63))
+    assert ((owner > 63) & (codes >> 2 == 63)).sum() > 1000  # saturation exercised
+
+
+def test_occluder_layers_agree_with_reference():
+    """Random overlapping boxes, some out of view, with tied and undefined depths; also when an
+    earlier result is reused."""
+    rng = np.random.default_rng(1)
+    for trial in range(20):
+        n = int(rng.integers(1, 12))
+        boxes = []
+        for _ in range(n):
+            u0, v0 = int(rng.integers(0, W)), int(rng.integers(0, H))      # clipped to the image, as boxes are
+            boxes.append(None if rng.random() < 0.15 else
+                         (u0, min(u0 + int(rng.integers(1, 150)), W), v0, min(v0 + int(rng.integers(1, 150)), H)))
+        depths = rng.choice([1.0, 2.0, 2.5, 4.0, np.nan, np.inf], n) if trial % 2 else rng.uniform(1.0, 8.0, n)
+        reused = occluder_layers((H, W), [(0, W, 0, H)] * 3, [3.0, 1.0, 2.0])
+        for got in (occluder_layers((H, W), boxes, depths), occluder_layers((H, W), boxes, depths, out=reused)):
+            near1, id1, near2 = got
+            r1, rid, r2 = occluder_layers_reference((H, W), boxes, depths)
+            np.testing.assert_array_equal(id1, rid)
+            np.testing.assert_array_equal(near1, r1)
+            np.testing.assert_array_equal(near2, r2)
+            for me in range(-1, n):
+                np.testing.assert_array_equal(got.depth_for(me), np.where(rid == me, r2, r1))
+    # The test covers pixels with two layers, and ties resolved in box order.
+    near1, id1, near2 = occluder_layers((H, W), [(0, 50, 0, 50), (20, 80, 20, 80), (10, 30, 10, 30)], [2.0, 2.0, 2.0])
+    assert (id1[25, 25], near2[25, 25]) == (0, 2.0) and id1[60, 60] == 1 and np.isinf(near2[60, 60])
+
+
+def test_column_kernel_agrees_with_reference_under_many_boxes():
+    """More than 63 boxes over a pixel (the codes saturate there) and a box per filter: the kernel,
+    reading the combined codes and the packed occluders, agrees with the reference."""
+    cam = make_scene().cameras["cam"]
+    rng = np.random.default_rng(2)
+    hit = (cv2.GaussianBlur(rng.random((H, W)).astype(np.float32), (0, 0), 4) > 0.5).astype(np.uint8)
+    hit[(hit == 1) & (rng.random((H, W)) < 0.2)] = 2
+    boxes = [(40, 120, 30, 200), (100, 180, 0, 120), None] + [(150, 200, 60, 180)] * 70
+    depths = np.concatenate([[2.0, 4.5, 3.0], rng.uniform(1.0, 6.0, 70)])
+    owner = owner_image((H, W), boxes)
+    assert owner.max() > 63
+    n = 4000
+    xy = np.column_stack([rng.uniform(-2.5, 2.5, n), rng.uniform(0.5, 6.0, n)])
+    which = rng.integers(0, 4, n)
+    hs = np.concatenate([[-0.2, -0.1], np.arange(20) * 0.1, [2.0, 2.1]])
+    args = dict(on=2.77, off=-1.56, k_min=10, radius=0.1, below=-2.77, n_below=2, n_above=2, owner=owner,
+                box=boxes[:2] + [None, boxes[3]], me=[0, 1, 2, 3], which=which, tops=rng.uniform(1.4, 2.0, n),
+                top_sigma=0.1, occluders=occluder_layers((H, W), boxes, depths), margin=0.3, outside_unknown=True)
+    out = CameraLikelihood(cam).column(hit, xy, hs, return_hidden=True, **args)
+    ref = column_counts_reference(cam, hit, xy, hs, return_hidden=True, **args)
+    for i in (0, 3, 4):                                   # counts, seen, hidden
+        np.testing.assert_array_equal(out[i], ref[i])
+    np.testing.assert_allclose(out[1], ref[1], rtol=0, atol=1e-9)
+    assert (out[2] == ref[2]).mean() > 0.999              # ties between tops may resolve either way
+    assert (out[4] > 0).sum() > 100                       # occluded samples exercised
