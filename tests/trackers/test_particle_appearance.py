@@ -13,8 +13,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_particle import CAM, COLOURS, FLOOR, make_scene, render, run, tracker_for  # noqa: E402
 
 from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
-                                                     SAT_BINS, ColourModel, colour_bins, colour_bins_reference,
-                                                     colour_log_ratio, column_bins, column_bins_reference)
+                                                     SAT_BINS, ColourModel, colour_bins, colour_bins_compiled,
+                                                     colour_bins_reference, colour_log_ratio, column_bins,
+                                                     column_bins_reference, column_penalties)
 from worldtrack.io.sources import Frame  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.trackers.particle_likelihood import CameraLikelihood  # noqa: E402
@@ -112,6 +113,42 @@ def test_column_bins_kernel_agrees_with_reference(dist):
     fast, slow = column_bins(CameraLikelihood(cam), image, hit, xy), column_bins_reference(cam, image, hit, xy)
     assert fast.dtype == slow.dtype and (slow >= 0).sum() > 100 and (slow < 0).sum() > 100
     np.testing.assert_array_equal(fast, slow)
+
+
+def test_compiled_colour_bins_agree_with_opencv_on_every_colour():
+    """The kernels' own HSV (OpenCV's fixed-point arithmetic) gives the bin OpenCV's conversion does,
+    for all 2^24 BGR colours."""
+    c = np.arange(1 << 24, dtype=np.uint32)
+    img = np.stack([c >> 16, (c >> 8) & 255, c & 255], axis=-1).astype(np.uint8).reshape(4096, 4096, 3)
+    fast = colour_bins_compiled(img)
+    np.testing.assert_array_equal(fast, colour_bins(img))
+    assert len(np.unique(fast)) == N_BINS                               # every bin occurs
+
+
+@pytest.mark.parametrize("dist", [None, [-0.2, 0.05, 0.001, -0.002, 0.0]])
+def test_column_penalties_agree_with_bins_and_log_ratio(dist):
+    """The fused penalty kernel: each particle's colour log-ratio of its column under its own
+    filter's model, 0 where the model is None or has learnt nothing — as column_bins_reference then
+    colour_log_ratio."""
+    scene = scene_from_dict({"name": "t", "cameras": [{**CAM, **({"distortion": dist} if dist else {})}], "floor": FLOOR})
+    cam = scene.camera("cam")
+    rng = np.random.default_rng(4)
+    hit = rng.integers(0, 3, (cam.height, cam.width)).astype(np.uint8)
+    image = rng.integers(0, 256, (cam.height, cam.width, 3)).astype(np.uint8)
+    models = [ColourModel(), None, ColourModel(), ColourModel()]
+    models[0].learn(rng.integers(0, 6, 50), 1.0)
+    models[2].learn(rng.integers(20, N_BINS, 50), 1.0)                  # models[3]: nothing learnt
+    n = 600
+    xy = np.column_stack([rng.uniform(-4, 4, n), rng.uniform(0.2, 7, n)])      # some outside the view
+    which = rng.integers(0, 4, n)
+    fast = column_penalties(CameraLikelihood(cam), image, hit, xy, models, which)
+    slow = colour_log_ratio(models, column_bins_reference(cam, image, hit, xy), which)
+    learnt = np.isin(which, [0, 2])
+    np.testing.assert_array_equal(fast[learnt], slow[learnt])
+    assert np.all(fast[~learnt] == 0.0)
+    assert (fast[which == 0] < 0).sum() > 50 and (fast[which == 2] < 0).sum() > 50
+    none = column_penalties(CameraLikelihood(cam), image, hit, xy, [None, ColourModel()], which % 2)
+    assert np.all(none == 0.0)
 
 
 def test_filters_learn_colours_only_while_their_boxes_are_apart():

@@ -9,9 +9,11 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, occluder_layers,
+from worldtrack.trackers.particle_likelihood import (CameraLikelihood, add_camera, add_camera_reference,
+                                                     column_counts_reference, occluder_layers,
                                                      occluder_layers_reference, owner_image, read_codes,
                                                      read_codes_reference)
+from worldtrack.trackers.particle_sampling import raster_contains
 
 from test_particle import CAM, H, W, make_scene
 
@@ -78,3 +80,50 @@ def test_column_kernel_agrees_with_reference_under_many_boxes():
     np.testing.assert_allclose(out[1], ref[1], rtol=0, atol=1e-9)
     assert (out[2] == ref[2]).mean() > 0.999              # ties between tops may resolve either way
     assert (out[4] > 0).sum() > 100                       # occluded samples exercised
+
+
+def test_lines_of_sight_and_near_surface_agree_with_floor_rays():
+    """The kernels' lines of sight equal Camera.floor_rays' (its fallback direction at the foot point
+    and for NaN included), and the near-surface points ``xy − offset·along``."""
+    cam = make_scene().cameras["cam"]
+    cl = CameraLikelihood(cam)
+    rng = np.random.default_rng(3)
+    xy = np.column_stack([rng.normal(0, 3, 5000), rng.normal(2, 3, 5000)])
+    xy[:3] = cam.centre[:2]                             # at the foot point
+    xy[3] = np.nan
+    along, _ = cam.floor_rays(xy)
+    np.testing.assert_array_equal(cl.along(xy), along)
+    np.testing.assert_array_equal(cl.near_surface(xy, 0.14), xy - 0.14 * along)
+    assert np.array_equal(cl.along(xy[:1]), cam.floor_direction[None])
+
+
+def test_add_camera_agrees_with_reference():
+    rng = np.random.default_rng(4)
+    n = 3000
+    cameras = []
+    for camera in range(3):
+        lv = np.where(rng.random(n) < 0.1, -np.inf, rng.normal(0, 5, n))
+        lv[:5] = -0.0
+        cameras.append((rng.random(n) < 0.7, lv, rng.uniform(0, 2, n), rng.random(n) < 0.5))
+    for penalty in (np.zeros(0), -rng.exponential(1.0, n)):
+        states = []
+        for fn in (add_camera, add_camera_reference):
+            logpi, likely = np.zeros(n), np.ones(n, dtype=bool)
+            n_seen, col = np.zeros(n, dtype=np.int32), np.zeros(n)
+            for seen, lv, col_h, ok in cameras:           # three cameras in turn
+                fn(seen, lv, penalty, 0.7, col_h, ok, logpi, likely, n_seen, col)
+            states.append((logpi, likely, n_seen, col))
+        for a, b in zip(*states):
+            np.testing.assert_array_equal(a, b)
+        assert np.isinf(states[0][0]).sum() > 100 and states[0][1].sum() > 100 and (states[0][2] == 3).sum() > 100
+
+
+def test_raster_contains_agrees_with_walkable_raster():
+    scene = make_scene()
+    raster = scene.walkable.raster(0.01)
+    rng = np.random.default_rng(5)
+    xy = np.column_stack([rng.uniform(-4, 4, 20000), rng.uniform(-1, 8, 20000)])
+    xy[:10] = np.nan
+    got = raster_contains(raster, xy)
+    np.testing.assert_array_equal(got, raster.contains(xy))
+    assert 1000 < got.sum() < len(xy) - 1000

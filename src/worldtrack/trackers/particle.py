@@ -92,17 +92,20 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
-from worldtrack.trackers.particle_appearance import ColourModel, colour_log_ratio, column_bins
-from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, floor_pixels, hit_image, hit_labels,
-                                                     occluder_layers, owner_image, thresholded_difference)
+from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties
+from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, floor_pixels, hit_image,
+                                                     hit_labels, occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, polygon_distance,
-                                                   resampler, splittable, velocity_walk)
+                                                   raster_contains, resampler, splittable, velocity_walk)
 
 Box = tuple[int, int, int, int]
 
 #: The per-particle arrays of a :class:`_Filter`, all indexed alike: the state (``xyz, v, h``) and
 #: this frame's observation (``logpi, likely, col_h``).
 PARTICLE_FIELDS = ("xyz", "v", "h", "logpi", "likely", "col_h")
+
+#: No colour term (an empty penalty array for :func:`add_camera`).
+_NO_PENALTY = np.zeros(0)
 
 #: Depth (m) at which a column sample weighs 1 with ``pixel_weights``: weights are the sample's
 #: image length over that of a sample this far from the camera.
@@ -221,7 +224,8 @@ class ParticleTracker:
                           for cid, cl in self._cams.items()}
         self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
         self._resample = resampler(cfg.resampling)
-        self._walkable = scene.walkable.raster(0.01).contains
+        self._walkable_raster = scene.walkable.raster(0.01)
+        self._walkable = self._walkable_raster.contains
         self.filters: list[_Filter] = []
         self._births = cfg.births if cfg.births != "auto" else ("entry+lost" if scene.entry_regions else "anywhere")
         self.detectors = [_Filter(np.zeros((0, 3)), np.zeros((0, 3)), region=r, h=np.zeros(0))
@@ -515,41 +519,26 @@ class ParticleTracker:
                     if hidden is not None:
                         hidden[cid] = hid
                     if cfg.weighting == "count":
-                        lv = np.log(counts / S)
-                        col += np.where(seen, counts * cfg.dz, 0.0)
+                        lv, col_h = np.log(counts / S), counts * cfg.dz
                     else:
-                        lv = ratio
-                        col += np.where(seen, self._column[top], 0.0)
+                        lv, col_h = ratio, self._column[top]
                     ok = counts >= cfg.likely_count
+                    penalty = _NO_PENALTY
                     if cid in self._frames:
                         models = [c.get(cid) if c else None for c in colours]
-                        lv = lv + cfg.appearance_weight * self._colour_penalty(cl, self._frames[cid], img, surface,
-                                                                               models, which)
+                        # Each particle's colour column under its filter's model (0 where nothing is learnt).
+                        penalty = column_penalties(cl, self._frames[cid], img, surface, models, which)
                 else:
                     values, seen = cl.point(img, xyz, owner, box, which)
-                    lv = np.log(values / F_MAX)
+                    lv, col_h, penalty = np.log(values / F_MAX), np.zeros(n), _NO_PENALTY
                     ok = values > 0
-                logpi += np.where(seen, lv, 0.0)
-                likely &= ok | ~seen
-                n_seen += seen
-        valid = (n_seen > 0) & self._walkable(xyz[:, :2])
+                # logpi += lv (+ the colour term) where seen; likely &= ok | ~seen; n_seen += seen
+                add_camera(seen, lv, penalty, float(cfg.appearance_weight), col_h, ok, logpi, likely, n_seen, col)
+        valid = (n_seen > 0) & raster_contains(self._walkable_raster, xyz[:, :2])
         if cfg.likelihood == "point":
             valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
         logpi = np.where(valid, logpi, -np.inf)
         return logpi, likely & valid, col / np.maximum(n_seen, 1)
-
-    @staticmethod
-    def _colour_penalty(cl: CameraLikelihood, frame: np.ndarray, hit: np.ndarray, surface: np.ndarray,
-                        models: list[ColourModel | None], which: np.ndarray) -> np.ndarray:
-        """(N,) colour log-ratio of each particle's colour column (≤ 0) under its filter's model,
-        0 for the particles of filters that have learnt nothing (their columns are not read)."""
-        learnt = np.array([m is not None and m.hist is not None for m in models], dtype=bool)
-        out = np.zeros(len(surface))
-        if not learnt.any():
-            return out
-        rows = np.flatnonzero(learnt[which])
-        out[rows] = colour_log_ratio(models, column_bins(cl, frame, hit, surface[rows]), which[rows])
-        return out
 
     def _learn_colours(self, images: Mapping[str, np.ndarray]) -> None:
         """Teach each filter the colours on its column, in the cameras where its box overlaps no other's.
@@ -574,7 +563,7 @@ class ParticleTracker:
             if not len(idx):
                 continue
             centre = self._near_surface(centres[idx], cl)
-            along, _ = cl.camera.floor_rays(centre)
+            along = cl.along(centre)
             across = np.column_stack([-along[:, 1], along[:, 0]]) * (0.25 * widths[idx])[:, None]
             xy = np.stack([centre, centre + across, centre - across], axis=1).reshape(-1, 2)
             bins = column_bins(cl, self._frames[cid], hit, xy).reshape(len(idx), -1)
@@ -586,8 +575,7 @@ class ParticleTracker:
         r = self.config.surface_offset
         if r <= 0:
             return xy
-        along, _ = cl.camera.floor_rays(xy)
-        return xy - r * along
+        return cl.near_surface(xy, r)
 
     # ------------------------------------------------------------------ prediction
     def _predict(self, fs: list[_Filter], dt: float) -> None:

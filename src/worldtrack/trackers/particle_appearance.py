@@ -73,15 +73,59 @@ _HUE_LUT = (np.minimum(_LEVELS * HUE_BINS // 180, HUE_BINS - 1) * SAT_BINS).asty
 _SAT_LUT = np.clip((_LEVELS - GREY_SATURATION) * SAT_BINS // (256 - GREY_SATURATION), 0, SAT_BINS - 1).astype(np.uint8)
 _GREY_LUT = (HUE_BINS * SAT_BINS + _LEVELS * GREY_BINS // 256).astype(np.uint8)
 
+# OpenCV's 8-bit BGR → HSV in fixed point (``hsv_shift`` 12, its tables ``sdiv_table`` and
+# ``hdiv_table180``), for the compiled kernels: :func:`pixel_bin` is :func:`colour_bins` of one pixel
+# (tested equal over all 2^24 colours).
+_HSV_SHIFT = 12
+_SDIV = np.array([0] + [round((255 << _HSV_SHIFT) / i) for i in range(1, 256)], dtype=np.int64)
+_HDIV = np.array([0] + [round((180 << _HSV_SHIFT) / (6.0 * i)) for i in range(1, 256)], dtype=np.int64)
+
+
+@njit(cache=True, inline="always")
+def pixel_bin(b, g, r):
+    """The :func:`colour_bins` bin of one BGR pixel (uint8 values), computed as OpenCV's
+    ``COLOR_BGR2HSV`` computes hue (0–179), saturation and value, then the same three tables."""
+    b, g, r = np.int64(b), np.int64(g), np.int64(r)
+    v = max(b, g, r)
+    diff = v - min(b, g, r)
+    s = (diff * _SDIV[v] + (1 << (_HSV_SHIFT - 1))) >> _HSV_SHIFT
+    if s < GREY_SATURATION:
+        return np.int64(_GREY_LUT[v])
+    if v == r:
+        h = g - b
+    elif v == g:
+        h = b - r + 2 * diff
+    else:
+        h = r - g + 4 * diff
+    h = (h * _HDIV[diff] + (1 << (_HSV_SHIFT - 1))) >> _HSV_SHIFT
+    if h < 0:
+        h += 180
+    return np.int64(_HUE_LUT[h]) + np.int64(_SAT_LUT[s])
+
+
+@njit(cache=True)
+def _pixel_bins(image, out):
+    for v in range(image.shape[0]):
+        for u in range(image.shape[1]):
+            out[v, u] = pixel_bin(image[v, u, 0], image[v, u, 1], image[v, u, 2])
+
+
+def colour_bins_compiled(image: np.ndarray) -> np.ndarray:
+    """:func:`colour_bins` by the compiled :func:`pixel_bin` (what the column kernels use), (H, W) uint8."""
+    image = np.ascontiguousarray(image, dtype=np.uint8)
+    out = np.empty(image.shape[:2], dtype=np.uint8)
+    _pixel_bins(image, out)
+    return out
+
 
 def column_bins(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
                 heights: np.ndarray = COLOUR_HEIGHTS) -> np.ndarray:
     """Colour bins along columns standing at ``xy``, where they read object.
 
-    A Numba kernel finds the samples' pixels and gathers their colours; only those pixels are
-    converted to colour bins, as one image row (a whole-frame HSV conversion costs ~1 ms at
-    640×480; OpenCV converts an (M, 1) column of pixels row by row, 7× slower than a (1, M) row).
-    Tested equal to :func:`column_bins_reference`.
+    A Numba kernel finds the samples' pixels and computes the bins of those that read object
+    (:func:`pixel_bin`: a whole-frame HSV conversion costs ~1 ms at 640×480, and converting the
+    gathered pixels with OpenCV cost more in calls than in work). Tested equal to
+    :func:`column_bins_reference`.
 
     Parameters
     ----------
@@ -97,32 +141,59 @@ def column_bins(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np
     outside the image or does not read object
     """
     xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
-    on = np.empty((len(xy), len(heights)), dtype=np.bool_)
-    pixels = np.empty((1, on.size, 3), dtype=np.uint8)
-    m = _column_pixels(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.R, cl.t, cl.K, cl.dist, cl.has_dist,
-                       hit, np.ascontiguousarray(image, dtype=np.uint8), on, pixels[0])
-    out = np.full(on.shape, -1, dtype=np.int16)
-    if m:
-        out[on] = colour_bins(pixels[:, :m])[0]
+    out = np.empty((len(xy), len(heights)), dtype=np.int16)
+    _column_bins(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.R, cl.t, cl.K, cl.dist, cl.has_dist,
+                 hit, np.ascontiguousarray(image, dtype=np.uint8), out)
     return out
 
 
 @njit(cache=True)
-def _column_pixels(xy, heights, R, t, K, dist, has_dist, hit, image, on, pixels):
-    """Mark the column samples that read object (``on`` (N, S), in place) and copy their BGR
-    pixels, in row-major order, to the first rows of ``pixels`` (≥ N·S, 3); return how many."""
+def _column_bins(xy, heights, R, t, K, dist, has_dist, hit, image, out):
+    """``out`` (N, S), in place: each column sample's :func:`pixel_bin` where it reads object, else −1."""
     H, W = hit.shape
     lens = _lens(K, dist)
-    m = 0
     for i in range(xy.shape[0]):
         for k in range(heights.shape[0]):
             iu, iv = _to_pixel(xy[i, 0], xy[i, 1], heights[k], R, t, lens, has_dist, W, H)
-            on[i, k] = iu >= 0 and hit[iv, iu] == 1
-            if on[i, k]:
-                for c in range(3):
-                    pixels[m, c] = image[iv, iu, c]
-                m += 1
-    return m
+            if iu >= 0 and hit[iv, iu] == 1:
+                out[i, k] = pixel_bin(image[iv, iu, 0], image[iv, iu, 1], image[iv, iu, 2])
+            else:
+                out[i, k] = -1
+
+
+def column_penalties(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
+                     models: Sequence["ColourModel | None"], which: np.ndarray,
+                     heights: np.ndarray = COLOUR_HEIGHTS) -> np.ndarray:
+    """:func:`colour_log_ratio` of the :func:`column_bins` of columns at ``xy`` (N, 2), metres, in one
+    kernel: (N,) float, ≤ 0 — 0 for the particles of models (``which`` (N,) int, 0 … F − 1 into
+    ``models``) that are None or have learnt nothing. Tested equal to the two calls."""
+    tables = np.array([m.penalty_table() if m is not None else np.zeros(N_BINS) for m in models]).reshape(-1, N_BINS)
+    learnt = np.array([m is not None and m.hist is not None for m in models], dtype=np.bool_)
+    xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+    out = np.zeros(len(xy))
+    if learnt.any():
+        _column_penalties(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.R, cl.t, cl.K, cl.dist,
+                          cl.has_dist, hit, np.ascontiguousarray(image, dtype=np.uint8), tables, learnt,
+                          np.ascontiguousarray(which, dtype=np.int64), out)
+    return out
+
+
+@njit(cache=True)
+def _column_penalties(xy, heights, R, t, K, dist, has_dist, hit, image, tables, learnt, which, out):
+    """``out[i]``, in place: ``Σ_k tables[which[i], bin]`` over the samples of column i that read
+    object, in sample order (as :func:`_table_sums`), for the particles of learnt models."""
+    H, W = hit.shape
+    lens = _lens(K, dist)
+    for i in range(xy.shape[0]):
+        f = which[i]
+        if not learnt[f]:
+            continue
+        s = 0.0
+        for k in range(heights.shape[0]):
+            iu, iv = _to_pixel(xy[i, 0], xy[i, 1], heights[k], R, t, lens, has_dist, W, H)
+            if iu >= 0 and hit[iv, iu] == 1:
+                s += tables[f, pixel_bin(image[iv, iu, 0], image[iv, iu, 1], image[iv, iu, 2])]
+        out[i] = s
 
 
 def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,

@@ -776,6 +776,70 @@ def box_pixels(xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: 
             out[i, 0], out[i, 1], out[i, 2], out[i, 3] = -1, -1, -1, -1
 
 
+@njit(cache=True)
+def floor_along(xy: np.ndarray, centre: np.ndarray, floor_direction: np.ndarray, out: np.ndarray) -> None:
+    """The camera's lines of sight on the floor through ``xy`` (N, 2), metres, in place: ``out``
+    (N, 2) unit vectors from the foot point ``centre`` (2,) towards the points, ``floor_direction``
+    (2,) within 1e-9 m of it — :meth:`Camera.floor_rays`' ``along``, the same arithmetic (tested
+    equal)."""
+    for i in range(xy.shape[0]):
+        dx = xy[i, 0] - centre[0]
+        dy = xy[i, 1] - centre[1]
+        n = math.hypot(dx, dy)
+        if n > 1e-9:
+            out[i, 0] = dx / n
+            out[i, 1] = dy / n
+        else:
+            out[i, 0] = floor_direction[0]
+            out[i, 1] = floor_direction[1]
+
+
+@njit(cache=True)
+def toward_camera(xy: np.ndarray, offset: float, centre: np.ndarray, floor_direction: np.ndarray,
+                  out: np.ndarray) -> None:
+    """``xy − offset·along`` (N, 2), metres, in place: the floor points ``offset`` m nearer to the
+    camera along its lines of sight (:func:`floor_along`); tested equal to the NumPy expression."""
+    for i in range(xy.shape[0]):
+        dx = xy[i, 0] - centre[0]
+        dy = xy[i, 1] - centre[1]
+        n = math.hypot(dx, dy)
+        if n > 1e-9:
+            ax, ay = dx / n, dy / n
+        else:
+            ax, ay = floor_direction[0], floor_direction[1]
+        out[i, 0] = xy[i, 0] - offset * ax
+        out[i, 1] = xy[i, 1] - offset * ay
+
+
+@njit(cache=True)
+def add_camera(seen: np.ndarray, lv: np.ndarray, penalty: np.ndarray, weight: float, col_h: np.ndarray,
+               ok: np.ndarray, logpi: np.ndarray, likely: np.ndarray, n_seen: np.ndarray, col: np.ndarray) -> None:
+    """One camera's share of a likelihood summed over cameras, in place (N particles):
+    ``logpi += lv + weight·penalty`` where the camera sees the particle (``+ 0`` elsewhere; no
+    penalty term when ``penalty`` is empty), ``likely &= ok | ~seen``, ``n_seen += seen``,
+    ``col += col_h`` where seen. The arithmetic of :func:`add_camera_reference`, one pass."""
+    pen = penalty.shape[0] > 0
+    for i in range(seen.shape[0]):
+        s = seen[i]
+        v = lv[i]
+        if pen:
+            v = v + weight * penalty[i]
+        logpi[i] = logpi[i] + (v if s else 0.0)
+        col[i] = col[i] + (col_h[i] if s else 0.0)
+        likely[i] = likely[i] and (ok[i] or not s)
+        n_seen[i] += s
+
+
+def add_camera_reference(seen, lv, penalty, weight, col_h, ok, logpi, likely, n_seen, col) -> None:
+    """:func:`add_camera` as NumPy expressions (the tracker's former code), in place."""
+    if len(penalty):
+        lv = lv + weight * penalty
+    logpi += np.where(seen, lv, 0.0)
+    col += np.where(seen, col_h, 0.0)
+    likely &= ok | ~seen
+    n_seen += seen
+
+
 # ---------------------------------------------------------------------------- NumPy references
 
 def read_codes_reference(hit: np.ndarray, owner: np.ndarray) -> np.ndarray:
@@ -949,6 +1013,22 @@ class CameraLikelihood:
         self._codes: np.ndarray | None = None     # read_codes' output, reused call to call
         self.centre = np.ascontiguousarray(camera.centre[:2], dtype=np.float64)
         self.floor_direction = np.ascontiguousarray(camera.floor_direction, dtype=np.float64)
+
+    def along(self, xy: np.ndarray) -> np.ndarray:
+        """(N, 2) the camera's lines of sight on the floor through ``xy`` (N, 2), metres: the
+        ``along`` of :meth:`Camera.floor_rays`, by the kernel :func:`floor_along`."""
+        xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+        out = np.empty_like(xy)
+        floor_along(xy, self.centre, self.floor_direction, out)
+        return out
+
+    def near_surface(self, xy: np.ndarray, offset: float) -> np.ndarray:
+        """(N, 2) floor points ``offset`` m nearer to the camera than ``xy`` (N, 2), metres, along its
+        lines of sight: ``xy − offset·along`` (:func:`toward_camera`)."""
+        xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+        out = np.empty_like(xy)
+        toward_camera(xy, float(offset), self.centre, self.floor_direction, out)
+        return out
 
     def boxes(self, xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: float,
               depth: float = 0.0) -> list[tuple[int, int, int, int] | None]:

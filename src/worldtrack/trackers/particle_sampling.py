@@ -161,6 +161,25 @@ class FloorRegion:
         return self.raster.contains(xy)
 
 
+def raster_contains(raster: WalkableRaster, xy: np.ndarray) -> np.ndarray:
+    """:meth:`WalkableRaster.contains <worldtrack.scene.floor.WalkableRaster.contains>` of ``xy`` (N, 2),
+    metres, by a kernel (one pass instead of a dozen NumPy calls; tested equal): (N,) bool."""
+    xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+    out = np.empty(len(xy), dtype=np.bool_)
+    _raster_contains(xy, float(raster.origin[0]), float(raster.origin[1]), float(raster.resolution),
+                     np.ascontiguousarray(raster.inside, dtype=np.bool_), out)
+    return out
+
+
+@njit(cache=True)
+def _raster_contains(xy, x0, y0, resolution, inside, out):
+    ny, nx = inside.shape
+    for k in range(xy.shape[0]):
+        fi = (xy[k, 0] - x0) / resolution
+        fj = (xy[k, 1] - y0) / resolution
+        out[k] = fi >= 0 and fi < nx and fj >= 0 and fj < ny and inside[int(fj), int(fi)]
+
+
 # ---------------------------------------------------------------------------- splitting a cloud
 
 def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mass: float,
