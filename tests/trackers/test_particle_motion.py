@@ -85,24 +85,43 @@ def test_walker_along_the_line_of_sight_is_followed(velocity):
     assert np.median(vy) == pytest.approx(-1.0, abs=0.25)
 
 
-def test_velocity_walk_kernel_equals_numpy_reference():
-    """The compiled velocity walk (``velocity="state"``) gives the NumPy code's values bit for bit,
-    clipped speeds, stopped walks (scale 0) and the vertical component included."""
-    from worldtrack.trackers.particle_sampling import velocity_walk, velocity_walk_reference
+def test_prediction_kernel_equals_numpy_reference():
+    """The compiled prediction (``velocity="state"``: the velocity walk, then ``x + a·noise + v·dt``)
+    gives the NumPy code's values bit for bit, clipped speeds, stopped walks (scale 0) and the
+    vertical component included."""
+    from worldtrack.trackers.particle_sampling import predict_state, predict_state_reference
 
     rng = np.random.default_rng(3)
     for f, n in ((1, 7), (6, 500)):
+        old = rng.normal(0, 3, (f, n, 3))
         v = rng.normal(0, 1.5, (f, n, 3))
-        a = rng.standard_normal((f, n, 2))
-        step = rng.normal(0, 0.05, (f, n, 3))
+        a, walk = rng.standard_normal((f, n, 3)), rng.standard_normal((f, n, 2))
+        noise = np.array([0.4, 0.4, 0.3]) * np.sqrt(0.1)
         scale = rng.uniform(0, 0.4, f)
         scale[0] = 0.0
-        v1, s1, v2, s2 = v.copy(), step.copy(), v.copy(), step.copy()
-        velocity_walk(v1, a, scale, 2.5, 0.1, s1)
-        velocity_walk_reference(v2, a, scale, 2.5, 0.1, s2)
+        v1, v2, x1, x2 = v.copy(), v.copy(), np.empty_like(old), np.empty_like(old)
+        predict_state(old, a, noise, v1, walk, scale, 2.5, 0.1, x1)
+        predict_state_reference(old, a, noise, v2, walk, scale, 2.5, 0.1, x2)
         assert (np.hypot(v2[..., 0], v2[..., 1]) >= 2.5 - 1e-12).any()     # some speeds were clipped
+        assert (v2[..., 2] == 0).all() and not np.allclose(x2, old)
         np.testing.assert_array_equal(v1, v2)
-        np.testing.assert_array_equal(s1, s2)
+        np.testing.assert_array_equal(x1, x2)
+
+
+def test_height_walk_kernel_equals_numpy_reflection():
+    """The heights' random walk folded into [lo, hi] (np.mod's sign rules, values far outside and
+    on the ends included) is the NumPy expression's, bit for bit."""
+    from worldtrack.trackers.particle_sampling import jitter_reflect, reflect_reference
+
+    rng = np.random.default_rng(4)
+    h, a = rng.uniform(-5, 8, (7, 1000)), rng.normal(0, 3, (7, 1000))
+    h[0, :30], a[0, :30] = np.repeat([0.8, 1.9, 3.0], 10), 0.0             # on the ends and on 2·span
+    for scale in (0.02, 0.3, 1.0):
+        out = np.empty_like(h)
+        jitter_reflect(h, a, scale, 0.8, 1.9, out)
+        ref = reflect_reference(h + a * scale, 0.8, 1.9)
+        np.testing.assert_array_equal(out, ref)
+        assert out.min() >= 0.8 and out.max() <= 1.9 and ((h + a * scale < 0.8) | (h + a * scale > 1.9)).sum() > 1000
 
 
 @pytest.mark.parametrize("q", [0.5, 0.3, 0.1, 0.9, 1.0, 0.0])

@@ -95,8 +95,9 @@ from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, floor_pixels, hit_image,
                                                      hit_labels, occluder_layers, owner_image, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, polygon_distance,
-                                                   raster_contains, resampler, splittable, velocity_walk)
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, jitter_reflect,
+                                                   polygon_distance, predict_state, raster_contains, resampler,
+                                                   splittable)
 
 Box = tuple[int, int, int, int]
 
@@ -233,6 +234,7 @@ class ParticleTracker:
         self._last_t: float | None = None
         self._close: dict[tuple[int, int], int] = {}
         self._layers: dict = {}          # per camera, the occluder layers reused frame to frame
+        self._rows: dict = {}            # per particle field, the tracking filters' rows and their array
         self._frames: dict[str, np.ndarray] = {}  # per camera, this frame's image (appearance)
         self._leaving: list[tuple[Track, float]] = []  # tracks ended at an exit, and when
         self.last_masks: dict[str, np.ndarray] = {}
@@ -360,7 +362,7 @@ class ParticleTracker:
             self._predict(fs, dt)
             owners = boxes = occluders = centres = None
             if cfg.explain == "all" and len(fs) > 1:      # a lone filter has nothing to explain away
-                centres = cloud_mean(_stack(fs, "xyz")[:, :, :2])
+                centres = cloud_mean(self._stacked(fs, "xyz")[:, :, :2])
                 boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
                 owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
                 if cfg.occlusion:
@@ -584,33 +586,33 @@ class ParticleTracker:
         cfg = self.config
         if dt <= 0:
             return
-        old = _stack(fs, "xyz")
-        step = self.rng.standard_normal(old.shape) * (np.array([cfg.noise_xy, cfg.noise_xy, cfg.noise_z])
-                                                      * math.sqrt(dt))
-        if cfg.velocity == "particle":
-            step += _stack(fs, "v") * dt
-        elif cfg.velocity == "state":
+        old = self._stacked(fs, "xyz")
+        noise = np.array([cfg.noise_xy, cfg.noise_xy, cfg.noise_z]) * math.sqrt(dt)
+        a = self.rng.standard_normal(old.shape)
+        if cfg.velocity == "state":
             # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it.
-            v = _stack(fs, "v")
+            v = self._stacked(fs, "v")                      # walked in place
             scale = cfg.noise_v * math.sqrt(dt) * self._coasting(fs)
-            velocity_walk(v, self.rng.standard_normal(v.shape[:2] + (2,)), scale, float(cfg.max_speed),
-                          float(dt), step)
-            for f, vv in zip(fs, v):
-                f.v = vv
-        elif cfg.velocity == "object":
-            step[..., :2] += np.array([f.V for f in fs])[:, None, :] * dt
-        xyz = old + step
+            xyz = np.empty_like(old)
+            predict_state(old, a, noise, v, self.rng.standard_normal(v.shape[:2] + (2,)), scale,
+                          float(cfg.max_speed), float(dt), xyz)
+            self._set_rows(fs, "v", v)
+        else:
+            step = a * noise
+            if cfg.velocity == "particle":
+                step += self._stacked(fs, "v") * dt
+            elif cfg.velocity == "object":
+                step[..., :2] += np.array([f.V for f in fs])[:, None, :] * dt
+            xyz = old + step
         if cfg.likelihood == "point":
             xyz[..., 2] = _reflect(xyz[..., 2], 0.0, cfg.max_height)
-        h = self._jitter_heights(_stack(fs, "h"), dt)
-        for f, x, hh in zip(fs, xyz, h):
-            f.xyz, f.h = x, hh
+        self._set_rows(fs, "h", self._jitter_heights(self._stacked(fs, "h"), dt))
+        self._set_rows(fs, "xyz", xyz)
         if cfg.velocity == "particle":
             # v_t = (x_t − x_{t−1}) / dt, each particle's velocity for the next frame (eq. 2).
             v = (xyz - old) / dt
             _clip_speed(v, cfg.max_speed)
-            for f, vv in zip(fs, v):
-                f.v = vv
+            self._set_rows(fs, "v", v)
 
     def _coasting(self, fs: list[_Filter]) -> np.ndarray:
         """(F,) factor of the velocity walk of filters ``fs``: ``1 − hidden / coast_hidden`` clipped to
@@ -620,17 +622,36 @@ class ParticleTracker:
         if cfg.coast_hidden <= 0:
             return np.ones(len(fs))
         n = len(self._column)
-        hidden = np.array([min(f.k_lo.values(), default=0) for f in fs], dtype=float) / n
-        return np.clip(1.0 - hidden / cfg.coast_hidden, 0.0, 1.0)
+        return np.array([min(max(1.0 - (min(f.k_lo.values(), default=0) / n) / cfg.coast_hidden, 0.0), 1.0)
+                         for f in fs])
 
     def _jitter_heights(self, h: np.ndarray, dt: float) -> np.ndarray:
         """Particles' object heights ``h`` (any shape) after a random walk of ``noise_h·√dt``, kept
-        in [min_height, max_height]."""
+        in [min_height, max_height] (a new array; ``h`` itself when there is no walk)."""
         cfg = self.config
         if self._top_sigma > 0 and cfg.noise_h > 0 and dt > 0 and h.size:
-            return _reflect(h + self.rng.standard_normal(h.shape) * (cfg.noise_h * math.sqrt(dt)),
-                            cfg.min_height, cfg.max_height)
+            out = np.empty(h.shape)
+            jitter_reflect(np.ascontiguousarray(h, dtype=np.float64), self.rng.standard_normal(h.shape),
+                           cfg.noise_h * math.sqrt(dt), float(cfg.min_height), float(cfg.max_height), out)
+            return out
         return h
+
+    def _stacked(self, fs: list[_Filter], name: str) -> np.ndarray:
+        """(F, N, ...) the per-particle array ``name`` of filters ``fs`` holding N particles each:
+        the array whose rows they hold, if :meth:`_set_rows` gave them those rows and they still
+        hold them (not to be changed then, except as the filters' own arrays), else a stacked copy."""
+        rows, a = self._rows.get(name, ((), None))
+        if len(rows) == len(fs) and all(getattr(f, name) is r for f, r in zip(fs, rows)):
+            return a
+        return _stack(fs, name)
+
+    def _set_rows(self, fs: list[_Filter], name: str, a: np.ndarray) -> None:
+        """Give each of filters ``fs`` its row of ``a`` (F, N, ...) as its ``name`` (views), and
+        remember them for :meth:`_stacked`."""
+        rows = list(a)
+        for f, r in zip(fs, rows):
+            setattr(f, name, r)
+        self._rows[name] = (rows, a)
 
     def _draw_velocities(self, n: int) -> np.ndarray:
         """(n, 3) velocities (m/s) of a new tracking filter's particles: with ``velocity="state"``
@@ -741,15 +762,18 @@ class ParticleTracker:
                 lo = np.partition(hid.reshape(len(fs), n), rank, axis=1)[:, rank]
                 for f, v in zip(fs, lo.tolist()):
                     f.k_lo[cid] = v
+        if tracking:                                    # equal particle counts: rows of (F, N)
+            for name, a in zip(("logpi", "likely", "col_h"), out):
+                self._set_rows(fs, name, a.reshape(len(fs), -1))
+            return
         ends = np.cumsum(sizes).tolist()
         for name, a in zip(("logpi", "likely", "col_h"), out):
             for f, start, end in zip(fs, [0] + ends, ends):
                 setattr(f, name, a[start:end])
 
-    @staticmethod
-    def _centres(fs: list[_Filter], centres: np.ndarray | None) -> np.ndarray:
+    def _centres(self, fs: list[_Filter], centres: np.ndarray | None) -> np.ndarray:
         """(F, 2) the mean floor position of each filter's particles (``centres`` if given)."""
-        return cloud_mean(_stack(fs, "xyz")[:, :, :2]) if centres is None else centres
+        return cloud_mean(self._stacked(fs, "xyz")[:, :, :2]) if centres is None else centres
 
     def _filter_pixel_scales(self, centres: np.ndarray, cameras) -> dict[str, np.ndarray]:
         """``pixel_weights="filter"``: per camera, (F,) 1 / the mean image length (pixels) of a body
@@ -771,11 +795,12 @@ class ParticleTracker:
         """Share of likely particles (end at ≤ β), weights (eq. 8), resampling and object region of
         the tracking filters ``fs`` (equal particle counts), at once."""
         cfg = self.config
-        parts = {name: _stack(fs, name) for name in PARTICLE_FIELDS if getattr(fs[0], name) is not None}
-        shares = parts["likely"].mean(axis=1).tolist()
+        parts = {name: self._stacked(fs, name) for name in PARTICLE_FIELDS if getattr(fs[0], name) is not None}
+        # The share of likely particles (a count over N: the mean of the booleans, exactly).
+        shares = (np.count_nonzero(parts["likely"], axis=1) / parts["likely"].shape[1]).tolist()
         resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
         kept, lost = [], []
-        for i, (f, share) in enumerate(zip(fs, shares)):
+        for f, share in zip(fs, shares):
             if share <= cfg.beta:
                 if f.low_since is None:
                     f.low_since = t
@@ -786,10 +811,16 @@ class ParticleTracker:
             else:
                 f.low_since = None
                 f.track.last_seen = t
-            for name, a in resampled.items():
-                setattr(f, name, a[i])
             f.track.score = share
             kept.append(f)
+        if len(kept) == len(fs):
+            for name, a in resampled.items():
+                self._set_rows(fs, name, a)
+        else:
+            rows = [i for i, f in enumerate(fs) if f in kept]
+            for name, a in resampled.items():
+                for i in rows:
+                    setattr(fs[i], name, a[i])
         self._watch_lost(lost, t)
         if not kept:
             return
@@ -803,7 +834,7 @@ class ParticleTracker:
         """Object region (eqs. 9–10) and the track's fields, from the resampled particles, of filters
         ``fs`` at once (equal particle counts)."""
         cfg = self.config
-        centre, sd = _mean_sd(_stack(fs, "xyz"))
+        centre, sd = _mean_sd(self._stacked(fs, "xyz"))
         if cfg.velocity == "object":
             V = np.array([f.V for f in fs], dtype=float).reshape(-1, 2)
             prev = np.array([(np.nan, np.nan) if f.centre is None else f.centre for f in fs], dtype=float)
@@ -814,15 +845,15 @@ class ParticleTracker:
                 V[moved] = (1 - a) * V[moved] + a * (centre[moved, :2] - prev[moved]) / since[moved, None]
                 _clip_speed(V, cfg.max_speed)
         elif cfg.velocity in ("particle", "state"):
-            V = cloud_mean(_stack(fs, "v")[..., :2])
+            V = cloud_mean(self._stacked(fs, "v")[..., :2])
         else:
             V = np.zeros((len(fs), 2))
         sigma = np.sqrt(0.5 * (sd[:, 0] ** 2 + sd[:, 1] ** 2))
         heights = None
         if cfg.likelihood == "column" and self._top_sigma > 0:
-            heights = _stack(fs, "h").mean(axis=1)
+            heights = self._stacked(fs, "h").mean(axis=1)
         elif cfg.likelihood == "column" and all(f.col_h is not None for f in fs):
-            heights = _stack(fs, "col_h").mean(axis=1)
+            heights = self._stacked(fs, "col_h").mean(axis=1)
         if cfg.likelihood == "column" and cfg.weighting == "ratio":
             # The particles are the object's axis on the floor; the object fills a disc of radius
             # width/2 round it (per-axis variance r²/4), as its z fills the height below the top.
@@ -948,7 +979,7 @@ class ParticleTracker:
         cfg = self.config
         fs = list(self.filters)
         if fs:
-            wide = splittable(_stack(fs, "xyz")[:, :, :2], cfg.split_distance, cfg.split_min_mass)
+            wide = splittable(self._stacked(fs, "xyz")[:, :, :2], cfg.split_distance, cfg.split_min_mass)
             for f, w in zip(fs, wide.tolist()):
                 self._maybe_split(f, t, w)
 

@@ -325,22 +325,19 @@ def splittable(xy: np.ndarray, min_separation: float, min_mass: float) -> np.nda
 # ---------------------------------------------------------------------------- motion
 
 @njit(cache=True)
-def velocity_walk(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: float, dt: float,
-                  step: np.ndarray) -> None:
-    """``velocity="state"``'s prediction of F filters, in place (one compiled pass instead of five
-    NumPy passes over strided views; equal to :func:`velocity_walk_reference`).
-
-    v : (F, N, 3) float64 — the particles' velocities (m/s); out: ``v + a·scale`` on the floor axes,
-        0 vertically, floor speeds above ``max_speed`` scaled down to it
-    a : (F, N, 2) float64 — standard normal draws of the walk
-    scale : (F,) float64 — per filter, the walk's σ·√dt (m/s)
-    step : (F, N, 3) float64 — the particles' moves (m); out: ``step + v·dt`` with the new ``v``
-    """
+def predict_state(old: np.ndarray, a: np.ndarray, noise: np.ndarray, v: np.ndarray, walk: np.ndarray,
+                  scale: np.ndarray, max_speed: float, dt: float, out: np.ndarray) -> None:
+    """``velocity="state"``'s prediction of F filters in one pass (:func:`predict_state_reference`):
+    ``out = old + a·noise + v·dt`` (``out`` (F, N, 3), metres) with each particle's velocity ``v``
+    (F, N, 3), m/s, first walked in place as :func:`velocity_walk_reference` walks it (``walk`` (F, N, 2)
+    standard normal draws, ``scale`` (F,) m/s); ``a`` (F, N, 3) standard normal draws, ``noise``
+    (3,) metres (σ·√dt per axis)."""
+    n0, n1, n2 = noise[0], noise[1], noise[2]
     for f in range(v.shape[0]):
         sc = scale[f]
         for i in range(v.shape[1]):
-            v0 = v[f, i, 0] + a[f, i, 0] * sc
-            v1 = v[f, i, 1] + a[f, i, 1] * sc
+            v0 = v[f, i, 0] + walk[f, i, 0] * sc
+            v1 = v[f, i, 1] + walk[f, i, 1] * sc
             s = math.hypot(v0, v1)
             if s > max_speed:
                 r = max_speed / s
@@ -349,13 +346,56 @@ def velocity_walk(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: fl
             v[f, i, 0] = v0
             v[f, i, 1] = v1
             v[f, i, 2] = 0.0
-            step[f, i, 0] += v0 * dt
-            step[f, i, 1] += v1 * dt
+            out[f, i, 0] = old[f, i, 0] + (a[f, i, 0] * n0 + v0 * dt)
+            out[f, i, 1] = old[f, i, 1] + (a[f, i, 1] * n1 + v1 * dt)
+            out[f, i, 2] = old[f, i, 2] + a[f, i, 2] * n2
+
+
+def predict_state_reference(old: np.ndarray, a: np.ndarray, noise: np.ndarray, v: np.ndarray, walk: np.ndarray,
+                            scale: np.ndarray, max_speed: float, dt: float, out: np.ndarray) -> None:
+    """:func:`predict_state` as the tracker's former NumPy steps."""
+    step = a * noise
+    velocity_walk_reference(v, walk, scale, max_speed, dt, step)
+    out[...] = old + step
+
+
+@njit(cache=True, inline="always")
+def _mod(x, y):
+    """``x mod y`` with the sign of ``y``, as NumPy's ``np.mod`` (and Python's ``%``) computes it."""
+    m = np.fmod(x, y)
+    if m != 0.0:
+        if (y < 0.0) != (m < 0.0):
+            m += y
+    else:
+        m = math.copysign(0.0, y)
+    return m
+
+
+@njit(cache=True)
+def jitter_reflect(h: np.ndarray, a: np.ndarray, scale: float, lo: float, hi: float, out: np.ndarray) -> None:
+    """``out = reflect(h + a·scale)`` into [lo, hi] by reflection at the ends, elementwise (any
+    shape, C order): the random walk of the particles' heights in one pass (tested equal to
+    :func:`reflect_reference` of the NumPy sum)."""
+    span = hi - lo
+    hf, af, of = h.reshape(h.size), a.reshape(a.size), out.reshape(out.size)     # views of C-contiguous arrays
+    for k in range(hf.shape[0]):
+        r = _mod(hf[k] + af[k] * scale - lo, 2 * span)
+        of[k] = lo + (2 * span - r if r > span else r)
+
+
+def reflect_reference(z: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Fold values into [lo, hi] by reflection at the ends (NumPy)."""
+    span = hi - lo
+    r = np.mod(z - lo, 2 * span)
+    return lo + np.where(r > span, 2 * span - r, r)
 
 
 def velocity_walk_reference(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max_speed: float, dt: float,
                             step: np.ndarray) -> None:
-    """:func:`velocity_walk` in NumPy (the tracker's former code), in place."""
+    """The walk of each particle's velocity (``velocity="state"``), in place: ``v + a·scale`` on the
+    floor axes (``a`` (F, N, 2) standard normal draws, ``scale`` (F,) m/s), 0 vertically, floor
+    speeds above ``max_speed`` scaled down to it; ``step += v·dt`` with the new ``v``. NumPy, the
+    reference of :func:`predict_state`."""
     v[..., :2] += a * np.asarray(scale)[:, None, None]
     v[..., 2] = 0.0
     s = np.hypot(v[..., 0], v[..., 1])
