@@ -127,3 +127,29 @@ def test_raster_contains_agrees_with_walkable_raster():
     got = raster_contains(raster, xy)
     np.testing.assert_array_equal(got, raster.contains(xy))
     assert 1000 < got.sum() < len(xy) - 1000
+
+
+def test_bimodal_split_with_splittables_principal_is_the_same():
+    """The split check reuses the principal axes that ``splittable`` computed for all clouds at once:
+    the same sides (and the same None) as computing them for each cloud alone."""
+    from worldtrack.trackers.particle_sampling import bimodal_split, splittable
+
+    rng = np.random.default_rng(6)
+    clouds = []
+    for k in range(40):
+        one = rng.normal(0, 0.1, (500, 3))
+        if k % 2:                                         # two lumps side by side
+            one[:250, 0] += rng.uniform(0.3, 0.9)
+        clouds.append(one + [rng.uniform(-3, 3), rng.uniform(0, 6), 0])
+    xyz = np.stack(clouds)
+    wide, principal = splittable(xyz[:, :, :2], 0.35, 0.2, principal=True)
+    np.testing.assert_array_equal(wide, splittable(xyz[:, :, :2], 0.35, 0.2))
+    splits = 0
+    for cloud, w, pc in zip(clouds, wide, principal):
+        alone = bimodal_split(cloud[:, :2], 0.35, 0.5, 0.2)
+        given = bimodal_split(cloud[:, :2], 0.35, 0.5, 0.2, principal=pc)
+        assert (alone is None) == (given is None)
+        if alone is not None:
+            np.testing.assert_array_equal(alone, given)
+            splits += 1
+    assert 10 <= splits <= 20 and wide.sum() >= splits

@@ -952,16 +952,17 @@ class ParticleTracker:
             return [idx]
         return self._lumps(xyz, idx[~side], depth - 1) + self._lumps(xyz, idx[side], depth - 1)
 
-    def _two_objects(self, xy: np.ndarray) -> np.ndarray | None:
+    def _two_objects(self, xy: np.ndarray, principal: tuple | None = None) -> np.ndarray | None:
         """Which side of a two-lump cloud each particle is on, or None for one object.
 
         Two lumps (:func:`~worldtrack.trackers.particle_sampling.bimodal_split`) are two objects only
         if the cameras can tell them apart: their image boxes must overlap less than
         ``merge_overlap`` in some camera that sees both (lumps one behind the other on a single
-        camera's line of sight are the depth ambiguity of one object, not two objects).
+        camera's line of sight are the depth ambiguity of one object, not two objects). ``principal``:
+        the cloud's row of :func:`~worldtrack.trackers.particle_sampling.splittable`'s, if at hand.
         """
         cfg = self.config
-        side = bimodal_split(xy, cfg.split_distance, cfg.split_dip, cfg.split_min_mass)
+        side = bimodal_split(xy, cfg.split_distance, cfg.split_dip, cfg.split_min_mass, principal=principal)
         if side is None:
             return None
         h, w = self.scene.people.height, self.scene.people.width
@@ -979,15 +980,17 @@ class ParticleTracker:
         cfg = self.config
         fs = list(self.filters)
         if fs:
-            wide = splittable(self._stacked(fs, "xyz")[:, :, :2], cfg.split_distance, cfg.split_min_mass)
-            for f, w in zip(fs, wide.tolist()):
-                self._maybe_split(f, t, w)
+            wide, principal = splittable(self._stacked(fs, "xyz")[:, :, :2], cfg.split_distance,
+                                         cfg.split_min_mass, principal=True)
+            for f, w, pc in zip(fs, wide.tolist(), principal):
+                self._maybe_split(f, t, w, pc)
 
-    def _maybe_split(self, f: _Filter, t: float, wide: bool = True) -> None:
+    def _maybe_split(self, f: _Filter, t: float, wide: bool = True, principal: tuple | None = None) -> None:
         """Split a filter whose particles have been two lumps for ``split_frames`` frames (``wide``
-        False: its cloud failed :func:`~worldtrack.trackers.particle_sampling.splittable`, one lump)."""
+        False: its cloud failed :func:`~worldtrack.trackers.particle_sampling.splittable`, one lump;
+        ``principal``: its cloud's row of splittable's, if at hand)."""
         cfg = self.config
-        side = self._two_objects(f.xyz[:, :2]) if wide else None
+        side = self._two_objects(f.xyz[:, :2], principal) if wide else None
         f.split_count = f.split_count + 1 if side is not None else 0
         if f.split_count < cfg.split_frames:
             return

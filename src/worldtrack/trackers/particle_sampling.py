@@ -183,7 +183,8 @@ def _raster_contains(xy, x0, y0, resolution, inside, out):
 # ---------------------------------------------------------------------------- splitting a cloud
 
 def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mass: float,
-                  bin_m: float = 0.04, smooth_m: float = 0.05) -> np.ndarray | None:
+                  bin_m: float = 0.04, smooth_m: float = 0.05,
+                  principal: tuple | None = None) -> np.ndarray | None:
     """Split a floor cloud of particles into two objects side by side, if it is two.
 
     The cloud is projected on its principal axis; the projection's histogram (``bin_m`` bins,
@@ -197,6 +198,8 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
     min_separation : float, metres
     max_dip : float in (0, 1)
     min_mass : float in (0, 0.5)
+    principal : tuple, optional — this cloud's row of :func:`splittable`'s ``principal`` (the
+        centred cloud and its covariance, computed for many clouds at once), not to compute it again
 
     Returns
     -------
@@ -206,8 +209,10 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
     xy = np.asarray(xy, dtype=float)
     if len(xy) < 8:
         return None
-    c, (sxx, syy, sxy, lam) = _principal(xy[None])
-    c, sxx, syy, sxy, lam = c[0], float(sxx[0]), float(syy[0]), float(sxy[0]), float(lam[0])
+    if principal is None:
+        c, (sxx, syy, sxy, lam) = _principal(xy[None])
+        principal = c[0], float(sxx[0]), float(syy[0]), float(sxy[0]), float(lam[0])
+    c, sxx, syy, sxy, lam = principal
     if not _wide_enough(lam, min_separation, min_mass):
         return None
     # The principal axis: the eigenvector of the covariance's largest eigenvalue.
@@ -303,7 +308,7 @@ def _valley_reference(s: np.ndarray, lo: float, bin_m: float, smooth_m: float, m
     return valley
 
 
-def splittable(xy: np.ndarray, min_separation: float, min_mass: float) -> np.ndarray:
+def splittable(xy: np.ndarray, min_separation: float, min_mass: float, principal: bool = False):
     """Which of F clouds :func:`bimodal_split` could split at all: the cheap test it starts with
     (at least 8 particles, wide enough along the principal axis), for many clouds at once.
 
@@ -311,15 +316,24 @@ def splittable(xy: np.ndarray, min_separation: float, min_mass: float) -> np.nda
     ----------
     xy : (F, N, 2) float, metres
     min_separation, min_mass : as in :func:`bimodal_split`
+    principal : bool — also return each cloud's centred particles and covariance, for
+        :func:`bimodal_split` (the same values as it computes for one cloud: the matrix products
+        run per cloud)
 
     Returns
     -------
-    (F,) bool — False: :func:`bimodal_split` returns None for that cloud
+    wide : (F,) bool — False: :func:`bimodal_split` returns None for that cloud
+    principal : list of F tuples, with ``principal`` — each cloud's ``principal`` argument of
+        :func:`bimodal_split` (None for clouds of fewer than 8 particles)
     """
     xy = np.asarray(xy, dtype=float)
     if xy.shape[1] < 8:
-        return np.zeros(len(xy), dtype=bool)
-    return _wide_enough(_principal(xy)[1][3], min_separation, min_mass)
+        wide, rows = np.zeros(len(xy), dtype=bool), [None] * len(xy)
+    else:
+        c, (sxx, syy, sxy, lam) = _principal(xy)
+        wide = _wide_enough(lam, min_separation, min_mass)
+        rows = list(zip(c, sxx.tolist(), syy.tolist(), sxy.tolist(), lam.tolist())) if principal else None
+    return (wide, rows) if principal else wide
 
 
 # ---------------------------------------------------------------------------- motion
