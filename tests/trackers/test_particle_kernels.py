@@ -153,3 +153,35 @@ def test_bimodal_split_with_splittables_principal_is_the_same():
             np.testing.assert_array_equal(alone, given)
             splits += 1
     assert 10 <= splits <= 20 and wide.sum() >= splits
+
+
+def test_resampling_kernel_agrees_with_reference():
+    """Systematic and stratified resampling (cumulative weights, normalised, points merged in one
+    kernel) draw the NumPy lookup's indices: ties, zero weights and a row with one weight included."""
+    from worldtrack.trackers.particle_sampling import resample_reference, stratified_resample, systematic_resample
+
+    rng = np.random.default_rng(7)
+    for trial in range(30):
+        f, m = int(rng.integers(1, 12)), int(rng.integers(1, 600))
+        w = rng.random((f, m)) ** rng.uniform(1, 30)
+        w[:, ::3] = 0.0
+        w[0] = 0.0
+        w[0, m // 2] = 2.5
+        for resample, shape in ((systematic_resample, (f, 1)), (stratified_resample, (f, m))):
+            got = resample(w, m, np.random.default_rng(trial))
+            ref = resample_reference(w, np.random.default_rng(trial).random(shape), m)
+            np.testing.assert_array_equal(got, ref)
+            assert np.all(got[0] == m // 2) and not np.any(got[1:] % 3 == 0)
+
+
+def test_take_rows_agrees_with_take_along_axis():
+    from worldtrack.trackers.particle_sampling import take_rows
+
+    rng = np.random.default_rng(8)
+    idx = rng.integers(0, 50, (4, 70))
+    for a in (rng.normal(size=(4, 50, 3)), rng.normal(size=(4, 50)), rng.random((4, 50)) < 0.5):
+        want = np.take_along_axis(a, idx.reshape(idx.shape + (1,) * (a.ndim - 2)), axis=1)
+        got = take_rows(a, idx)
+        assert got.dtype == a.dtype and got.shape == want.shape
+        np.testing.assert_array_equal(got, want)
+    assert take_rows(np.zeros((2, 0, 3)), np.zeros((2, 0), dtype=np.int64)).shape == (2, 0, 3)

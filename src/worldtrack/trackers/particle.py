@@ -97,7 +97,7 @@ from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, ad
                                                      hit_labels, occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, jitter_reflect,
                                                    polygon_distance, predict_state, raster_contains, resampler,
-                                                   splittable)
+                                                   splittable, take_rows)
 
 Box = tuple[int, int, int, int]
 
@@ -709,9 +709,7 @@ class ParticleTracker:
         sees (the column does not depend on z), so that the particles fill the object (the box's z
         extent)."""
         idx = self._resample(weights, n, self.rng)
-        flat = (idx + weights.shape[1] * np.arange(len(idx))[:, None]).ravel()
-        out = {name: a.reshape((-1,) + a.shape[2:]).take(flat, axis=0).reshape(idx.shape + a.shape[2:])
-               for name, a in parts.items()}
+        out = {name: take_rows(a, idx) for name, a in parts.items()}
         if self.config.likelihood == "column":
             out["xyz"][..., 2] = self.rng.random(idx.shape) * out["col_h"]
         return out
