@@ -7,6 +7,7 @@ Uses the small scene of ``test_particle.py``.
 from __future__ import annotations
 
 import cv2
+import pytest
 import numpy as np
 
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, add_camera, add_camera_reference,
@@ -185,3 +186,51 @@ def test_take_rows_agrees_with_take_along_axis():
         assert got.dtype == a.dtype and got.shape == want.shape
         np.testing.assert_array_equal(got, want)
     assert take_rows(np.zeros((2, 0, 3)), np.zeros((2, 0), dtype=np.int64)).shape == (2, 0, 3)
+
+
+def test_columns_beside_and_boxes_apart_agree_with_numpy():
+    """Where a filter learns its colours: the columns beside its centre (kernel against floor_rays),
+    and which boxes overlap no other (integers against _overlaps)."""
+    from worldtrack.trackers.particle import _overlaps
+    from worldtrack.trackers.particle_likelihood import boxes_apart, columns_beside_reference
+
+    cam = make_scene().cameras["cam"]
+    cl = CameraLikelihood(cam)
+    rng = np.random.default_rng(9)
+    xy = np.column_stack([rng.uniform(-3, 3, 300), rng.uniform(0, 7, 300)])
+    xy[0] = cam.centre[:2]
+    spread = rng.uniform(0.05, 0.2, 300)
+    for offset in (0.14, 0.0):
+        got = cl.beside(xy, offset, spread)
+        np.testing.assert_array_equal(got, columns_beside_reference(cam, xy, offset, spread))
+    assert np.allclose(np.hypot(*(got[1::3] - got[::3]).T), spread)
+    for trial in range(50):
+        k = int(rng.integers(1, 15))
+        u0, v0 = rng.integers(0, W - 1, k), rng.integers(0, H - 1, k)
+        boxes = [None if rng.random() < 0.2 else (int(a), int(min(a + rng.integers(1, 60), W)), int(b),
+                                                 int(min(b + rng.integers(1, 60), H))) for a, b in zip(u0, v0)]
+        arr = np.array([(-1,) * 4 if b is None else b for b in boxes], dtype=np.int64).reshape(-1, 4)
+        ov = _overlaps(boxes)
+        np.fill_diagonal(ov, 0.0)
+        want = np.array([b is not None for b in boxes]) & ~(ov > 0).any(axis=1)
+        np.testing.assert_array_equal(boxes_apart(arr), want)
+    assert boxes_apart(np.array([[0, 10, 0, 10], [10, 20, 0, 10], [5, 15, 9, 12]])).tolist() == [False, False, False]
+    assert boxes_apart(np.array([[0, 10, 0, 10], [10, 20, 0, 10]])).tolist() == [True, True]   # edges touch
+
+
+def test_colour_learning_kernel_agrees_with_numpy():
+    from worldtrack.trackers.particle_appearance import MIN_LEARN_SAMPLES, N_BINS, ColourModel
+
+    rng = np.random.default_rng(10)
+    fast, slow = ColourModel(), ColourModel()
+    for frame in range(30):
+        bins = rng.integers(-1, N_BINS, (3, 6)).astype(np.int16)
+        if frame % 7 == 3:
+            bins[:] = -1
+            bins[0, :MIN_LEARN_SAMPLES - 1] = 2                  # too few to learn from
+        assert fast.learn(bins, 0.1) == slow.learn_reference(bins, 0.1)
+        np.testing.assert_array_equal(fast.hist, slow.hist)
+        assert fast.frames == slow.frames
+    assert fast.frames > 20 and abs(fast.hist.sum() - 1) < 1e-12
+    with pytest.raises(ValueError, match="below"):
+        fast.learn(np.full(10, N_BINS), 0.1)

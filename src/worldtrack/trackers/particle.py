@@ -93,8 +93,9 @@ from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties
-from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, floor_pixels, hit_image,
-                                                     hit_labels, occluder_layers, owner_image, thresholded_difference)
+from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart, floor_pixels,
+                                                     hit_image, hit_labels, occluder_layers, owner_image,
+                                                     thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, jitter_reflect,
                                                    polygon_distance, predict_state, raster_contains, resampler,
                                                    splittable, take_rows)
@@ -550,27 +551,26 @@ class ParticleTracker:
         """
         cfg = self.config
         fs = self.filters
-        learners = np.array([f.likely is not None and f.likely.mean() > 0.5 for f in fs], dtype=bool)
+        # More than half likely (the mean of the booleans above 0.5, with integers).
+        learners = np.array([f.likely is not None and 2 * np.count_nonzero(f.likely) > len(f.likely) for f in fs],
+                            dtype=bool)
         if not learners.any():
             return
         centres = np.array([f.centre for f in fs], dtype=float).reshape(-1, 2)
         widths = np.array([f.track.width for f in fs], dtype=float)
-        boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
+        heights = np.array([f.track.height for f in fs], dtype=float)
         for cid, hit in images.items():
             cl = self._cams[cid]
-            ov = _overlaps(boxes[cid])
-            np.fill_diagonal(ov, 0.0)
-            apart = np.array([b is not None for b in boxes[cid]], dtype=bool) & ~(ov > 0).any(axis=1)
-            idx = np.flatnonzero(learners & apart)
+            idx = np.flatnonzero(learners & boxes_apart(cl.box_array(centres, widths, heights, cfg.box_margin)))
             if not len(idx):
                 continue
-            centre = self._near_surface(centres[idx], cl)
-            along = cl.along(centre)
-            across = np.column_stack([-along[:, 1], along[:, 0]]) * (0.25 * widths[idx])[:, None]
-            xy = np.stack([centre, centre + across, centre - across], axis=1).reshape(-1, 2)
+            xy = cl.beside(centres[idx], cfg.surface_offset, 0.25 * widths[idx])
             bins = column_bins(cl, self._frames[cid], hit, xy).reshape(len(idx), -1)
-            for i, b in zip(idx, bins):
-                fs[i].colours.setdefault(cid, ColourModel()).learn(b, cfg.appearance_rate)
+            for i, b in zip(idx.tolist(), bins):
+                model = fs[i].colours.get(cid)
+                if model is None:
+                    model = fs[i].colours[cid] = ColourModel()
+                model.learn(b, cfg.appearance_rate)
 
     def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
         """Where a camera's column stands for particles at ``xy`` (N, 2): ``surface_offset`` m nearer to it."""

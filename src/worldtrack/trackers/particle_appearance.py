@@ -223,6 +223,20 @@ class ColourModel:
     def learn(self, sample_bins: np.ndarray, rate: float) -> bool:
         """Blend the histogram of the valid (≥ 0) bins in ``sample_bins`` in with weight ``rate``
         (the first frame sets it); False, and nothing learnt, with fewer than MIN_LEARN_SAMPLES."""
+        bins = np.ascontiguousarray(sample_bins, dtype=np.int64).reshape(-1)
+        out = np.empty(N_BINS)
+        done = _blend_histogram(bins, _NO_HIST if self.hist is None else self.hist, float(rate), MIN_LEARN_SAMPLES,
+                                out)
+        if done < 0:
+            raise ValueError(f"ColourModel.learn: colour bins must be below {N_BINS}, got {int(bins.max())}")
+        if not done:
+            return False
+        self.hist = out
+        self.frames += 1
+        return True
+
+    def learn_reference(self, sample_bins: np.ndarray, rate: float) -> bool:
+        """:meth:`learn` in NumPy (its former code), the reference of :func:`_blend_histogram`."""
         valid = np.asarray(sample_bins).ravel()
         valid = valid[valid >= 0]
         if len(valid) < MIN_LEARN_SAMPLES:
@@ -243,6 +257,31 @@ class ColourModel:
         """(N,) sum over each row's valid samples of :meth:`penalty_table`, ≤ 0; 0 when nothing is learnt."""
         sample_bins = np.asarray(sample_bins)
         return colour_log_ratio([self], sample_bins, np.zeros(len(sample_bins), dtype=np.int64))
+
+
+_NO_HIST = np.zeros(0)
+
+
+@njit(cache=True)
+def _blend_histogram(bins, hist, rate, min_samples, out):
+    """``out`` (N_BINS,): the histogram ``p`` of the valid (≥ 0) ``bins`` (counts over their number),
+    or ``(1 − rate)·hist + rate·p`` when ``hist`` is not empty; 1 when done, 0 (``out`` unset) with
+    fewer than ``min_samples`` valid bins, −1 for a bin beyond ``out``."""
+    counts = np.zeros(out.shape[0], dtype=np.int64)
+    n = 0
+    for b in bins:
+        if b >= out.shape[0]:
+            return -1
+        if b >= 0:
+            counts[b] += 1
+            n += 1
+    if n < min_samples:
+        return 0
+    keep = 1.0 - rate
+    for c in range(out.shape[0]):
+        p = counts[c] / n
+        out[c] = p if hist.shape[0] == 0 else keep * hist[c] + rate * p
+    return 1
 
 
 def colour_log_ratio(models: Sequence[ColourModel | None], sample_bins: np.ndarray, which: np.ndarray) -> np.ndarray:

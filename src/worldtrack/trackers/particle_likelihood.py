@@ -812,6 +812,67 @@ def toward_camera(xy: np.ndarray, offset: float, centre: np.ndarray, floor_direc
 
 
 @njit(cache=True)
+def columns_beside(xy: np.ndarray, offset: float, spread: np.ndarray, centre: np.ndarray,
+                   floor_direction: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (3K, 2), in place: per point of ``xy`` (K, 2), metres, ``c`` = the point moved ``offset``
+    nearer to the camera (:func:`toward_camera`; the point itself for ``offset ≤ 0``), then
+    ``c ± spread·(−a_y, a_x)`` with ``a`` the line of sight through ``c`` (:func:`floor_along`) —
+    the arithmetic of :func:`columns_beside_reference`."""
+    for i in range(xy.shape[0]):
+        x, y = xy[i, 0], xy[i, 1]
+        if offset > 0.0:
+            dx = x - centre[0]
+            dy = y - centre[1]
+            n = math.hypot(dx, dy)
+            if n > 1e-9:
+                ax, ay = dx / n, dy / n
+            else:
+                ax, ay = floor_direction[0], floor_direction[1]
+            x, y = x - offset * ax, y - offset * ay
+        dx = x - centre[0]
+        dy = y - centre[1]
+        n = math.hypot(dx, dy)
+        if n > 1e-9:
+            ax, ay = dx / n, dy / n
+        else:
+            ax, ay = floor_direction[0], floor_direction[1]
+        sx, sy = -ay * spread[i], ax * spread[i]
+        out[3 * i, 0], out[3 * i, 1] = x, y
+        out[3 * i + 1, 0], out[3 * i + 1, 1] = x + sx, y + sy
+        out[3 * i + 2, 0], out[3 * i + 2, 1] = x - sx, y - sy
+
+
+def columns_beside_reference(camera: Camera, xy: np.ndarray, offset: float, spread: np.ndarray) -> np.ndarray:
+    """:func:`columns_beside` with :meth:`Camera.floor_rays` in NumPy (the tracker's former code)."""
+    centre = xy - offset * camera.floor_rays(xy)[0] if offset > 0 else xy
+    along, _ = camera.floor_rays(centre)
+    across = np.column_stack([-along[:, 1], along[:, 0]]) * np.asarray(spread)[:, None]
+    return np.stack([centre, centre + across, centre - across], axis=1).reshape(-1, 2)
+
+
+@njit(cache=True)
+def boxes_apart(boxes: np.ndarray) -> np.ndarray:
+    """(K,) bool: which of ``boxes`` (K, 4) int ``(u0, u1, v0, v1)`` (rows with ``u0 < 0``: none) exist
+    and overlap no other existing box (a positive intersection) — what ``_overlaps`` (above 0 off
+    the diagonal) tells, with integers."""
+    k = boxes.shape[0]
+    out = np.zeros(k, dtype=np.bool_)
+    for i in range(k):
+        if boxes[i, 0] < 0:
+            continue
+        alone = True
+        for j in range(k):
+            if j != i and boxes[j, 0] >= 0:
+                w = min(boxes[i, 1], boxes[j, 1]) - max(boxes[i, 0], boxes[j, 0])
+                h = min(boxes[i, 3], boxes[j, 3]) - max(boxes[i, 2], boxes[j, 2])
+                if w > 0 and h > 0:
+                    alone = False
+                    break
+        out[i] = alone
+    return out
+
+
+@njit(cache=True)
 def add_camera(seen: np.ndarray, lv: np.ndarray, penalty: np.ndarray, weight: float, col_h: np.ndarray,
                ok: np.ndarray, logpi: np.ndarray, likely: np.ndarray, n_seen: np.ndarray, col: np.ndarray) -> None:
     """One camera's share of a likelihood summed over cameras, in place (N particles):
@@ -1034,6 +1095,11 @@ class CameraLikelihood:
               depth: float = 0.0) -> list[tuple[int, int, int, int] | None]:
         """:func:`~worldtrack.trackers.particle.image_boxes` of objects at ``xy`` (K, 2) with
         ``widths, heights`` (K,) — by the kernel :func:`box_pixels`."""
+        return [tuple(b) if b[0] >= 0 else None for b in self.box_array(xy, widths, heights, margin, depth).tolist()]
+
+    def box_array(self, xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: float,
+                  depth: float = 0.0) -> np.ndarray:
+        """:meth:`boxes` as (K, 4) int64 ``(u0, u1, v0, v1)``, rows of −1 for no box."""
         xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
         k = len(xy)
         out = np.empty((k, 4), dtype=np.int64)
@@ -1041,7 +1107,17 @@ class CameraLikelihood:
                    np.ascontiguousarray(np.broadcast_to(np.asarray(heights, dtype=np.float64), (k,))),
                    float(margin), float(depth), self.R, self.t, self.K, self.dist, self.has_dist, self.centre,
                    self.floor_direction, self.camera.width, self.camera.height, out)
-        return [tuple(b) if b[0] >= 0 else None for b in out.tolist()]
+        return out
+
+    def beside(self, xy: np.ndarray, offset: float, spread: np.ndarray) -> np.ndarray:
+        """(3K, 2) metres: for each of ``xy`` (K, 2), its column ``offset`` m nearer to the camera
+        (as :meth:`near_surface`; ``xy`` itself for ``offset ≤ 0``) and the two ``spread`` (K,) m to
+        either side of it across the line of sight through it, in that order (:func:`columns_beside`)."""
+        xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+        out = np.empty((3 * len(xy), 2))
+        columns_beside(xy, float(offset), np.ascontiguousarray(spread, dtype=np.float64), self.centre,
+                       self.floor_direction, out)
+        return out
 
     def column(self, hit: np.ndarray, xy: np.ndarray, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
                k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
