@@ -234,3 +234,18 @@ def test_colour_learning_kernel_agrees_with_numpy():
     assert fast.frames > 20 and abs(fast.hist.sum() - 1) < 1e-12
     with pytest.raises(ValueError, match="below"):
         fast.learn(np.full(10, N_BINS), 0.1)
+
+
+def test_order_statistic_agrees_with_partition():
+    from worldtrack.trackers.particle_sampling import order_statistic
+
+    rng = np.random.default_rng(11)
+    for f, n, top in ((1, 1, 3), (4, 500, 27), (3, 37, 5), (2, 9, 5000)):      # 5000: the partition fallback
+        x = rng.integers(0, top + 1, (f, n)).astype(np.int32)
+        for rank in {0, n // 2, n - 1}:
+            got = order_statistic(x, rank)
+            assert got.dtype == x.dtype
+            np.testing.assert_array_equal(got, np.partition(x, rank, axis=1)[:, rank])
+    x = np.array([[5, 1, 3, 3, 0]], dtype=np.int32)
+    assert order_statistic(x, 0)[0] == 0 and order_statistic(x, 2)[0] == 3 and order_statistic(x, 4)[0] == 5
+

@@ -97,8 +97,8 @@ from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, ad
                                                      hit_image, hit_labels, occluder_layers, owner_image,
                                                      thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, jitter_reflect,
-                                                   polygon_distance, predict_state, raster_contains, resampler,
-                                                   splittable, take_rows)
+                                                   order_statistic, polygon_distance, predict_state, raster_contains,
+                                                   resampler, splittable, take_rows)
 
 Box = tuple[int, int, int, int]
 
@@ -236,6 +236,7 @@ class ParticleTracker:
         self._close: dict[tuple[int, int], int] = {}
         self._layers: dict = {}          # per camera, the occluder layers reused frame to frame
         self._rows: dict = {}            # per particle field, the tracking filters' rows and their array
+        self._which: dict = {}           # (F, N) -> each of F·N particles' filter index
         self._frames: dict[str, np.ndarray] = {}  # per camera, this frame's image (appearance)
         self._leaving: list[tuple[Track, float]] = []  # tracks ended at an exit, and when
         self.last_masks: dict[str, np.ndarray] = {}
@@ -729,16 +730,16 @@ class ParticleTracker:
         ``boxes`` and ``occluders`` (optional) are of the filters' objects in the order of ``fs``;
         ``centres`` (optional, (F, 2)) their particles' mean floor positions, if already at hand."""
         cfg = self.config
-        sizes = [len(f.xyz) for f in fs]
         tracking = fs[0].track is not None
         scales = k_lo = hidden = None
         if cfg.pixel_weights in ("filter", "hidden") and cfg.weighting == "ratio" and tracking:
             # "hidden": only where the lower body was hidden last frame (above the foot samples).
-            use = ({cid: np.array([f.k_lo.get(cid, 0) > self._n_below for f in fs]) for cid in images}
-                   if cfg.pixel_weights == "hidden" else None)
-            if use is not None and not any(u.any() for u in use.values()):
+            nb = self._n_below
+            if cfg.pixel_weights == "hidden" and not any(f.k_lo.get(cid, 0) > nb for f in fs for cid in images):
                 scales = {cid: np.zeros(len(fs)) for cid in images}   # nobody hidden: no scales to compute
             else:
+                use = ({cid: np.array([f.k_lo.get(cid, 0) > nb for f in fs]) for cid in images}
+                       if cfg.pixel_weights == "hidden" else None)
                 scales = self._filter_pixel_scales(self._centres(fs, centres), images)
                 if use is not None:
                     scales = {cid: np.where(use[cid], s, 0.0) for cid, s in scales.items()}
@@ -747,20 +748,27 @@ class ParticleTracker:
             hidden = {}
             if cfg.common_view > 0 and cfg.weighting == "ratio":
                 k_lo = {cid: np.array([f.k_lo.get(cid, 0) for f in fs], dtype=np.int64) for cid in images}
-        out = self.likelihood(np.concatenate([f.xyz for f in fs]), images, owners, boxes,
-                              np.concatenate([f.h for f in fs]), occluders, np.arange(len(fs)),
-                              [f.colours for f in fs], np.repeat(np.arange(len(fs)), sizes), scales, k_lo, hidden)
+        if tracking:                                    # equal particle counts: (F, N) as (F·N,)
+            n = len(fs[0].xyz)
+            xyz, h = self._stacked(fs, "xyz").reshape(-1, 3), self._stacked(fs, "h").reshape(-1)
+            which = self._which.get((len(fs), n))
+            if which is None:
+                which = self._which[(len(fs), n)] = np.repeat(np.arange(len(fs)), n)
+        else:
+            sizes = [len(f.xyz) for f in fs]
+            xyz, h = np.concatenate([f.xyz for f in fs]), np.concatenate([f.h for f in fs])
+            which = np.repeat(np.arange(len(fs)), sizes)
+        out = self.likelihood(xyz, images, owners, boxes, h, occluders, np.arange(len(fs)), [f.colours for f in fs],
+                              which, scales, k_lo, hidden)
         if hidden:
             # Next frame's k_lo: the share ``common_view`` of the filter's columns see every sample
             # from there up (tracking filters hold equal particle counts).
             # (np.quantile(..., method="higher") of each row, as the order statistic it picks.)
-            n = len(fs[0].xyz)
             rank = _quantile_rank(n, cfg.common_view or 0.5)
             for cid, hid in hidden.items():
-                lo = np.partition(hid.reshape(len(fs), n), rank, axis=1)[:, rank]
-                for f, v in zip(fs, lo.tolist()):
+                for f, v in zip(fs, order_statistic(hid.reshape(len(fs), n), rank).tolist()):
                     f.k_lo[cid] = v
-        if tracking:                                    # equal particle counts: rows of (F, N)
+        if tracking:
             for name, a in zip(("logpi", "likely", "col_h"), out):
                 self._set_rows(fs, name, a.reshape(len(fs), -1))
             return

@@ -405,19 +405,26 @@ def filter_rows(box, me: int | Sequence[int], which: np.ndarray | None,
         box, me, which = [box], [me], np.zeros(n, dtype=np.int64)
     elif box is None:
         box = [None] * (len(me) if np.ndim(me) else int(np.max(which, initial=-1)) + 1)
-    boxes = np.array([NO_BOX if b is None else b for b in box], dtype=np.int64).reshape(-1, 4)
-    mes = np.array(np.broadcast_to(np.asarray(me, dtype=np.int64), (len(boxes),)))
-    return boxes, mes, np.ascontiguousarray(which, dtype=np.int64)
+    boxes = np.array([_NO_BOX_TUPLE if b is None else b for b in box], dtype=np.int64).reshape(-1, 4)
+    return boxes, _per_filter_int(me, len(boxes)), np.ascontiguousarray(which, dtype=np.int64)
+
+
+_NO_BOX_TUPLE = tuple(NO_BOX.tolist())
 
 
 def _per_filter_int(v: int | Sequence[int], f: int) -> np.ndarray:
     """(F,) int64 of one value for all ``f`` filters or one per filter."""
+    if isinstance(v, np.ndarray) and v.dtype == np.int64 and v.shape == (f,) and v.flags.c_contiguous:
+        return v
     return np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=np.int64), (f,)))
 
 
 def pixel_scales(px_scale: float | Sequence[float], f: int) -> np.ndarray:
     """(F,) float64 pixel-weight scales (1 / pixels) of ``f`` filters from one scale for all or one
     per filter (0: unweighted samples)."""
+    if isinstance(px_scale, np.ndarray) and px_scale.dtype == np.float64 and px_scale.shape == (f,) \
+            and px_scale.flags.c_contiguous:
+        return px_scale
     return np.ascontiguousarray(np.broadcast_to(np.asarray(px_scale, dtype=np.float64), (f,)))
 
 

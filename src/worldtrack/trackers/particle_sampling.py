@@ -130,7 +130,7 @@ def take_rows(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """(F, n, ...) ``a[f, idx[f, j]]``: each of F filters' particles ``a`` (F, M, ...) picked by its own
     indices ``idx`` (F, n) — ``np.take_along_axis`` in one kernel (tested equal)."""
     f, m = a.shape[:2]
-    c = int(np.prod(a.shape[2:], dtype=np.int64))
+    c = math.prod(a.shape[2:])
     out = np.empty((f, idx.shape[1], c), dtype=a.dtype)
     _take_rows(np.ascontiguousarray(a).reshape(f, m, c), np.ascontiguousarray(idx, dtype=np.int64), out)
     return out.reshape(idx.shape + a.shape[2:])
@@ -143,6 +143,37 @@ def _take_rows(a, idx, out):
             k = idx[f, j]
             for c in range(a.shape[2]):
                 out[f, j, c] = a[f, k, c]
+
+
+def order_statistic(x: np.ndarray, rank: int) -> np.ndarray:
+    """(F,) the value of rank ``rank`` (0-based, ascending) in each row of ``x`` (F, N) of small
+    non-negative integers: ``np.partition(x, rank, axis=1)[:, rank]`` by counting (tested equal)."""
+    x = np.ascontiguousarray(x)
+    out = np.empty(len(x), dtype=x.dtype)
+    if not 0 <= rank < x.shape[1] or not _order_statistic(x, int(rank), out):
+        return np.partition(x, rank, axis=1)[:, rank]         # (other values, or rank out of range: its error)
+    return out
+
+
+@njit(cache=True)
+def _order_statistic(x, rank, out):
+    """False (``out`` not filled) if some value is negative or above 4096."""
+    for f in range(x.shape[0]):
+        top = 0
+        for v in x[f]:
+            if v < 0 or v > 4096:
+                return False
+            top = max(top, v)
+        counts = np.zeros(top + 1, dtype=np.int64)
+        for v in x[f]:
+            counts[v] += 1
+        seen = 0
+        for v in range(top + 1):
+            seen += counts[v]
+            if seen > rank:
+                out[f] = v
+                break
+    return True
 
 
 def resampler(name: str) -> Callable[[np.ndarray, int, np.random.Generator], np.ndarray]:
