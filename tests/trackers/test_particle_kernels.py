@@ -249,3 +249,42 @@ def test_order_statistic_agrees_with_partition():
     x = np.array([[5, 1, 3, 3, 0]], dtype=np.int32)
     assert order_statistic(x, 0)[0] == 0 and order_statistic(x, 2)[0] == 3 and order_statistic(x, 4)[0] == 5
 
+
+def test_boxes_on_one_object_agrees_with_reference():
+    """The merge's test of two filters on one object (boxes overlapping by ``merge_overlap`` in
+    every camera that sees both), integers against the NumPy ratios of _overlaps."""
+    from worldtrack.trackers.particle import _overlaps
+    from worldtrack.trackers.particle_likelihood import boxes_on_one_object, boxes_on_one_object_reference
+
+    rng = np.random.default_rng(12)
+    found = 0
+    for trial in range(60):
+        c, k = int(rng.integers(1, 4)), int(rng.integers(2, 12))
+        cams = []
+        for _ in range(c):
+            u0, v0 = rng.integers(0, 60, k), rng.integers(0, 60, k)
+            cams.append([None if rng.random() < 0.2 else (int(a), int(a + rng.integers(5, 40)), int(b),
+                                                         int(b + rng.integers(5, 40))) for a, b in zip(u0, v0)])
+        arr = np.array([[(-1,) * 4 if b is None else b for b in cam] for cam in cams], dtype=np.int64)
+        for min_overlap in (0.6, 0.3):
+            got = boxes_on_one_object(arr, min_overlap)
+            np.testing.assert_array_equal(got, boxes_on_one_object_reference(cams, min_overlap))
+            found += got.sum()
+        assert np.array_equal(boxes_on_one_object_reference([cams[0]], 0.6),
+                              np.triu(~np.isnan(_overlaps(cams[0])) & (_overlaps(cams[0]) >= 0.6), 1))
+    assert found > 20
+
+
+def test_owner_image_reused_equals_fresh():
+    rng = np.random.default_rng(13)
+    buf, previous = None, ()
+    for trial in range(20):
+        k = int(rng.integers(0, 6))
+        boxes = [None if rng.random() < 0.2 else
+                 (int(u), int(min(u + rng.integers(1, 90), W)), int(v), int(min(v + rng.integers(1, 90), H)))
+                 for u, v in zip(rng.integers(0, W, k), rng.integers(0, H, k))]
+        fresh = owner_image((H, W), boxes)
+        buf = owner_image((H, W), boxes, buf, previous)
+        previous = boxes
+        np.testing.assert_array_equal(buf, fresh)
+    assert buf.max() >= 1

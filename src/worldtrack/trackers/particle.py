@@ -93,9 +93,9 @@ from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties
-from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart, floor_pixels,
-                                                     hit_image, hit_labels, occluder_layers, owner_image,
-                                                     thresholded_difference)
+from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart,
+                                                     boxes_on_one_object, floor_pixels, hit_image, hit_labels,
+                                                     occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, jitter_reflect,
                                                    order_statistic, polygon_distance, predict_state, raster_contains,
                                                    resampler, splittable, take_rows)
@@ -237,6 +237,7 @@ class ParticleTracker:
         self._layers: dict = {}          # per camera, the occluder layers reused frame to frame
         self._rows: dict = {}            # per particle field, the tracking filters' rows and their array
         self._which: dict = {}           # (F, N) -> each of F·N particles' filter index
+        self._owner_buffers: dict = {}   # per camera, the owner image reused frame to frame and its boxes
         self._frames: dict[str, np.ndarray] = {}  # per camera, this frame's image (appearance)
         self._leaving: list[tuple[Track, float]] = []  # tracks ended at an exit, and when
         self.last_masks: dict[str, np.ndarray] = {}
@@ -366,7 +367,7 @@ class ParticleTracker:
             if cfg.explain == "all" and len(fs) > 1:      # a lone filter has nothing to explain away
                 centres = cloud_mean(self._stacked(fs, "xyz")[:, :, :2])
                 boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
-                owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
+                owners = self._owner_images(images, boxes)
                 if cfg.occlusion:
                     occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
                                                       self._cams[cid].camera.floor_rays(centres)[1],
@@ -395,7 +396,7 @@ class ParticleTracker:
             boxes = self._boxes([f.track for f in self.filters] + left,
                                 [f.centre for f in self.filters] + [np.array([tr.x, tr.y]) for tr in left],
                                 cfg.box_margin, cfg.exclusion_depth)
-            owners = {cid: owner_image(img.shape, boxes[cid]) for cid, img in images.items()}
+            owners = self._owner_images(images, boxes)
         if self.detectors:
             for d in self.detectors:
                 self._move_detector(d, dt)
@@ -432,6 +433,16 @@ class ParticleTracker:
             if cfg.appearance_weight > 0:
                 self._frames[cid] = image
             out[cid] = hit if cfg.likelihood == "column" else thresholded_difference(np.where(hit == 1, F, 0), cfg.gamma)
+        return out
+
+    def _owner_images(self, images: Mapping[str, np.ndarray], boxes: Mapping[str, list]) -> dict[str, np.ndarray]:
+        """Per camera, :func:`owner_image` of ``boxes[camera_id]``, in one image per camera reused
+        frame to frame (valid until the next call)."""
+        out = {}
+        for cid, img in images.items():
+            buf, previous = self._owner_buffers.get(cid, (None, ()))
+            out[cid] = owner_image(img.shape[:2], boxes[cid], buf, previous)
+            self._owner_buffers[cid] = (out[cid], list(boxes[cid]))
         return out
 
     def _boxes(self, tracks: list[Track], centres: list[np.ndarray], margin: float,
@@ -1022,15 +1033,17 @@ class ParticleTracker:
         if len(fs) < 2:
             self._close = {}
             return
-        boxes = self._boxes([f.track for f in fs], [f.centre for f in fs], 0.0)
-        ov = np.array([_overlaps(b) for b in boxes.values()]).reshape(len(boxes), len(fs), len(fs))
-        both = ~np.isnan(ov)                                  # (camera, i, j): the camera sees both
-        apart = both & ~(ov >= cfg.merge_overlap)
-        close = both.any(axis=0) & ~apart.any(axis=0)
         c = np.array([f.centre for f in fs], dtype=float)
+        xy, widths, heights = c, [f.track.width for f in fs], [f.track.height for f in fs]
+        close = boxes_on_one_object(np.stack([cl.box_array(xy, widths, heights, 0.0) for cl in self._cams.values()]),
+                                    float(cfg.merge_overlap))
+        pairs = np.nonzero(close)
+        if not len(pairs[0]):
+            self._close = {}
+            return
         far = cdist(c, c) > self._merge_distances(c)
         close_now, frames = set(), {}
-        for i, j in zip(*np.nonzero(np.triu(close, 1))):
+        for i, j in zip(*pairs):
             a, b = fs[i].track.id, fs[j].track.id
             close_now.add((min(a, b), max(a, b)))
             # One behind the other on the floor: two people passing, unless it lasts.

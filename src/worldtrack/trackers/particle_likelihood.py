@@ -229,9 +229,18 @@ def floor_pixels(camera: Camera, walkable, occlusion_floor_distance: np.ndarray 
     return out.reshape(camera.height, camera.width)
 
 
-def owner_image(shape: tuple[int, int], boxes) -> np.ndarray:
-    """(H, W) uint8: how many of ``boxes`` — ``(u0, u1, v0, v1)`` pixel ranges, or None — cover each pixel."""
-    out = np.zeros(shape, dtype=np.uint8)
+def owner_image(shape: tuple[int, int], boxes, out: np.ndarray | None = None, previous=()) -> np.ndarray:
+    """(H, W) uint8: how many of ``boxes`` — ``(u0, u1, v0, v1)`` pixel ranges, or None — cover each pixel.
+
+    ``out``: an earlier result to reuse, whose ``previous`` boxes are cleared (not the whole frame:
+    a fresh 640×480 image costs more in page faults than its boxes cost to fill)."""
+    if out is None or out.shape != tuple(shape):
+        out = np.zeros(shape, dtype=np.uint8)
+    else:
+        for b in previous:
+            if b is not None:
+                u0, u1, v0, v1 = b
+                out[v0:v1, u0:u1] = 0
     for b in boxes:
         if b is not None:
             u0, u1, v0, v1 = b
@@ -877,6 +886,49 @@ def boxes_apart(boxes: np.ndarray) -> np.ndarray:
                     break
         out[i] = alone
     return out
+
+
+@njit(cache=True)
+def boxes_on_one_object(boxes: np.ndarray, min_overlap: float) -> np.ndarray:
+    """(K, K) bool, True above the diagonal for pairs of objects whose boxes ``boxes`` (C, K, 4) int
+    ``(u0, u1, v0, v1)`` (rows with ``u0 < 0``: none) in C cameras overlap by at least ``min_overlap``
+    (intersection over the smaller box) in every camera that sees both, and some camera sees both —
+    the arithmetic of :func:`boxes_on_one_object_reference`."""
+    c, k = boxes.shape[0], boxes.shape[1]
+    out = np.zeros((k, k), dtype=np.bool_)
+    for i in range(k):
+        for j in range(i + 1, k):
+            both = False
+            apart = False
+            for cam in range(c):
+                a, b = boxes[cam, i], boxes[cam, j]
+                if a[0] < 0 or b[0] < 0:
+                    continue
+                both = True
+                w = min(a[1], b[1]) - max(a[0], b[0])
+                h = min(a[3], b[3]) - max(a[2], b[2])
+                inter = float(w * h) if w > 0 and h > 0 else 0.0
+                if not inter / float(min((a[1] - a[0]) * (a[3] - a[2]), (b[1] - b[0]) * (b[3] - b[2]))) >= min_overlap:
+                    apart = True
+            out[i, j] = both and not apart
+    return out
+
+
+def boxes_on_one_object_reference(boxes: Sequence[Sequence], min_overlap: float) -> np.ndarray:
+    """:func:`boxes_on_one_object` of box lists (per camera, K boxes or None) by the tracker's former
+    NumPy code (intersection over the smaller box of every pair, NaN where either is missing)."""
+    ov = []
+    for cam in boxes:
+        b = np.array([(np.nan,) * 4 if x is None else x for x in cam], dtype=float).reshape(-1, 4)
+        w = np.minimum(b[:, None, 1], b[None, :, 1]) - np.maximum(b[:, None, 0], b[None, :, 0])
+        h = np.minimum(b[:, None, 3], b[None, :, 3]) - np.maximum(b[:, None, 2], b[None, :, 2])
+        area = (b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2])
+        with np.errstate(invalid="ignore"):
+            ov.append(np.where((w > 0) & (h > 0), w * h, 0.0) / np.minimum(area[:, None], area[None, :]))
+    ov = np.array(ov)
+    both = ~np.isnan(ov)
+    apart = both & ~(ov >= min_overlap)
+    return np.triu(both.any(axis=0) & ~apart.any(axis=0), 1)
 
 
 @njit(cache=True)
