@@ -288,3 +288,36 @@ def test_owner_image_reused_equals_fresh():
         previous = boxes
         np.testing.assert_array_equal(buf, fresh)
     assert buf.max() >= 1
+
+
+def test_split_sides_kernel_agrees_with_reference():
+    """The end of bimodal_split (valley, sides, each side's mass) in one kernel, against NumPy."""
+    from worldtrack.trackers.particle_sampling import _sides, _sides_reference
+
+    rng = np.random.default_rng(14)
+    found = 0
+    for trial in range(200):
+        n = int(rng.integers(8, 600))
+        s = rng.normal(0, 0.1, n)
+        if trial % 2:
+            s[: int(rng.integers(1, n))] += rng.uniform(0.2, 0.9)
+        side = np.empty(n, dtype=bool)
+        for min_mass in (0.2, 0.45):
+            ok = _sides(s, s.min(), 0.04, 0.05, 0.35, 0.5, min_mass, side)
+            ref = _sides_reference(s, s.min(), 0.04, 0.05, 0.35, 0.5, min_mass)
+            assert ok == (ref is not None)
+            if ok:
+                np.testing.assert_array_equal(side, ref)
+                found += 1
+    assert found > 30
+
+
+def test_kernels_read_the_floor_columns_of_xyz():
+    """near_surface and raster_contains read (N, 3) positions as their first two columns."""
+    scene = make_scene()
+    cl = CameraLikelihood(scene.cameras["cam"])
+    rng = np.random.default_rng(15)
+    xyz = np.column_stack([rng.uniform(-4, 4, 500), rng.uniform(-1, 8, 500), rng.uniform(0, 2, 500)])
+    np.testing.assert_array_equal(cl.near_surface(xyz, 0.14), cl.near_surface(xyz[:, :2].copy(), 0.14))
+    raster = scene.walkable.raster(0.01)
+    np.testing.assert_array_equal(raster_contains(raster, xyz), raster.contains(xyz[:, :2]))

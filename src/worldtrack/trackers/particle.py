@@ -524,7 +524,7 @@ class ParticleTracker:
                 owner = owners.get(cid) if owners is not None else None
                 box = boxes.get(cid) if boxes is not None else [None] * len(me)
                 if cfg.likelihood == "column":
-                    surface = self._near_surface(xyz[:, :2], cl)
+                    surface = self._near_surface(xyz, cl)
                     counts, ratio, top, seen, hid = cl.column(
                         img, surface, self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
                         self._n_below, self._n_above, owner, box, h, self._top_sigma,
@@ -549,7 +549,7 @@ class ParticleTracker:
                     ok = values > 0
                 # logpi += lv (+ the colour term) where seen; likely &= ok | ~seen; n_seen += seen
                 add_camera(seen, lv, penalty, float(cfg.appearance_weight), col_h, ok, logpi, likely, n_seen, col)
-        valid = (n_seen > 0) & raster_contains(self._walkable_raster, xyz[:, :2])
+        valid = (n_seen > 0) & raster_contains(self._walkable_raster, xyz)
         if cfg.likelihood == "point":
             valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
         logpi = np.where(valid, logpi, -np.inf)
@@ -585,10 +585,11 @@ class ParticleTracker:
                 model.learn(b, cfg.appearance_rate)
 
     def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
-        """Where a camera's column stands for particles at ``xy`` (N, 2): ``surface_offset`` m nearer to it."""
+        """Where a camera's column stands for particles at ``xy`` (N, 2) (or the floor positions of
+        ``xyz`` (N, 3)): ``surface_offset`` m nearer to it."""
         r = self.config.surface_offset
         if r <= 0:
-            return xy
+            return xy[:, :2]
         return cl.near_surface(xy, r)
 
     # ------------------------------------------------------------------ prediction

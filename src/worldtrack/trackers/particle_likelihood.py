@@ -1143,10 +1143,13 @@ class CameraLikelihood:
         return out
 
     def near_surface(self, xy: np.ndarray, offset: float) -> np.ndarray:
-        """(N, 2) floor points ``offset`` m nearer to the camera than ``xy`` (N, 2), metres, along its
-        lines of sight: ``xy − offset·along`` (:func:`toward_camera`)."""
-        xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
-        out = np.empty_like(xy)
+        """(N, 2) floor points ``offset`` m nearer to the camera than ``xy`` (N, 2) (or the first two
+        columns of (N, ≥ 2)), metres, along its lines of sight: ``xy − offset·along``
+        (:func:`toward_camera`)."""
+        xy = np.asarray(xy, dtype=np.float64)
+        if xy.ndim != 2 or xy.shape[1] < 2:
+            xy = xy.reshape(-1, 2)
+        out = np.empty((len(xy), 2))
         toward_camera(xy, float(offset), self.centre, self.floor_direction, out)
         return out
 

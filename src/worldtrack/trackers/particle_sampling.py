@@ -251,8 +251,11 @@ class FloorRegion:
 
 def raster_contains(raster: WalkableRaster, xy: np.ndarray) -> np.ndarray:
     """:meth:`WalkableRaster.contains <worldtrack.scene.floor.WalkableRaster.contains>` of ``xy`` (N, 2),
-    metres, by a kernel (one pass instead of a dozen NumPy calls; tested equal): (N,) bool."""
-    xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+    metres (or the first two columns of (N, ≥ 2)), by a kernel (one pass instead of a dozen NumPy
+    calls; tested equal): (N,) bool."""
+    xy = np.asarray(xy, dtype=np.float64)
+    if xy.ndim != 2 or xy.shape[1] < 2:
+        xy = xy.reshape(-1, 2)
     out = np.empty(len(xy), dtype=np.bool_)
     _raster_contains(xy, float(raster.origin[0]), float(raster.origin[1]), float(raster.resolution),
                      np.ascontiguousarray(raster.inside, dtype=np.bool_), out)
@@ -308,15 +311,25 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
                                                                    else np.array([0.0, 1.0]))
     axis /= np.linalg.norm(axis)
     s = c @ axis
-    lo = s.min()
+    side = np.empty(len(s), dtype=np.bool_)
+    return side if _sides(s, s.min(), bin_m, smooth_m, min_separation, max_dip, min_mass, side) else None
+
+
+@njit(cache=True)
+def _sides(s, lo, bin_m, smooth_m, min_separation, max_dip, min_mass, side):
+    """The end of :func:`bimodal_split` in one call: ``side = s > lo + (valley + 0.5)·bin_m`` (in
+    place) and True if :func:`_valley` finds a valley and each side holds at least ``min_mass`` of the
+    particles (``side.mean()``, as a count over N)."""
     valley = _valley(s, lo, bin_m, smooth_m, min_separation, max_dip)
     if valley < 0:
-        return None
-    side = s > lo + (valley + 0.5) * bin_m
-    m = side.mean()
-    if min(m, 1 - m) < min_mass:
-        return None
-    return side
+        return False
+    cut = lo + (valley + 0.5) * bin_m
+    n = 0
+    for i in range(s.shape[0]):
+        side[i] = s[i] > cut
+        n += side[i]
+    m = n / s.shape[0]
+    return not min(m, 1 - m) < min_mass
 
 
 @njit(cache=True)
@@ -396,6 +409,19 @@ def _valley_reference(s: np.ndarray, lo: float, bin_m: float, smooth_m: float, m
     return valley
 
 
+def _sides_reference(s: np.ndarray, lo: float, bin_m: float, smooth_m: float, min_separation: float,
+                     max_dip: float, min_mass: float) -> np.ndarray | None:
+    """:func:`_sides` in NumPy (:func:`bimodal_split`'s former end): the sides, or None."""
+    valley = _valley_reference(s, lo, bin_m, smooth_m, min_separation, max_dip)
+    if valley < 0:
+        return None
+    side = s > lo + (valley + 0.5) * bin_m
+    m = side.mean()
+    if min(m, 1 - m) < min_mass:
+        return None
+    return side
+
+
 def splittable(xy: np.ndarray, min_separation: float, min_mass: float, principal: bool = False):
     """Which of F clouds :func:`bimodal_split` could split at all: the cheap test it starts with
     (at least 8 particles, wide enough along the principal axis), for many clouds at once.
@@ -435,16 +461,20 @@ def predict_state(old: np.ndarray, a: np.ndarray, noise: np.ndarray, v: np.ndarr
     standard normal draws, ``scale`` (F,) m/s); ``a`` (F, N, 3) standard normal draws, ``noise``
     (3,) metres (σ·√dt per axis)."""
     n0, n1, n2 = noise[0], noise[1], noise[2]
+    # Below 0.99·max_speed by the squares (rounding errors ~1e-16) the speed is below max_speed:
+    # the exact hypot, which decides, is needed only above that.
+    slow = (0.99 * max_speed) ** 2 if max_speed > 0.0 else -1.0
     for f in range(v.shape[0]):
         sc = scale[f]
         for i in range(v.shape[1]):
             v0 = v[f, i, 0] + walk[f, i, 0] * sc
             v1 = v[f, i, 1] + walk[f, i, 1] * sc
-            s = math.hypot(v0, v1)
-            if s > max_speed:
-                r = max_speed / s
-                v0 *= r
-                v1 *= r
+            if not v0 * v0 + v1 * v1 < slow:
+                s = math.hypot(v0, v1)
+                if s > max_speed:
+                    r = max_speed / s
+                    v0 *= r
+                    v1 *= r
             v[f, i, 0] = v0
             v[f, i, 1] = v1
             v[f, i, 2] = 0.0
