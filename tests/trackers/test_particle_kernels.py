@@ -321,3 +321,30 @@ def test_kernels_read_the_floor_columns_of_xyz():
     np.testing.assert_array_equal(cl.near_surface(xyz, 0.14), cl.near_surface(xyz[:, :2].copy(), 0.14))
     raster = scene.walkable.raster(0.01)
     np.testing.assert_array_equal(raster_contains(raster, xyz), raster.contains(xyz[:, :2]))
+
+
+def test_gather_particles_and_principal_agree_with_numpy():
+    """The resampled particles gathered in one kernel (heights drawn below the column tops) equal
+    take_rows and the NumPy product; the covariance tail of _principal equals its NumPy code."""
+    from worldtrack.trackers.particle_sampling import _principal, _principal_reference, gather_particles, take_rows
+
+    rng = np.random.default_rng(16)
+    f, m, n = 5, 300, 280
+    parts = [rng.normal(size=(f, m, 3)), rng.normal(size=(f, m, 3)), rng.normal(size=(f, m)),
+             rng.normal(size=(f, m)), rng.random((f, m)) < 0.5, rng.uniform(0, 2, (f, m))]
+    idx = np.sort(rng.integers(0, m, (f, n)), axis=1)
+    z = rng.random((f, n))
+    for draws in (None, z):
+        got = gather_particles(idx, *parts, z=draws)
+        want = [take_rows(a, idx) for a in parts]
+        if draws is not None:
+            want[0][..., 2] = draws * want[5]
+        for a, b in zip(got, want):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+    xy = rng.normal(0, 0.3, (7, 500, 3))[:, :, :2]
+    c, stats = _principal(xy)
+    c_ref, stats_ref = _principal_reference(xy)
+    np.testing.assert_array_equal(c, c_ref)
+    for a, b in zip(stats, stats_ref):
+        np.testing.assert_array_equal(a, b)

@@ -96,9 +96,9 @@ from worldtrack.trackers.particle_appearance import ColourModel, column_bins, co
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart,
                                                      boxes_on_one_object, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, jitter_reflect,
-                                                   order_statistic, polygon_distance, predict_state, raster_contains,
-                                                   resampler, splittable, take_rows)
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, gather_particles,
+                                                   jitter_reflect, order_statistic, polygon_distance, predict_state,
+                                                   raster_contains, resampler, splittable, take_rows)
 
 Box = tuple[int, int, int, int]
 
@@ -722,8 +722,13 @@ class ParticleTracker:
         sees (the column does not depend on z), so that the particles fill the object (the box's z
         extent)."""
         idx = self._resample(weights, n, self.rng)
+        column = self.config.likelihood == "column"
+        if tuple(parts) == PARTICLE_FIELDS and parts["likely"].dtype == np.bool_:
+            # All six fields (as tracking filters hold them): one kernel, heights drawn in it.
+            arrays = gather_particles(idx, *parts.values(), z=self.rng.random(idx.shape) if column else None)
+            return dict(zip(PARTICLE_FIELDS, arrays))
         out = {name: take_rows(a, idx) for name, a in parts.items()}
-        if self.config.likelihood == "column":
+        if column:
             out["xyz"][..., 2] = self.rng.random(idx.shape) * out["col_h"]
         return out
 

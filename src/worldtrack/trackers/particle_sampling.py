@@ -126,6 +126,39 @@ def _merge_sorted(c, u, out):
             out[f, k] = min(j, m - 1)
 
 
+def gather_particles(idx: np.ndarray, xyz: np.ndarray, v: np.ndarray, h: np.ndarray, logpi: np.ndarray,
+                     likely: np.ndarray, col_h: np.ndarray, z: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """:func:`take_rows` of the six per-particle arrays of F filters (``xyz, v`` (F, M, 3), the others
+    (F, M)) in one kernel; with ``z`` (F, n) uniform draws, each picked particle's height is then
+    ``z · col_h`` (the column likelihood's draw below the top its column sees)."""
+    f, n = idx.shape
+    out = (np.empty((f, n, 3)), np.empty((f, n, 3)), np.empty((f, n)), np.empty((f, n)),
+           np.empty((f, n), dtype=np.bool_), np.empty((f, n)))
+    _gather_particles(np.ascontiguousarray(idx, dtype=np.int64), xyz, v, h, logpi, likely, col_h,
+                      _NO_DRAWS if z is None else z, *out)
+    return out
+
+
+_NO_DRAWS = np.zeros((0, 0))
+
+
+@njit(cache=True)
+def _gather_particles(idx, xyz, v, h, logpi, likely, col_h, z, oxyz, ov, oh, ologpi, olikely, ocol_h):
+    draw = z.shape[0] > 0
+    for f in range(idx.shape[0]):
+        for j in range(idx.shape[1]):
+            k = idx[f, j]
+            for c in range(3):
+                oxyz[f, j, c] = xyz[f, k, c]
+                ov[f, j, c] = v[f, k, c]
+            oh[f, j] = h[f, k]
+            ologpi[f, j] = logpi[f, k]
+            olikely[f, j] = likely[f, k]
+            ocol_h[f, j] = col_h[f, k]
+            if draw:
+                oxyz[f, j, 2] = z[f, j] * ocol_h[f, j]
+
+
 def take_rows(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """(F, n, ...) ``a[f, idx[f, j]]``: each of F filters' particles ``a`` (F, M, ...) picked by its own
     indices ``idx`` (F, n) — ``np.take_along_axis`` in one kernel (tested equal)."""
@@ -546,6 +579,27 @@ def cloud_mean(x: np.ndarray) -> np.ndarray:
 def _principal(xy: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
     """The clouds ``xy`` (F, N, 2) centred, and per cloud the covariance ``sxx, syy, sxy`` and its
     largest eigenvalue (the variance along the principal axis), each (F,), m²."""
+    c = xy - cloud_mean(xy)[:, None, :]
+    out = np.empty((4, len(xy)))
+    _covariance_axes(c.transpose(0, 2, 1) @ c, xy.shape[1], out)
+    return c, (out[0], out[1], out[2], out[3])
+
+
+@njit(cache=True)
+def _covariance_axes(products, n, out):
+    """``out`` (4, F), in place: ``sxx, syy, sxy`` of the (F, 2, 2) sums of products over ``n`` and the
+    largest eigenvalue ``(sxx + syy)/2 + hypot((sxx − syy)/2, sxy)`` — :func:`_principal_reference`'s
+    arithmetic."""
+    for f in range(products.shape[0]):
+        sxx = products[f, 0, 0] / n
+        syy = products[f, 1, 1] / n
+        sxy = products[f, 0, 1] / n
+        out[0, f], out[1, f], out[2, f] = sxx, syy, sxy
+        out[3, f] = 0.5 * (sxx + syy) + math.hypot(0.5 * (sxx - syy), sxy)
+
+
+def _principal_reference(xy: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """:func:`_principal` in NumPy (its former code)."""
     c = xy - cloud_mean(xy)[:, None, :]
     cov = c.transpose(0, 2, 1) @ c / xy.shape[1]
     sxx, syy, sxy = cov[:, 0, 0], cov[:, 1, 1], cov[:, 0, 1]
