@@ -348,3 +348,49 @@ def test_gather_particles_and_principal_agree_with_numpy():
     np.testing.assert_array_equal(c, c_ref)
     for a, b in zip(stats, stats_ref):
         np.testing.assert_array_equal(a, b)
+
+
+def test_fused_resampling_agrees_with_weights_resampler_and_gather():
+    """The tracking filters' update: exponents, NumPy's exp, resampling and gathering in two kernels,
+    against weights_reference, systematic/stratified_resample and gather_particles with the same draws
+    (rows of zero likelihood, one -inf everywhere, resampled uniformly)."""
+    from worldtrack.trackers.particle_sampling import (gather_particles, resample_draws, resample_particles,
+                                                       stratified_resample, systematic_resample, weight_exponents,
+                                                       weights_reference)
+
+    rng = np.random.default_rng(17)
+    f, m, n = 4, 300, 300
+    logpi = rng.normal(0, 20, (f, m))
+    logpi[logpi < -25] = -np.inf
+    logpi[2] = -np.inf                                   # nothing likely: uniform weights
+    parts = [rng.normal(size=(f, m, 3)), rng.normal(size=(f, m, 3)), rng.normal(size=(f, m)), logpi,
+             rng.random((f, m)) < 0.5, rng.uniform(0, 2, (f, m))]
+    for name, resample in (("systematic", systematic_resample), ("stratified", stratified_resample)):
+        arg, finite = weight_exponents(logpi, 0.2)
+        got = resample_particles(np.exp(arg), finite, resample_draws(name, f, n, np.random.default_rng(3)), n, *parts,
+                                 z=np.random.default_rng(4).random((f, n)))
+        idx = resample(weights_reference(logpi, 0.2), n, np.random.default_rng(3))
+        want = gather_particles(idx, *parts, z=np.random.default_rng(4).random((f, n)))
+        for a, b in zip(got, want):
+            np.testing.assert_array_equal(a, b)
+        assert not finite[2] and finite[[0, 1, 3]].all()
+        assert len(np.unique(idx[2])) > 250 and len(np.unique(idx[0])) < 100   # uniform row vs peaked rows
+
+
+def test_region_sizes_and_row_means_agree_with_numpy():
+    from worldtrack.trackers.particle import _mean_rows
+    from worldtrack.trackers.particle_sampling import region_sizes, region_sizes_reference
+
+    rng = np.random.default_rng(18)
+    sd = rng.uniform(0, 0.5, (9, 3))
+    widths = rng.uniform(0.3, 0.6, 9)
+    for w in (widths, np.zeros(0)):
+        a, b = sd.copy(), sd.copy()
+        sa, sb = np.empty(9), np.empty(9)
+        region_sizes(a, w, sa)
+        region_sizes_reference(b, w, sb)
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(sa, sb)
+        assert (a[:, :2] > sd[:, :2]).all() if len(w) else np.array_equal(a, sd)
+    h = rng.normal(1.7, 0.1, (6, 500))
+    np.testing.assert_array_equal(_mean_rows(h), h.mean(axis=1))

@@ -98,7 +98,9 @@ from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, ad
                                                      occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, gather_particles,
                                                    jitter_reflect, order_statistic, polygon_distance, predict_state,
-                                                   raster_contains, resampler, splittable, take_rows)
+                                                   raster_contains, region_sizes, resample_draws, resample_particles,
+                                                   resampler, splittable, take_rows, weight_exponents,
+                                                   weights_reference)
 
 Box = tuple[int, int, int, int]
 
@@ -710,9 +712,7 @@ class ParticleTracker:
         per filter): ``g ∝ π^κ``; uniform in a row whose every π is 0."""
         if logpi.shape[-1] == 0:
             return np.ones(logpi.shape)
-        m = logpi.max(axis=-1, keepdims=True)
-        finite = np.isfinite(m)
-        return np.where(finite, np.exp(self.config.likelihood_power * (logpi - np.where(finite, m, 0.0))), 1.0)
+        return weights_reference(logpi, self.config.likelihood_power)
 
     def _resampled(self, parts: dict[str, np.ndarray], weights: np.ndarray, n: int) -> dict[str, np.ndarray]:
         """The particles of F filters resampled to ``n`` each in proportion to ``weights`` (F, M).
@@ -820,8 +820,17 @@ class ParticleTracker:
         cfg = self.config
         parts = {name: self._stacked(fs, name) for name in PARTICLE_FIELDS if getattr(fs[0], name) is not None}
         # The share of likely particles (a count over N: the mean of the booleans, exactly).
-        shares = (np.count_nonzero(parts["likely"], axis=1) / parts["likely"].shape[1]).tolist()
-        resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
+        shares = (parts["likely"].sum(axis=1) / parts["likely"].shape[1]).tolist()
+        if tuple(parts) == PARTICLE_FIELDS and parts["logpi"].shape[1]:
+            # Weights (eq. 8) and resampling of all the filters' particles in two kernel calls
+            # round NumPy's exp, with the draws of _resampled in the same order.
+            arg, finite = weight_exponents(parts["logpi"], cfg.likelihood_power)
+            n = cfg.particles
+            r = resample_draws(cfg.resampling, len(fs), n, self.rng)
+            z = self.rng.random((len(fs), n)) if cfg.likelihood == "column" else None
+            resampled = dict(zip(PARTICLE_FIELDS, resample_particles(np.exp(arg), finite, r, n, *parts.values(), z=z)))
+        else:
+            resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
         kept, lost = [], []
         for f, share in zip(fs, shares):
             if share <= cfg.beta:
@@ -871,17 +880,18 @@ class ParticleTracker:
             V = cloud_mean(self._stacked(fs, "v")[..., :2])
         else:
             V = np.zeros((len(fs), 2))
-        sigma = np.sqrt(0.5 * (sd[:, 0] ** 2 + sd[:, 1] ** 2))
         heights = None
         if cfg.likelihood == "column" and self._top_sigma > 0:
-            heights = self._stacked(fs, "h").mean(axis=1)
+            heights = _mean_rows(self._stacked(fs, "h"))
         elif cfg.likelihood == "column" and all(f.col_h is not None for f in fs):
-            heights = self._stacked(fs, "col_h").mean(axis=1)
-        if cfg.likelihood == "column" and cfg.weighting == "ratio":
-            # The particles are the object's axis on the floor; the object fills a disc of radius
-            # width/2 round it (per-axis variance r²/4), as its z fills the height below the top.
-            widths = np.array([f.track.width for f in fs], dtype=float)
-            sd[:, :2] = np.hypot(sd[:, :2], 0.25 * widths[:, None])
+            heights = _mean_rows(self._stacked(fs, "col_h"))
+        # sigma = sqrt((sx² + sy²) / 2); with the ratio weighting the particles are the object's axis
+        # on the floor and the object fills a disc of radius width/2 round it (per-axis variance
+        # r²/4), as its z fills the height below the top: then sx, sy = hypot(sx, width/4).
+        widths = (np.array([f.track.width for f in fs], dtype=float)
+                  if cfg.likelihood == "column" and cfg.weighting == "ratio" else _NO_WIDTHS)
+        sigma = np.empty(len(fs))
+        region_sizes(sd, widths, sigma)
         floor_centre = centre[:, :2].copy()
         rows = zip(fs, floor_centre, V, centre.tolist(), V.tolist(), sd.tolist(), sigma.tolist(),
                    heights.tolist() if heights is not None else [None] * len(fs))
@@ -1157,6 +1167,14 @@ def _quantile_rank(n: int, q: float) -> int:
 def _stack(fs: list[_Filter], name: str) -> np.ndarray:
     """(F, N, ...) the per-particle array ``name`` of filters holding N particles each."""
     return np.stack([getattr(f, name) for f in fs])
+
+
+def _mean_rows(a: np.ndarray) -> np.ndarray:
+    """(F,) the mean of each row of ``a`` (F, N): ``a.mean(axis=1)``, which is this sum over N."""
+    return np.add.reduce(a, axis=1) / a.shape[1]
+
+
+_NO_WIDTHS = np.zeros(0)
 
 
 def _mean_sd(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -47,13 +47,19 @@ def systematic_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -
     (n,) or (F, n) int64, sorted — indices into each row
     """
     rows = _rows(weights)
-    return _draw_rows(rows, rng.random((len(rows), 1)), n).reshape(np.shape(weights)[:-1] + (n,))
+    return _draw_rows(rows, resample_draws("systematic", len(rows), n, rng), n).reshape(np.shape(weights)[:-1] + (n,))
 
 
 def stratified_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
     """As :func:`systematic_resample` with an independent uniform number in each stratum ``[j/n, (j+1)/n)``."""
     rows = _rows(weights)
-    return _draw_rows(rows, rng.random((len(rows), n)), n).reshape(np.shape(weights)[:-1] + (n,))
+    return _draw_rows(rows, resample_draws("stratified", len(rows), n, rng), n).reshape(np.shape(weights)[:-1] + (n,))
+
+
+def resample_draws(name: str, f: int, n: int, rng: np.random.Generator) -> np.ndarray:
+    """The uniform numbers resampler ``name`` draws for F rows of ``n`` points: (F, 1) for
+    ``systematic`` (one per row), (F, n) for ``stratified`` (one per stratum)."""
+    return rng.random((f, 1) if name == "systematic" else (f, n))
 
 
 def resample_reference(weights: np.ndarray, r: np.ndarray, n: int) -> np.ndarray:
@@ -157,6 +163,68 @@ def _gather_particles(idx, xyz, v, h, logpi, likely, col_h, z, oxyz, ov, oh, olo
             ocol_h[f, j] = col_h[f, k]
             if draw:
                 oxyz[f, j, 2] = z[f, j] * ocol_h[f, j]
+
+
+def weight_exponents(logpi: np.ndarray, power: float) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 8's weights before their exponential, per row of ``logpi`` (F, M): ``power·(logpi − max)``
+    (F, M), and (F,) whether the row's max is finite (rows without weigh 1 throughout) — the
+    arithmetic of :func:`weights_reference` up to its ``np.exp`` (which stays NumPy's)."""
+    logpi = np.ascontiguousarray(logpi, dtype=np.float64)
+    arg = np.empty(logpi.shape)
+    finite = np.empty(len(logpi), dtype=np.bool_)
+    _weight_exponents(logpi, float(power), arg, finite)
+    return arg, finite
+
+
+@njit(cache=True)
+def _weight_exponents(logpi, power, arg, finite):
+    for f in range(logpi.shape[0]):
+        m = logpi[f, 0]
+        for x in logpi[f]:
+            if x != x:                          # NaN: np.max's result
+                m = x
+                break
+            if x > m:
+                m = x
+        fin = math.isfinite(m)
+        finite[f] = fin
+        mm = m if fin else 0.0
+        for j in range(logpi.shape[1]):
+            arg[f, j] = power * (logpi[f, j] - mm)
+
+
+def weights_reference(logpi: np.ndarray, power: float) -> np.ndarray:
+    """Eq. 8 up to its sum, per row of ``logpi`` (F, M): ``π^κ`` scaled by the row's largest, 1 in rows
+    whose every π is 0 (NumPy; the tracker's ``_weights``)."""
+    m = logpi.max(axis=-1, keepdims=True)
+    finite = np.isfinite(m)
+    return np.where(finite, np.exp(power * (logpi - np.where(finite, m, 0.0))), 1.0)
+
+
+def resample_particles(e: np.ndarray, finite: np.ndarray, r: np.ndarray, n: int, xyz: np.ndarray, v: np.ndarray,
+                       h: np.ndarray, logpi: np.ndarray, likely: np.ndarray, col_h: np.ndarray,
+                       z: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """Resample F filters' particles to ``n`` each in two kernel calls: the weights ``e`` (F, M)
+    (``np.exp`` of :func:`weight_exponents`; 1 throughout the rows not ``finite``), the resampler's
+    uniform numbers ``r`` (:func:`resample_draws`), then :func:`gather_particles` of the picked ones
+    (with ``z``, the heights drawn). The same as :func:`_draw_rows` then :func:`gather_particles`."""
+    f = len(e)
+    idx = np.empty((f, n), dtype=np.int64)
+    out = (np.empty((f, n, 3)), np.empty((f, n, 3)), np.empty((f, n)), np.empty((f, n)),
+           np.empty((f, n), dtype=np.bool_), np.empty((f, n)))
+    _resample_particles(np.ascontiguousarray(e), finite, np.ascontiguousarray(r), idx)
+    _gather_particles(idx, xyz, v, h, logpi, likely, col_h, _NO_DRAWS if z is None else z, *out)
+    return out
+
+
+@njit(cache=True)
+def _resample_particles(e, finite, r, out):
+    """Per row: the weights (``e``, or 1 where not ``finite``), then :func:`_cumulative_lookup`."""
+    w = np.empty(e.shape)
+    for f in range(e.shape[0]):
+        for j in range(e.shape[1]):
+            w[f, j] = e[f, j] if finite[f] else 1.0
+    _cumulative_lookup(w, r, out)
 
 
 def take_rows(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
@@ -611,6 +679,26 @@ def _wide_enough(lam, min_separation: float, min_mass: float):
     along the axis joining them: a cloud of principal variance ``lam`` narrower than that cannot be
     split."""
     return np.sqrt(np.maximum(lam, 0.0)) >= min_separation * np.sqrt(min_mass * (1 - min_mass))
+
+
+@njit(cache=True)
+def region_sizes(sd: np.ndarray, widths: np.ndarray, sigma: np.ndarray) -> None:
+    """The object regions' sizes from the particles' standard deviations ``sd`` (F, 3), metres, in
+    place: ``sigma`` (F,) ``= sqrt((sx² + sy²) / 2)``, then, with ``widths`` (F,) (not empty),
+    ``sx, sy = hypot(sx, width/4), hypot(sy, width/4)`` — :func:`region_sizes_reference`'s arithmetic."""
+    for f in range(sd.shape[0]):
+        sigma[f] = math.sqrt(0.5 * (sd[f, 0] * sd[f, 0] + sd[f, 1] * sd[f, 1]))
+        if widths.shape[0]:
+            q = 0.25 * widths[f]
+            sd[f, 0] = math.hypot(sd[f, 0], q)
+            sd[f, 1] = math.hypot(sd[f, 1], q)
+
+
+def region_sizes_reference(sd: np.ndarray, widths: np.ndarray, sigma: np.ndarray) -> None:
+    """:func:`region_sizes` in NumPy (the tracker's former code), in place."""
+    sigma[:] = np.sqrt(0.5 * (sd[:, 0] ** 2 + sd[:, 1] ** 2))
+    if len(widths):
+        sd[:, :2] = np.hypot(sd[:, :2], 0.25 * np.asarray(widths)[:, None])
 
 
 def polygon_distance(xy: ArrayLike, ring: ArrayLike) -> np.ndarray:
