@@ -394,3 +394,51 @@ def test_region_sizes_and_row_means_agree_with_numpy():
         assert (a[:, :2] > sd[:, :2]).all() if len(w) else np.array_equal(a, sd)
     h = rng.normal(1.7, 0.1, (6, 500))
     np.testing.assert_array_equal(_mean_rows(h), h.mean(axis=1))
+
+
+@pytest.mark.parametrize("offset", [0.14, 0.0])
+def test_observe_column_equals_the_calls_one_by_one(offset):
+    """One camera's share of the column likelihood in one compiled call (near surface, column kernel,
+    colour penalties, sums) equals near_surface, CameraLikelihood.column, column_penalties and
+    add_camera one after the other; with and without a colour image, and close_sums its NumPy code."""
+    from worldtrack.trackers.particle_appearance import ColourModel, N_BINS, column_penalties, observe_column
+    from worldtrack.trackers.particle_sampling import close_sums, close_sums_reference
+
+    scene = make_scene()
+    cam = scene.cameras["cam"]
+    cl = CameraLikelihood(cam)
+    rng = np.random.default_rng(19)
+    hit = (cv2.GaussianBlur(rng.random((H, W)).astype(np.float32), (0, 0), 4) > 0.5).astype(np.uint8)
+    hit[(hit == 1) & (rng.random((H, W)) < 0.2)] = 2
+    image = rng.integers(0, 256, (H, W, 3)).astype(np.uint8)
+    boxes = [(40, 160, 60, 240), (120, 220, 0, 150), None]
+    n = 3000
+    xyz = np.column_stack([rng.uniform(-3, 3, n), rng.uniform(-0.5, 6.0, n), rng.uniform(0, 2, n)])
+    which = rng.integers(0, 3, n)
+    models = [ColourModel(), None, ColourModel()]
+    models[0].learn(rng.integers(0, N_BINS, 60), 1.0)
+    heights = np.concatenate([[-0.2, -0.1], np.arange(20) * 0.1, [2.0, 2.1]])
+    kw = dict(on=2.77, off=-1.56, k_min=10, radius=0.1, below=-2.77, n_below=2, n_above=2,
+              owner=owner_image((H, W), boxes), box=boxes, tops=rng.uniform(1.4, 2.0, n), top_sigma=0.1,
+              px_scale=[0.0, 0.3, 0.0], occluders=occluder_layers((H, W), boxes, [1.5, 2.5, 3.0]), me=[0, 1, 2],
+              margin=0.3, which=which, outside_unknown=True, k_lo=[0, 4, 0])
+    for colour in (image, None):
+        state = [np.zeros(n), np.ones(n, dtype=bool), np.zeros(n, dtype=np.int32), np.zeros(n)]
+        hid = np.empty(n, dtype=np.int32)
+        observe_column(cl, xyz, offset, cl.column_args(hit, n, heights, **kw), hit, colour, models, 0.7, 8, *state, hid)
+        surface = cl.near_surface(xyz, offset) if offset > 0 else xyz[:, :2]
+        counts, ratio, top, seen, want_hid = cl.column(hit, surface, heights, return_hidden=True, **kw)
+        penalty = column_penalties(cl, colour, hit, surface, models, which) if colour is not None else np.zeros(0)
+        want = [np.zeros(n), np.ones(n, dtype=bool), np.zeros(n, dtype=np.int32), np.zeros(n)]
+        add_camera_reference(seen, ratio, penalty, 0.7, heights[top], counts >= 8, *want)
+        np.testing.assert_array_equal(hid, want_hid)
+        for a, b in zip(state, want):
+            np.testing.assert_array_equal(a, b)
+        assert (penalty < 0).sum() > 100 if colour is not None else True
+        raster = scene.walkable.raster(0.01)
+        got, ref = [a.copy() for a in state], [a.copy() for a in state]
+        close_sums(got[2], xyz, raster, got[0], got[1], got[3])
+        close_sums_reference(ref[2], xyz, raster, ref[0], ref[1], ref[3])
+        for a, b in zip(got, ref):
+            np.testing.assert_array_equal(a, b)
+        assert np.isinf(got[0]).sum() > 100 and got[1].sum() > 100

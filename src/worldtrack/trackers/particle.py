@@ -92,11 +92,11 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
-from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties
+from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties, observe_column
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart,
                                                      boxes_on_one_object, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, cloud_mean, gather_particles,
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean, gather_particles,
                                                    jitter_reflect, order_statistic, polygon_distance, predict_state,
                                                    raster_contains, region_sizes, resample_draws, resample_particles,
                                                    resampler, splittable, take_rows, weight_exponents,
@@ -525,6 +525,21 @@ class ParticleTracker:
                 cl = self._cams[cid]
                 owner = owners.get(cid) if owners is not None else None
                 box = boxes.get(cid) if boxes is not None else [None] * len(me)
+                if cfg.likelihood == "column" and cfg.weighting == "ratio":
+                    # The default: the whole camera's share in one compiled call (observe_column).
+                    hid = np.empty(n, dtype=np.int32)
+                    frame = self._frames.get(cid)
+                    observe_column(cl, xyz, cfg.surface_offset, cl.column_args(
+                        img, n, self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
+                        self._n_below, self._n_above, owner, box, h, self._top_sigma,
+                        self._px_scale[cid] if px_scale is None else px_scale[cid],
+                        occluders.get(cid) if occluders is not None else None, me, cfg.occlusion_margin, which,
+                        cfg.out_of_view == "unknown", k_lo[cid] if k_lo is not None else 0), img, frame,
+                        [c.get(cid) if c else None for c in colours] if frame is not None else (),
+                        cfg.appearance_weight, cfg.likely_count, logpi, likely, n_seen, col, hid)
+                    if hidden is not None:
+                        hidden[cid] = hid
+                    continue
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz, cl)
                     counts, ratio, top, seen, hid = cl.column(
@@ -551,9 +566,12 @@ class ParticleTracker:
                     ok = values > 0
                 # logpi += lv (+ the colour term) where seen; likely &= ok | ~seen; n_seen += seen
                 add_camera(seen, lv, penalty, float(cfg.appearance_weight), col_h, ok, logpi, likely, n_seen, col)
+        if cfg.likelihood == "column":
+            # −inf, not likely off the walkable floor or where no camera sees; col over the cameras that see
+            close_sums(n_seen, xyz, self._walkable_raster, logpi, likely, col)
+            return logpi, likely, col
         valid = (n_seen > 0) & raster_contains(self._walkable_raster, xyz)
-        if cfg.likelihood == "point":
-            valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
+        valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
         logpi = np.where(valid, logpi, -np.inf)
         return logpi, likely & valid, col / np.maximum(n_seen, 1)
 

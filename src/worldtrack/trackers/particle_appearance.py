@@ -27,7 +27,8 @@ import numpy as np
 from numba import njit
 
 from ..geometry.camera import Camera
-from .particle_likelihood import CameraLikelihood, _lens, _pixels, _to_pixel, column_points
+from .particle_likelihood import (CameraLikelihood, _lens, _pixels, _to_pixel, column_counts, column_points,
+                                  toward_camera)
 
 HUE_BINS = 12
 SAT_BINS = 3          # saturated pixels only: saturation ≥ GREY_SATURATION
@@ -161,14 +162,20 @@ def _column_bins(xy, heights, R, t, K, dist, has_dist, hit, image, out):
                 out[i, k] = -1
 
 
+def penalty_tables(models: Sequence["ColourModel | None"]) -> tuple[np.ndarray, np.ndarray]:
+    """(F, N_BINS) each model's :meth:`ColourModel.penalty_table` (0 for None) and (F,) bool which
+    models have learnt something."""
+    tables = np.array([m.penalty_table() if m is not None else np.zeros(N_BINS) for m in models]).reshape(-1, N_BINS)
+    return tables, np.array([m is not None and m.hist is not None for m in models], dtype=np.bool_)
+
+
 def column_penalties(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
                      models: Sequence["ColourModel | None"], which: np.ndarray,
                      heights: np.ndarray = COLOUR_HEIGHTS) -> np.ndarray:
     """:func:`colour_log_ratio` of the :func:`column_bins` of columns at ``xy`` (N, 2), metres, in one
     kernel: (N,) float, ≤ 0 — 0 for the particles of models (``which`` (N,) int, 0 … F − 1 into
     ``models``) that are None or have learnt nothing. Tested equal to the two calls."""
-    tables = np.array([m.penalty_table() if m is not None else np.zeros(N_BINS) for m in models]).reshape(-1, N_BINS)
-    learnt = np.array([m is not None and m.hist is not None for m in models], dtype=np.bool_)
+    tables, learnt = penalty_tables(models)
     xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
     out = np.zeros(len(xy))
     if learnt.any():
@@ -194,6 +201,66 @@ def _column_penalties(xy, heights, R, t, K, dist, has_dist, hit, image, tables, 
             if iu >= 0 and hit[iv, iu] == 1:
                 s += tables[f, pixel_bin(image[iv, iu, 0], image[iv, iu, 1], image[iv, iu, 2])]
         out[i] = s
+
+
+def observe_column(cl: CameraLikelihood, xy: np.ndarray, offset: float, column_args: tuple, hit: np.ndarray,
+                   image: np.ndarray | None, models: Sequence["ColourModel | None"], weight: float, likely_count: int,
+                   logpi: np.ndarray, likely: np.ndarray, n_seen: np.ndarray, col: np.ndarray,
+                   hidden: np.ndarray) -> None:
+    """One camera's share of the tracker's column likelihood (``weighting="ratio"``) in one compiled
+    call, added in place (as :func:`~worldtrack.trackers.particle_likelihood.add_camera` adds it):
+    the columns ``offset`` m nearer to the camera than the particles ``xy`` (N, ≥ 2)
+    (:func:`~worldtrack.trackers.particle_likelihood.toward_camera`), their
+    :func:`~worldtrack.trackers.particle_likelihood.column_counts` (``column_args`` from
+    :meth:`CameraLikelihood.column_args`; its best ratio and top), with ``image`` the colour term
+    ``weight ·`` :func:`column_penalties` under ``models`` (per filter), and ``hidden`` (N,) out.
+    The same values as those calls one by one (tested)."""
+    n = len(xy)
+    if image is None:
+        tables, learnt, image = _NO_TABLES, np.zeros(0, dtype=np.bool_), _NO_IMAGE
+    else:
+        tables, learnt = penalty_tables(models)
+    _observe_column(xy, float(offset), cl.centre, cl.floor_direction, *column_args, hit,
+                    np.ascontiguousarray(image, dtype=np.uint8), COLOUR_HEIGHTS, tables, learnt, float(weight),
+                    int(likely_count), logpi, likely, n_seen, col, hidden, np.empty((n, 2)), np.empty(n, dtype=np.int32),
+                    np.empty(n), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.bool_), np.zeros(n))
+
+
+_NO_TABLES = np.zeros((0, N_BINS))
+_NO_IMAGE = np.zeros((0, 0, 3), dtype=np.uint8)
+
+
+@njit(cache=True)
+def _observe_column(xy, offset, centre, floor_direction, heights, R, t, K, dist, has_dist, radius, codes, boxes, which,
+                    pairs, depths, mes, cam_centre, margin, on, off, below, n_below, n_above, k_min, tops, top_sigma,
+                    px_scale, outside_unknown, k_lo, hit, image, colour_heights, tables, learnt, weight, likely_count,
+                    logpi, likely, n_seen, col, hidden, surface, counts, ratio, top, seen, penalty):
+    if offset > 0.0:
+        toward_camera(xy, offset, centre, floor_direction, surface)
+    else:
+        for i in range(xy.shape[0]):
+            surface[i, 0], surface[i, 1] = xy[i, 0], xy[i, 1]
+    column_counts(surface, heights, R, t, K, dist, has_dist, radius, codes, boxes, which, pairs, depths, mes,
+                  cam_centre, margin, on, off, below, n_below, n_above, k_min, tops, top_sigma, px_scale,
+                  outside_unknown, k_lo, counts, ratio, top, seen, hidden)
+    colour = image.shape[0] > 0
+    if colour:
+        any_learnt = False
+        for f in range(learnt.shape[0]):
+            any_learnt = any_learnt or learnt[f]
+        if any_learnt:
+            _column_penalties(surface, colour_heights, R, t, K, dist, has_dist, hit, image, tables, learnt, which,
+                              penalty)
+    # add_camera with lv = the best ratio (+ weight · penalty), col_h = its top, ok = counts ≥ likely_count
+    for i in range(xy.shape[0]):
+        s = seen[i]
+        v = ratio[i]
+        if colour:
+            v = v + weight * penalty[i]
+        logpi[i] = logpi[i] + (v if s else 0.0)
+        col[i] = col[i] + (heights[top[i]] if s else 0.0)
+        likely[i] = likely[i] and (counts[i] >= likely_count or not s)
+        n_seen[i] += s
 
 
 def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,

@@ -1202,12 +1202,27 @@ class CameraLikelihood:
         :func:`column_counts`' ``hidden`` (N,) int32, the number of lowest samples hidden."""
         xy = np.ascontiguousarray(xy, dtype=np.float64)
         n = len(xy)
-        boxes, mes, which = filter_rows(box, me, which, n)
         counts = np.empty(n, dtype=np.int32)
         ratio = np.empty(n, dtype=np.float64)
         top = np.empty(n, dtype=np.int32)
         seen = np.empty(n, dtype=np.bool_)
         hidden = np.empty(n, dtype=np.int32)
+        column_counts(xy, *self.column_args(hit, n, heights, on, off, k_min, radius, below, n_below, n_above, owner,
+                                            box, tops, top_sigma, px_scale, occluders, me, margin, which,
+                                            outside_unknown, k_lo),
+                      counts, ratio, top, seen, hidden)
+        return (counts, ratio, top, seen, hidden) if return_hidden else (counts, ratio, top, seen)
+
+    def column_args(self, hit: np.ndarray, n: int, heights: np.ndarray, on: float = 1.0, off: float = -1.0,
+                    k_min: int = 0, radius: float = 0.0, below: float = 0.0, n_below: int = 0, n_above: int = 0,
+                    owner: np.ndarray | None = None, box=None, tops: np.ndarray | None = None,
+                    top_sigma: float = 0.0, px_scale: float | Sequence[float] = 0.0,
+                    occluders: "Occluders | None" = None, me: int | Sequence[int] = -1, margin: float = 0.0,
+                    which: np.ndarray | None = None, outside_unknown: bool = False,
+                    k_lo: int | Sequence[int] = 0) -> tuple:
+        """The arguments of :func:`column_counts` between ``xy`` and its outputs, for ``n`` particles
+        read as :meth:`column` reads them (its parameters)."""
+        boxes, mes, which = filter_rows(box, me, which, n)
         if owner is None:
             codes = hit                             # labels 0, 1, 2 are the codes of pixels in no box
         else:
@@ -1215,14 +1230,12 @@ class CameraLikelihood:
                 self._codes = np.empty(hit.shape, dtype=np.uint8)
             codes = read_codes(hit, owner, self._codes)
         occ = NO_OCCLUDERS if occluders is None else occluders
-        column_counts(xy, np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist,
-                      self.has_dist, float(radius), codes, boxes, which, occ.pairs, occ.depths, mes, self.centre,
-                      float(margin),
-                      float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
-                      np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
-                      float(top_sigma) if tops is not None else 0.0, pixel_scales(px_scale, len(boxes)),
-                      bool(outside_unknown), _per_filter_int(k_lo, len(boxes)), counts, ratio, top, seen, hidden)
-        return (counts, ratio, top, seen, hidden) if return_hidden else (counts, ratio, top, seen)
+        return (np.ascontiguousarray(heights, dtype=np.float64), self.R, self.t, self.K, self.dist, self.has_dist,
+                float(radius), codes, boxes, which, occ.pairs, occ.depths, mes, self.centre, float(margin),
+                float(on), float(off), float(below), int(n_below), int(n_above), int(k_min),
+                np.zeros(n) if tops is None else np.ascontiguousarray(tops, dtype=np.float64),
+                float(top_sigma) if tops is not None else 0.0, pixel_scales(px_scale, len(boxes)),
+                bool(outside_unknown), _per_filter_int(k_lo, len(boxes)))
 
     def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
               box=None, which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -372,6 +372,37 @@ def _raster_contains(xy, x0, y0, resolution, inside, out):
         out[k] = fi >= 0 and fi < nx and fj >= 0 and fj < ny and inside[int(fj), int(fi)]
 
 
+def close_sums(n_seen: np.ndarray, xyz: np.ndarray, raster: WalkableRaster, logpi: np.ndarray, likely: np.ndarray,
+               col: np.ndarray) -> None:
+    """The end of a likelihood summed over cameras, in place (:func:`close_sums_reference`): where no
+    camera sees the particle (``n_seen`` 0) or it stands off the walkable ``raster`` (``xyz`` (N, ≥ 2)),
+    ``logpi`` is −inf and ``likely`` False; ``col`` is divided by ``max(n_seen, 1)``."""
+    xyz = np.asarray(xyz, dtype=np.float64)
+    _close_sums(n_seen, xyz, float(raster.origin[0]), float(raster.origin[1]), float(raster.resolution),
+                np.ascontiguousarray(raster.inside, dtype=np.bool_), logpi, likely, col)
+
+
+@njit(cache=True)
+def _close_sums(n_seen, xyz, x0, y0, resolution, inside, logpi, likely, col):
+    ny, nx = inside.shape
+    for k in range(n_seen.shape[0]):
+        fi = (xyz[k, 0] - x0) / resolution
+        fj = (xyz[k, 1] - y0) / resolution
+        valid = n_seen[k] > 0 and fi >= 0 and fi < nx and fj >= 0 and fj < ny and inside[int(fj), int(fi)]
+        if not valid:
+            logpi[k] = -np.inf
+            likely[k] = False
+        col[k] = col[k] / max(n_seen[k], 1)
+
+
+def close_sums_reference(n_seen, xyz, raster, logpi, likely, col) -> None:
+    """:func:`close_sums` in NumPy (the tracker's former code), in place."""
+    valid = (n_seen > 0) & raster.contains(np.asarray(xyz)[:, :2])
+    logpi[:] = np.where(valid, logpi, -np.inf)
+    likely &= valid
+    col[:] = col / np.maximum(n_seen, 1)
+
+
 # ---------------------------------------------------------------------------- splitting a cloud
 
 def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mass: float,
