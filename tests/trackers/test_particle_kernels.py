@@ -343,11 +343,16 @@ def test_gather_particles_and_principal_agree_with_numpy():
             assert a.dtype == b.dtype
             np.testing.assert_array_equal(a, b)
     xy = rng.normal(0, 0.3, (7, 500, 3))[:, :, :2]
+    xy[3] *= 0.2                                          # a narrow cloud, not wide enough
     c, stats = _principal(xy)
     c_ref, stats_ref = _principal_reference(xy)
     np.testing.assert_array_equal(c, c_ref)
     for a, b in zip(stats, stats_ref):
         np.testing.assert_array_equal(a, b)
+    from worldtrack.trackers.particle_sampling import _wide_enough, splittable
+    wide = splittable(xy, 0.35, 0.2)
+    np.testing.assert_array_equal(wide, _wide_enough(stats_ref[3], 0.35, 0.2))
+    assert wide.sum() == 6 and not wide[3]
 
 
 def test_fused_resampling_agrees_with_weights_resampler_and_gather():
@@ -442,3 +447,24 @@ def test_observe_column_equals_the_calls_one_by_one(offset):
         for a, b in zip(got, ref):
             np.testing.assert_array_equal(a, b)
         assert np.isinf(got[0]).sum() > 100 and got[1].sum() > 100
+
+
+def test_predict_walk_is_prediction_then_height_walk():
+    from worldtrack.trackers.particle_sampling import predict_state_reference, predict_walk, reflect_reference
+
+    rng = np.random.default_rng(20)
+    f, n = 3, 400
+    old, v = rng.normal(0, 3, (f, n, 3)), rng.normal(0, 1.5, (f, n, 3))
+    a, walk = rng.standard_normal((f, n, 3)), rng.standard_normal((f, n, 2))
+    h, ha = rng.uniform(0.8, 1.9, (f, n)), rng.standard_normal((f, n))
+    noise, scale = np.array([0.1, 0.1, 0.05]), np.array([0.3, 0.0, 0.2])
+    v1, v2, x1, x2, h1 = v.copy(), v.copy(), np.empty_like(old), np.empty_like(old), np.empty_like(h)
+    predict_walk(old, a, noise, v1, walk, scale, 2.5, 0.1, x1, h, ha, 0.2, 0.8, 1.9, h1)
+    predict_state_reference(old, a, noise, v2, walk, scale, 2.5, 0.1, x2)
+    np.testing.assert_array_equal(x1, x2)
+    np.testing.assert_array_equal(v1, v2)
+    np.testing.assert_array_equal(h1, reflect_reference(h + ha * 0.2, 0.8, 1.9))
+    assert not np.array_equal(h1, h)
+    h2 = h.copy()
+    predict_walk(old, a, noise, v.copy(), walk, scale, 2.5, 0.1, x1, h, np.zeros(0), 0.2, 0.8, 1.9, h2)
+    np.testing.assert_array_equal(h2, h)                  # no draws: the heights stay

@@ -97,7 +97,7 @@ from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, ad
                                                      boxes_on_one_object, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean, gather_particles,
-                                                   jitter_reflect, order_statistic, polygon_distance, predict_state,
+                                                   jitter_reflect, order_statistic, polygon_distance, predict_walk,
                                                    raster_contains, region_sizes, resample_draws, resample_particles,
                                                    resampler, splittable, take_rows, weight_exponents,
                                                    weights_reference)
@@ -110,6 +110,8 @@ PARTICLE_FIELDS = ("xyz", "v", "h", "logpi", "likely", "col_h")
 
 #: No colour term (an empty penalty array for :func:`add_camera`).
 _NO_PENALTY = np.zeros(0)
+#: No random draws (an empty array for a kernel's optional draws).
+_NO_DRAWS = np.zeros(0)
 
 #: Depth (m) at which a column sample weighs 1 with ``pixel_weights``: weights are the sample's
 #: image length over that of a sample this far from the camera.
@@ -623,12 +625,18 @@ class ParticleTracker:
         noise = np.array([cfg.noise_xy, cfg.noise_xy, cfg.noise_z]) * math.sqrt(dt)
         a = self.rng.standard_normal(old.shape)
         if cfg.velocity == "state":
-            # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it.
+            # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it;
+            # and the heights' walk (_jitter_heights), all in one call with the draws in their order.
             v = self._stacked(fs, "v")                      # walked in place
             scale = cfg.noise_v * math.sqrt(dt) * self._coasting(fs)
             xyz = np.empty_like(old)
-            predict_state(old, a, noise, v, self.rng.standard_normal(v.shape[:2] + (2,)), scale,
-                          float(cfg.max_speed), float(dt), xyz)
+            walk = self.rng.standard_normal(v.shape[:2] + (2,))
+            h = np.ascontiguousarray(self._stacked(fs, "h"), dtype=np.float64)
+            jitter = self._top_sigma > 0 and cfg.noise_h > 0 and h.size
+            h_out = np.empty(h.shape) if jitter else h
+            predict_walk(old, a, noise, v, walk, scale, float(cfg.max_speed), float(dt), xyz, h,
+                         self.rng.standard_normal(h.shape) if jitter else _NO_DRAWS,
+                         cfg.noise_h * math.sqrt(dt), float(cfg.min_height), float(cfg.max_height), h_out)
             self._set_rows(fs, "v", v)
         else:
             step = a * noise
@@ -637,9 +645,10 @@ class ParticleTracker:
             elif cfg.velocity == "object":
                 step[..., :2] += np.array([f.V for f in fs])[:, None, :] * dt
             xyz = old + step
+            h_out = None
         if cfg.likelihood == "point":
             xyz[..., 2] = _reflect(xyz[..., 2], 0.0, cfg.max_height)
-        self._set_rows(fs, "h", self._jitter_heights(self._stacked(fs, "h"), dt))
+        self._set_rows(fs, "h", self._jitter_heights(self._stacked(fs, "h"), dt) if h_out is None else h_out)
         self._set_rows(fs, "xyz", xyz)
         if cfg.velocity == "particle":
             # v_t = (x_t − x_{t−1}) / dt, each particle's velocity for the next frame (eq. 2).

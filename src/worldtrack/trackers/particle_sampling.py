@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -576,9 +577,11 @@ def splittable(xy: np.ndarray, min_separation: float, min_mass: float, principal
     if xy.shape[1] < 8:
         wide, rows = np.zeros(len(xy), dtype=bool), [None] * len(xy)
     else:
-        c, (sxx, syy, sxy, lam) = _principal(xy)
-        wide = _wide_enough(lam, min_separation, min_mass)
-        rows = list(zip(c, sxx.tolist(), syy.tolist(), sxy.tolist(), lam.tolist())) if principal else None
+        c = xy - cloud_mean(xy)[:, None, :]
+        out = np.empty((4, len(xy)))
+        wide = np.empty(len(xy), dtype=np.bool_)
+        _covariance_axes(c.transpose(0, 2, 1) @ c, xy.shape[1], out, float(min_separation), float(min_mass), wide)
+        rows = list(zip(c, *out.tolist())) if principal else None
     return (wide, rows) if principal else wide
 
 
@@ -647,6 +650,17 @@ def jitter_reflect(h: np.ndarray, a: np.ndarray, scale: float, lo: float, hi: fl
         of[k] = lo + (2 * span - r if r > span else r)
 
 
+@njit(cache=True)
+def predict_walk(old: np.ndarray, a: np.ndarray, noise: np.ndarray, v: np.ndarray, walk: np.ndarray,
+                 scale: np.ndarray, max_speed: float, dt: float, out: np.ndarray, h: np.ndarray, ha: np.ndarray,
+                 h_scale: float, lo: float, hi: float, h_out: np.ndarray) -> None:
+    """:func:`predict_state` and, with ``ha`` not empty, :func:`jitter_reflect` of the heights ``h``
+    into ``h_out``, in one call."""
+    predict_state(old, a, noise, v, walk, scale, max_speed, dt, out)
+    if ha.size:
+        jitter_reflect(h, ha, h_scale, lo, hi, h_out)
+
+
 def reflect_reference(z: np.ndarray, lo: float, hi: float) -> np.ndarray:
     """Fold values into [lo, hi] by reflection at the ends (NumPy)."""
     span = hi - lo
@@ -672,7 +686,15 @@ def velocity_walk_reference(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max
 def cloud_mean(x: np.ndarray) -> np.ndarray:
     """Mean over the particles of each cloud, ``x`` (F, N, C) → (F, C), as a matrix product
     (NumPy's reduction over the middle axis of an (F, N, 3) array is many times slower)."""
-    return np.full(x.shape[1], 1.0 / x.shape[1]) @ x
+    return _mean_weights(x.shape[1]) @ x
+
+
+@functools.lru_cache(maxsize=8)
+def _mean_weights(n: int) -> np.ndarray:
+    """(n,) all ``1/n``, read-only: :func:`cloud_mean`'s weights, made once per particle count."""
+    w = np.full(n, 1.0 / n)
+    w.setflags(write=False)
+    return w
 
 
 def _principal(xy: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
@@ -680,21 +702,25 @@ def _principal(xy: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray
     largest eigenvalue (the variance along the principal axis), each (F,), m²."""
     c = xy - cloud_mean(xy)[:, None, :]
     out = np.empty((4, len(xy)))
-    _covariance_axes(c.transpose(0, 2, 1) @ c, xy.shape[1], out)
+    _covariance_axes(c.transpose(0, 2, 1) @ c, xy.shape[1], out, 0.0, 0.0, np.empty(0, dtype=np.bool_))
     return c, (out[0], out[1], out[2], out[3])
 
 
 @njit(cache=True)
-def _covariance_axes(products, n, out):
+def _covariance_axes(products, n, out, min_separation, min_mass, wide):
     """``out`` (4, F), in place: ``sxx, syy, sxy`` of the (F, 2, 2) sums of products over ``n`` and the
     largest eigenvalue ``(sxx + syy)/2 + hypot((sxx − syy)/2, sxy)`` — :func:`_principal_reference`'s
-    arithmetic."""
+    arithmetic; and, if ``wide`` is not empty, :func:`_wide_enough` of the eigenvalues into it."""
+    limit = min_separation * math.sqrt(min_mass * (1 - min_mass))
     for f in range(products.shape[0]):
         sxx = products[f, 0, 0] / n
         syy = products[f, 1, 1] / n
         sxy = products[f, 0, 1] / n
         out[0, f], out[1, f], out[2, f] = sxx, syy, sxy
-        out[3, f] = 0.5 * (sxx + syy) + math.hypot(0.5 * (sxx - syy), sxy)
+        lam = 0.5 * (sxx + syy) + math.hypot(0.5 * (sxx - syy), sxy)
+        out[3, f] = lam
+        if wide.shape[0]:
+            wide[f] = math.sqrt(lam if not lam < 0.0 else 0.0) >= limit
 
 
 def _principal_reference(xy: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
