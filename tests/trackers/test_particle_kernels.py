@@ -275,19 +275,29 @@ def test_boxes_on_one_object_agrees_with_reference():
     assert found > 20
 
 
-def test_owner_image_reused_equals_fresh():
+def test_owner_image_agrees_with_reference_and_reused_equals_fresh():
+    """The owner image (a kernel over the boxes, Python's slice rules, saturating at 255) against the
+    box-by-box NumPy code, fresh and reusing the last image."""
+    from worldtrack.trackers.particle_likelihood import owner_image_reference
+
     rng = np.random.default_rng(13)
     buf, previous = None, ()
-    for trial in range(20):
+    for trial in range(40):
         k = int(rng.integers(0, 6))
         boxes = [None if rng.random() < 0.2 else
                  (int(u), int(min(u + rng.integers(1, 90), W)), int(v), int(min(v + rng.integers(1, 90), H)))
                  for u, v in zip(rng.integers(0, W, k), rng.integers(0, H, k))]
+        if trial % 5 == 4:
+            boxes += [(-30, -5, 10, 400), (300, 10, -50, 20)]           # slices from the end, empty
         fresh = owner_image((H, W), boxes)
+        np.testing.assert_array_equal(fresh, owner_image_reference((H, W), boxes))
         buf = owner_image((H, W), boxes, buf, previous)
         previous = boxes
         np.testing.assert_array_equal(buf, fresh)
     assert buf.max() >= 1
+    many = [(10, 20, 10, 20)] * 300
+    np.testing.assert_array_equal(owner_image((H, W), many), owner_image_reference((H, W), many))
+    assert owner_image((H, W), many)[15, 15] == 255
 
 
 def test_split_sides_kernel_agrees_with_reference():
