@@ -335,15 +335,17 @@ def occluder_layers(shape: tuple[int, int], boxes, depths, out: "Occluders | Non
         raise ValueError(f"occluder_layers: at most {_MAX_BOXES - 1} boxes, got {len(boxes)}")
     if out is None or out.pairs.shape != tuple(shape):
         out = Occluders(np.zeros(shape, dtype=np.int32), np.full(1, np.inf))
-    for u0, u1, v0, v1 in out.filled:               # clear last use's boxes only (no full-frame pass)
-        out.pairs[v0:v1, u0:u1] = 0
+    clear = _box_rows(out.filled)                   # last use's boxes only (no full-frame pass)
     given = [k for k, b in enumerate(boxes) if b is not None]
     out.filled = [boxes[k] for k in given]
     out.depths = np.full(len(boxes) + 1, np.inf)
     if given:
-        ids = np.array(given, dtype=np.int32)
-        out.depths[ids + 1] = [depths[k] for k in given]
-        _fill_layers(out.pairs, out.depths, np.array([boxes[k] for k in given], dtype=np.int64).reshape(-1, 4), ids)
+        out.depths[np.array(given) + 1] = [depths[k] for k in given]
+    # Nearest first (stable: the earlier box first at equal depths); a box of NaN or infinite depth
+    # is never one of the two nearest. Each pixel then keeps the first two boxes that cover it.
+    order = sorted((k for k in given if out.depths[k + 1] < math.inf), key=lambda k: out.depths[k + 1])
+    _fill_layers(out.pairs, clear, np.array([boxes[k] for k in order], dtype=np.int64).reshape(-1, 4),
+                 np.array(order, dtype=np.int32))
     return out
 
 
@@ -352,21 +354,24 @@ _MAX_BOXES = 32767
 
 
 @njit(cache=True)
-def _fill_layers(pairs, depths, boxes, ids):
-    """Insert each box ``(u0, u1, v0, v1)`` with its index into the two nearest layers ``pairs``, in
-    place; ``depths`` (B + 1,) the boxes' depths by index + 1 (``depths[0] = inf``, no box)."""
+def _fill_layers(pairs, clear, boxes, ids):
+    """Zero the ranges ``clear`` (K, 4) of ``pairs`` (Python's slice rules), then give each pixel of
+    the boxes ``(u0, u1, v0, v1)`` (nearest first, with their indices ``ids``) the first two that
+    cover it: index + 1 in bits 0–15, then 16–30, in place."""
     H, W = pairs.shape
+    for j in range(clear.shape[0]):
+        for v in range(_start(clear[j, 2], H), _stop(clear[j, 3], H)):
+            for u in range(_start(clear[j, 0], W), _stop(clear[j, 1], W)):
+                pairs[v, u] = 0
     for j in range(boxes.shape[0]):
         k = ids[j] + 1
-        d = depths[k]
         for v in range(max(boxes[j, 2], 0), min(boxes[j, 3], H)):
             for u in range(max(boxes[j, 0], 0), min(boxes[j, 1], W)):
                 p = pairs[v, u]
-                first = p & 0xFFFF
-                if d < depths[first]:                   # nearest: the old nearest becomes second
-                    pairs[v, u] = k | (first << 16)
-                elif d < depths[p >> 16]:
-                    pairs[v, u] = first | (k << 16)
+                if p == 0:
+                    pairs[v, u] = k
+                elif p >> 16 == 0:
+                    pairs[v, u] = p | (k << 16)
 
 
 class Occluders:
