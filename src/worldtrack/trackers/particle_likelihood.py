@@ -261,16 +261,17 @@ def _count_boxes(out, clear, boxes):
     """Zero the pixel ranges ``clear`` (K, 4) of ``out``, then add 1 (up to 255) over each of ``boxes``
     — ranges ``(u0, u1, v0, v1)`` as Python slices take them (ends clipped to the image; a start
     beyond the end is empty)."""
-    H, W = out.shape
+    # (Row slices: loops over them compile to vector code, indexing with possibly negative ints does not.)
+    H = out.shape[0]
     for j in range(clear.shape[0]):
         for v in range(_start(clear[j, 2], H), _stop(clear[j, 3], H)):
-            for u in range(_start(clear[j, 0], W), _stop(clear[j, 1], W)):
-                out[v, u] = 0
+            out[v, clear[j, 0]:clear[j, 1]] = 0
     for j in range(boxes.shape[0]):
         for v in range(_start(boxes[j, 2], H), _stop(boxes[j, 3], H)):
-            for u in range(_start(boxes[j, 0], W), _stop(boxes[j, 1], W)):
-                if out[v, u] < 255:
-                    out[v, u] += 1
+            row = out[v, boxes[j, 0]:boxes[j, 1]]
+            for u in range(row.shape[0]):
+                x = row[u]
+                row[u] = x + (x < 255)
 
 
 @njit(cache=True, inline="always")
@@ -361,17 +362,15 @@ def _fill_layers(pairs, clear, boxes, ids):
     H, W = pairs.shape
     for j in range(clear.shape[0]):
         for v in range(_start(clear[j, 2], H), _stop(clear[j, 3], H)):
-            for u in range(_start(clear[j, 0], W), _stop(clear[j, 1], W)):
-                pairs[v, u] = 0
+            pairs[v, clear[j, 0]:clear[j, 1]] = 0
     for j in range(boxes.shape[0]):
-        k = ids[j] + 1
+        k = np.int32(ids[j] + 1)
+        k2 = np.int32((ids[j] + 1) << 16)
         for v in range(max(boxes[j, 2], 0), min(boxes[j, 3], H)):
-            for u in range(max(boxes[j, 0], 0), min(boxes[j, 1], W)):
-                p = pairs[v, u]
-                if p == 0:
-                    pairs[v, u] = k
-                elif p >> 16 == 0:
-                    pairs[v, u] = p | (k << 16)
+            row = pairs[v, max(boxes[j, 0], 0):max(min(boxes[j, 1], W), 0)]
+            for u in range(row.shape[0]):
+                p = row[u]
+                row[u] = k if p == 0 else (p | k2 if p >> 16 == 0 else p)
 
 
 class Occluders:
