@@ -478,3 +478,30 @@ def test_predict_walk_is_prediction_then_height_walk():
     h2 = h.copy()
     predict_walk(old, a, noise, v.copy(), walk, scale, 2.5, 0.1, x1, h, np.zeros(0), 0.2, 0.8, 1.9, h2)
     np.testing.assert_array_equal(h2, h)                  # no draws: the heights stay
+
+
+def test_raster_blocks_answer_as_the_cells_do():
+    """A walkable raster with holes and a ragged edge: with its blocks of all-walkable cells the
+    look-up answers as WalkableRaster.contains, for points everywhere (and NaN)."""
+    from worldtrack.scene.floor import WalkableRaster
+    from worldtrack.trackers.particle_sampling import close_sums, close_sums_reference, raster_blocks
+
+    rng = np.random.default_rng(21)
+    inside = np.ones((250, 333), dtype=bool)
+    inside[40:90, 100:180] = False                        # an obstacle
+    inside[:, 300:] = rng.random((250, 33)) < 0.5         # a ragged edge
+    raster = WalkableRaster(np.array([-1.0, 0.5]), 0.01, inside)
+    blocks = raster_blocks(raster)
+    assert blocks.shape == (8, 11) and 0 < blocks.sum() < blocks.size
+    xy = np.column_stack([rng.uniform(-1.2, 2.5, 20000), rng.uniform(0.3, 3.2, 20000)])
+    xy[:5] = np.nan
+    want = raster.contains(xy)
+    np.testing.assert_array_equal(raster_contains(raster, xy, blocks), want)
+    assert 2000 < want.sum() < 18000
+    n_seen = rng.integers(0, 3, 20000).astype(np.int32)
+    a = [rng.normal(size=20000), rng.random(20000) < 0.5, rng.uniform(0, 4, 20000)]
+    b = [x.copy() for x in a]
+    close_sums(n_seen, xy, raster, *a, blocks)
+    close_sums_reference(n_seen, xy, raster, *b)
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x, y)

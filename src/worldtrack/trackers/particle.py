@@ -96,11 +96,11 @@ from worldtrack.trackers.particle_appearance import ColourModel, column_bins, co
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart,
                                                      boxes_on_one_object, floor_pixels, hit_image, hit_labels,
                                                      occluder_layers, owner_image, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean, gather_particles,
-                                                   jitter_reflect, order_statistic, polygon_distance, predict_walk,
-                                                   raster_contains, region_sizes, resample_draws, resample_particles,
-                                                   resampler, splittable, take_rows, weight_exponents,
-                                                   weights_reference)
+from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
+                                                   gather_particles, jitter_reflect, order_statistic,
+                                                   polygon_distance, predict_walk, raster_blocks, raster_contains,
+                                                   region_sizes, resample_draws, resample_particles, resampler,
+                                                   splittable, take_rows, weight_exponents, weights_reference)
 
 Box = tuple[int, int, int, int]
 
@@ -231,6 +231,7 @@ class ParticleTracker:
         self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
         self._resample = resampler(cfg.resampling)
         self._walkable_raster = scene.walkable.raster(0.01)
+        self._walkable_blocks = raster_blocks(self._walkable_raster)
         self._walkable = self._walkable_raster.contains
         self.filters: list[_Filter] = []
         self._births = cfg.births if cfg.births != "auto" else ("entry+lost" if scene.entry_regions else "anywhere")
@@ -570,9 +571,9 @@ class ParticleTracker:
                 add_camera(seen, lv, penalty, float(cfg.appearance_weight), col_h, ok, logpi, likely, n_seen, col)
         if cfg.likelihood == "column":
             # −inf, not likely off the walkable floor or where no camera sees; col over the cameras that see
-            close_sums(n_seen, xyz, self._walkable_raster, logpi, likely, col)
+            close_sums(n_seen, xyz, self._walkable_raster, logpi, likely, col, self._walkable_blocks)
             return logpi, likely, col
-        valid = (n_seen > 0) & raster_contains(self._walkable_raster, xyz)
+        valid = (n_seen > 0) & raster_contains(self._walkable_raster, xyz, self._walkable_blocks)
         valid &= (xyz[:, 2] >= 0) & (xyz[:, 2] <= cfg.max_height)
         logpi = np.where(valid, logpi, -np.inf)
         return logpi, likely & valid, col / np.maximum(n_seen, 1)

@@ -351,45 +351,73 @@ class FloorRegion:
         return self.raster.contains(xy)
 
 
-def raster_contains(raster: WalkableRaster, xy: np.ndarray) -> np.ndarray:
+def raster_contains(raster: WalkableRaster, xy: np.ndarray, blocks: np.ndarray | None = None) -> np.ndarray:
     """:meth:`WalkableRaster.contains <worldtrack.scene.floor.WalkableRaster.contains>` of ``xy`` (N, 2),
     metres (or the first two columns of (N, ≥ 2)), by a kernel (one pass instead of a dozen NumPy
-    calls; tested equal): (N,) bool."""
+    calls; tested equal): (N,) bool. ``blocks``: :func:`raster_blocks` of ``raster``, to read few
+    cells (a 1 cm raster is a megabyte, mostly out of cache)."""
     xy = np.asarray(xy, dtype=np.float64)
     if xy.ndim != 2 or xy.shape[1] < 2:
         xy = xy.reshape(-1, 2)
     out = np.empty(len(xy), dtype=np.bool_)
     _raster_contains(xy, float(raster.origin[0]), float(raster.origin[1]), float(raster.resolution),
-                     np.ascontiguousarray(raster.inside, dtype=np.bool_), out)
+                     np.ascontiguousarray(raster.inside, dtype=np.bool_), _NO_BLOCKS if blocks is None else blocks,
+                     out)
     return out
 
 
-@njit(cache=True)
-def _raster_contains(xy, x0, y0, resolution, inside, out):
+#: Cells per side of a :func:`raster_blocks` block (a power of two).
+RASTER_BLOCK = 32
+_NO_BLOCKS = np.zeros((0, 0), dtype=np.bool_)
+
+
+def raster_blocks(raster: WalkableRaster) -> np.ndarray:
+    """(⌈ny/32⌉, ⌈nx/32⌉) bool: which blocks of 32 × 32 cells of ``raster`` (fewer at the far edges) are
+    inside throughout — where :func:`raster_contains` need not read the cell."""
+    inside = np.asarray(raster.inside, dtype=bool)
     ny, nx = inside.shape
+    b = RASTER_BLOCK
+    pad = np.ones((-(-ny // b) * b, -(-nx // b) * b), dtype=bool)
+    pad[:ny, :nx] = inside
+    return pad.reshape(pad.shape[0] // b, b, pad.shape[1] // b, b).all(axis=(1, 3))
+
+
+@njit(cache=True, inline="always")
+def _in_raster(x, y, x0, y0, resolution, inside, blocks):
+    """The cell test of :meth:`WalkableRaster.contains` for one point (a block inside throughout answers first)."""
+    ny, nx = inside.shape
+    fi = (x - x0) / resolution
+    fj = (y - y0) / resolution
+    if not (fi >= 0 and fi < nx and fj >= 0 and fj < ny):
+        return False
+    i, j = int(fi), int(fj)
+    if blocks.shape[0] and blocks[j // RASTER_BLOCK, i // RASTER_BLOCK]:
+        return True
+    return inside[j, i]
+
+
+@njit(cache=True)
+def _raster_contains(xy, x0, y0, resolution, inside, blocks, out):
     for k in range(xy.shape[0]):
-        fi = (xy[k, 0] - x0) / resolution
-        fj = (xy[k, 1] - y0) / resolution
-        out[k] = fi >= 0 and fi < nx and fj >= 0 and fj < ny and inside[int(fj), int(fi)]
+        out[k] = _in_raster(xy[k, 0], xy[k, 1], x0, y0, resolution, inside, blocks)
 
 
 def close_sums(n_seen: np.ndarray, xyz: np.ndarray, raster: WalkableRaster, logpi: np.ndarray, likely: np.ndarray,
-               col: np.ndarray) -> None:
+               col: np.ndarray, blocks: np.ndarray | None = None) -> None:
     """The end of a likelihood summed over cameras, in place (:func:`close_sums_reference`): where no
-    camera sees the particle (``n_seen`` 0) or it stands off the walkable ``raster`` (``xyz`` (N, ≥ 2)),
-    ``logpi`` is −inf and ``likely`` False; ``col`` is divided by ``max(n_seen, 1)``."""
+    camera sees the particle (``n_seen`` 0) or it stands off the walkable ``raster`` (``xyz`` (N, ≥ 2);
+    ``blocks`` as in :func:`raster_contains`), ``logpi`` is −inf and ``likely`` False; ``col`` is
+    divided by ``max(n_seen, 1)``."""
     xyz = np.asarray(xyz, dtype=np.float64)
     _close_sums(n_seen, xyz, float(raster.origin[0]), float(raster.origin[1]), float(raster.resolution),
-                np.ascontiguousarray(raster.inside, dtype=np.bool_), logpi, likely, col)
+                np.ascontiguousarray(raster.inside, dtype=np.bool_), _NO_BLOCKS if blocks is None else blocks,
+                logpi, likely, col)
 
 
 @njit(cache=True)
-def _close_sums(n_seen, xyz, x0, y0, resolution, inside, logpi, likely, col):
-    ny, nx = inside.shape
+def _close_sums(n_seen, xyz, x0, y0, resolution, inside, blocks, logpi, likely, col):
     for k in range(n_seen.shape[0]):
-        fi = (xyz[k, 0] - x0) / resolution
-        fj = (xyz[k, 1] - y0) / resolution
-        valid = n_seen[k] > 0 and fi >= 0 and fi < nx and fj >= 0 and fj < ny and inside[int(fj), int(fi)]
+        valid = n_seen[k] > 0 and _in_raster(xyz[k, 0], xyz[k, 1], x0, y0, resolution, inside, blocks)
         if not valid:
             logpi[k] = -np.inf
             likely[k] = False
