@@ -505,3 +505,35 @@ def test_raster_blocks_answer_as_the_cells_do():
     close_sums_reference(n_seen, xy, raster, *b)
     for x, y in zip(a, b):
         np.testing.assert_array_equal(x, y)
+
+
+def test_stacked_rows_follow_the_filters_arrays():
+    """The tracking filters' per-particle arrays are kept as rows of one array between frames; the
+    tracker reads that array only while every filter still holds its row, else it stacks afresh."""
+    from worldtrack.trackers.particle import ParticleTracker, ParticleConfig
+    from worldtrack.foreground.background import StaticBackground
+
+    from test_particle import render
+    from _render import texture
+
+    scene = make_scene(entry=False)
+    bg = texture(0)
+    tracker = ParticleTracker(scene, {"cam": StaticBackground(bg, 30.0, "colour")},
+                              ParticleConfig(births="none", surface_offset=0.0))
+    people = [(-1.0, 3.0), (1.0, 3.5)]
+    for x, y in people:
+        tracker.init_track(x, y)
+    rng = np.random.default_rng(22)
+    for k in range(3):
+        tracker.step({"cam": render(scene.camera("cam"), bg, people, rng)}, k / 10)
+    fs = list(tracker.filters)
+    assert len(fs) == 2
+    kept = tracker._stacked(fs, "xyz")
+    assert all(f.xyz.base is kept for f in fs)                      # rows of the kept array
+    np.testing.assert_array_equal(kept, np.stack([f.xyz for f in fs]))
+    fs[1].xyz = fs[1].xyz + 1.0                                     # a filter given a new array
+    fresh = tracker._stacked(fs, "xyz")
+    assert fresh is not kept
+    np.testing.assert_array_equal(fresh, np.stack([f.xyz for f in fs]))
+    np.testing.assert_array_equal(fresh[1], kept[1] + 1.0)
+    np.testing.assert_array_equal(tracker._stacked(fs[::-1], "xyz"), np.stack([fs[1].xyz, fs[0].xyz]))  # other order
