@@ -17,10 +17,11 @@ Measured, with the median over frames after a warm-up:
   one filter) for each configuration, and the bare line-column kernel against its NumPy reference.
 
 Configurations: ``paper`` (500 particles, a line column of 20 heights, weights ∝ count, shadows
-count as object) and ``default`` (500 particles, a 3-line column of 20 heights with 2 samples below
-the floor and 2 above the top, ratio weights with the height prior, shadows removed, explaining
-away, split and merge checks, the colour model of ``particle_appearance``) and ``no-appearance``
-(the default without the colour model, to show what it costs).
+count as object) and ``default`` (500 particles, a 3-line column of 20 heights with 4 samples below
+the floor and 3 above the top — ``foot_samples``, ``head_samples`` — ratio weights with the height
+prior, shadows removed, explaining away, split and merge checks, the colour model of
+``particle_appearance``) and ``no-appearance`` (the default without the colour model, to show what it
+costs).
 
 Usage: ``.venv/bin/python benchmarks/particle_speed.py`` — writes ``benchmarks/results/particle_speed.md``.
 """
@@ -168,7 +169,8 @@ def main() -> int:
     text = (f"One MOG2 apply on {W}x{H}: {1000 * mog2:.2f} ms (the reference). {summary}.\n\n"
             f"Per frame, independent of the objects:\n\n{t1}\n\nTracking (median over {FRAMES - 3} frames; "
             f"per object = (ms/frame(K) − ms/frame(0)) / K):\n\n{t2}\n\nThe likelihood alone (one filter's "
-            f"500 particles, as step reads them; default: 20 heights + 2 below + 2 above, 3 lines):\n\n{t3}\n")
+            f"500 particles, as step reads them; default: 20 heights + {configs['default'].foot_samples} below + "
+            f"{configs['default'].head_samples} above, 3 lines):\n\n{t3}\n")
     print(text)
     path = write_result("particle_speed", "Particle tracker (seed 004): speed",
                         "Command: `.venv/bin/python benchmarks/particle_speed.py`\n\n" + text)
