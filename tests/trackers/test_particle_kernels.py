@@ -537,3 +537,45 @@ def test_stacked_rows_follow_the_filters_arrays():
     np.testing.assert_array_equal(fresh, np.stack([f.xyz for f in fs]))
     np.testing.assert_array_equal(fresh[1], kept[1] + 1.0)
     np.testing.assert_array_equal(tracker._stacked(fs[::-1], "xyz"), np.stack([fs[1].xyz, fs[0].xyz]))  # other order
+
+
+def test_learn_columns_equals_the_calls_one_by_one():
+    """Colour learning in one compiled call: the same models (histograms, frames) as box_array,
+    boxes_apart, beside, column_bins and ColourModel.learn one after the other; filters whose boxes
+    overlap another's, or that are not learners, are not taught."""
+    from worldtrack.trackers.particle_appearance import ColourModel, N_BINS, column_bins, learn_columns
+    from worldtrack.trackers.particle_likelihood import boxes_apart
+
+    cam = make_scene().cameras["cam"]
+    cl = CameraLikelihood(cam)
+    rng = np.random.default_rng(23)
+    hit = (rng.random((H, W)) < 0.7).astype(np.uint8)
+    image = rng.integers(0, 256, (H, W, 3)).astype(np.uint8)
+    centres = np.array([[-2.0, 3.0], [0.0, 2.5], [0.2, 2.6], [2.0, 4.0], [1.0, 5.5], [-1.0, 5.0]])
+    widths, heights = np.full(6, 0.45), np.array([1.7, 1.6, 1.8, 1.7, 1.75, 1.7])
+    learners = np.array([True, True, True, True, False, True])
+    old = ColourModel()
+    old.learn(rng.integers(0, N_BINS, 30), 1.0)
+    for trial in range(2):
+        models = [ColourModel() if i % 2 else None for i in range(6)]
+        models[3] = old if trial else models[3]
+        ref = [None if m is None else ColourModel() for m in models]
+        for a, b in zip(models, ref):                     # the same models, for the calls one by one
+            if a is not None and a.hist is not None:
+                b.hist, b.frames = a.hist.copy(), a.frames
+        given = [m if m is not None else ColourModel() for m in models]
+        taught = learn_columns(cl, image, hit, centres, widths, heights, learners, 0.05, 0.14, given, 0.1)
+        boxes = cl.box_array(centres, widths, heights, 0.05)
+        idx = np.flatnonzero(learners & boxes_apart(boxes))
+        np.testing.assert_array_equal(np.flatnonzero(taught), idx)
+        bins = column_bins(cl, image, hit, cl.beside(centres[idx], 0.14, 0.25 * widths[idx])).reshape(len(idx), -1)
+        want = [r if r is not None else ColourModel() for r in ref]
+        for i, b in zip(idx, bins):
+            want[i].learn(b, 0.1)
+        for a, b in zip(given, want):
+            assert a.frames == b.frames
+            assert (a.hist is None) == (b.hist is None)
+            if a.hist is not None:
+                np.testing.assert_array_equal(a.hist, b.hist)
+        assert 1 not in idx and 2 not in idx and 4 not in idx and 3 in idx   # overlapping, not a learner
+    assert old.frames == 2                                # learnt once more, blending into its histogram

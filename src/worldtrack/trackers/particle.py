@@ -92,10 +92,10 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track
 from worldtrack.trackers.particle_config import ParticleConfig
-from worldtrack.trackers.particle_appearance import ColourModel, column_bins, column_penalties, observe_column
-from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_apart,
-                                                     boxes_on_one_object, floor_pixels, hit_image, hit_labels,
-                                                     occluder_layers, owner_image, thresholded_difference)
+from worldtrack.trackers.particle_appearance import ColourModel, column_penalties, learn_columns, observe_column
+from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_on_one_object,
+                                                     floor_pixels, hit_image, hit_labels, occluder_layers, owner_image,
+                                                     thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
                                                    gather_particles, jitter_reflect, order_statistic,
                                                    polygon_distance, predict_walk, raster_blocks, raster_contains,
@@ -595,17 +595,15 @@ class ParticleTracker:
         widths = np.array([f.track.width for f in fs], dtype=float)
         heights = np.array([f.track.height for f in fs], dtype=float)
         for cid, hit in images.items():
-            cl = self._cams[cid]
-            idx = np.flatnonzero(learners & boxes_apart(cl.box_array(centres, widths, heights, cfg.box_margin)))
-            if not len(idx):
-                continue
-            xy = cl.beside(centres[idx], cfg.surface_offset, 0.25 * widths[idx])
-            bins = column_bins(cl, self._frames[cid], hit, xy).reshape(len(idx), -1)
-            for i, b in zip(idx.tolist(), bins):
-                model = fs[i].colours.get(cid)
-                if model is None:
-                    model = fs[i].colours[cid] = ColourModel()
-                model.learn(b, cfg.appearance_rate)
+            # The boxes (box_margin), those overlapping no other, the three columns of each, their
+            # colour bins and the histograms' blend: learn_columns, one compiled call.
+            models = [f.colours.get(cid) for f in fs]
+            given = [m if m is not None else ColourModel() for m in models]
+            chosen = learn_columns(self._cams[cid], self._frames[cid], hit, centres, widths, heights, learners,
+                                   cfg.box_margin, cfg.surface_offset, given, cfg.appearance_rate)
+            for f, m, new, taught in zip(fs, models, given, chosen.tolist()):
+                if taught and m is None:                # a filter taught for the first time keeps its model
+                    f.colours[cid] = new
 
     def _near_surface(self, xy: np.ndarray, cl: CameraLikelihood) -> np.ndarray:
         """Where a camera's column stands for particles at ``xy`` (N, 2) (or the floor positions of

@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit
 
 from ..geometry.camera import Camera
-from .particle_likelihood import (CameraLikelihood, _lens, _pixels, _to_pixel, column_counts, column_points,
-                                  toward_camera)
+from .particle_likelihood import (CameraLikelihood, _lens, _pixels, _to_pixel, box_pixels, boxes_apart,
+                                  column_counts, column_points, columns_beside, toward_camera)
 
 HUE_BINS = 12
 SAT_BINS = 3          # saturated pixels only: saturation ≥ GREY_SATURATION
@@ -263,6 +263,63 @@ def _observe_column(xy, offset, centre, floor_direction, heights, R, t, K, dist,
         n_seen[i] += s
 
 
+def learn_columns(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, centres: np.ndarray, widths: np.ndarray,
+                  heights: np.ndarray, learners: np.ndarray, margin: float, offset: float,
+                  models: Sequence["ColourModel | None"], rate: float) -> np.ndarray:
+    """What the tracker's colour learning does in one camera, in one compiled call: the objects'
+    boxes (``margin`` m, :func:`~worldtrack.trackers.particle_likelihood.box_pixels`), which of the
+    ``learners`` (F,) bool have a box overlapping no other
+    (:func:`~worldtrack.trackers.particle_likelihood.boxes_apart`), and for those the
+    :func:`column_bins` of the column ``offset`` m nearer the camera than ``centres`` (F, 2) and the two
+    ``widths/4`` beside it (:func:`~worldtrack.trackers.particle_likelihood.columns_beside`), blended
+    into ``models`` (F, None where a filter has none yet) as :meth:`ColourModel.learn` blends them.
+
+    Returns (F,) bool, the filters that were taught (whether or not they had enough object samples to
+    learn from); the models of those that learnt are updated in place. Tested equal to those calls.
+    """
+    f = len(centres)
+    hists = np.zeros((f, N_BINS))
+    has_hist = np.zeros(f, dtype=np.bool_)
+    for i, m in enumerate(models):
+        if m is not None and m.hist is not None:
+            hists[i], has_hist[i] = m.hist, True
+    chosen = np.empty(f, dtype=np.bool_)
+    status = np.zeros(f, dtype=np.int64)
+    out = np.empty((f, N_BINS))
+    _learn_columns(np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 2),
+                   np.ascontiguousarray(widths, dtype=np.float64), np.ascontiguousarray(heights, dtype=np.float64),
+                   np.ascontiguousarray(learners, dtype=np.bool_), float(margin), float(offset), cl.R, cl.t, cl.K,
+                   cl.dist, cl.has_dist, cl.centre, cl.floor_direction, cl.camera.width, cl.camera.height, hit,
+                   np.ascontiguousarray(image, dtype=np.uint8), COLOUR_HEIGHTS, hists, has_hist, float(rate),
+                   MIN_LEARN_SAMPLES, chosen, status, out)
+    for i in np.flatnonzero(status).tolist():
+        if status[i] < 0:
+            raise ValueError(f"learn_columns: colour bins must be below {N_BINS}")
+        models[i]._learnt(out[i])
+    return chosen
+
+
+@njit(cache=True)
+def _learn_columns(centres, widths, heights, learners, margin, offset, R, t, K, dist, has_dist, centre, floor_direction,
+                   W, H, hit, image, colour_heights, hists, has_hist, rate, min_samples, chosen, status, out):
+    f = centres.shape[0]
+    boxes = np.empty((f, 4), dtype=np.int64)
+    box_pixels(centres, widths, heights, margin, 0.0, R, t, K, dist, has_dist, centre, floor_direction, W, H, boxes)
+    apart = boxes_apart(boxes)
+    spread = np.empty(1)
+    columns = np.empty((3, 2))
+    bins = np.empty((3, colour_heights.shape[0]), dtype=np.int16)
+    for i in range(f):
+        chosen[i] = learners[i] and apart[i]
+        if not chosen[i]:
+            continue
+        spread[0] = 0.25 * widths[i]
+        columns_beside(centres[i:i + 1], offset, spread, centre, floor_direction, columns)
+        _column_bins(columns, colour_heights, R, t, K, dist, has_dist, hit, image, bins)
+        status[i] = _blend_histogram(bins.reshape(bins.size), hists[i] if has_hist[i] else hists[i, :0], rate,
+                                     min_samples, out[i])
+
+
 def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
                           heights: np.ndarray = COLOUR_HEIGHTS) -> np.ndarray:
     """:func:`column_bins` written plainly: the whole frame's bins, every sample through
@@ -298,9 +355,13 @@ class ColourModel:
             raise ValueError(f"ColourModel.learn: colour bins must be below {N_BINS}, got {int(bins.max())}")
         if not done:
             return False
-        self.hist = out
-        self.frames += 1
+        self._learnt(out)
         return True
+
+    def _learnt(self, hist: np.ndarray) -> None:
+        """Take ``hist`` (N_BINS,) as the histogram after one more frame of learning."""
+        self.hist = hist
+        self.frames += 1
 
     def learn_reference(self, sample_bins: np.ndarray, rate: float) -> bool:
         """:meth:`learn` in NumPy (its former code), the reference of :func:`_blend_histogram`."""
