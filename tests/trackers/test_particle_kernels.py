@@ -579,3 +579,13 @@ def test_learn_columns_equals_the_calls_one_by_one():
                 np.testing.assert_array_equal(a.hist, b.hist)
         assert 1 not in idx and 2 not in idx and 4 not in idx and 3 in idx   # overlapping, not a learner
     assert old.frames == 2                                # learnt once more, blending into its histogram
+
+
+def test_floor_distances_equal_floor_rays():
+    cam = make_scene().cameras["cam"]
+    rng = np.random.default_rng(24)
+    xy = np.column_stack([rng.normal(0, 3, 3000), rng.normal(2, 3, 3000)])
+    xy[0] = cam.centre[:2]
+    got = CameraLikelihood(cam).distances(xy)
+    np.testing.assert_array_equal(got, cam.floor_rays(xy)[1])
+    assert got[0] == 0.0 and got.max() > 5

@@ -374,8 +374,7 @@ class ParticleTracker:
                 boxes = self._boxes([f.track for f in fs], centres, cfg.box_margin)
                 owners = self._owner_images(images, boxes)
                 if cfg.occlusion:
-                    occluders = {cid: occluder_layers(img.shape[:2], boxes[cid],
-                                                      self._cams[cid].camera.floor_rays(centres)[1],
+                    occluders = {cid: occluder_layers(img.shape[:2], boxes[cid], self._cams[cid].distances(centres),
                                                       self._layers.get(cid))
                                  for cid, img in images.items()}
                     self._layers.update(occluders)
