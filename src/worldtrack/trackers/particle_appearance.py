@@ -222,8 +222,22 @@ def observe_column(cl: CameraLikelihood, xy: np.ndarray, offset: float, column_a
         tables, learnt = penalty_tables(models)
     _observe_column(xy, float(offset), cl.centre, cl.floor_direction, *column_args, hit,
                     np.ascontiguousarray(image, dtype=np.uint8), COLOUR_HEIGHTS, tables, learnt, float(weight),
-                    int(likely_count), logpi, likely, n_seen, col, hidden, np.empty((n, 2)), np.empty(n, dtype=np.int32),
-                    np.empty(n), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.bool_), np.zeros(n))
+                    int(likely_count), logpi, likely, n_seen, col, hidden, *_work_arrays(cl, n))
+
+
+def _work_arrays(cl: CameraLikelihood, n: int) -> tuple[np.ndarray, ...]:
+    """Work arrays of :func:`_observe_column` for ``n`` particles (surface, counts, ratio, top, seen,
+    penalty), kept in the camera's ``cl.work`` between calls (the last few sizes): all are written
+    before they are read, the penalty set to 0 here."""
+    key = ("observe_column", n)
+    out = cl.work.get(key)
+    if out is None:
+        if len(cl.work) > 8:
+            cl.work.clear()
+        out = cl.work[key] = (np.empty((n, 2)), np.empty(n, dtype=np.int32), np.empty(n),
+                              np.empty(n, dtype=np.int32), np.empty(n, dtype=np.bool_), np.empty(n))
+    out[5][:] = 0.0
+    return out
 
 
 _NO_TABLES = np.zeros((0, N_BINS))

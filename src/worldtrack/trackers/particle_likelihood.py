@@ -473,6 +473,8 @@ def _per_filter_int(v: int | Sequence[int], f: int) -> np.ndarray:
     """(F,) int64 of one value for all ``f`` filters or one per filter."""
     if isinstance(v, np.ndarray) and v.dtype == np.int64 and v.shape == (f,) and v.flags.c_contiguous:
         return v
+    if isinstance(v, int):
+        return np.full(f, v, dtype=np.int64)
     return np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=np.int64), (f,)))
 
 
@@ -1187,6 +1189,7 @@ class CameraLikelihood:
         self.has_dist = bool(camera.has_distortion)
         self.no_owner = np.zeros((camera.height, camera.width), dtype=np.uint8)
         self._codes: np.ndarray | None = None     # read_codes' output, reused call to call
+        self.work: dict = {}                      # work arrays of compiled calls, kept call to call
         self.centre = np.ascontiguousarray(camera.centre[:2], dtype=np.float64)
         self.floor_direction = np.ascontiguousarray(camera.floor_direction, dtype=np.float64)
 
