@@ -590,3 +590,22 @@ def test_floor_distances_equal_floor_rays():
     got = CameraLikelihood(cam).distances(xy)
     np.testing.assert_array_equal(got, cam.floor_rays(xy)[1])
     assert got[0] == 0.0 and got.max() > 5
+
+
+def test_bimodal_split_width_test_is_wide_enough():
+    """bimodal_split's own 'wide enough' test on the principal variance it is given (one float, the
+    IEEE operations of _wide_enough): a two-lump cloud is split with its own variance, and is one
+    object with a variance below the limit or NaN."""
+    import math
+    from worldtrack.trackers.particle_sampling import _principal, _wide_enough, bimodal_split
+
+    rng = np.random.default_rng(25)
+    xy = rng.normal(0, 0.05, (500, 2))
+    xy[:250, 0] += 0.8                                    # two lumps 0.8 m apart
+    c, (sxx, syy, sxy, lam) = _principal(xy[None])
+    row = (c[0], float(sxx[0]), float(syy[0]), float(sxy[0]), float(lam[0]))
+    assert _wide_enough(lam, 0.35, 0.2)[0] and bimodal_split(xy, 0.35, 0.5, 0.2, principal=row) is not None
+    limit = (0.35 * math.sqrt(0.2 * 0.8)) ** 2
+    for narrow in (limit * (1 - 1e-9), 0.0, -0.0, -1.0, float("nan")):
+        assert not _wide_enough(np.array([narrow]), 0.35, 0.2)[0]
+        assert bimodal_split(xy, 0.35, 0.5, 0.2, principal=row[:4] + (narrow,)) is None

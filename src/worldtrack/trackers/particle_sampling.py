@@ -465,7 +465,8 @@ def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mas
         c, (sxx, syy, sxy, lam) = _principal(xy[None])
         principal = c[0], float(sxx[0]), float(syy[0]), float(sxy[0]), float(lam[0])
     c, sxx, syy, sxy, lam = principal
-    if not _wide_enough(lam, min_separation, min_mass):
+    # _wide_enough of one float: the same IEEE operations (max keeps NaN and −0.0 as np.maximum does).
+    if not math.sqrt(max(lam, 0.0)) >= min_separation * math.sqrt(min_mass * (1 - min_mass)):
         return None
     # The principal axis: the eigenvector of the covariance's largest eigenvalue.
     axis = np.array([sxy, lam - sxx]) if abs(sxy) > 1e-15 else (np.array([1.0, 0.0]) if sxx >= syy
