@@ -609,3 +609,16 @@ def test_bimodal_split_width_test_is_wide_enough():
     for narrow in (limit * (1 - 1e-9), 0.0, -0.0, -1.0, float("nan")):
         assert not _wide_enough(np.array([narrow]), 0.35, 0.2)[0]
         assert bimodal_split(xy, 0.35, 0.5, 0.2, principal=row[:4] + (narrow,)) is None
+
+
+def test_inverse_lengths_agree_with_numpy():
+    from worldtrack.trackers.particle_sampling import inverse_lengths, inverse_lengths_reference
+
+    rng = np.random.default_rng(26)
+    uv = rng.normal(300, 80, (2, 200, 2))
+    uv[1, :5] = uv[0, :5]                                 # zero length
+    uv[0, 5:8] = np.nan                                   # not in front of the camera
+    out = np.empty(200)
+    inverse_lengths(uv, 19, out)
+    np.testing.assert_array_equal(out, inverse_lengths_reference(uv, 19))
+    assert np.all(out[:8] == 0) and np.all(out[8:] > 0)

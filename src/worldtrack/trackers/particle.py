@@ -97,7 +97,7 @@ from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, ad
                                                      floor_pixels, hit_image, hit_labels, occluder_layers, owner_image,
                                                      thresholded_difference)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
-                                                   gather_particles, jitter_reflect, order_statistic,
+                                                   gather_particles, inverse_lengths, jitter_reflect, order_statistic,
                                                    polygon_distance, predict_walk, raster_blocks, raster_contains,
                                                    region_sizes, resample_draws, resample_particles, resampler,
                                                    splittable, take_rows, weight_exponents, weights_reference)
@@ -831,12 +831,12 @@ class ParticleTracker:
         for cid in cameras:
             cl = self._cams[cid]
             xy = self._near_surface(centres, cl)
-            ends = np.concatenate([np.column_stack([xy, np.zeros(len(xy))]),
-                                   np.column_stack([xy, np.full(len(xy), top)])])
-            uv = cl.camera.project(ends).reshape(2, len(xy), 2)
-            length = np.hypot(*(uv[1] - uv[0]).T) / (len(self.heights) - 1)
-            ok = np.isfinite(length) & (length > 0)
-            out[cid] = np.where(ok, 1.0 / np.where(ok, length, 1.0), 0.0)
+            ends = np.empty((2, len(xy), 3))            # the column's foot and top points, (2F, 3)
+            ends[:, :, :2] = xy
+            ends[0, :, 2], ends[1, :, 2] = 0.0, top
+            uv = cl.camera.project(ends.reshape(-1, 3)).reshape(2, len(xy), 2)
+            out[cid] = np.empty(len(xy))
+            inverse_lengths(uv, len(self.heights) - 1, out[cid])
         return out
 
     def _update_tracking(self, fs: list[_Filter], t: float) -> None:

@@ -768,6 +768,23 @@ def _wide_enough(lam, min_separation: float, min_mass: float):
 
 
 @njit(cache=True)
+def inverse_lengths(uv: np.ndarray, steps: int, out: np.ndarray) -> None:
+    """``out`` (F,), in place: 1 / (the image length from ``uv[0, f]`` to ``uv[1, f]`` (pixels) over
+    ``steps``), 0 where that is not finite and positive — :func:`inverse_lengths_reference`'s
+    arithmetic (the pixel scale of ``pixel_weights="filter"``)."""
+    for f in range(uv.shape[1]):
+        length = math.hypot(uv[1, f, 0] - uv[0, f, 0], uv[1, f, 1] - uv[0, f, 1]) / steps
+        out[f] = 1.0 / length if math.isfinite(length) and length > 0 else 0.0
+
+
+def inverse_lengths_reference(uv: np.ndarray, steps: int) -> np.ndarray:
+    """:func:`inverse_lengths` in NumPy (the tracker's former code)."""
+    length = np.hypot(*(uv[1] - uv[0]).T) / steps
+    ok = np.isfinite(length) & (length > 0)
+    return np.where(ok, 1.0 / np.where(ok, length, 1.0), 0.0)
+
+
+@njit(cache=True)
 def region_sizes(sd: np.ndarray, widths: np.ndarray, sigma: np.ndarray) -> None:
     """The object regions' sizes from the particles' standard deviations ``sd`` (F, 3), metres, in
     place: ``sigma`` (F,) ``= sqrt((sx² + sy²) / 2)``, then, with ``widths`` (F,) (not empty),
