@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..geometry.camera import Camera
-from .particle_likelihood import (CameraLikelihood, _lens, _pixels, _to_pixel, box_pixels, boxes_apart,
+from .particle_likelihood import (CameraLikelihood, _lens, add_camera, _pixels, _to_pixel, box_pixels, boxes_apart,
                                   column_counts, column_points, columns_beside, toward_camera)
 
 HUE_BINS = 12
@@ -265,16 +265,9 @@ def _observe_column(xy, offset, centre, floor_direction, heights, R, t, K, dist,
         if any_learnt:
             _column_penalties(surface, colour_heights, R, t, K, dist, has_dist, hit, image, tables, learnt, which,
                               penalty)
-    # add_camera with lv = the best ratio (+ weight · penalty), col_h = its top, ok = counts ≥ likely_count
-    for i in range(xy.shape[0]):
-        s = seen[i]
-        v = ratio[i]
-        if colour:
-            v = v + weight * penalty[i]
-        logpi[i] = logpi[i] + (v if s else 0.0)
-        col[i] = col[i] + (heights[top[i]] if s else 0.0)
-        likely[i] = likely[i] and (counts[i] >= likely_count or not s)
-        n_seen[i] += s
+    # lv = the best ratio (+ weight · penalty), col_h = its top's height, ok = counts ≥ likely_count
+    add_camera(seen, ratio, penalty if colour else penalty[:0], weight, heights[top], counts >= likely_count,
+               logpi, likely, n_seen, col)
 
 
 def learn_columns(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, centres: np.ndarray, widths: np.ndarray,

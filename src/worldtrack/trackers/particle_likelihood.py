@@ -814,9 +814,7 @@ def box_pixels(xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: 
     shifts = (0.0, -depth, depth)
     for i in range(xy.shape[0]):
         # The line of sight on the floor (as Camera.floor_rays) and across it.
-        dx, dy = xy[i, 0] - centre[0], xy[i, 1] - centre[1]
-        n = math.hypot(dx, dy)
-        ax, ay = (dx / n, dy / n) if n > 1e-9 else (floor_direction[0], floor_direction[1])
+        ax, ay = _floor_unit(xy[i, 0], xy[i, 1], centre, floor_direction)
         hw = 0.5 * widths[i] + margin
         lo_u, lo_v, hi_u, hi_v = np.inf, np.inf, -np.inf, -np.inf
         for a in range(3 if depth > 0.0 else 1):
@@ -842,6 +840,18 @@ def box_pixels(xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: 
             out[i, 0], out[i, 1], out[i, 2], out[i, 3] = -1, -1, -1, -1
 
 
+@njit(cache=True, inline="always")
+def _floor_unit(x, y, centre, floor_direction):
+    """Unit floor vector (a_x, a_y) from the camera's foot point ``centre`` towards (x, y); the
+    camera's ``floor_direction`` within 1e-9 m of it (:meth:`Camera.floor_rays`' ``along``)."""
+    dx = x - centre[0]
+    dy = y - centre[1]
+    n = math.hypot(dx, dy)
+    if n > 1e-9:
+        return dx / n, dy / n
+    return floor_direction[0], floor_direction[1]
+
+
 @njit(cache=True)
 def floor_along(xy: np.ndarray, centre: np.ndarray, floor_direction: np.ndarray, out: np.ndarray) -> None:
     """The camera's lines of sight on the floor through ``xy`` (N, 2), metres, in place: ``out``
@@ -849,15 +859,7 @@ def floor_along(xy: np.ndarray, centre: np.ndarray, floor_direction: np.ndarray,
     (2,) within 1e-9 m of it — :meth:`Camera.floor_rays`' ``along``, the same arithmetic (tested
     equal)."""
     for i in range(xy.shape[0]):
-        dx = xy[i, 0] - centre[0]
-        dy = xy[i, 1] - centre[1]
-        n = math.hypot(dx, dy)
-        if n > 1e-9:
-            out[i, 0] = dx / n
-            out[i, 1] = dy / n
-        else:
-            out[i, 0] = floor_direction[0]
-            out[i, 1] = floor_direction[1]
+        out[i, 0], out[i, 1] = _floor_unit(xy[i, 0], xy[i, 1], centre, floor_direction)
 
 
 @njit(cache=True)
@@ -874,13 +876,7 @@ def toward_camera(xy: np.ndarray, offset: float, centre: np.ndarray, floor_direc
     """``xy − offset·along`` (N, 2), metres, in place: the floor points ``offset`` m nearer to the
     camera along its lines of sight (:func:`floor_along`); tested equal to the NumPy expression."""
     for i in range(xy.shape[0]):
-        dx = xy[i, 0] - centre[0]
-        dy = xy[i, 1] - centre[1]
-        n = math.hypot(dx, dy)
-        if n > 1e-9:
-            ax, ay = dx / n, dy / n
-        else:
-            ax, ay = floor_direction[0], floor_direction[1]
+        ax, ay = _floor_unit(xy[i, 0], xy[i, 1], centre, floor_direction)
         out[i, 0] = xy[i, 0] - offset * ax
         out[i, 1] = xy[i, 1] - offset * ay
 
@@ -895,21 +891,9 @@ def columns_beside(xy: np.ndarray, offset: float, spread: np.ndarray, centre: np
     for i in range(xy.shape[0]):
         x, y = xy[i, 0], xy[i, 1]
         if offset > 0.0:
-            dx = x - centre[0]
-            dy = y - centre[1]
-            n = math.hypot(dx, dy)
-            if n > 1e-9:
-                ax, ay = dx / n, dy / n
-            else:
-                ax, ay = floor_direction[0], floor_direction[1]
+            ax, ay = _floor_unit(x, y, centre, floor_direction)
             x, y = x - offset * ax, y - offset * ay
-        dx = x - centre[0]
-        dy = y - centre[1]
-        n = math.hypot(dx, dy)
-        if n > 1e-9:
-            ax, ay = dx / n, dy / n
-        else:
-            ax, ay = floor_direction[0], floor_direction[1]
+        ax, ay = _floor_unit(x, y, centre, floor_direction)
         sx, sy = -ay * spread[i], ax * spread[i]
         out[3 * i, 0], out[3 * i, 1] = x, y
         out[3 * i + 1, 0], out[3 * i + 1, 1] = x + sx, y + sy
