@@ -159,7 +159,7 @@ def test_bimodal_split_with_splittables_principal_is_the_same():
 def test_resampling_kernel_agrees_with_reference():
     """Systematic and stratified resampling (cumulative weights, normalised, points merged in one
     kernel) draw the NumPy lookup's indices: ties, zero weights and a row with one weight included."""
-    from worldtrack.trackers.particle_sampling import resample_reference, stratified_resample, systematic_resample
+    from worldtrack.trackers.particle_sampling import _draw_rows, resample_reference, stratified_resample, systematic_resample
 
     rng = np.random.default_rng(7)
     for trial in range(30):
@@ -173,6 +173,11 @@ def test_resampling_kernel_agrees_with_reference():
             ref = resample_reference(w, np.random.default_rng(trial).random(shape), m)
             np.testing.assert_array_equal(got, ref)
             assert np.all(got[0] == m // 2) and not np.any(got[1:] % 3 == 0)
+    # Points exactly on a cumulative weight (0, 1/4, 2/4, 3/4 over four equal weights) fall after it
+    # (side="right"), in the kernel as in the reference; random points never test that.
+    for r in (np.zeros((1, 1)), np.zeros((1, 4))):
+        np.testing.assert_array_equal(_draw_rows(np.ones((1, 4)), r, 4), [[0, 1, 2, 3]])
+        np.testing.assert_array_equal(resample_reference(np.ones((1, 4)), r, 4), [[0, 1, 2, 3]])
 
 
 def test_take_rows_agrees_with_take_along_axis():

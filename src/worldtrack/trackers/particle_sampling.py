@@ -110,27 +110,15 @@ def _rows(weights: np.ndarray) -> np.ndarray:
 
 
 def _lookup(weights: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """(F, n) the index in each row of ``weights`` (F, M) where its sorted points ``u`` (F, n) in
-    [0, 1) fall in the normalised cumulative weights: ``searchsorted(c, u, side="right")`` per row,
-    capped at M − 1, found by one linear merge of each row's sorted points and weights (a
-    ``searchsorted`` of all rows at once costs ~5× more)."""
+    """(F, n) the index in each row of ``weights`` (F, M) where its points ``u`` (F, n) in [0, 1)
+    fall in the normalised cumulative weights: ``searchsorted(c, u, side="right")`` per row, capped
+    at M − 1. Plain NumPy, one call per row: the reference that :func:`_cumulative_lookup`'s merge
+    is tested against."""
     c = np.cumsum(weights, axis=1)
     c /= c[:, -1:]
-    out = np.empty(u.shape, dtype=np.int64)
-    _merge_sorted(c, np.ascontiguousarray(u), out)
-    return out
-
-
-@njit(cache=True)
-def _merge_sorted(c, u, out):
-    """Per row: the number of ``c`` values ≤ each ``u`` value (both ascending), at most M − 1, in place."""
     m = c.shape[1]
-    for f in range(c.shape[0]):
-        j = 0
-        for k in range(u.shape[1]):
-            while j < m and c[f, j] <= u[f, k]:
-                j += 1
-            out[f, k] = min(j, m - 1)
+    return np.array([np.minimum(np.searchsorted(row, points, side="right"), m - 1) for row, points in zip(c, u)],
+                    dtype=np.int64).reshape(u.shape)
 
 
 def gather_particles(idx: np.ndarray, xyz: np.ndarray, v: np.ndarray, h: np.ndarray, logpi: np.ndarray,
