@@ -370,31 +370,28 @@ def test_gather_particles_and_principal_agree_with_numpy():
     assert wide.sum() == 6 and not wide[3]
 
 
-def test_fused_resampling_agrees_with_weights_resampler_and_gather():
-    """The tracking filters' update: exponents, NumPy's exp, resampling and gathering in two kernels,
-    against weights_reference, systematic/stratified_resample and gather_particles with the same draws
-    (rows of zero likelihood, one -inf everywhere, resampled uniformly)."""
-    from worldtrack.trackers.particle_sampling import (gather_particles, resample_draws, resample_particles,
-                                                       stratified_resample, systematic_resample, weight_exponents,
-                                                       weights_reference)
+def test_particle_weights_agree_with_numpy_bit_for_bit():
+    """Eq. 8's weights from the kernel's max and exponents against weights_reference: equal bit for bit
+    for rows of filters and for one filter's row, a row of zero likelihood (-inf everywhere) weighs 1
+    throughout and is resampled uniformly, and so does a row with a NaN (np.max's NaN is not finite)."""
+    from worldtrack.trackers.particle_sampling import particle_weights, systematic_resample, weights_reference
 
     rng = np.random.default_rng(17)
-    f, m, n = 4, 300, 300
-    logpi = rng.normal(0, 20, (f, m))
+    logpi = rng.normal(0, 20, (4, 300))
     logpi[logpi < -25] = -np.inf
     logpi[2] = -np.inf                                   # nothing likely: uniform weights
-    parts = [rng.normal(size=(f, m, 3)), rng.normal(size=(f, m, 3)), rng.normal(size=(f, m)), logpi,
-             rng.random((f, m)) < 0.5, rng.uniform(0, 2, (f, m))]
-    for name, resample in (("systematic", systematic_resample), ("stratified", stratified_resample)):
-        arg, finite = weight_exponents(logpi, 0.2)
-        got = resample_particles(np.exp(arg), finite, resample_draws(name, f, n, np.random.default_rng(3)), n, *parts,
-                                 z=np.random.default_rng(4).random((f, n)))
-        idx = resample(weights_reference(logpi, 0.2), n, np.random.default_rng(3))
-        want = gather_particles(idx, *parts, z=np.random.default_rng(4).random((f, n)))
-        for a, b in zip(got, want):
-            np.testing.assert_array_equal(a, b)
-        assert not finite[2] and finite[[0, 1, 3]].all()
-        assert len(np.unique(idx[2])) > 250 and len(np.unique(idx[0])) < 100   # uniform row vs peaked rows
+    for power in (0.2, 1.0):
+        w = particle_weights(logpi, power)
+        np.testing.assert_array_equal(w, weights_reference(logpi, power))
+        np.testing.assert_array_equal(particle_weights(logpi[1], power), weights_reference(logpi[1], power))
+    assert (w[2] == 1).all() and w[[0, 1, 3]].max(axis=1).tolist() == [1.0, 1.0, 1.0]
+    idx = systematic_resample(w, 300, np.random.default_rng(3))
+    assert len(np.unique(idx[2])) == 300 and len(np.unique(idx[0])) < 100   # uniform row vs peaked rows
+    nan = logpi.copy()
+    nan[0, 5] = np.nan
+    np.testing.assert_array_equal(particle_weights(nan, 0.2), weights_reference(nan, 0.2))
+    assert (particle_weights(nan, 0.2)[0] == 1).all()
+    assert particle_weights(np.zeros((3, 0)), 0.2).shape == (3, 0)
 
 
 def test_region_sizes_and_row_means_agree_with_numpy():

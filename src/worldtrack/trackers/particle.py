@@ -99,8 +99,8 @@ from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, ad
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
                                                    gather_particles, inverse_lengths, jitter_reflect, order_statistic,
                                                    polygon_distance, predict_walk, raster_blocks, raster_contains,
-                                                   region_sizes, resample_draws, resample_particles, resampler,
-                                                   splittable, take_rows, weight_exponents, weights_reference)
+                                                   particle_weights, region_sizes, resampler, splittable,
+                                                   take_rows)
 
 Box = tuple[int, int, int, int]
 
@@ -735,9 +735,7 @@ class ParticleTracker:
     def _weights(self, logpi: np.ndarray) -> np.ndarray:
         """Eq. 8 up to its sum (the resampler normalises), along the last axis of ``logpi`` (one row
         per filter): ``g ∝ π^κ``; uniform in a row whose every π is 0."""
-        if logpi.shape[-1] == 0:
-            return np.ones(logpi.shape)
-        return weights_reference(logpi, self.config.likelihood_power)
+        return particle_weights(logpi, self.config.likelihood_power)
 
     def _resampled(self, parts: dict[str, np.ndarray], weights: np.ndarray, n: int) -> dict[str, np.ndarray]:
         """The particles of F filters resampled to ``n`` each in proportion to ``weights`` (F, M).
@@ -846,16 +844,7 @@ class ParticleTracker:
         parts = {name: self._stacked(fs, name) for name in PARTICLE_FIELDS if getattr(fs[0], name) is not None}
         # The share of likely particles (a count over N: the mean of the booleans, exactly).
         shares = (parts["likely"].sum(axis=1) / parts["likely"].shape[1]).tolist()
-        if tuple(parts) == PARTICLE_FIELDS and parts["logpi"].shape[1]:
-            # Weights (eq. 8) and resampling of all the filters' particles in two kernel calls
-            # round NumPy's exp, with the draws of _resampled in the same order.
-            arg, finite = weight_exponents(parts["logpi"], cfg.likelihood_power)
-            n = cfg.particles
-            r = resample_draws(cfg.resampling, len(fs), n, self.rng)
-            z = self.rng.random((len(fs), n)) if cfg.likelihood == "column" else None
-            resampled = dict(zip(PARTICLE_FIELDS, resample_particles(np.exp(arg), finite, r, n, *parts.values(), z=z)))
-        else:
-            resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
+        resampled = self._resampled(parts, self._weights(parts["logpi"]), cfg.particles)
         kept, lost = [], []
         for f, share in zip(fs, shares):
             if share <= cfg.beta:

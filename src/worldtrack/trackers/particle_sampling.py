@@ -154,19 +154,26 @@ def _gather_particles(idx, xyz, v, h, logpi, likely, col_h, z, oxyz, ov, oh, olo
                 oxyz[f, j, 2] = z[f, j] * ocol_h[f, j]
 
 
-def weight_exponents(logpi: np.ndarray, power: float) -> tuple[np.ndarray, np.ndarray]:
-    """Eq. 8's weights before their exponential, per row of ``logpi`` (F, M): ``power·(logpi − max)``
-    (F, M), and (F,) whether the row's max is finite (rows without weigh 1 throughout) — the
-    arithmetic of :func:`weights_reference` up to its ``np.exp`` (which stays NumPy's)."""
-    logpi = np.ascontiguousarray(logpi, dtype=np.float64)
-    arg = np.empty(logpi.shape)
-    finite = np.empty(len(logpi), dtype=np.bool_)
-    _weight_exponents(logpi, float(power), arg, finite)
-    return arg, finite
+def particle_weights(logpi: np.ndarray, power: float) -> np.ndarray:
+    """Eq. 8 up to its sum, along the last axis of ``logpi`` (M,) or (F, M): ``π^κ`` scaled by the
+    row's largest, 1 throughout a row whose every π is 0 — :func:`weights_reference` with its max and
+    exponent taken in one kernel pass (the ``np.exp`` stays NumPy's, so the weights are equal bit
+    for bit; tested)."""
+    shape = np.shape(logpi)
+    rows = np.ascontiguousarray(logpi, dtype=np.float64).reshape(math.prod(shape[:-1]), shape[-1])
+    arg = np.empty(rows.shape)
+    finite = np.empty(len(rows), dtype=np.bool_)
+    if rows.shape[1]:
+        _weight_exponents(rows, float(power), arg, finite)
+    else:
+        finite[:] = False
+    return np.where(finite[:, None], np.exp(arg), 1.0).reshape(shape)
 
 
 @njit(cache=True)
 def _weight_exponents(logpi, power, arg, finite):
+    """Per row: ``arg = power·(logpi − max)`` and whether the max is finite (where it is not, the
+    exponents are taken about 0 and then unused) — :func:`weights_reference` before its ``np.exp``."""
     for f in range(logpi.shape[0]):
         m = logpi[f, 0]
         for x in logpi[f]:
@@ -183,37 +190,10 @@ def _weight_exponents(logpi, power, arg, finite):
 
 
 def weights_reference(logpi: np.ndarray, power: float) -> np.ndarray:
-    """Eq. 8 up to its sum, per row of ``logpi`` (F, M): ``π^κ`` scaled by the row's largest, 1 in rows
-    whose every π is 0 (NumPy; the tracker's ``_weights``)."""
+    """:func:`particle_weights` in NumPy."""
     m = logpi.max(axis=-1, keepdims=True)
     finite = np.isfinite(m)
     return np.where(finite, np.exp(power * (logpi - np.where(finite, m, 0.0))), 1.0)
-
-
-def resample_particles(e: np.ndarray, finite: np.ndarray, r: np.ndarray, n: int, xyz: np.ndarray, v: np.ndarray,
-                       h: np.ndarray, logpi: np.ndarray, likely: np.ndarray, col_h: np.ndarray,
-                       z: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
-    """Resample F filters' particles to ``n`` each in two kernel calls: the weights ``e`` (F, M)
-    (``np.exp`` of :func:`weight_exponents`; 1 throughout the rows not ``finite``), the resampler's
-    uniform numbers ``r`` (:func:`resample_draws`), then :func:`gather_particles` of the picked ones
-    (with ``z``, the heights drawn). The same as :func:`_draw_rows` then :func:`gather_particles`."""
-    f = len(e)
-    idx = np.empty((f, n), dtype=np.int64)
-    out = (np.empty((f, n, 3)), np.empty((f, n, 3)), np.empty((f, n)), np.empty((f, n)),
-           np.empty((f, n), dtype=np.bool_), np.empty((f, n)))
-    _resample_particles(np.ascontiguousarray(e), finite, np.ascontiguousarray(r), idx)
-    _gather_particles(idx, xyz, v, h, logpi, likely, col_h, _NO_DRAWS if z is None else z, *out)
-    return out
-
-
-@njit(cache=True)
-def _resample_particles(e, finite, r, out):
-    """Per row: the weights (``e``, or 1 where not ``finite``), then :func:`_cumulative_lookup`."""
-    w = np.empty(e.shape)
-    for f in range(e.shape[0]):
-        for j in range(e.shape[1]):
-            w[f, j] = e[f, j] if finite[f] else 1.0
-    _cumulative_lookup(w, r, out)
 
 
 def take_rows(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
