@@ -293,7 +293,7 @@ def test_owner_image_agrees_with_reference_and_reused_equals_fresh():
                  (int(u), int(min(u + rng.integers(1, 90), W)), int(v), int(min(v + rng.integers(1, 90), H)))
                  for u, v in zip(rng.integers(0, W, k), rng.integers(0, H, k))]
         if trial % 5 == 4:
-            boxes += [(-30, -5, 10, 400), (300, 10, -50, 20)]           # slices from the end, empty
+            boxes += [(-30, -5, 10, 400), (300, 10, -50, 20), (10, 40, -30, H)]   # slices from the end, empty
         fresh = owner_image((H, W), boxes)
         np.testing.assert_array_equal(fresh, owner_image_reference((H, W), boxes))
         buf = owner_image((H, W), boxes, buf, previous)

@@ -263,11 +263,9 @@ def _count_boxes(out, clear, boxes):
     beyond the end is empty)."""
     # (Row slices: loops over them compile to vector code, indexing with possibly negative ints does not.)
     H = out.shape[0]
-    for j in range(clear.shape[0]):
-        for v in range(_start(clear[j, 2], H), _stop(clear[j, 3], H)):
-            out[v, clear[j, 0]:clear[j, 1]] = 0
+    _clear_ranges(out, clear)
     for j in range(boxes.shape[0]):
-        for v in range(_start(boxes[j, 2], H), _stop(boxes[j, 3], H)):
+        for v in range(_slice_index(boxes[j, 2], H), _slice_index(boxes[j, 3], H)):
             row = out[v, boxes[j, 0]:boxes[j, 1]]
             for u in range(row.shape[0]):
                 x = row[u]
@@ -275,15 +273,19 @@ def _count_boxes(out, clear, boxes):
 
 
 @njit(cache=True, inline="always")
-def _start(i, n):
-    """A slice start as Python takes it on an axis of ``n``: negative counts from the end."""
+def _slice_index(i, n):
+    """A slice start or stop as Python takes it on an axis of ``n`` (step 1): negative counts from
+    the end, then clipped to [0, n]."""
     return max(i + n, 0) if i < 0 else min(i, n)
 
 
 @njit(cache=True, inline="always")
-def _stop(i, n):
-    """A slice stop as Python takes it on an axis of ``n``."""
-    return max(i + n, 0) if i < 0 else min(i, n)
+def _clear_ranges(a, ranges):
+    """Zero the pixel ranges ``(u0, u1, v0, v1)`` (K, 4) of the image ``a`` as Python slices take them."""
+    H = a.shape[0]
+    for j in range(ranges.shape[0]):
+        for v in range(_slice_index(ranges[j, 2], H), _slice_index(ranges[j, 3], H)):
+            a[v, ranges[j, 0]:ranges[j, 1]] = 0
 
 
 def read_codes(hit: np.ndarray, owner: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -360,9 +362,7 @@ def _fill_layers(pairs, clear, boxes, ids):
     the boxes ``(u0, u1, v0, v1)`` (nearest first, with their indices ``ids``) the first two that
     cover it: index + 1 in bits 0–15, then 16–30, in place."""
     H, W = pairs.shape
-    for j in range(clear.shape[0]):
-        for v in range(_start(clear[j, 2], H), _stop(clear[j, 3], H)):
-            pairs[v, clear[j, 0]:clear[j, 1]] = 0
+    _clear_ranges(pairs, clear)
     for j in range(boxes.shape[0]):
         k = np.int32(ids[j] + 1)
         k2 = np.int32((ids[j] + 1) << 16)
