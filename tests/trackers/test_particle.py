@@ -731,7 +731,8 @@ def test_image_box_with_depth_covers_the_object_nearer_and_farther():
                                  dict(hit_rate_object=0.01), dict(births="lost"), dict(births="entry+anywhere"),
                                  dict(lost_radius=-1.0), dict(lost_hold_s=float("nan")), dict(merge_distance=0.0),
                                  dict(merge_distance=float("nan")), dict(merge_far_frames=0), dict(entry_reach=-1.0),
-                                 dict(merge_depth=0.0), dict(merge_depth=float("nan"))])
+                                 dict(merge_depth=0.0), dict(merge_depth=float("nan")),
+                                 dict(top_edge=-1.0), dict(top_edge_step=0.0), dict(top_edge_samples=-1)])
 def test_bad_configuration_is_an_input_error(bad):
     with pytest.raises(InputError):
         ParticleConfig(**bad)

@@ -229,6 +229,9 @@ class ParticleTracker:
                                 if cfg.pixel_weights == "depth" and cfg.weighting == "ratio" else 0.0)
                           for cid, cl in self._cams.items()}
         self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
+        # Top-edge samples about each particle's own height: below it on the object, above it over it.
+        steps = cfg.top_edge_step * np.arange(1, cfg.top_edge_samples + 1)
+        self._edge_offsets = np.concatenate([-steps, steps]) if self._top_sigma > 0 and cfg.top_edge > 0 else None
         self._resample = resampler(cfg.resampling)
         self._walkable_raster = scene.walkable.raster(0.01)
         self._walkable_blocks = raster_blocks(self._walkable_raster)
@@ -465,7 +468,7 @@ class ParticleTracker:
                    me: int | Sequence[int] = -1, colours: Mapping[str, ColourModel] | None = None,
                    which: np.ndarray | None = None,
                    px_scale: Mapping[str, np.ndarray] | None = None, k_lo: Mapping[str, np.ndarray] | None = None,
-                   hidden: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   hidden: dict | None = None, top_edge: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Log-likelihood of particles, summed over the cameras that see them.
 
         The particles of one filter, or (``which``) of several filters in one call: the kernels
@@ -497,6 +500,9 @@ class ParticleTracker:
             evidence (``common_view``); default none
         hidden : dict, optional — filled with {camera_id: (N,) int}, how many of each particle's
             lowest column samples are hidden (occluded or out of view)
+        top_edge : bool — with ``h``, add ``ParticleConfig.top_edge`` times the top-edge terms at each
+            particle's own height (:func:`top_edge_terms`; tracking filters, whose heights have
+            settled on their object's)
 
         Returns
         -------
@@ -541,6 +547,8 @@ class ParticleTracker:
                         cfg.appearance_weight, cfg.likely_count, logpi, likely, n_seen, col, hid)
                     if hidden is not None:
                         hidden[cid] = hid
+                    if top_edge and h is not None and self._edge_offsets is not None:
+                        cl.top_edge(img, xyz, h, self._edge_offsets, self._on, self._off, cfg.top_edge, logpi)
                     continue
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz, cl)
@@ -799,7 +807,7 @@ class ParticleTracker:
             xyz, h = np.concatenate([f.xyz for f in fs]), np.concatenate([f.h for f in fs])
             which = np.repeat(np.arange(len(fs)), sizes)
         out = self.likelihood(xyz, images, owners, boxes, h, occluders, np.arange(len(fs)), [f.colours for f in fs],
-                              which, scales, k_lo, hidden)
+                              which, scales, k_lo, hidden, top_edge=tracking)
         if hidden:
             # Next frame's k_lo: the share ``common_view`` of the filter's columns see every sample
             # from there up (tracking filters hold equal particle counts).

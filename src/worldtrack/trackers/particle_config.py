@@ -182,6 +182,21 @@ class ParticleConfig:
         grid). 0: no height state, the top is free in [min_height, max_height]. One camera's column
         leaves a valley of (depth, height) pairs that fit a body; a height that persists from frame
         to frame closes it where the feet do not show (clothes like the floor, a shadow) (0.05).
+    top_edge, top_edge_step, top_edge_samples
+        With ``ratio`` and ``top_sigma > 0``, for tracking filters (not in the paper): the column
+        reads its top on the ``dz`` grid, 5–10 pixels a step at 3–6 m. ``top_edge_samples`` (2)
+        samples ``top_edge_step`` (0.03 m) apart just below each particle's own height ``h`` must
+        read object and as many just above it background, each adding the column's ``on`` /
+        ``off`` / ``−on`` terms, the sum weighted by ``top_edge`` (1.0; 0 = off, the paper preset).
+        The top edge is then read to a pixel, and with the height held from frame to frame it fixes
+        depth along the line of sight where the feet, moving with the stride, do not: a walker's
+        head does not swing. Entry scenario (``benchmarks/particle_entry.py``, seeds 0–11 × tracker
+        seeds 0, 1), 0 → 1: mean error 0.102 → 0.091 m (along the line of sight 0.085 → 0.077), box
+        holds centre 91.9 → 94.1 %, MOTA 0.898 → 0.897; seeds 0–2: 0.115 → 0.096 m, tracks per
+        person 1.57 → 1.23, IDF1 0.79 → 0.86. With a scratch copy of the same terms (seeds 0–11):
+        weight 0.5 / 2: 0.095 / 0.095 m against 0.090; steps 0.02 m × 3: 0.090, 0.03 m × 3: 0.093;
+        for detection filters too: 0.093 m (their heights have not settled); with it,
+        ``foot_samples`` 2 or ``head_samples`` 1 change nothing (0.090, 0.091 m).
     height_spread : float, metres
         σ of new particles' heights about the scene's person height (0.1).
     noise_h : float, m/√s
@@ -375,6 +390,9 @@ class ParticleConfig:
     head_samples: int = 3
     pixel_weights: str = "hidden"
     top_sigma: float = 0.05
+    top_edge: float = 1.0
+    top_edge_step: float = 0.03
+    top_edge_samples: int = 2
     height_spread: float = 0.1
     noise_h: float = 0.02
     shadows: str = "background"
@@ -423,7 +441,7 @@ class ParticleConfig:
         a door out of view comes into view).
         Numbers it does not state stay ours."""
         base = cls(velocity="particle", weighting="count", likelihood_power=1.0, column_radius=0.0,
-                   foot_samples=0, head_samples=0, pixel_weights="none", top_sigma=0.0, shadows="object",
+                   foot_samples=0, head_samples=0, pixel_weights="none", top_sigma=0.0, top_edge=0.0, shadows="object",
                    out_of_view="background", explain="detection",
                    occlusion=False, appearance_weight=0.0, surface_offset=0.0,
                    split=False, merge=False, entry_reach=0.0,
@@ -449,14 +467,14 @@ class ParticleConfig:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
                 raise bad(name, "an integer ≥ 1")
-        for name in ("foot_samples", "head_samples"):
+        for name in ("foot_samples", "head_samples", "top_edge_samples"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
                 raise bad(name, "an integer ≥ 0")
-        for name in ("dz", "max_height", "min_height", "max_speed", "velocity_smoothing", "split_distance"):
+        for name in ("dz", "max_height", "min_height", "max_speed", "velocity_smoothing", "split_distance", "top_edge_step"):
             if not _number(getattr(self, name)) or not getattr(self, name) > 0:
                 raise bad(name, "a positive number")
-        for name in ("gamma", "top_sigma", "height_spread", "noise_h", "noise_xy", "noise_z", "noise_v", "velocity_spread", "box_margin", "surface_offset", "occlusion_margin", "exclusion_depth", "detection_noise", "entry_margin",
+        for name in ("gamma", "top_sigma", "top_edge", "height_spread", "noise_h", "noise_xy", "noise_z", "noise_v", "velocity_spread", "box_margin", "surface_offset", "occlusion_margin", "exclusion_depth", "detection_noise", "entry_margin",
                      "entry_reach", "lost_radius", "lost_hold_s", "end_after_s", "exit_lookahead_s", "exit_speed", "exit_hold_s", "likelihood_power", "column_radius", "appearance_weight"):
             if not _number(getattr(self, name)) or not getattr(self, name) >= 0:
                 raise bad(name, "a number ≥ 0")
