@@ -151,8 +151,16 @@ def main() -> int:
             box = image_box(cam, person[0, 0], person[0, 1], scene.people.width, scene.people.height,
                             cfg.box_margin)
             owners, boxes = {"cam": owner_image(seen.shape, [box])}, {"cam": box}
-        tk = median_time(lambda: tracker.likelihood(xyz, {"cam": seen}, owners, boxes, h), repeats=200)
+        tk = median_time(lambda: tracker.likelihood(xyz, {"cam": seen}, owners, boxes, h, top_edge=True),
+                         repeats=200)
         kernel_rows.append([f"ParticleTracker.likelihood, {name} config", 1000 * tk, tk / mog2])
+        if cfg.top_edge > 0 and cfg.top_sigma > 0:
+            offsets = cfg.top_edge_step * np.arange(-cfg.top_edge_samples, cfg.top_edge_samples + 1)
+            offsets = offsets[offsets != 0]
+            out, cl_edge = np.zeros(len(xyz)), CameraLikelihood(cam)
+            te = median_time(lambda: cl_edge.top_edge(seen, xyz, h, offsets, 2.5, -0.9, 1.0, out),
+                             repeats=200)
+            kernel_rows.append([f"of which the top edge ({len(offsets)} samples), {name} config", 1000 * te, te / mog2])
     # The bare kernel: a line column of the paper's 20 heights, against the NumPy reference.
     cl = CameraLikelihood(cam)
     hit = hit_image(fg.difference(img), gamma)
@@ -170,7 +178,7 @@ def main() -> int:
             f"Per frame, independent of the objects:\n\n{t1}\n\nTracking (median over {FRAMES - 3} frames; "
             f"per object = (ms/frame(K) − ms/frame(0)) / K):\n\n{t2}\n\nThe likelihood alone (one filter's "
             f"500 particles, as step reads them; default: 20 heights + {configs['default'].foot_samples} below + "
-            f"{configs['default'].head_samples} above, 3 lines):\n\n{t3}\n")
+            f"{configs['default'].head_samples} above, 3 lines, and the top edge of tracking filters):\n\n{t3}\n")
     print(text)
     path = write_result("particle_speed", "Particle tracker (seed 004): speed",
                         "Command: `.venv/bin/python benchmarks/particle_speed.py`\n\n" + text)

@@ -626,23 +626,40 @@ def test_inverse_lengths_agree_with_numpy():
     assert np.all(out[:8] == 0) and np.all(out[8:] > 0)
 
 
+def _top_edge(cl, hit, xy, tops, offsets, on, off, weight, out=None, **reading):
+    """CameraLikelihood.top_edge for particles read with ``reading`` (column_args' owner, box, ...)."""
+    out = np.zeros(len(xy)) if out is None else out
+    args = cl.column_args(hit, len(xy), np.zeros(1), on, off, **reading)
+    cl.top_edge(args, xy, tops, offsets, weight, out)
+    return out
+
+
 def test_top_edge_kernel_agrees_with_reference():
     """Random labels (object, background, no evidence), particles in and out of view, heights up to
-    where the samples leave the image; with and without lens distortion."""
+    where the samples leave the image; with and without lens distortion; plain, and with other
+    objects' boxes (background) and nearer ones (no evidence) over the samples."""
     rng = np.random.default_rng(11)
     labels = rng.integers(0, 3, (H, W)).astype(np.uint8)
     n = 3000
     xyz = np.column_stack([rng.uniform(-4, 4, n), rng.uniform(-0.5, 8.0, n), np.zeros(n)])
     tops = rng.uniform(0.5, 4.0, n)
     offsets = np.array([-0.06, -0.03, 0.03, 0.06])
+    boxes = [(40, 160, 0, 140), (120, 260, 20, 200), None, (0, W, 0, 60)]
+    depths = [2.0, 5.0, 3.0, 4.0]
+    which = rng.integers(0, 4, n)
+    explained = dict(owner=owner_image((H, W), boxes), box=boxes, me=[0, 1, 2, 3], which=which,
+                     occluders=occluder_layers((H, W), boxes, depths), margin=0.3)
     for dist in ([0, 0, 0, 0, 0], [-0.2, 0.05, 0.001, -0.002, 0]):
         cam = make_scene(cameras=(dict(CAM, distortion=dist) if any(dist) else CAM,)).cameras["cam"]
-        out = np.full(n, 0.5)
-        CameraLikelihood(cam).top_edge(labels, xyz, tops, offsets, 2.5, -0.9, 0.7, out)
-        ref = 0.5 + top_edge_terms_reference(cam, labels, xyz, tops, offsets, 2.5, -0.9, 0.7)
-        np.testing.assert_allclose(out, ref, rtol=0, atol=1e-12)
-        assert len(np.unique(np.round(out, 9))) > 10       # every kind of term exercised
-        assert (out == 0.5).sum() > 50                      # some particles wholly out of view
+        cl = CameraLikelihood(cam)
+        for reading in ({}, explained):
+            out = _top_edge(cl, labels, xyz, tops, offsets, 2.5, -0.9, 0.7, out=np.full(n, 0.5), **reading)
+            ref = 0.5 + top_edge_terms_reference(cam, labels, xyz, tops, offsets, 2.5, -0.9, 0.7, **reading)
+            np.testing.assert_allclose(out, ref, rtol=0, atol=1e-12)
+            assert len(np.unique(np.round(out, 9))) > 10       # every kind of term exercised
+            assert (out == 0.5).sum() > 50                      # some particles wholly out of view
+        plain = top_edge_terms_reference(cam, labels, xyz, tops, offsets, 2.5, -0.9, 0.7)
+        assert (out - 0.5 != plain).sum() > 300                 # the boxes changed many particles' terms
 
 
 def test_top_edge_peaks_at_the_true_height_and_depth():
@@ -661,9 +678,7 @@ def test_top_edge_peaks_at_the_true_height_and_depth():
     on, off = 2.5, -0.9
 
     def terms(xy, tops):
-        out = np.zeros(len(xy))
-        cl.top_edge(labels, np.asarray(xy, dtype=float), np.asarray(tops, dtype=float), offsets, on, off, 1.0, out)
-        return out
+        return _top_edge(cl, labels, np.asarray(xy, dtype=float), np.asarray(tops, dtype=float), offsets, on, off, 1.0)
 
     heights = np.arange(1.3, 1.9, 0.005)
     by_height = terms(np.repeat(truth[None], len(heights), 0), heights)

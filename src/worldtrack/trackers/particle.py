@@ -537,18 +537,19 @@ class ParticleTracker:
                     # The default: the whole camera's share in one compiled call (observe_column).
                     hid = np.empty(n, dtype=np.int32)
                     frame = self._frames.get(cid)
-                    observe_column(cl, xyz, cfg.surface_offset, cl.column_args(
+                    args = cl.column_args(
                         img, n, self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
                         self._n_below, self._n_above, owner, box, h, self._top_sigma,
                         self._px_scale[cid] if px_scale is None else px_scale[cid],
                         occluders.get(cid) if occluders is not None else None, me, cfg.occlusion_margin, which,
-                        cfg.out_of_view == "unknown", k_lo[cid] if k_lo is not None else 0), img, frame,
-                        [c.get(cid) if c else None for c in colours] if frame is not None else (),
-                        cfg.appearance_weight, cfg.likely_count, logpi, likely, n_seen, col, hid)
+                        cfg.out_of_view == "unknown", k_lo[cid] if k_lo is not None else 0)
+                    observe_column(cl, xyz, cfg.surface_offset, args, img, frame,
+                                   [c.get(cid) if c else None for c in colours] if frame is not None else (),
+                                   cfg.appearance_weight, cfg.likely_count, logpi, likely, n_seen, col, hid)
                     if hidden is not None:
                         hidden[cid] = hid
                     if top_edge and h is not None and self._edge_offsets is not None:
-                        cl.top_edge(img, xyz, h, self._edge_offsets, self._on, self._off, cfg.top_edge, logpi)
+                        cl.top_edge(args, xyz, h, self._edge_offsets, cfg.top_edge, logpi)
                     continue
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz, cl)

@@ -800,38 +800,45 @@ def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, d
 
 
 @njit(cache=True)
-def top_edge_terms(xyz: np.ndarray, tops: np.ndarray, offsets: np.ndarray, R: np.ndarray, t: np.ndarray,
-                   K: np.ndarray, dist: np.ndarray, has_dist: bool, labels: np.ndarray, on: float, off: float,
-                   weight: float, out: np.ndarray) -> None:
+def top_edge_terms(xy: np.ndarray, tops: np.ndarray, offsets: np.ndarray, weight: float, out: np.ndarray,
+                   R: np.ndarray, t: np.ndarray, K: np.ndarray, dist: np.ndarray, has_dist: bool, codes: np.ndarray,
+                   boxes: np.ndarray, which: np.ndarray, pairs: np.ndarray, depths: np.ndarray, mes: np.ndarray,
+                   centre: np.ndarray, margin: float, on: float, off: float) -> None:
     """Log-ratio of the object's top edge at each particle's own height, added to ``out`` in place.
 
     The column reads its top on the ``dz`` grid (0.1 m: 5–10 pixels at 3–6 m); these samples read it
     at the particle's own height ``tops[i]``, which the particle carries from frame to frame. Where
     that height has settled on the object's, the top edge tells depth along the line of sight, and
-    a walker's head, unlike the feet, does not move with the stride.
+    a walker's head, unlike the feet, does not move with the stride. Each sample is read as a
+    column sample on the particle's axis is (:func:`column_counts`): in another object's box it
+    reads background, or no evidence if that object is nearer by more than ``margin``.
 
     Parameters
     ----------
-    xyz : (N, ≥ 2) float64, metres — particles' floor positions (columns 0, 1)
+    xy : (N, ≥ 2) float64, metres — particles' floor positions (columns 0, 1)
     tops : (N,) float64, metres — the particles' object heights
     offsets : (E,) float64, metres — sample heights relative to the top: those below 0 are on the
         object (``on`` if they read object, ``off`` if background), those above it over it (``−on``
-        if they read object, nothing if background)
-    R, t, K, dist, has_dist : the camera, as in :func:`column_counts`
-    labels : (H, W) uint8 — 1 object, 0 background, anything else no evidence (:func:`hit_labels`)
-    on, off : float — the column's log-ratio terms of a sample on / off the object
+        if they read object, nothing if background); a sample out of view reads no evidence
     weight : float — multiplies the sum of the terms
     out : (N,) float64 — in/out: the terms are added
+    R, t, K, dist, has_dist, codes, boxes, which, pairs, depths, mes, centre, margin, on, off :
+        as in :func:`column_counts` (:meth:`CameraLikelihood.column_args` gives them)
     """
-    H, W = labels.shape
+    H, W = codes.shape
     lens = _lens(K, dist)
-    for i in range(xyz.shape[0]):
+    for i in range(xy.shape[0]):
+        box = _box(boxes, which[i])
+        me = mes[which[i]]
+        depth = math.hypot(xy[i, 0] - centre[0], xy[i, 1] - centre[1])
         s = 0.0
         for j in range(offsets.shape[0]):
-            iu, iv = _to_pixel(xyz[i, 0], xyz[i, 1], tops[i] + offsets[j], R, t, lens, has_dist, W, H)
+            iu, iv = _to_pixel(xy[i, 0], xy[i, 1], tops[i] + offsets[j], R, t, lens, has_dist, W, H)
             if iu < 0:
                 continue                                    # out of view: no evidence
-            lab = labels[iv, iu]
+            lab, other = _read_line(codes, box, iu, iv, _OUT_OF_VIEW)
+            if other and _occluded(pairs, depths, me, iu, iv, depth, margin):
+                continue                                    # behind a nearer object: no evidence
             if offsets[j] < 0.0:
                 if lab == 1:
                     s += on
@@ -1203,15 +1210,26 @@ def point_values_reference(camera: Camera, F: np.ndarray, xyz: np.ndarray, owner
     return np.where(ok, F[iv, iu], 0.0).astype(float), inside
 
 
-def top_edge_terms_reference(camera: Camera, labels: np.ndarray, xyz: np.ndarray, tops: np.ndarray,
-                             offsets: Sequence[float], on: float, off: float, weight: float = 1.0) -> np.ndarray:
-    """:func:`top_edge_terms` written plainly: (N,) the weighted top-edge terms of each particle."""
-    xyz = np.asarray(xyz, dtype=float).reshape(len(tops), -1)
+def top_edge_terms_reference(camera: Camera, hit: np.ndarray, xy: np.ndarray, tops: np.ndarray,
+                             offsets: Sequence[float], on: float, off: float, weight: float = 1.0,
+                             owner: np.ndarray | None = None, box=None, occluders: Occluders | None = None,
+                             me: int | Sequence[int] = -1, margin: float = 0.0,
+                             which: np.ndarray | None = None) -> np.ndarray:
+    """:func:`top_edge_terms` written plainly: (N,) the weighted top-edge terms of each particle;
+    ``owner``, ``box``, ``occluders``, ``me``, ``margin`` and ``which`` as in :meth:`CameraLikelihood.column`."""
+    tops = np.asarray(tops, dtype=float)
+    xy = np.asarray(xy, dtype=float).reshape(len(tops), -1)[:, :2]
     offsets = np.asarray(offsets, dtype=float)
-    points = np.concatenate([np.broadcast_to(xyz[:, None, :2], (len(xyz), len(offsets), 2)),
-                             (np.asarray(tops, dtype=float)[:, None] + offsets)[..., None]], axis=-1)
+    boxes, mes, which = filter_rows(box, me, which, len(xy))
+    points = np.concatenate([np.broadcast_to(xy[:, None, :], (len(xy), len(offsets), 2)),
+                             (tops[:, None] + offsets)[..., None]], axis=-1)
     iu, iv, inside = _pixels(camera, points)
-    lab = np.where(inside, labels[iv, iu], 2)
+    readable = _readable(owner, boxes[which], iu, iv)
+    lab = np.where(readable, hit[iv, iu], 0)               # in another object's box: background
+    lab = np.where(inside, lab, 2)
+    if occluders is not None and occluders.pairs.size:
+        nearer = occluders.depth_for(mes[which][:, None], iv, iu) < camera.floor_rays(xy)[1][:, None] - margin
+        lab = np.where(inside & ~readable & nearer, 2, lab)
     below = offsets < 0
     terms = np.where(below, np.where(lab == 1, on, np.where(lab == 0, off, 0.0)), np.where(lab == 1, -on, 0.0))
     return weight * terms.sum(axis=1)
@@ -1350,13 +1368,14 @@ class CameraLikelihood:
                 float(top_sigma) if tops is not None else 0.0, pixel_scales(px_scale, len(boxes)),
                 bool(outside_unknown), _per_filter_int(k_lo, len(boxes)))
 
-    def top_edge(self, labels: np.ndarray, xyz: np.ndarray, tops: np.ndarray, offsets: np.ndarray, on: float,
-                 off: float, weight: float, out: np.ndarray) -> None:
-        """Add ``weight`` times the top-edge terms of the particles ``xyz`` (N, ≥ 2) at heights
-        ``tops`` (N,) to ``out`` (N,) in place (:func:`top_edge_terms`)."""
-        top_edge_terms(np.ascontiguousarray(xyz, dtype=np.float64), np.ascontiguousarray(tops, dtype=np.float64),
-                       np.ascontiguousarray(offsets, dtype=np.float64), self.R, self.t, self.K, self.dist,
-                       self.has_dist, labels, float(on), float(off), float(weight), out)
+    def top_edge(self, column_args: tuple, xy: np.ndarray, tops: np.ndarray, offsets: np.ndarray, weight: float,
+                 out: np.ndarray) -> None:
+        """Add ``weight`` times the top-edge terms (:func:`top_edge_terms`) of the particles ``xy``
+        (N, ≥ 2) at heights ``tops`` (N,), metres, at ``offsets`` (E,) metres from them, to ``out`` (N,)
+        in place, read as :meth:`column_args` ``column_args`` (for the same N particles) reads."""
+        a = column_args
+        top_edge_terms(np.ascontiguousarray(xy, dtype=np.float64), np.ascontiguousarray(tops, dtype=np.float64),
+                       np.ascontiguousarray(offsets, dtype=np.float64), float(weight), out, *a[1:6], *a[7:17])
 
     def point(self, F: np.ndarray, xyz: np.ndarray, owner: np.ndarray | None = None,
               box=None, which: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
