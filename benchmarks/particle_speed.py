@@ -45,7 +45,7 @@ from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box  # noqa: E402
 from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
                                                      floor_pixels, hit_image, hit_labels, hit_labels_reference,
-                                                     owner_image)
+                                                     owner_image, top_edge_offsets)
 
 W, H = 640, 480
 SCENE = {"name": "speed", "cameras": [{"id": "cam", "image_size": [W, H], "position": [0, -2, 3.5],
@@ -155,11 +155,11 @@ def main() -> int:
                          repeats=200)
         kernel_rows.append([f"ParticleTracker.likelihood, {name} config", 1000 * tk, tk / mog2])
         if cfg.top_edge > 0 and cfg.top_sigma > 0:
-            offsets = cfg.top_edge_step * np.arange(-cfg.top_edge_samples, cfg.top_edge_samples + 1)
-            offsets = offsets[offsets != 0]
+            offsets = top_edge_offsets(cfg.top_edge_step, cfg.top_edge_samples)
             out, cl_edge = np.zeros(len(xyz)), CameraLikelihood(cam)
-            te = median_time(lambda: cl_edge.top_edge(seen, xyz, h, offsets, 2.5, -0.9, 1.0, out),
-                             repeats=200)
+            args = cl_edge.column_args(seen, len(xyz), cfg.heights, owner=owners["cam"] if owners else None,
+                                       box=boxes["cam"] if boxes else None)
+            te = median_time(lambda: cl_edge.top_edge(args, xyz, h, offsets, cfg.top_edge, out), repeats=200)
             kernel_rows.append([f"of which the top edge ({len(offsets)} samples), {name} config", 1000 * te, te / mog2])
     # The bare kernel: a line column of the paper's 20 heights, against the NumPy reference.
     cl = CameraLikelihood(cam)

@@ -95,7 +95,7 @@ from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_appearance import ColourModel, column_penalties, learn_columns, observe_column
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_on_one_object,
                                                      floor_pixels, hit_image, hit_labels, occluder_layers, owner_image,
-                                                     thresholded_difference)
+                                                     thresholded_difference, top_edge_offsets)
 from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
                                                    gather_particles, inverse_lengths, jitter_reflect, order_statistic,
                                                    polygon_distance, predict_walk, raster_blocks, raster_contains,
@@ -230,8 +230,8 @@ class ParticleTracker:
                           for cid, cl in self._cams.items()}
         self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
         # Top-edge samples about each particle's own height: below it on the object, above it over it.
-        steps = cfg.top_edge_step * np.arange(1, cfg.top_edge_samples + 1)
-        self._edge_offsets = np.concatenate([-steps, steps]) if self._top_sigma > 0 and cfg.top_edge > 0 else None
+        self._edge_offsets = (top_edge_offsets(cfg.top_edge_step, cfg.top_edge_samples)
+                              if self._top_sigma > 0 and cfg.top_edge > 0 else None)
         self._resample = resampler(cfg.resampling)
         self._walkable_raster = scene.walkable.raster(0.01)
         self._walkable_blocks = raster_blocks(self._walkable_raster)

@@ -799,6 +799,13 @@ def point_values(xyz: np.ndarray, R: np.ndarray, t: np.ndarray, K: np.ndarray, d
             values[i] = F[iv, iu]
 
 
+def top_edge_offsets(step: float, samples: int) -> np.ndarray:
+    """(2·samples,) float64, metres: the top-edge sample heights relative to a particle's top,
+    ``−step, −2·step, …`` (on the object) then ``step, 2·step, …`` (over it)."""
+    steps = float(step) * np.arange(1, int(samples) + 1)
+    return np.concatenate([-steps, steps])
+
+
 @njit(cache=True)
 def top_edge_terms(xy: np.ndarray, tops: np.ndarray, offsets: np.ndarray, weight: float, out: np.ndarray,
                    R: np.ndarray, t: np.ndarray, K: np.ndarray, dist: np.ndarray, has_dist: bool, codes: np.ndarray,
