@@ -549,7 +549,10 @@ class ParticleTracker:
                     if hidden is not None:
                         hidden[cid] = hid
                     if top_edge and h is not None and self._edge_offsets is not None:
-                        cl.top_edge(args, xyz, h, self._edge_offsets, cfg.top_edge, logpi)
+                        # Raw labels unless top_edge_explain: no boxes, so codes are the labels themselves.
+                        edge_args = args if cfg.top_edge_explain else cl.column_args(img, n, self._column, self._on,
+                                                                                     self._off)
+                        cl.top_edge(edge_args, xyz, h, self._edge_offsets, cfg.top_edge, logpi)
                     continue
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz, cl)

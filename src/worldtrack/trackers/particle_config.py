@@ -188,18 +188,22 @@ class ParticleConfig:
         samples ``top_edge_step`` (0.03 m) apart just below each particle's own height ``h`` must
         read object and as many just above it background, each adding the column's ``on`` /
         ``off`` / ``−on`` terms, the sum weighted by ``top_edge`` (1.0; 0 = off, the paper preset).
-        They are read as the column's samples are (another object's box reads background, a nearer
-        one's no evidence). The top edge is then read to a pixel, and with the height held from
-        frame to frame it fixes depth along the line of sight where the feet, moving with the
-        stride, do not: a walker's head does not swing. Entry scenario
-        (``benchmarks/particle_entry.py``, seeds 0–11 × tracker seeds 0, 1), 0 → 1: mean error 0.102
-        → 0.092 m (along the line of sight 0.085 → 0.079), box holds centre 91.9 → 93.7 %, MOTA
-        0.898 → 0.892 (tracker seeds 2, 3: 0.094 m); seeds 0–2: 0.115 → 0.097 m. Reading raw labels
-        instead (every box ignored): 0.091 m, but crowd-5 (``compare_methods.py``' scene, tracker
-        seeds 0–2) MOTA 0.42 → 0.38. With a scratch copy of the raw-label terms (seeds 0–11): weight
-        0.5 / 2: 0.095 / 0.095 m against 0.090; steps 0.02 m × 3: 0.090, 0.03 m × 3: 0.093; for
-        detection filters too: 0.093 m (their heights have not settled); ``foot_samples`` 2 or
-        ``head_samples`` 1 change nothing (0.090, 0.091 m).
+        The top edge is then read to a pixel, and with the height held from frame to frame it fixes
+        depth along the line of sight where the feet, moving with the stride, do not: a walker's
+        head does not swing. Entry scenario (``benchmarks/particle_entry.py``, seeds 0–11 × tracker
+        seeds 0, 1), 0 → 1: mean error 0.102 → 0.091 m (along the line of sight 0.085 → 0.077), box
+        holds centre 91.9 → 94.1 %, MOTA 0.898 → 0.897 (tracker seeds 2, 3: 0.094 m); seeds 0–2:
+        0.115 → 0.096 m. With a scratch copy of the same terms (seeds 0–11): weight 0.5 / 2: 0.095 /
+        0.095 m; steps 0.02 m × 3: 0.090, 0.03 m × 3: 0.093; for detection filters too: 0.093 m
+        (their heights have not settled); ``foot_samples`` 2 or ``head_samples`` 1 change nothing.
+        PETS 2009 S2.L1 (``benchmarks/real_data.py``, 3 seeds): MOTA 0.882 ± 0.017 → 0.872 ± 0.020,
+        IDF1 0.497 → 0.536.
+    top_edge_explain : bool
+        Read the top-edge samples as the column's are — in another tracked object's box background,
+        in a nearer one's no evidence — rather than the labels as they are (False). In principle the
+        consistent choice, in practice worse: entry seeds 0–11 × tracker seeds 0–3 0.093 against
+        0.092 m, PETS 2009 S2.L1 MOTA 0.836 ± 0.029 against 0.872 ± 0.020 (``compare_methods.py``'
+        crowd-5 scene, tracker seeds 0–2: 0.42 against 0.38; its entry scene 0.74 against 0.87).
     height_spread : float, metres
         σ of new particles' heights about the scene's person height (0.1).
     noise_h : float, m/√s
@@ -396,6 +400,7 @@ class ParticleConfig:
     top_edge: float = 1.0
     top_edge_step: float = 0.03
     top_edge_samples: int = 2
+    top_edge_explain: bool = False
     height_spread: float = 0.1
     noise_h: float = 0.02
     shadows: str = "background"
