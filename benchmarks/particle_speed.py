@@ -157,8 +157,10 @@ def main() -> int:
         if cfg.top_edge > 0 and cfg.top_sigma > 0:
             offsets = top_edge_offsets(cfg.top_edge_step, cfg.top_edge_samples)
             out, cl_edge = np.zeros(len(xyz)), CameraLikelihood(cam)
-            args = cl_edge.column_args(seen, len(xyz), cfg.heights, owner=owners["cam"] if owners else None,
-                                       box=boxes["cam"] if boxes else None)
+            # The route step takes: the labels as they are, unless top_edge_explain reads the boxes.
+            args = (cl_edge.column_args(seen, len(xyz), cfg.heights, owner=owners["cam"] if owners else None,
+                                        box=boxes["cam"] if boxes else None)
+                    if cfg.top_edge_explain else cl_edge.column_args(seen, len(xyz), cfg.heights))
             te = median_time(lambda: cl_edge.top_edge(args, xyz, h, offsets, cfg.top_edge, out), repeats=200)
             kernel_rows.append([f"of which the top edge ({len(offsets)} samples), {name} config", 1000 * te, te / mog2])
     # The bare kernel: a line column of the paper's 20 heights, against the NumPy reference.

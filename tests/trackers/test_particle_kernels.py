@@ -723,13 +723,14 @@ def test_tracking_likelihood_adds_the_weighted_top_edge_terms():
     # top_edge_explain.
     boxes = [(0, W // 2, 0, H), None]
     owners = {"cam": owner_image((H, W), boxes)}
+    second = np.ones(n, dtype=np.int64)                     # every particle is filter 1's
     for explain in (False, True):
         tr = ParticleTracker(scene, fgs, ParticleConfig(top_edge=0.7, top_edge_step=0.04, top_edge_samples=3,
                                                         top_edge_explain=explain))
-        args = (xyz, {"cam": labels}, owners, {"cam": [b for b in boxes]}, h)
-        base = tr.likelihood(*args, me=[0, 1], which=np.ones(n, dtype=np.int64))[0]
-        got = tr.likelihood(*args, me=[0, 1], which=np.ones(n, dtype=np.int64), top_edge=True)[0]
-        reading = dict(owner=owners["cam"], box=boxes, me=[0, 1], which=np.ones(n, dtype=np.int64)) if explain else {}
+        args = (xyz, {"cam": labels}, owners, {"cam": list(boxes)}, h)
+        base = tr.likelihood(*args, me=[0, 1], which=second)[0]
+        got = tr.likelihood(*args, me=[0, 1], which=second, top_edge=True)[0]
+        reading = dict(owner=owners["cam"], box=boxes, me=[0, 1], which=second) if explain else {}
         want = top_edge_terms_reference(cam, labels, xyz, h, [-0.04, -0.08, -0.12, 0.04, 0.08, 0.12], on, off, 0.7,
                                         **reading)
         ok = np.isfinite(base)

@@ -502,7 +502,8 @@ class ParticleTracker:
             lowest column samples are hidden (occluded or out of view)
         top_edge : bool — with ``h``, add ``ParticleConfig.top_edge`` times the top-edge terms at each
             particle's own height (:func:`top_edge_terms`; tracking filters, whose heights have
-            settled on their object's)
+            settled on their object's), read from the labels as they are, or with
+            ``top_edge_explain`` as the column reads them (``owners``, ``boxes``, ``occluders``)
 
         Returns
         -------
