@@ -24,6 +24,7 @@ from worldtrack.io.sources import Frame
 from worldtrack.io.tracks import TrackTable
 from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
 from worldtrack.trackers import make_tracker
+from worldtrack.trackers.base import warm_started
 
 
 @dataclass
@@ -114,12 +115,18 @@ def step_tracker(tracker, frames: Iterable[tuple[int, float, dict]],
     """Step ``tracker`` over ``(index, time, {camera: Frame})`` items (e.g. :func:`bundle_frames`).
 
     Returns ``row(index, time, track)`` for every reported track, in order (nothing when ``row``
-    is None), and the seconds spent in ``tracker.step`` alone.
+    is None), and the seconds spent in the tracker: ``tracker.step`` and its warm start, if it has
+    one (:func:`worldtrack.trackers.base.warm_started`).
     """
     rows: list = []
     seconds = 0.0
-    for index, t, views in frames:
+    items = warm_started(tracker, frames)
+    while True:
         t0 = time.perf_counter()
+        item = next(items, None)    # the first item also runs the tracker's warm start, if any
+        if item is None:
+            break
+        index, t, views = item
         tracks = tracker.step(views, t)
         seconds += time.perf_counter() - t0
         if row is not None:

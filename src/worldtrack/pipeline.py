@@ -19,6 +19,7 @@ import numpy as np
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import AdaptiveBackground, StaticBackground, estimate_background
 from worldtrack.scene.model import Scene
+from worldtrack.trackers.base import warm_started
 
 FOREGROUNDS = ("grey", "colour", "mog2", "knn")
 #: Difference thresholds for the static foregrounds: grey levels, and RGB distance. 30 suits
@@ -114,7 +115,8 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
     Parameters
     ----------
     source : iterable of ``(index, t, {camera_id: Frame})`` (e.g. :class:`VideoSource`)
-    tracker : object with ``step(frames, t) -> list[Track]``
+    tracker : object with ``step(frames, t) -> list[Track]`` (and a warm start on the first frames,
+        if it has one: :func:`worldtrack.trackers.base.warm_started`)
     json_stream : write one JSON object per frame (``{"frame", "time", "tracks": [...]}``) here
     gt_paths : ground-truth paths to draw dashed on the floor plan
 
@@ -145,7 +147,7 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
         bar = tqdm(total=total, unit="frame", desc="tracking", leave=False, dynamic_ncols=True, mininterval=0.5)
     t_start = time.perf_counter()
     try:
-        for index, t, frames in source:
+        for index, t, frames in warm_started(tracker, source):
             tracks = tracker.step(frames, t)
             rows = [_row(tr) for tr in tracks]
             writer.write(index, t, rows)

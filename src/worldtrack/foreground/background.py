@@ -32,6 +32,9 @@ _MOG[127] = UNSURE
 
 
 class Foreground(Protocol):
+    #: True when ``labels``/``mask`` update a model (the answer depends on the frames seen before).
+    learns: bool
+
     def mask(self, image: np.ndarray) -> np.ndarray:
         """(H, W) uint8, 1 = foreground."""
         ...
@@ -82,6 +85,8 @@ class StaticBackground:
         dark garment of the floor's colour hides the floor's pattern, a shadow keeps it (see
         :mod:`worldtrack.foreground.texture`). None: no texture test.
     """
+
+    learns = False  #: a fixed background: the same frame always gives the same labels
 
     def __init__(self, background: np.ndarray, threshold: float = 30.0, mode: str = "grey", open_px: int = 0,
                  shadows: bool = False, shadow_min_ratio: float = 0.45, shadow_distortion: float = 0.08,
@@ -158,6 +163,8 @@ class AdaptiveBackground:
     learning_rate : float — −1 for OpenCV's automatic rate
     open_px : int — radius of a morphological opening after thresholding
     """
+
+    learns = True  #: every frame updates the model
 
     def __init__(self, method: str = "mog2", history: int = 500, shadows: bool = True,
                  background: np.ndarray | None = None, learning_rate: float = -1.0, open_px: int = 1,

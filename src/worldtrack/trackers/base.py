@@ -8,7 +8,7 @@ this process currently sees. It is the integration point between trackers, camer
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Iterator, Mapping, Protocol
+from typing import Iterable, Iterator, Mapping, Protocol
 
 import numpy as np
 
@@ -138,3 +138,42 @@ class Tracker(Protocol):
     def step(self, frames: Mapping[str, "object"], t: float) -> list[Track]:
         """Update with ``frames`` (``{camera_id: Frame}``) taken at time ``t`` (s)."""
         ...
+
+
+def warm_started(tracker: object, items: Iterable[tuple[int, float, Mapping[str, object]]]
+                 ) -> Iterator[tuple[int, float, Mapping[str, object]]]:
+    """The frames ``items`` unchanged, after the tracker's warm start on the first ones.
+
+    A tracker that wants one (``warm_start_frames`` > 0, e.g. the ellipsoid tracker's) gets
+    ``warm_start([(t, frames), ...])`` with up to that many first items before the first is
+    yielded; any other tracker gets the items as they come.
+
+    Parameters
+    ----------
+    tracker : object, optionally with ``warm_start_frames`` and ``warm_start``
+    items : iterable of ``(index, t, {camera_id: Frame})`` (e.g. a ``VideoSource``)
+
+    Yields
+    ------
+    the same items, in order. An error met while reading the first items (a corrupt frame) is
+    raised after the items read before it, which are warmed on and yielded first, so nothing
+    readable is lost.
+    """
+    n = int(getattr(tracker, "warm_start_frames", 0) or 0)
+    it = iter(items)
+    if n <= 0:
+        yield from it
+        return
+    head: list = []
+    try:
+        for item in it:
+            head.append(item)
+            if len(head) >= n:
+                break
+    except BaseException:
+        tracker.warm_start([(t, frames) for _, t, frames in head])  # type: ignore[attr-defined]
+        yield from head
+        raise
+    tracker.warm_start([(t, frames) for _, t, frames in head])  # type: ignore[attr-defined]
+    yield from head
+    yield from it
