@@ -146,8 +146,8 @@ class EllipsoidConfig:
         crowd the first 5 frames held 1 in 4 of all misses. Costs a delay of this many frames
         before the first output (10: 1 s at 10 frames/s), and about twice their tracking time once.
         In that crowd 10, 15 and 25 frames did equally well (mean MOTA over 40 seeds 0.895, 0.889,
-        0.893, against 0.881 with none). Skipped when the
-        foreground learns from the frames it sees (MOG2/KNN) or people were put on the map by hand
+        0.893, against 0.881 with none). Skipped when the foreground learns from the frames it sees
+        (MOG2/KNN) or people were put on the map by hand
     """
 
     step_m: float = 0.05
