@@ -165,15 +165,16 @@ def warm_started(tracker: object, items: Iterable[tuple[int, float, Mapping[str,
         yield from it
         return
     head: list = []
+    error: BaseException | None = None
     try:
         for item in it:
             head.append(item)
             if len(head) >= n:
                 break
-    except BaseException:
-        tracker.warm_start([(t, frames) for _, t, frames in head])  # type: ignore[attr-defined]
-        yield from head
-        raise
+    except BaseException as e:     # raised below, once the frames read before it are through
+        error = e
     tracker.warm_start([(t, frames) for _, t, frames in head])  # type: ignore[attr-defined]
     yield from head
+    if error is not None:
+        raise error
     yield from it
