@@ -20,7 +20,7 @@ Today that is PETS 2009 S2.L1, View_001 (``pets2009_s2l1``), processed as
 5. scoring: ``worldtrack.eval.evaluate_detailed`` inside Milan's tracking area
    (``examples/pets2009/tracking_area.txt``) with a 1 m gate — MOTA, IDF1, ID switches — and the mean
    position error of the matched pairs (``position_errors``, 1 m gate, over the rows in the area);
-   frames/s is ``tracker.step`` alone.
+   frames/s is the tracker alone (``step``, and the ellipsoid tracker's warm start).
 
 Folders without what this needs are skipped with one line saying why (``eth_ewap`` has world
 trajectories but no video, so no image-based tracker can run on it); when ``../shared/data`` is
@@ -114,8 +114,8 @@ def read_video(path: Path, limit: int | None) -> list[np.ndarray]:
 
 def track(method: str, scene, camera: str, background: np.ndarray, frames: list,
           fps: float, first: int = 0, **options) -> tuple[TrackTable, float]:
-    """Run one tracker over the frames from index ``first`` on; (predictions, frames/s of
-    ``step``). ``options`` go to :func:`make_tracker` (e.g. ``seed`` for the particle tracker)."""
+    """Run one tracker over the frames from index ``first`` on; (predictions, frames/s of the
+    tracker, warm start included). ``options`` go to :func:`make_tracker` (e.g. ``seed`` for the particle tracker)."""
     fgs = make_foregrounds(scene, {camera: background}, FOREGROUND)
     tracker = make_tracker(method, scene, fgs, **options)
     rows, seconds = step_tracker(tracker, ((k, k / fps, {camera: Frame(img, k / fps, k)})
@@ -191,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
     table = markdown_table(["data", "frames", "method", "runs", "MOTA", "IDF1", "ID switches", "mean error m",
                             "recall", "precision", "frames/s"], rows)
     text = (f"Inside the tracking area, gate {GATE_M} m; default presets, foreground `{FOREGROUND}` (blobs: MOG2); "
-            f"frames/s of `tracker.step` alone. Each row is the mean over `runs` runs (MOTA and IDF1 ± their "
+            f"frames/s of the tracker alone (its steps, and the ellipsoid tracker's warm start). Each row is the mean over `runs` runs (MOTA and IDF1 ± their "
             f"standard deviation): the particle tracker with seeds 0, 1, ...; the deterministic trackers started on "
             f"frame 0, 1, ... in turn, each scored on the frames it saw. Both kinds are chaotic: one early decision "
             f"taken differently changes everything after it, and one run's MOTA moves by up to ±0.05.\n\n{table}\n\n" + "\n".join(f"- {n}" for n in notes) + "\n")

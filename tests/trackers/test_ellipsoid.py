@@ -421,7 +421,7 @@ def test_head_rays_that_miss_each_other_give_no_height_that_frame(monkeypatch):
 # ---------------------------------------------------------------- warm start
 
 
-def _walker_run(warm_start_frames: int, foreground: str = "colour") -> tuple[list, list]:
+def _walker_run(warm_start_frames: int) -> tuple[list, list]:
     """A 1.85 m person walking 1 m/s along +x from (−2, 1.5), 12 frames in both lab cameras
     (320x240), tracked through :func:`step_tracker`: the rows ``(frame, id, x, y, vx, vy, height)``
     and the true path."""
@@ -431,7 +431,7 @@ def _walker_run(warm_start_frames: int, foreground: str = "colour") -> tuple[lis
     path = [np.array([-2.0 + 0.1 * i, 1.5]) for i in range(12)]
     items = [(i, i / 10, _ellipsoid_frames(scene, bgs, *q.person_ellipsoid([p], 1.85, 0.4), rng, i))
              for i, p in enumerate(path)]
-    tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, foreground),
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
                                EllipsoidConfig(warm_start_frames=warm_start_frames))
     rows, _ = step_tracker(tracker, items, lambda i, t, tr: (i, tr.id, tr.x, tr.y, tr.vx, tr.vy, tr.height))
     return rows, path
@@ -478,6 +478,9 @@ def test_warm_start_is_skipped_where_it_cannot_help_or_would_harm():
     by_hand = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"))
     by_hand.init_track(-1.0, 1.2, track_id=7)        # --init: the user says who is where on frame 0
     assert by_hand.warm_start_frames == 0
+    stepped = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"))
+    stepped.step({cid: bg for cid, bg in bgs.items()}, 0.0)   # too late: frame 0 is already out
+    assert stepped.warm_start_frames == 0
     with pytest.raises(ValueError, match="warm_start_frames"):
         EllipsoidConfig(warm_start_frames=-1)
 
