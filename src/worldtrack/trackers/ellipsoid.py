@@ -123,7 +123,9 @@ class EllipsoidConfig:
         reach it to be confirmed
     min_own_share : float — a captured person, or one tracked for less than ``young_s``, whose
         visible pixels are more than ``1 − min_own_share`` covered by others for ``lost_after_s``
-        duplicates them and ends (an older track that walks behind someone is kept)
+        duplicates them and ends. An older track that walks behind someone is kept, unless the
+        tracker has several cameras and at most one of them shows the track's own pixels: a real
+        person hidden behind somebody in one view is seen in another
     young_s : float
     min_evidence : float — a tracked person ends when, for ``lost_after_s``, no camera shows at
         least this share of its ellipse as its own foreground or explained by others (it has
@@ -133,6 +135,11 @@ class EllipsoidConfig:
     confirm_views : int — a captured person that passes the capture tests in a frame while at
         least this many cameras show enough of its own pixels, all of them foreground-supported,
         is confirmed at once instead of after ``confirm_frames`` (0 = never)
+    empty_support : float — with ``score="symmetric"``: a failing track whose support is below this
+        (its own pixels nearly all floor) counts two frames toward ``lost_after_s``, so an empty
+        track ends in half the time (0 = never). With the ``min_own_share`` rule for older tracks,
+        crowd-10 MOTA over 80 seeds went from 0.883 to 0.892 (paired gain 0.008 ± 0.003) and the false
+        positives in places only one camera sees fell from 943 to 726 (seeds 0–39)
     lost_after_s : float
     leave_after_frames : int — frames unseen by every camera before a track ends
     merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
@@ -189,6 +196,7 @@ class EllipsoidConfig:
     young_s: float = 3.0
     min_seen_share: float = 0.3
     confirm_views: int = 2
+    empty_support: float = 0.1
     lost_after_s: float = 1.0
     leave_after_frames: int = 2
     merge_distance_m: float = 0.25
@@ -211,8 +219,8 @@ class EllipsoidConfig:
             raise ValueError(f"score: expected 'paper' or 'symmetric', got {self.score!r}")
         if self.step_m <= 0 or self.iterations < 1:
             raise ValueError("step_m must be positive and iterations at least 1")
-        if self.confirm_views < 0 or self.rescue_retry_frames < 0:
-            raise ValueError("confirm_views and rescue_retry_frames must not be negative")
+        if self.confirm_views < 0 or self.rescue_retry_frames < 0 or self.empty_support < 0:
+            raise ValueError("confirm_views, rescue_retry_frames and empty_support must not be negative")
         if not (isinstance(self.warm_start_frames, (int, np.integer)) and self.warm_start_frames >= 0):
             raise ValueError(f"warm_start_frames: expected a whole number of frames ≥ 0, got {self.warm_start_frames!r}")
 
@@ -837,10 +845,15 @@ class EllipsoidTracker:
                     continue
             else:
                 low = (sup < cfg.min_support or evidence < cfg.min_evidence) if symmetric else e < cfg.keep_score
-                # A young track living inside someone else's silhouette duplicates them.
-                if symmetric and t - tr.born < cfg.young_s and own_share < cfg.min_own_share:
+                # A young track living inside someone else's silhouette duplicates them. So does one of
+                # any age that at most one of several cameras shows: a person who walks behind
+                # somebody in one view is still seen in another.
+                if symmetric and own_share < cfg.min_own_share and (
+                        t - tr.born < cfg.young_s or (len(self.cams) >= 2 and views <= 1)):
                     low = True
-                tr.frames_low = tr.frames_low + 1 if low else 0
+                # Own pixels that are nearly all floor: a ghost, or a track that lost its person.
+                empty = symmetric and sup < cfg.empty_support
+                tr.frames_low = tr.frames_low + (2 if empty else 1) if low else 0
                 if tr.frames_low >= fps_frames(cfg.lost_after_s):
                     self._end(tr)
                     continue
