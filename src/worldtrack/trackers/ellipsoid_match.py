@@ -31,11 +31,66 @@ def walkable_lookup(walk, origin, resolution, x, y):
 
 
 @njit(cache=True)
+def held_scores(num: np.ndarray, den: np.ndarray, ref: int) -> np.ndarray:
+    """E of each candidate with every camera weighed as at candidate ``ref`` (the current place).
+
+    Parameters
+    ----------
+    num, den : (C, J) — each camera's Σ sim·real and Σ|sim| for each of J candidates
+    ref : int — the candidate that is the person's current place
+
+    Returns
+    -------
+    (J,) — Σ_c den[c, ref] · num[c, j] / den[c, j] over Σ_c den[c, ref]. A camera that shows
+    candidate ``j`` none of the person counts at its ratio at ``ref``; one that shows nothing at
+    ``ref`` does not count; −inf where no camera shows candidate ``j`` or none shows ``ref``.
+    At ``ref`` this is Σ num / Σ den; with one camera it is num / den everywhere.
+
+    With Σ num / Σ den for every candidate, each camera weighs in by how much of the candidate
+    it shows, so a candidate gains by sliding out of the view of a camera that fits the person
+    badly (at the image border, from steeply above), and with two cameras facing each other a
+    track slid 0.5–1 m along their shared line of sight.
+    """
+    C, J = num.shape
+    total = 0.0
+    for c in range(C):
+        total += den[c, ref]
+    e = np.full(J, -np.inf)
+    if not total > 0:
+        return e
+    for j in range(J):
+        seen = False
+        acc = 0.0
+        for c in range(C):
+            seen = seen or den[c, j] > 0
+            w = den[c, ref]
+            if w > 0:
+                acc += w * (num[c, j] / den[c, j] if den[c, j] > 0 else num[c, ref] / w)
+        if seen:
+            e[j] = acc / total
+    return e
+
+
+def held_scores_reference(num: np.ndarray, den: np.ndarray, ref: int) -> np.ndarray:
+    """:func:`held_scores` in plain NumPy, the version it is tested against."""
+    w = den[:, ref]
+    e = np.full(num.shape[1], -np.inf)
+    if not w.sum() > 0:
+        return e
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(den > 0, num / den, (num[:, ref] / w)[:, None])
+    mean = (w[:, None] * np.where(w[:, None] > 0, ratio, 0.0)).sum(axis=0) / w.sum()
+    seen = (den > 0).any(axis=0)
+    e[seen] = mean[seen]
+    return e
+
+
+@njit(cache=True)
 def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_dist, cam_size, cam_centre,
                cam_dir, cam_ring_px, ring_fraction, grids, occs, reals,
                s_inner, s_ring, s_box, s_valid, s_dist, walk, walk_origin, walk_res,
                step_m, min_step, max_step, iterations, max_iterations, adaptive, min_gain, target_pixels,
-               symmetric, min_depth):
+               symmetric, min_depth, held):
     """Move people ``0 … n_moving − 1`` round after round; the others stay fixed.
 
     Parameters
@@ -53,6 +108,8 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
         updated in place for the people who move
     walk, walk_origin, walk_res : the walkable raster
     step_m … min_depth : the tracker's configuration
+    held : bool — score candidates with :func:`held_scores` (cameras weighed as at the current
+        place) instead of Σ num / Σ den
 
     Returns
     -------
@@ -94,8 +151,8 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                 cand[j, 1] = xy[k, 1] + a * dy + b * dx
                 h9[j] = hs[k]
                 w9[j] = ws[k]
-            num = np.zeros(9)
-            den = np.zeros(9)
+            num = np.zeros((C, 9))
+            den = np.zeros((C, 9))
             for c in range(C):
                 nu, de, ci, cr, cb, cv, cd = score_camera(
                     cam_P[c], cam_K[c], cam_dist[c], cam_has_dist[c], cam_size[c, 0], cam_size[c, 1], cam_centre[c],
@@ -107,24 +164,31 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                 f_box[c] = cb
                 f_valid[c] = cv
                 f_dist[c] = cd
-                num += nu
-                den += de
-            if not den[STAY] > 0:
+                num[c] = nu
+                den[c] = de
+            den_all = den.sum(axis=0)
+            if not den_all[STAY] > 0:
                 # Nobody sees this person at all: nothing to match.
                 done[k] = True
                 best_e[k] = 0.0
-                best_den[k] = den[STAY]
+                best_den[k] = den_all[STAY]
                 continue
-            e = np.empty(9)
+            if held and C > 1:  # (the same as Σ num / Σ den with one camera)
+                e = held_scores(num, den, STAY)
+            else:
+                num_all = num.sum(axis=0)
+                e = np.full(9, -np.inf)
+                for j in range(9):
+                    if den_all[j] > 0:
+                        e[j] = num_all[j] / den_all[j]
             for j in range(9):
-                e[j] = num[j] / den[j] if den[j] > 0 else -np.inf
                 if j != STAY and not walkable_lookup(walk, walk_origin, walk_res, cand[j, 0], cand[j, 1]):
                     e[j] = -np.inf
             b = int(np.argmax(e))
             if adaptive and e[b] - e[STAY] < min_gain:
                 b = STAY
             best_e[k] = e[b]
-            best_den[k] = den[b]
+            best_den[k] = den_all[b]
             if b != STAY:
                 xy[k, 0] = cand[b, 0]
                 xy[k, 1] = cand[b, 1]
