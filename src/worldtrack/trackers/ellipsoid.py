@@ -145,10 +145,11 @@ class EllipsoidConfig:
         "candidate" takes each camera's denominator at the candidate, "current" at the person's
         place now, so a candidate cannot score higher by sliding out of the view of a camera that
         fits the person badly (at the image border, or from steeply above), and a camera that no
-        longer sees a candidate counts at its ratio there. Same with one camera. In the 10-person
-        crowd with two cameras facing each other, "candidate" left tracks 0.5–1 m off along the
-        shared line of sight; "current" raised MOTA over 80 seeds from 0.892 to 0.911 (paired
-        gain 0.020 ± 0.005, 58 seeds up, 22 down)
+        longer sees a candidate counts at its ratio there. Same with one camera; people in capture
+        mode (sliding into their blob) always use "candidate". In the 10-person crowd with two
+        cameras facing each other, "candidate" left tracks 0.5–1 m off along the shared line of
+        sight; "current" raised MOTA over 80 seeds from 0.892 to 0.913 (paired gain
+        0.022 ± 0.004, 60 seeds up, 19 down)
     lost_after_s : float
     leave_after_frames : int — frames unseen by every camera before a track ends
     merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
@@ -540,7 +541,7 @@ class EllipsoidTracker:
         d, e_perp = self._axes(k, state)
         cand = xy[k] + step * (OFFSETS[:, :1] * d + OFFSETS[:, 1:] * e_perp)
         e, den, forms = self._score_candidates(k, cand, np.full(9, hs[k]), np.full(9, ws[k]), state, real, use_ring,
-                                               current=STAY)
+                                               current=STAY if use_ring else None)
         walk = self._walkable(cand)
         walk[STAY] = True
         e[~walk] = -np.inf

@@ -108,8 +108,9 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
         updated in place for the people who move
     walk, walk_origin, walk_res : the walkable raster
     step_m … min_depth : the tracker's configuration
-    held : bool — score candidates with :func:`held_scores` (cameras weighed as at the current
-        place) instead of Σ num / Σ den
+    held : bool — score the candidates of tracked people (not those in capture mode, still sliding
+        into their blob) with :func:`held_scores`, cameras weighed as at the current place, instead
+        of Σ num / Σ den
 
     Returns
     -------
@@ -173,7 +174,7 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                 best_e[k] = 0.0
                 best_den[k] = den_all[STAY]
                 continue
-            if held and C > 1:  # (the same as Σ num / Σ den with one camera)
+            if held and C > 1 and use_ring[k]:  # tracked people; one camera: the same either way
                 e = held_scores(num, den, STAY)
             else:
                 num_all = num.sum(axis=0)
