@@ -8,6 +8,7 @@ video tracker must do per frame), and decoding a frame.
 from __future__ import annotations
 
 import os
+import shlex
 import statistics
 import sys
 import time
@@ -126,5 +127,6 @@ def save_result(name: str, title: str, text: str, quick: bool, seconds: float) -
     if quick:
         print(f"{name}: --quick smoke run in {seconds:.0f} s; results/{name}.md not written", file=sys.stderr)
         return
-    path = write_result(name, title, f"Command: `.venv/bin/python benchmarks/{name}.py` ({seconds:.0f} s)\n\n{text}")
+    args = "".join(f" {shlex.quote(a)}" for a in sys.argv[1:])  # the arguments this run was given
+    path = write_result(name, title, f"Command: `.venv/bin/python benchmarks/{name}.py{args}` ({seconds:.0f} s)\n\n{text}")
     print(f"wrote {path} in {seconds:.0f} s", file=sys.stderr)

@@ -17,6 +17,7 @@ distance along its line of sight rests on their height alone.
 Usage::
 
     .venv/bin/python benchmarks/crowd_seeds.py                    # seeds 0-9, ~1.5 min
+    .venv/bin/python benchmarks/crowd_seeds.py --seeds 0-79       # ~13 min
     .venv/bin/python benchmarks/crowd_seeds.py --quick            # smoke run: 2 seeds, 40 frames
     .venv/bin/python benchmarks/crowd_seeds.py --seeds 0 1 --set rescue_gain=0.1 --quick
     .venv/bin/python benchmarks/crowd_seeds.py --texture-ncc 0     # the foreground's texture test on
@@ -84,9 +85,19 @@ def _value(text: str):
     return {"true": True, "false": False}.get(text.lower(), text)
 
 
+def _seed_list(text: str) -> list[int]:
+    """``"7"`` → [7]; ``"0-79"`` → [0, …, 79]."""
+    first, _, last = text.partition("-")
+    try:
+        return list(range(int(first), int(last or first) + 1))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a seed or a range like 0-79, got {text!r}") from None
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--seeds", type=int, nargs="+", default=None, help="default 0-9 (0 1 with --quick)")
+    p.add_argument("--seeds", type=_seed_list, nargs="+", default=None,
+                   help="seeds and ranges, e.g. 0-79 or 3 5 (default 0-9; 0 1 with --quick)")
     p.add_argument("--frames", type=int, default=None, help=f"default {FRAMES} (40 with --quick)")
     p.add_argument("--people", type=int, default=PEOPLE)
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
@@ -96,8 +107,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--quick", action="store_true",
                    help="a smoke run (2 seeds, 40 frames unless given); prints only, writes no results file")
     args = p.parse_args(argv)
-    if args.seeds is None:
-        args.seeds = [0, 1] if args.quick else list(range(10))
+    args.seeds = ([0, 1] if args.quick else list(range(10))) if args.seeds is None else sum(args.seeds, [])
     if args.frames is None:
         args.frames = 40 if args.quick else FRAMES
     options = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
