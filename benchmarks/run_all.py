@@ -1,7 +1,7 @@
 """Run every benchmark of issue 5 in turn and print their tables (``make bench``).
 
 Question: all of them at once — seed 000's tables on the synthetic world (``paper_kato``), the three
-trackers on the same frames (``compare_methods``), the 10-person crowd over 10 seeds
+trackers on the same frames (``compare_methods``), the 10-person crowd over 80 seeds
 (``crowd_seeds``, issue 4's MOTA target), where a frame's time goes (``speed``) and the trackers on
 real footage (``real_data``). Each runs as its own process (so one's memory and
 compiled kernels do not affect another's timing), one after the other, and writes
