@@ -11,7 +11,9 @@ mode without the ring until E > 0.7, every pixel summed, a fixed-threshold grey 
 Beyond the paper (the default configuration adds these; each can be switched off):
 
 * several cameras on one map — a candidate's score is Σ numerators / Σ denominators over the
-  cameras that see it, so a person hidden in one view is held by another;
+  cameras that see it, so a person hidden in one view is held by another; for a tracked person
+  each camera's denominator is taken at the person's current place (``camera_weights``), so a
+  candidate cannot gain by sliding out of the view of a camera that fits the person badly;
 * automatic start of tracks from foreground the simulation does not explain, confirmed in capture
   mode; tracks end when the person leaves every view or the score stays low;
 * coarse-to-fine steps and constant-velocity prediction, so fast walkers are followed and the
@@ -537,7 +539,8 @@ class EllipsoidTracker:
 
     def _score_person(self, k: int, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, step: float,
                       state: dict, real: dict[str, np.ndarray], use_ring: bool):
-        """E of the 9 candidates of person ``k`` over all cameras (Σ num / Σ den)."""
+        """E of the 9 candidates of person ``k`` over all cameras: Σ num / Σ den, with the cameras
+        weighed as at the current place for a tracked person (``camera_weights``)."""
         d, e_perp = self._axes(k, state)
         cand = xy[k] + step * (OFFSETS[:, :1] * d + OFFSETS[:, 1:] * e_perp)
         e, den, forms = self._score_candidates(k, cand, np.full(9, hs[k]), np.full(9, ws[k]), state, real, use_ring,
@@ -673,8 +676,8 @@ class EllipsoidTracker:
                 use_ring, cand, heights, widths, float(cs.ring_px), cfg.min_depth_m, cfg.ring_fraction,
                 st.inner, st.ring, st.box, st.dist, st.valid, k, cfg.target_pixels, unexplained)
             forms[cid] = _Forms(ci, cr, cb, cv, cd)
-        if current is not None and cfg.camera_weights == "current":
-            return held_scores(num, den, current), den.sum(axis=0), forms
+        if current is not None and cfg.camera_weights == "current" and len(state) > 1:
+            return held_scores(num, den, current), den.sum(axis=0), forms  # (one camera: the same)
         num, den = num.sum(axis=0), den.sum(axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):
             e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)

@@ -2,7 +2,9 @@
 
 Each round moves every person in turn to the best of 9 candidates (−s, 0, +s along the viewing
 direction of the camera that sees them largest and its perpendicular), with everybody else fixed
-in the joint simulated image, and adapts the step (coarse to fine). This is
+in the joint simulated image, and adapts the step (coarse to fine). With several cameras a tracked
+person's candidates are scored with the cameras weighed as at their current place
+(:func:`held_scores`). This is
 ``EllipsoidTracker._rounds_python`` — the readable version it is tested against — without the
 Python overhead per person and round, which at 640×480 was ~40 % of the tracker's time.
 """
