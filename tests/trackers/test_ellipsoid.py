@@ -255,13 +255,15 @@ def _two_camera_scene(size=(160, 120)):
     })
 
 
-def _ellipsoid_frames(scene, bgs: dict, cen: np.ndarray, rad: np.ndarray, rng, i: int) -> dict:
+def _ellipsoid_frames(scene, bgs: dict, cen: np.ndarray, rad: np.ndarray, rng, i: int,
+                      shown_in: tuple[str, ...] | None = None) -> dict:
     """Frame ``i`` (10 frames/s) of every camera: its background with the ellipsoid ``cen, rad``
-    drawn green, plus pixel noise (σ 3)."""
+    drawn green (only in the cameras ``shown_in``, if given), plus pixel noise (σ 3)."""
     frames = {}
     for cid, cam in scene.cameras.items():
         img = bgs[cid].copy()
-        img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
+        if shown_in is None or cid in shown_in:
+            img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
         frames[cid] = Frame(np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8), i / 10, i)
     return frames
 
@@ -323,10 +325,8 @@ def _one_person_seen(seed: int) -> tuple:
     cen, rad = q.person_ellipsoid([person], 1.65, 0.4)
     tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig())
     real, images = {}, {}
-    for cid, cam in scene.cameras.items():
-        img = bgs[cid].copy()
-        img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
-        images[cid] = np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8)
+    for cid, frame in _ellipsoid_frames(scene, bgs, cen, rad, rng, 0).items():
+        images[cid] = frame.image
         labels = tracker.cams[cid].foreground.labels(images[cid])
         tracker.last_labels[cid], tracker.last_masks[cid] = labels, (labels == 1).astype(np.uint8)
         real[cid] = ternary_real(labels, tracker.cams[cid].ring_px)
@@ -572,13 +572,8 @@ def _facing_cameras_match(camera_weights: str, python_rounds: bool = False, seed
     cen, rad = q.person_ellipsoid([[8.0, 6.2]], 1.7, 0.45)
     tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(camera_weights=camera_weights))
     tracker._python_rounds = python_rounds
-    real = {}
-    for cid, cam in scene.cameras.items():
-        img = bgs[cid].copy()
-        if cid == "c1":
-            img[q.ellipse_mask(q.ellipsoid_conics(cam.P, cen, rad)[0], (cam.height, cam.width))] = (30, 200, 60)
-        img = np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.uint8)
-        real[cid] = ternary_real(tracker.cams[cid].foreground.labels(img), tracker.cams[cid].ring_px)
+    real = {cid: ternary_real(tracker.cams[cid].foreground.labels(frame.image), tracker.cams[cid].ring_px)
+            for cid, frame in _ellipsoid_frames(scene, bgs, cen, rad, rng, 0, shown_in=("c1",)).items()}
     tr = tracker.init_track(8.0, 6.2, track_id=1, mode=mode)
     scores = [tracker._match([tr], real)[1] for _ in range(5)]
     return np.array([tr.x, tr.y]), scores
