@@ -53,7 +53,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, median_time, mog2_apply_time, save_result  # noqa: E402
 
 from worldtrack.foreground.background import AdaptiveBackground  # noqa: E402
-from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402

@@ -23,7 +23,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import AdaptiveBackground, StaticBackground
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 from worldtrack.scene import scene_from_dict
 
 from _render import texture  # tests/trackers/_render.py

@@ -10,7 +10,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.experiment import run_scenario, standing_with_head_and_feet, step_tracker
 from worldtrack.geometry import quadric as q
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 from worldtrack.pipeline import make_foregrounds
 from worldtrack.scene import scene_from_dict
 from worldtrack.synth import make_scenario
@@ -506,7 +506,8 @@ def test_warm_started_gives_the_first_frames_first_and_passes_every_frame_on():
     assert list(warm_started(rec, items)) == items and rec.warmed == [i / 10 for i in range(6)]
     rec = _Recorder(0)
     assert list(warm_started(rec, items)) == items and rec.warmed is None
-    assert list(warm_started(object(), items)) == items    # trackers without a warm start
+    from worldtrack.trackers.base import TrackerBase
+    assert list(warm_started(TrackerBase(), items)) == items   # trackers without a warm start
 
     def corrupt_third():
         yield from items[:2]

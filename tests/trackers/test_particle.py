@@ -20,7 +20,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import StaticBackground
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 from worldtrack.scene import scene_from_dict
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box, image_boxes

@@ -16,7 +16,7 @@ from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BIN
                                                      SAT_BINS, ColourModel, colour_bins, colour_bins_compiled,
                                                      colour_bins_reference, colour_log_ratio, column_bins,
                                                      column_bins_reference, column_penalties)
-from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.trackers.particle_likelihood import CameraLikelihood  # noqa: E402
 

@@ -6,7 +6,6 @@ problems into :class:`~worldtrack.errors.InputError` with the camera, file and f
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator, Mapping, Sequence
 
@@ -15,28 +14,9 @@ import numpy as np
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Frame
 
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
-
-
-@dataclass
-class Frame:
-    """One camera's image at one time.
-
-    Attributes
-    ----------
-    image : (H, W, 3) uint8 — BGR (OpenCV order)
-    t : float — time stamp, seconds
-    index : int — frame number from 0
-    depth : (H, W) float32 or None — metres along the optical axis (RGB-D sensors)
-    meta : dict — e.g. white-balance gains
-    """
-
-    image: np.ndarray
-    t: float
-    index: int
-    depth: np.ndarray | None = None
-    meta: dict = field(default_factory=dict)
 
 
 class _CameraReader:

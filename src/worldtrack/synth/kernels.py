@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
+from worldtrack.geometry._kernels import distort, undistort
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.raycast import ray_capsule, ray_ellipsoid
 
@@ -115,23 +116,11 @@ def _pixel_ray(u, v, intr):
     k1, k2, p1, p2, k3 = intr[5], intr[6], intr[7], intr[8], intr[9]
     if k1 != 0.0 or k2 != 0.0 or p1 != 0.0 or p2 != 0.0 or k3 != 0.0:
         xd, yd = x, y
-        for _ in range(200):  # the fixed-point inversion of Camera.undistort_normalised
-            r2 = x * x + y * y
-            radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-            ddx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
-            ddy = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
-            xn = (xd - ddx) / radial
-            yn = (yd - ddy) / radial
-            change = max(abs(xn - x), abs(yn - y))
-            x, y = xn, yn
-            if not change > 1e-12:
-                break
+        # The fixed-point inversion of Camera.undistort_normalised.
+        x, y = undistort(xd, yd, k1, k2, p1, p2, k3, 200, 1e-12)
         # Beyond the lens's monotonic range the pixel has no ray (as in Camera): no hit.
-        r2 = x * x + y * y
-        radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-        ex = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) - xd
-        ey = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y - yd
-        if not max(abs(ex), abs(ey)) <= 1e-7:
+        ex, ey = distort(x, y, k1, k2, p1, p2, k3)
+        if not max(abs(ex - xd), abs(ey - yd)) <= 1e-7:
             return math.nan, math.nan, math.nan
     n = math.sqrt(x * x + y * y + 1.0)
     return x / n, y / n, 1.0 / n

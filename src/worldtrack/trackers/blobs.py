@@ -54,7 +54,7 @@ from worldtrack.foreground.components import blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.quadric import ellipse_parameters, ellipsoid_conics, person_ellipsoid
 from worldtrack.scene.model import Scene
-from worldtrack.trackers.base import PositionMap, Track
+from worldtrack.trackers.base import PositionMap, Track, TrackerBase
 
 #: Stone Soup wants datetimes; a frame at ``t`` seconds is at ``_EPOCH + t``. Any fixed epoch works:
 #: only differences of time stamps enter the filter.
@@ -261,7 +261,7 @@ def _disc(radius: int) -> np.ndarray | None:
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
 
 
-class BlobTracker:
+class BlobTracker(TrackerBase):
     """Tracking by detection: MOG2 blobs → foot points on the floor → Stone Soup GNN tracker.
 
     Parameters

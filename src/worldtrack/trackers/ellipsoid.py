@@ -45,7 +45,7 @@ from worldtrack.foreground.background import Foreground
 from worldtrack.foreground.components import blob_extent, blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
-from worldtrack.trackers.base import PositionMap, Track
+from worldtrack.trackers.base import PositionMap, Track, TrackerBase
 from worldtrack.trackers.ellipsoid_match import OFFSETS, STAY, held_scores, run_rounds
 from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, owner_crop, score_camera,
                                                  ternary_real, track_support)
@@ -286,7 +286,7 @@ class _CameraState:
         return _Forms(inner, ring, box, valid, dist)
 
 
-class EllipsoidTracker:
+class EllipsoidTracker(TrackerBase):
     """Multi-person, multi-camera ellipsoid tracker on a shared :class:`PositionMap`.
 
     Parameters

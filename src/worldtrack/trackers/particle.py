@@ -90,7 +90,7 @@ from scipy.spatial.distance import cdist
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
-from worldtrack.trackers.base import PositionMap, Track
+from worldtrack.trackers.base import PositionMap, Track, TrackerBase
 from worldtrack.trackers.particle_config import ParticleConfig
 from worldtrack.trackers.particle_appearance import ColourModel, column_penalties, learn_columns, observe_column
 from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_on_one_object,
@@ -168,7 +168,7 @@ class _Filter:
         return _Filter(**own, **fields)
 
 
-class ParticleTracker:
+class ParticleTracker(TrackerBase):
     """Multi-object tracker: one 3-D particle filter per object, detection filters for new ones.
 
     Parameters
