@@ -44,7 +44,7 @@ from common import markdown_table, render_images, save_result  # noqa: E402
 
 from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, synthetic_tracker  # noqa: E402
 from worldtrack.trackers.base import Frame  # noqa: E402
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 

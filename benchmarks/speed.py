@@ -55,7 +55,7 @@ from common import markdown_table, median_time, mog2_apply_time, save_result  # 
 from worldtrack.foreground.background import AdaptiveBackground  # noqa: E402
 from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 from worldtrack.trackers.ellipsoid_score import ternary_real  # noqa: E402

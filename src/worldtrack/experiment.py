@@ -22,7 +22,7 @@ from worldtrack.eval.mot import drop_ignored, evaluate
 from worldtrack.eval.tables import PositionErrors, position_errors
 from worldtrack.trackers.base import Frame
 from worldtrack.io.tracks import TrackTable
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.base import warm_started
 

@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
+from worldtrack.foreground.estimate import estimate_background
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
 
@@ -154,3 +155,22 @@ def read_image(path: str | Path, camera: Camera | None = None, what: str = "imag
         raise InputError(f"{path}: {what} is {img.shape[1]}x{img.shape[0]} but camera {camera.id!r} "
                          f"is {camera.width}x{camera.height}")
     return img
+
+
+def background_from_video(path: str | Path, samples: int = 50) -> np.ndarray:
+    """Temporal median of ``samples`` frames spread over a video (people must keep moving)."""
+    cap = cv2.VideoCapture(str(path))
+    if not cap.isOpened():
+        raise InputError(f"{path}: cannot open as a video")
+    n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
+    frames = []
+    if n > 0:
+        for idx in np.linspace(0, n - 1, min(samples, n)).astype(int):
+            cap.set(cv2.CAP_PROP_POS_FRAMES, int(idx))
+            ok, img = cap.read()
+            if ok:
+                frames.append(img)
+    cap.release()
+    if not frames:
+        raise InputError(f"{path}: no frames could be read to estimate a background")
+    return estimate_background(frames)
