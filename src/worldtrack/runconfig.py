@@ -62,8 +62,9 @@ def _mapping(section: Any) -> dict[str, Any]:
     # TRANSITION (issue 33): configurations not yet moved to sections are dataclasses.
     if isinstance(section, Section):
         return to_mapping(section)
+    import json
     from dataclasses import asdict
-    return asdict(section)
+    return json.loads(json.dumps(asdict(section)))
 
 
 def _method_config_class(method: str) -> type[Section]:

@@ -142,7 +142,8 @@ def run(args: argparse.Namespace) -> int:
         tracker.init_track(x, y, track_id=tid)
     write_run_info(Path(args.out), cfg.to_mapping(), inputs={
         "scene": args.scene, "videos": videos, "backgrounds": background_files,
-        "init": list(args.init), "fps": args.fps, "frames": args.frames})
+        "init": list(args.init), "fps": args.fps, "frames": args.frames},
+        argv=getattr(args, "command_line", None))
     source = VideoSource(videos, scene.cameras, fps=args.fps, stop=args.frames)
     result = run_tracking(scene, source, tracker, args.out, write_video=not args.no_video,
                           json_stream=sys.stdout if args.json else None, progress=not args.quiet,

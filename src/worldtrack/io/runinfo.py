@@ -49,7 +49,7 @@ def write_run_info(out_dir: Path, config: Mapping[str, Any], inputs: Mapping[str
     out_dir : the run's output folder (created if missing)
     config : the resolved settings as plain values (``RunConfig.to_mapping()``)
     inputs : what the run reads: ``scene`` (a path: its SHA-256 is recorded too), videos, backgrounds, …
-    argv : the command line (default ``sys.argv``)
+    argv : the command line, program name first (default ``sys.argv``)
     """
     from worldtrack import __version__
 
