@@ -21,6 +21,7 @@ agree on small images.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -126,26 +127,53 @@ def _pixel_ray(u, v, intr):
     return x / n, y / n, 1.0 / n
 
 
-@njit(cache=True)
-def trace_people(rays, Rt, origin, axis, intr, geom, part_box, person_box, person_start, person_id,
-                 zbuf, inst, part_hit, alone):
-    """Z-buffered ray casting of people (modifies ``zbuf``, ``inst``, ``part_hit``, ``alone``).
+class RayCamera(NamedTuple):
+    """A camera as :func:`trace_people` casts rays from it.
 
-    Parameters
-    ----------
     rays : (H, W, 3) float64 — unit rays of the image's pixels in the camera frame
     Rt : (3, 3) — camera → world rotation (``Rᵀ``); origin : (3,) camera centre, metres
     axis : (3,) — optical axis in world coordinates (depth = s·(d·axis))
     intr : (10,) — [fx, fy, cx, cy, skew, k1, k2, p1, p2, k3], for pixels outside the image
+    """
+
+    rays: np.ndarray
+    Rt: np.ndarray
+    origin: np.ndarray
+    axis: np.ndarray
+    intr: np.ndarray
+
+
+class PackedPeople(NamedTuple):
+    """People's parts as :func:`trace_people` reads them.
+
     geom : (P, 17) — packed parts, person-major
     part_box : (P, 4) int — pixel box [u0, u1) × [v0, v1) outside which part p is never hit
     person_box : (N, 4) int — union of the person's part boxes (may extend beyond the image)
     person_start : (N + 1,) int — parts of person n are ``person_start[n]:person_start[n + 1]``
     person_id : (N,) int — value written to ``inst``
+    """
+
+    geom: np.ndarray
+    part_box: np.ndarray
+    person_box: np.ndarray
+    person_start: np.ndarray
+    person_id: np.ndarray
+
+
+@njit(cache=True)
+def trace_people(camera, people, zbuf, inst, part_hit, alone):
+    """Z-buffered ray casting of people (modifies ``zbuf``, ``inst``, ``part_hit``, ``alone``).
+
+    Parameters
+    ----------
+    camera : RayCamera
+    people : PackedPeople
     zbuf : (H, W) float32 — depth along the optical axis (m) of what is already drawn
     inst : (H, W) int32; part_hit : (H, W) int32 — global part index, −1 where no person
     alone : (N,) int64 — out: pixels the person covers when rendered alone, image border ignored
     """
+    rays, Rt, origin, axis, intr = camera
+    geom, part_box, person_box, person_start, person_id = people
     H, W = zbuf.shape
     for n in range(person_start.shape[0] - 1):
         p0, p1 = person_start[n], person_start[n + 1]
