@@ -58,7 +58,7 @@ from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
-from worldtrack.trackers.ellipsoid_score import ternary_real  # noqa: E402
+from worldtrack.trackers.ellipsoid.score import ternary_real  # noqa: E402
 from worldtrack.trackers.particle_likelihood import hit_image, hit_labels  # noqa: E402
 
 SEED = 0

@@ -15,9 +15,9 @@ from worldtrack.pipeline import make_foregrounds
 from worldtrack.scene import scene_from_dict
 from worldtrack.synth import make_scenario
 from worldtrack.trackers import make_tracker
-from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker, _form_mask, _ray_direction
-from worldtrack.trackers.ellipsoid_score import ternary_real
-from worldtrack.trackers.height import measure_height
+from worldtrack.trackers.ellipsoid.tracker import EllipsoidConfig, EllipsoidTracker, _form_mask, _ray_direction
+from worldtrack.trackers.ellipsoid.score import ternary_real
+from worldtrack.trackers.ellipsoid.height import measure_height
 
 
 @pytest.fixture(scope="module")
@@ -215,7 +215,7 @@ def test_compiled_rounds_equal_the_python_rounds(crossing):
 
 
 def test_two_head_rays_from_different_sides_give_the_height():
-    from worldtrack.trackers.height import triangulate_height
+    from worldtrack.trackers.ellipsoid.height import triangulate_height
     head = np.array([1.0, 2.0, 1.78])
     rays = []
     for cam in ((0.0, 0.0, 3.5), (4.0, 0.5, 3.2)):
@@ -228,7 +228,7 @@ def test_two_head_rays_from_different_sides_give_the_height():
 
 
 def test_head_rays_through_two_different_heads_give_no_height():
-    from worldtrack.trackers.height import triangulate_height
+    from worldtrack.trackers.ellipsoid.height import triangulate_height
     # Camera 1 sees this person's head (1.70 m); camera 2's "top" is a taller person's 0.3 m
     # behind, at 1.95 m. The rays still have a nearest point, 6 cm off each ray, at a wrong height.
     c1, c2 = np.array([0.0, 0.0, 3.5]), np.array([4.0, 0.5, 3.2])
@@ -295,7 +295,7 @@ def test_two_views_that_agree_confirm_a_new_person_at_once():
 def test_height_is_no_longer_measured_once_the_samples_are_in(monkeypatch):
     # A person's height does not change: after ``height_samples`` measurements the median is final.
     # (The measurement itself is stubbed: this is about when it is asked for.)
-    import worldtrack.trackers.ellipsoid as ell
+    import worldtrack.trackers.ellipsoid.tracker as ell
     calls = []
     monkeypatch.setattr(ell, "measure_height", lambda *a, **k: calls.append(1) or 1.8)
     scene = _lab_scene((320, 240))
@@ -388,7 +388,7 @@ def _heights_measured(monkeypatch, heads: dict) -> list[float]:
     """Height samples of one person seen by both lab cameras over 5 frames, with each camera's
     head ray stubbed to pass through ``heads[camera id]`` (None: no head found in that view) and
     the single-view measurement stubbed to 1.50 m."""
-    import worldtrack.trackers.ellipsoid as ell
+    import worldtrack.trackers.ellipsoid.tracker as ell
 
     def head_ray(cam, *args, **kwargs):
         head = heads[cam.id]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from worldtrack.trackers.ellipsoid_match import held_scores, held_scores_reference
+from worldtrack.trackers.ellipsoid.match import held_scores, held_scores_reference
 
 
 def test_cameras_are_weighed_as_at_the_current_place():

@@ -7,7 +7,7 @@ import pytest
 
 from worldtrack.geometry import quadric as q
 from worldtrack.scene import load_scene
-from worldtrack.trackers.ellipsoid_score import (ellipse_forms, score_candidates, score_candidates_reference,
+from worldtrack.trackers.ellipsoid.score import (ellipse_forms, score_candidates, score_candidates_reference,
                                                  ternary_real, ternary_real_reference)
 
 LAB = Path(__file__).parents[2] / "examples" / "scenes" / "kato_lab.yaml"
@@ -131,7 +131,7 @@ def test_obstacle_hides_the_lower_body(lab):
 
 @pytest.mark.parametrize("cam_id", ["cam1", "cam2"])
 def test_ellipse_crop_equals_the_conic_mask(lab, cam_id):
-    from worldtrack.trackers.ellipsoid_score import ellipse_crop
+    from worldtrack.trackers.ellipsoid.score import ellipse_crop
     cam = lab.cameras[cam_id]
     args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
     xy = np.array([[-1.0, 1.0], [-0.5, 2.0]])
@@ -158,7 +158,7 @@ def test_ellipse_crop_equals_the_conic_mask(lab, cam_id):
 
 @pytest.mark.parametrize("cam_id", ["cam1", "cam2"])
 def test_owner_crop_equals_the_owner_map_and_the_masks(lab, cam_id):
-    from worldtrack.trackers.ellipsoid_score import owner_crop, owner_map
+    from worldtrack.trackers.ellipsoid.score import owner_crop, owner_map
     cam = lab.cameras[cam_id]
     args = (cam.P, cam.K, cam.dist, cam.has_distortion, cam.width, cam.height)
     xy = np.array([[-1.0, 1.0], [-0.8, 1.2], [-0.5, 2.0]])    # the first two overlap in both views
@@ -206,7 +206,7 @@ def test_kernel_equals_reference_in_a_crowd_behind_the_desk(lab):
 
 @pytest.mark.parametrize("radius", [0, 1, 2, 7, 26])
 def test_within_l1_equals_the_iterated_cross_dilation(radius):
-    from worldtrack.trackers.ellipsoid_score import within_l1, within_l1_reference
+    from worldtrack.trackers.ellipsoid.score import within_l1, within_l1_reference
     rng = np.random.default_rng(radius)
     for trial in range(8):
         H, W = int(rng.integers(1, 90)), int(rng.integers(1, 120))

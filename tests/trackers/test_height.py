@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from worldtrack.trackers.height import extreme_ends, extreme_ends_reference
+from worldtrack.trackers.ellipsoid.height import extreme_ends, extreme_ends_reference
 
 
 @pytest.mark.parametrize("down", [(0.0, 1.0), (0.6, 0.8), (-0.28, 0.96), (1.0, 0.0)])
@@ -41,7 +41,7 @@ def test_extreme_ends_of_a_rectangle_are_its_top_and_bottom_rows():
 
 def test_pixel_clear_equals_the_reference():
     from worldtrack.geometry.camera import Camera
-    from worldtrack.trackers.height import pixel_clear, pixel_clear_reference
+    from worldtrack.trackers.ellipsoid.height import pixel_clear, pixel_clear_reference
     cam = Camera.look_at("c", 64, 48, [0.0, -5.0, 3.0], [0.0, 0.0, 0.0], hfov_deg=60.0)
     occ = np.full((48, 64), np.inf, np.float32)
     occ[30:, 10:40] = 4.0                                     # an obstacle in the lower left

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from worldtrack.trackers.ellipsoid_score import score_camera
+from worldtrack.trackers.ellipsoid.score import score_camera
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=np.float64)

@@ -46,10 +46,10 @@ from worldtrack.foreground.components import blob_extent, blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track, TrackerBase
-from worldtrack.trackers.ellipsoid_match import OFFSETS, STAY, held_scores, run_rounds
-from worldtrack.trackers.ellipsoid_score import (ellipse_crop, ellipse_forms, owner_crop, score_camera,
+from worldtrack.trackers.ellipsoid.match import OFFSETS, STAY, held_scores, run_rounds
+from worldtrack.trackers.ellipsoid.score import (ellipse_crop, ellipse_forms, owner_crop, score_camera,
                                                  ternary_real, track_support)
-from worldtrack.trackers.height import head_ray, measure_height, pixel_clear, triangulate_height
+from worldtrack.trackers.ellipsoid.height import head_ray, measure_height, pixel_clear, triangulate_height
 
 _DUMMY_GRID = np.zeros((1, 1, 2), dtype=np.float32)
 #: Pixels a person must show (in all cameras together) to count as seen, or as its own.
@@ -895,7 +895,7 @@ class EllipsoidTracker(TrackerBase):
     def _update_heights(self, tracks: list[Track]) -> None:
         """Measure the height of people a camera sees whole and alone; use the running median.
 
-        See :mod:`worldtrack.trackers.height`. In one camera, a tracked person is measured when
+        See :mod:`worldtrack.trackers.ellipsoid.height`. In one camera, a tracked person is measured when
         others' ellipses cover at most ``_MAX_COVERED_FOR_HEIGHT`` of its region (the tallest
         plausible person's ellipse with its ring), on the pixels nobody else covers; the feet found
         may be up to ``height_depth_offset_m`` from the track along the line of sight (a wrong model
