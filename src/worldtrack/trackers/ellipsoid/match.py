@@ -11,9 +11,12 @@ Python overhead per person and round, which at 640×480 was ~40 % of the tracker
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
+from worldtrack.trackers.ellipsoid.args import DrawArgs, Forms, ScoreArgs
 from worldtrack.trackers.ellipsoid.score import score_camera
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
@@ -22,14 +25,26 @@ OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=np.fl
 STAY = 4
 
 
+class RoundScoring(NamedTuple):
+    """How the rounds draw and score candidates: ``draw`` (DrawArgs), ``target_pixels`` (int),
+    ``symmetric`` (count the unexplained foreground for tracked people), ``held`` (weigh cameras as
+    at the current place for tracked people, with several cameras)."""
+
+    draw: DrawArgs
+    target_pixels: int
+    symmetric: bool
+    held: bool
+
+
 @njit(cache=True)
-def walkable_lookup(walk, origin, resolution, x, y):
-    """True when floor point (x, y) falls in a walkable cell of the raster ``walk``."""
-    fi = (x - origin[0]) / resolution
-    fj = (y - origin[1]) / resolution
-    if not (0.0 <= fi < walk.shape[1] and 0.0 <= fj < walk.shape[0]):
+def walkable_lookup(walk, x, y):
+    """True when floor point (x, y) falls in a walkable cell of the raster ``walk`` (:class:`Walkable`)."""
+    fi = (x - walk.origin[0]) / walk.resolution
+    fj = (y - walk.origin[1]) / walk.resolution
+    inside = walk.inside
+    if not (0.0 <= fi < inside.shape[1] and 0.0 <= fj < inside.shape[0]):
         return False
-    return walk[int(fj), int(fi)]
+    return inside[int(fj), int(fi)]
 
 
 @njit(cache=True)
@@ -88,43 +103,42 @@ def held_scores_reference(num: np.ndarray, den: np.ndarray, ref: int) -> np.ndar
 
 
 @njit(cache=True)
-def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_dist, cam_size, cam_centre,
-               cam_dir, cam_ring_px, ring_fraction, grids, occs, reals,
-               s_inner, s_ring, s_box, s_valid, s_dist, walk, walk_origin, walk_res,
-               step_m, min_step, max_step, iterations, max_iterations, adaptive, min_gain, target_pixels,
-               symmetric, min_depth, held):
+def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scoring):
     """Move people ``0 … n_moving − 1`` round after round; the others stay fixed.
+
+    Compiled, and one loop: the per-person candidates' arrays are allocated once for all rounds
+    (the readable version is :func:`rounds_python`, which the tests compare it with).
 
     Parameters
     ----------
-    xy : (N, 2) — floor positions, updated in place
-    hs, ws : (N,) — ellipsoid heights and widths
+    people : People — floor positions (N, 2), updated in place; heights, widths (N,)
+    n_moving : int
     use_ring : (n_moving,) bool — False for people in capture mode
-    cam_* : per camera (C, …) — P, K, distortion, has_dist, (width, height), centre, floor viewing
-        direction (unit (2,)), ring width (px)
-    grids, occs : typed lists of per-camera arrays (ideal pixel grid, obstacle floor distances),
-        built once per tracker
+    cams : tuple of CameraArgs — the cameras (C of them)
     reals : tuple of the per-camera ternary real images (C of them, int8): a tuple costs nothing
         to pass each frame, where building a typed list took ~0.1 ms
-    s_inner, s_ring, s_box, s_valid, s_dist : (C, N, …) — everybody's ellipse forms per camera,
-        updated in place for the people who move
-    walk, walk_origin, walk_res : the walkable raster
-    step_m … min_depth : the tracker's configuration
-    held : bool — score the candidates of tracked people (not those in capture mode, still sliding
-        into their blob) with :func:`held_scores`, cameras weighed as at the current place, instead
-        of Σ num / Σ den
+    state : Forms — everybody's ellipse forms per camera, (C, N, …), updated in place for the
+        people who move
+    walk : Walkable — the walkable raster
+    steps : StepArgs
+    scoring : RoundScoring — how candidates are drawn and scored; ``held``: score the candidates
+        of tracked people (not those in capture mode, still sliding into their blob) with
+        :func:`held_scores`, cameras weighed as at the current place, instead of Σ num / Σ den
 
     Returns
     -------
     best_e, best_den : (n_moving,) — E and its denominator at each person's final place
     """
-    C = cam_P.shape[0]
+    xy, hs, ws = people
+    s_inner, s_ring, s_box, s_valid, s_dist = state
+    C = len(cams)
     n = n_moving
-    step = np.full(n, step_m)
+    step = np.full(n, steps.step_m)
     done = np.zeros(n, dtype=np.bool_)
     best_e = np.zeros(n)
     best_den = np.zeros(n)
-    rounds = max_iterations if adaptive else iterations
+    adaptive = steps.adaptive
+    rounds = steps.max_iterations if adaptive else steps.iterations
     cand = np.empty((9, 2))
     h9 = np.empty(9)
     w9 = np.empty(9)
@@ -147,7 +161,7 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                 if area > best_area:
                     best_cam = c
                     best_area = area
-            dx, dy = cam_dir[best_cam, 0], cam_dir[best_cam, 1]
+            dx, dy = cams[best_cam].floor_direction[0], cams[best_cam].floor_direction[1]
             for j in range(9):
                 a, b = OFFSETS[j, 0] * step[k], OFFSETS[j, 1] * step[k]
                 cand[j, 0] = xy[k, 0] + a * dx - b * dy
@@ -156,12 +170,11 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                 w9[j] = ws[k]
             num = np.zeros((C, 9))
             den = np.zeros((C, 9))
+            opts = ScoreArgs(use_ring[k], scoring.target_pixels, use_ring[k] and scoring.symmetric)
             for c in range(C):
-                nu, de, ci, cr, cb, cv, cd = score_camera(
-                    cam_P[c], cam_K[c], cam_dist[c], cam_has_dist[c], cam_size[c, 0], cam_size[c, 1], cam_centre[c],
-                    grids[c], occs[c], reals[c], use_ring[k], cand, h9, w9, cam_ring_px[c], min_depth,
-                    ring_fraction, s_inner[c], s_ring[c], s_box[c], s_dist[c], s_valid[c], k, target_pixels,
-                    use_ring[k] and symmetric)
+                others = Forms(s_inner[c], s_ring[c], s_box[c], s_valid[c], s_dist[c])
+                nu, de, ci, cr, cb, cv, cd = score_camera(cams[c], reals[c], cand, h9, w9, scoring.draw, others, k,
+                                                          opts)
                 f_inner[c] = ci
                 f_ring[c] = cr
                 f_box[c] = cb
@@ -176,7 +189,7 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                 best_e[k] = 0.0
                 best_den[k] = den_all[STAY]
                 continue
-            if held and C > 1 and use_ring[k]:  # tracked people; one camera: the same either way
+            if scoring.held and C > 1 and use_ring[k]:  # tracked people; one camera: the same either way
                 e = held_scores(num, den, STAY)
             else:
                 num_all = num.sum(axis=0)
@@ -185,10 +198,10 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                     if den_all[j] > 0:
                         e[j] = num_all[j] / den_all[j]
             for j in range(9):
-                if j != STAY and not walkable_lookup(walk, walk_origin, walk_res, cand[j, 0], cand[j, 1]):
+                if j != STAY and not walkable_lookup(walk, cand[j, 0], cand[j, 1]):
                     e[j] = -np.inf
             b = int(np.argmax(e))
-            if adaptive and e[b] - e[STAY] < min_gain:
+            if adaptive and e[b] - e[STAY] < steps.min_gain:
                 b = STAY
             best_e[k] = e[b]
             best_den[k] = den_all[b]
@@ -203,12 +216,12 @@ def run_rounds(xy, hs, ws, n_moving, use_ring, cam_P, cam_K, cam_dist, cam_has_d
                     s_dist[c, k] = f_dist[c, b]
             if adaptive:
                 if b == STAY:
-                    if step[k] <= min_step * 1.001:
+                    if step[k] <= steps.min_step_m * 1.001:
                         done[k] = True
                     else:
-                        step[k] = max(step[k] / 2, min_step)
-                elif it >= iterations - 1:
-                    step[k] = min(step[k] * 2, max_step)
+                        step[k] = max(step[k] / 2, steps.min_step_m)
+                elif it >= steps.iterations - 1:
+                    step[k] = min(step[k] * 2, steps.max_step_m)
         if done.all():
             break
     return best_e, best_den

@@ -39,19 +39,21 @@ from typing import Mapping, NamedTuple, Sequence
 
 import cv2
 import numpy as np
-from numba.typed import List as NumbaList
 
 from worldtrack.foreground.background import Foreground
 from worldtrack.foreground.components import blob_extent, blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track, TrackerBase
-from worldtrack.trackers.ellipsoid.match import OFFSETS, STAY, held_scores, run_rounds
-from worldtrack.trackers.ellipsoid.score import (ellipse_crop, ellipse_forms, owner_crop, score_camera,
-                                                 ternary_real, track_support)
+from worldtrack.trackers.ellipsoid.args import (CameraArgs, DrawArgs, Forms, People, ScoreArgs, StepArgs, Walkable,
+                                                camera_args)
+from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop, person_forms
+from worldtrack.trackers.ellipsoid.match import OFFSETS, STAY, RoundScoring, held_scores, run_rounds
+from worldtrack.trackers.ellipsoid.real import ternary_real
+from worldtrack.trackers.ellipsoid.score import score_camera
+from worldtrack.trackers.ellipsoid.support import track_support
 from worldtrack.trackers.ellipsoid.height import head_ray, measure_height, pixel_clear, triangulate_height
 
-_DUMMY_GRID = np.zeros((1, 1, 2), dtype=np.float32)
 #: Pixels a person must show (in all cameras together) to count as seen, or as its own.
 _MIN_OWN_PIXELS = 40
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
@@ -240,28 +242,25 @@ class EllipsoidConfig:
             raise ValueError(f"warm_start_frames: expected a whole number of frames ≥ 0, got {self.warm_start_frames!r}")
 
 
-class _Forms(NamedTuple):
-    """People's ellipses in one camera (N, …): :func:`ellipse_forms` output and floor distances."""
-
-    inner: np.ndarray
-    ring: np.ndarray
-    box: np.ndarray
-    valid: np.ndarray
-    dist: np.ndarray
-
-
 @dataclass
 class _CameraState:
     """Everything about one camera that does not change from frame to frame."""
 
     camera: Camera
-    grid: np.ndarray
-    occ: np.ndarray
+    args: CameraArgs
     ring_px: int
     foreground: Foreground
-    config: EllipsoidConfig
+    draw: DrawArgs
     _down: tuple | None = None
     _smallest: float | None = None
+
+    @property
+    def grid(self) -> np.ndarray:
+        return self.args.grid
+
+    @property
+    def occ(self) -> np.ndarray:
+        return self.args.occ
 
     def down_direction(self, uv: np.ndarray) -> np.ndarray | None:
         """Image direction of world-down at pixel ``uv`` (from a map built once), or None."""
@@ -276,14 +275,9 @@ class _CameraState:
         d = grid[max(j, 0), max(i, 0)]
         return d if np.isfinite(d).all() else None
 
-    def forms(self, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray) -> _Forms:
+    def forms(self, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray) -> Forms:
         """Ellipse forms of people at ``xy`` plus their floor distances from this camera."""
-        c, cfg = self.camera, self.config
-        inner, ring, box, valid = ellipse_forms(c.P, c.K, c.dist, c.has_distortion, c.width, c.height,
-                                                xy, heights, widths, float(self.ring_px), cfg.min_depth_m,
-                                                cfg.ring_fraction)
-        dist = np.hypot(xy[:, 0] - c.centre[0], xy[:, 1] - c.centre[1])
-        return _Forms(inner, ring, box, valid, dist)
+        return person_forms(self.args, xy, heights, widths, self.draw)
 
 
 class EllipsoidTracker(TrackerBase):
@@ -304,17 +298,17 @@ class EllipsoidTracker(TrackerBase):
         self.config = config or EllipsoidConfig()
         self.position_map = position_map if position_map is not None else PositionMap()
         self.cams: dict[str, _CameraState] = {}
+        self._draw = DrawArgs(float(self.config.min_depth_m), float(self.config.ring_fraction))
         for cid, fg in foregrounds.items():
             cam = scene.camera(cid)
             ring = max(1, int(round(self.config.ring_px_160 * math.sqrt(cam.width * cam.height / (160 * 120)))))
-            occ = scene.occlusion(cid).floor_distance
-            # Writable copies: the compiled rounds take them in typed lists of one array type.
-            grid = np.array(cam.ideal_pixel_grid) if cam.has_distortion else _DUMMY_GRID.copy()
-            self.cams[cid] = _CameraState(cam, grid, np.array(occ), ring, fg, self.config)
+            args = camera_args(cam, float(ring), scene.occlusion(cid).floor_distance)
+            self.cams[cid] = _CameraState(cam, args, ring, fg, self._draw)
         self._walk_raster = scene.walkable.raster(0.01)
         self._walkable = self._walk_raster.contains
+        self._walk_args = Walkable(self._walk_raster.inside, np.asarray(self._walk_raster.origin, float),
+                                   float(self._walk_raster.resolution))
         self._python_rounds = False  # tests switch to the readable rounds to compare
-        self._kernel_args: dict[tuple, tuple] = {}
         self._last_t: float | None = None
         self._frame = 0
         self._close_frames: dict[tuple[int, int], int] = {}
@@ -440,9 +434,9 @@ class EllipsoidTracker(TrackerBase):
             return {tr.id: (0.0, 0.0) for tr in tracks}
         xy, hs, ws = _arrays(everyone)
         cids = list(real)
-        stacked = [np.stack(a) for a in zip(*(self.cams[cid].forms(xy, hs, ws) for cid in cids))]
+        stacked = Forms(*(np.stack(a) for a in zip(*(self.cams[cid].forms(xy, hs, ws) for cid in cids))))
         # Per camera, views into the stacked arrays: updates through either are shared.
-        state = {cid: _Forms(*(a[c] for a in stacked)) for c, cid in enumerate(cids)}
+        state = {cid: Forms(*(a[c] for a in stacked)) for c, cid in enumerate(cids)}
         for k, tr in enumerate(tracks):
             seen_by = tr.extra.pop("seen_by", None)  # births' note for this search only
             if cfg.birth_search_m > 0 and tr.mode == "capture" and tr.age_frames == 0:
@@ -451,13 +445,13 @@ class EllipsoidTracker(TrackerBase):
         if self._python_rounds:
             best_e, best_den = self._rounds_python(use_ring, xy, hs, ws, state, real)
         else:
+            steps = StepArgs(float(cfg.step_m), float(cfg.min_step_m), float(cfg.max_step_m), int(cfg.iterations),
+                             int(cfg.max_iterations), bool(cfg.adaptive_step), float(cfg.min_gain))
+            scoring = RoundScoring(self._draw, int(cfg.target_pixels), cfg.score == "symmetric",
+                                   cfg.camera_weights == "current")
             best_e, best_den = run_rounds(
-                xy, hs, ws, n, use_ring, *self._kernel_cameras(tuple(cids)), cfg.ring_fraction,
-                *self._kernel_cameras(tuple(cids), lists=True), tuple(real[cid] for cid in cids),
-                *stacked, self._walk_raster.inside, self._walk_raster.origin, self._walk_raster.resolution,
-                cfg.step_m, cfg.min_step_m, cfg.max_step_m, cfg.iterations,
-                cfg.max_iterations, cfg.adaptive_step, cfg.min_gain, cfg.target_pixels,
-                cfg.score == "symmetric", cfg.min_depth_m, cfg.camera_weights == "current")
+                People(xy, hs, ws), n, use_ring, tuple(self.cams[cid].args for cid in cids),
+                tuple(real[cid] for cid in cids), stacked, self._walk_args, steps, scoring)
         if cfg.rescue_search_m > 0:
             for k, tr in enumerate(tracks):
                 # Periodically too, for everyone (``_rescue`` never moves onto somebody else).
@@ -475,29 +469,6 @@ class EllipsoidTracker(TrackerBase):
             tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
             result[tr.id] = (float(best_e[k]), float(best_den[k]))
         return result
-
-    def _kernel_cameras(self, cids: tuple[str, ...], lists: bool = False) -> tuple:
-        """The cameras ``cids`` as :func:`ellipsoid_match.run_rounds` takes them, built once per set.
-
-        Without ``lists``: stacked P (C, 3, 4), K (C, 3, 3), distortion (C, 5), has-distortion (C,),
-        (width, height) (C, 2), centre (C, 3), floor viewing direction (C, 2), ring width (C,) px.
-        With ``lists``: typed lists of the ideal pixel grids and obstacle floor distances.
-        """
-        key = (cids, lists)
-        if key not in self._kernel_args:
-            cams = [self.cams[cid] for cid in cids]
-            if lists:
-                args = (NumbaList([cs.grid for cs in cams]), NumbaList([cs.occ for cs in cams]))
-            else:
-                args = (np.stack([cs.camera.P for cs in cams]), np.stack([cs.camera.K for cs in cams]),
-                        np.stack([cs.camera.dist for cs in cams]),
-                        np.array([cs.camera.has_distortion for cs in cams]),
-                        np.array([[cs.camera.width, cs.camera.height] for cs in cams], dtype=np.int64),
-                        np.stack([cs.camera.centre for cs in cams]),
-                        np.stack([cs.camera.floor_direction for cs in cams]),
-                        np.array([float(cs.ring_px) for cs in cams]))
-            self._kernel_args[key] = args
-        return self._kernel_args[key]
 
     def _rounds_python(self, use_ring: np.ndarray, xy: np.ndarray, hs: np.ndarray, ws: np.ndarray, state: dict,
                        real: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -669,13 +640,10 @@ class EllipsoidTracker(TrackerBase):
         forms = {}
         unexplained = use_ring and cfg.score == "symmetric"
         for i, (cid, st) in enumerate(state.items()):
-            cs = self.cams[cid]
-            c = cs.camera
             num[i], den[i], ci, cr, cb, cv, cd = score_camera(
-                c.P, c.K, c.dist, c.has_distortion, c.width, c.height, c.centre, cs.grid, cs.occ, real[cid],
-                use_ring, cand, heights, widths, float(cs.ring_px), cfg.min_depth_m, cfg.ring_fraction,
-                st.inner, st.ring, st.box, st.dist, st.valid, k, cfg.target_pixels, unexplained)
-            forms[cid] = _Forms(ci, cr, cb, cv, cd)
+                self.cams[cid].args, real[cid], cand, heights, widths, self._draw, st, k,
+                ScoreArgs(use_ring, int(cfg.target_pixels), unexplained))
+            forms[cid] = Forms(ci, cr, cb, cv, cd)
         if current is not None and cfg.camera_weights == "current" and len(state) > 1:
             return held_scores(num, den, current), den.sum(axis=0), forms  # (one camera: the same)
         num, den = num.sum(axis=0), den.sum(axis=0)
@@ -798,9 +766,7 @@ class EllipsoidTracker(TrackerBase):
         views = np.zeros(len(tracks), dtype=int)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
-            inner, _, box, valid, dist = cs.forms(xy, hs, ws)
-            vis, own, own_fg, area = track_support(cs.grid, cs.camera.has_distortion, cs.occ, labels, inner, box,
-                                                   dist, valid, cfg.target_pixels, covers)
+            vis, own, own_fg, area = track_support(cs.args, labels, cs.forms(xy, hs, ws), int(cfg.target_pixels), covers)
             visible += vis
             own_total += own
             seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
@@ -928,7 +894,7 @@ class EllipsoidTracker(TrackerBase):
             # 1.9 m person sticks out of a 1.65 m ellipse), with its ring.
             _, ring, box, valid, _ = cs.forms(xy, np.full(len(xy), hi), 1.25 * ws)
             cam = cs.camera
-            inner, _, ibox, ivalid, _ = cs.forms(xy, hs, ws)
+            current = cs.forms(xy, hs, ws)
             for k in due:
                 tr = tracks[k]
                 if not valid[k]:
@@ -942,7 +908,7 @@ class EllipsoidTracker(TrackerBase):
                 if down is None:
                     continue
                 # Who each pixel of the box belongs to (current ellipses): −1 nobody, −2 several people.
-                mine = owner_crop(b, inner, ibox, ivalid, cs.grid, cam.has_distortion)
+                mine = owner_crop(b, current, cs.grid, cam.has_distortion)
                 free = (mine == k) | (mine == -1)
                 if triangulate:
                     ray = head_ray(cam, labels, cs.occ, region & free, tuple(b), down)
@@ -1099,7 +1065,7 @@ def _arrays(tracks: list[Track]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return xy, hs, ws
 
 
-def _keep(state: dict[str, _Forms], forms: dict[str, _Forms], k: int, b: int) -> None:
+def _keep(state: dict[str, Forms], forms: dict[str, Forms], k: int, b: int) -> None:
     """Person ``k`` moves to candidate ``b``: copy the candidate's forms into everybody's, per camera."""
     for cid, f in forms.items():
         for dst, src in zip(state[cid], f):

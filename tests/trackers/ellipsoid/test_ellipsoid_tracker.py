@@ -16,7 +16,7 @@ from worldtrack.scene import scene_from_dict
 from worldtrack.synth import make_scenario
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.ellipsoid.tracker import EllipsoidConfig, EllipsoidTracker, _form_mask, _ray_direction
-from worldtrack.trackers.ellipsoid.score import ternary_real
+from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.height import measure_height
 
 
