@@ -7,6 +7,7 @@ the accuracy figures at 640x480 are the benchmarks' job.
 import numpy as np
 import pytest
 
+from worldtrack.config import with_overrides
 from worldtrack.errors import InputError
 from worldtrack.experiment import run_scenario, standing_with_head_and_feet, step_tracker
 from worldtrack.geometry import quadric as q
@@ -106,7 +107,7 @@ def test_runner_is_followed_by_default_and_outruns_the_paper_preset():
     step_limit = 3 * 0.05                          # the paper's K x s per frame
     final, survived = {}, {}
     for preset in ("paper", "default"):
-        cfg = EllipsoidConfig.paper(births="none") if preset == "paper" else EllipsoidConfig(births="none")
+        cfg = with_overrides(EllipsoidConfig.paper() if preset == "paper" else EllipsoidConfig(), {"births.where": "none"})
         tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"), cfg)
         tr.init_track(xs[0], 1.5, track_id=1)
         survived[preset] = 0
@@ -126,9 +127,10 @@ def test_runner_is_followed_by_default_and_outruns_the_paper_preset():
 
 def test_paper_preset_values_are_the_papers():
     cfg = EllipsoidConfig.paper()
-    assert (cfg.step_m, cfg.iterations, cfg.ring_px_160, cfg.capture_threshold) == (0.05, 3, 5.0, 0.7)
-    assert cfg.target_pixels == 0 and cfg.score == "paper" and not cfg.adaptive_step and not cfg.predict
-    assert not cfg.measure_height and cfg.ring_fraction == 0.0
+    assert (cfg.match.step_m, cfg.match.iterations, cfg.score.ring_px_160, cfg.confirm.capture_threshold) == (0.05, 3, 5.0, 0.7)
+    assert cfg.score.target_pixels == 0 and cfg.score.kind == "paper" and not cfg.match.adaptive_step
+    assert not cfg.match.predict and not cfg.height.measure and cfg.score.ring_fraction == 0.0
+    assert cfg.births.search_m == 0 and cfg.rescue.search_m == 0 and cfg.warm_start.frames == 0
 
 
 def test_new_person_is_found_and_track_ends_after_leaving_the_view():
@@ -154,7 +156,7 @@ def still_tall_person():
     cam = sc.scene.cameras["cam1"]
     fg = make_foregrounds(sc.scene, {"cam1": sc.background("cam1")}, "colour", 20)["cam1"]
     tr = EllipsoidTracker(sc.scene, {"cam1": fg})
-    cs, (lo, hi) = tr.cams["cam1"], tr.config.height_range_m
+    cs, (lo, hi) = tr.cams["cam1"], tr.config.height.range_m
     views = []
     for b in sc.render():
         g = b.gt[0]
@@ -271,7 +273,7 @@ def _ellipsoid_frames(scene, bgs: dict, cen: np.ndarray, rad: np.ndarray, rng, i
 def _first_confirmed_frame(scene, confirm_views: int) -> int | None:
     rng = np.random.default_rng(3)
     bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
-    tr = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(confirm_views=confirm_views))
+    tr = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(confirm={"views": confirm_views}))
     # Smaller than the model's 1.65 x 0.4 m ellipsoid: E stays below the paper's 0.7, so only the
     # held frames (or the two views) confirm.
     cen, rad = q.person_ellipsoid([[-1.0, 1.2]], 1.45, 0.3)
@@ -302,7 +304,7 @@ def test_height_is_no_longer_measured_once_the_samples_are_in(monkeypatch):
     rng = np.random.default_rng(2)
     bg = _background(scene, rng)
     tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"),
-                          EllipsoidConfig(births="none", height_samples=4))
+                          EllipsoidConfig(births={"where": "none"}, height={"samples": 4}))
     tr.init_track(-1.0, 1.5, track_id=1)
     per_frame = []
     for i in range(30):
@@ -377,7 +379,7 @@ def test_new_person_is_placed_along_the_line_of_sight_of_the_camera_that_propose
             new = tracker.position_map.add(*guess, mode="capture", tentative=True)
             if seen_by:
                 new.extra["seen_by"] = seen_by
-            tracker._match([new], real)
+            tracker._match([new], real, 0.0)
             errors[proposer, seen_by] = np.hypot(new.x - person[0], new.y - person[1])
             tracker.position_map.remove(new.id)
     assert errors["c1", "c1"] < 0.03 and errors["c2", "c2"] < 0.03, errors
@@ -399,7 +401,7 @@ def _heights_measured(monkeypatch, heads: dict) -> list[float]:
     scene = _two_camera_scene((320, 240))
     rng = np.random.default_rng(5)
     bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
-    tr = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(births="none"))
+    tr = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(births={"where": "none"}))
     tr.init_track(-1.0, 1.2, track_id=1)
     cen, rad = q.person_ellipsoid([[-1.0, 1.2]], 1.65, 0.4)
     for i in range(5):
@@ -432,7 +434,7 @@ def _walker_run(warm_start_frames: int) -> tuple[list, list]:
     items = [(i, i / 10, _ellipsoid_frames(scene, bgs, *q.person_ellipsoid([p], 1.85, 0.4), rng, i))
              for i, p in enumerate(path)]
     tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
-                               EllipsoidConfig(warm_start_frames=warm_start_frames))
+                               EllipsoidConfig(warm_start={"frames": warm_start_frames}))
     rows, _ = step_tracker(tracker, items, lambda i, t, tr: (i, tr.id, tr.x, tr.y, tr.vx, tr.vy, tr.height))
     return rows, path
 
@@ -455,7 +457,7 @@ def test_warm_start_reports_from_the_first_frame_someone_a_cold_start_finds_late
     # The second person is small in both 160x120 views: a cold start confirms them on frame 10, so
     # a warm start finds them only if its window is longer than that (the default 10 is not).
     for n in (15, 0):
-        r = run_scenario(sc, bundles=bundles, warm_start_frames=n)
+        r = run_scenario(sc, bundles=bundles, overrides={"warm_start.frames": n})
         on0 = r.pred.frame == 0
         gt0 = r.gt.xy[r.gt.frame == 0]
         if n:
@@ -481,8 +483,8 @@ def test_warm_start_is_skipped_where_it_cannot_help_or_would_harm():
     stepped = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"))
     stepped.step({cid: bg for cid, bg in bgs.items()}, 0.0)   # too late: frame 0 is already out
     assert stepped.warm_start_frames == 0
-    with pytest.raises(ValueError, match="warm_start_frames"):
-        EllipsoidConfig(warm_start_frames=-1)
+    with pytest.raises(InputError, match=r"^ellipsoid\.warm_start\.frames: expected a number ≥ 0, got -1$"):
+        EllipsoidConfig(warm_start={"frames": -1})
 
 
 class _Recorder:
@@ -553,10 +555,10 @@ def test_an_older_track_hidden_behind_others_ends_when_no_second_camera_shows_it
 def test_a_track_on_empty_floor_ends_in_half_the_time():
     assert _frames_until_ended(0.05, 0.9, views=2) == 5          # own pixels nearly all floor
     assert _frames_until_ended(0.2, 0.9, views=2) == 10          # failing (below 0.25), not empty
-    assert _frames_until_ended(0.05, 0.9, views=2, config=EllipsoidConfig(empty_support=0.0)) == 10
+    assert _frames_until_ended(0.05, 0.9, views=2, config=EllipsoidConfig(support={"empty_support": 0.0})) == 10
     assert _frames_until_ended(0.3, 0.9, views=2) is None
-    with pytest.raises(ValueError, match="empty_support"):
-        EllipsoidConfig(empty_support=-0.1)
+    with pytest.raises(InputError, match=r"^ellipsoid\.support\.empty_support: expected a number ≥ 0"):
+        EllipsoidConfig(support={"empty_support": -0.1})
 
 
 def _facing_cameras_match(camera_weights: str, python_rounds: bool = False, seed: int = 1,
@@ -571,12 +573,12 @@ def _facing_cameras_match(camera_weights: str, python_rounds: bool = False, seed
     rng = np.random.default_rng(seed)
     bgs = {cid: rng.integers(70, 150, (c.height, c.width, 3), dtype=np.uint8) for cid, c in scene.cameras.items()}
     cen, rad = q.person_ellipsoid([[8.0, 6.2]], 1.7, 0.45)
-    tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(camera_weights=camera_weights))
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(score={"camera_weights": camera_weights}))
     tracker._python_rounds = python_rounds
     real = {cid: ternary_real(tracker.cams[cid].foreground.labels(frame.image), tracker.cams[cid].ring_px)
             for cid, frame in _ellipsoid_frames(scene, bgs, cen, rad, rng, 0, shown_in=("c1",)).items()}
     tr = tracker.init_track(8.0, 6.2, track_id=1, mode=mode)
-    scores = [tracker._match([tr], real)[1] for _ in range(5)]
+    scores = [tracker._match([tr], real, 0.0)[1] for _ in range(5)]
     return np.array([tr.x, tr.y]), scores
 
 
@@ -604,5 +606,5 @@ def test_compiled_rounds_equal_the_python_rounds_with_two_cameras(camera_weights
 
 
 def test_camera_weights_must_be_current_or_candidate():
-    with pytest.raises(ValueError, match="camera_weights"):
-        EllipsoidConfig(camera_weights="mean")
+    with pytest.raises(InputError, match=r"^ellipsoid\.score\.camera_weights: expected one of 'current' or 'candidate', got 'mean'$"):
+        EllipsoidConfig(score={"camera_weights": "mean"})

@@ -45,6 +45,8 @@ from worldtrack.foreground.components import blob_extent, blobs
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track, TrackerBase
+from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
+from worldtrack.trackers.lifecycle import frames_for
 from worldtrack.trackers.ellipsoid.args import (CameraArgs, DrawArgs, Forms, People, ScoreArgs, StepArgs, Walkable,
                                                 camera_args)
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop, person_forms
@@ -58,188 +60,6 @@ from worldtrack.trackers.ellipsoid.height import head_ray, measure_height, pixel
 _MIN_OWN_PIXELS = 40
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 _MAX_COVERED_FOR_HEIGHT = 0.3
-
-
-@dataclass(frozen=True)
-class EllipsoidConfig:
-    """Parameters of the ellipsoid tracker; defaults are the paper's where the paper gives one.
-
-    Attributes
-    ----------
-    step_m : float — candidate step s (paper: 50 mm)
-    iterations : int — rounds over all people per frame (paper: K = 3)
-    ring_px_160 : float — ring width at 160×120 (paper: 5 px); scaled by ``sqrt(W·H / (160·120))``,
-        i.e. with the image's linear size, so the ring covers the same part of a person at any
-        resolution
-    ring_fraction : float — the simulated ring is at most this fraction of the ellipse's semi-minor
-        axis (0 = always the image's ring width, as published). At 640×480 the scaled ring is
-        20 px, wider than a person 10 m away; a narrow ring keeps neighbours apart
-    capture_threshold : float — E above which a captured person switches to tracking (paper: 0.7)
-    capture_threshold_symmetric : float — with ``score="symmetric"`` a captured person is
-        confirmed after ``confirm_frames`` consecutive frames with capture-mode E above this and
-        ``min_support`` met. 0.3, not 0.7: an articulated body whose clothes match the background
-        in places covers only 30–80 % of its ellipse even at the right place
-    confirm_frames : int
-    birth_search_m : float — a just-proposed person is placed by a grid search ±this far along
-        the viewing direction (0 = start at the foot point, as the paper's capture does)
-    rescue_search_m, rescue_gain, rescue_every : a tracked person whose support is failing, and
-        every person every ``rescue_every`` frames, is moved along the viewing line up to
-        ±``rescue_search_m`` (along every seeing camera's line) if E there is higher by
-        ``rescue_gain`` (0 = never, as published)
-    rescue_retry_frames : int — after a search that found nothing better, a failing track waits
-        this many frames before the next one
-    target_pixels : int — pixels visited per candidate set (0 = all, as published)
-    score : {"paper", "symmetric"} — eq. 5 as published, or with the foreground the simulation
-        leaves unexplained added to the denominator in tracking mode (see ``ellipsoid_score``)
-    adaptive_step : bool — halve the step when "stay" wins, double it (up to ``max_step_m``) when
-        the best candidate is on the edge after the K rounds, up to ``max_iterations`` rounds
-    min_gain : float — with the adaptive step, a move must raise E by at least this much;
-        smaller gains are noise and count as "stay" (stops random walks along flat directions)
-    min_step_m, max_step_m : float — limits of the adaptive step
-    max_iterations : int — cap on rounds with the adaptive step
-    predict : bool — constant-velocity prediction before matching
-    measure_height : bool — measure each person's height when a camera sees them whole and
-        alone (median of the last ``height_samples`` measurements within ``height_range_m``);
-        the paper fixes 1.65 m, which puts people of other heights at the wrong distance
-    height_range_m : (min, max) metres
-    height_samples : int
-    height_deadband_m : float — the measured height replaces the default only when it differs by
-        more than this: the measurement's own scatter (~4 cm) would otherwise add depth error
-    height_min_px : int — measure only in views where the person is at least this tall, and
-        seen at more than 45° from the vertical
-    height_ray_gap_m : float — head rays of two cameras or more give a height only when each passes
-        within this distance of their nearest common point; rays that miss each other by more
-        mean that some view took another person's head for this one's (in a crowd 3 in 10
-        triangulations did, 0.13–0.21 m off), and the frame gives no measurement
-    height_depth_offset_m : float — in one view, the feet found may be this far from the track
-        along the camera's line of sight (0.4 m across it)
-    velocity_smoothing : float — weight of the new velocity measurement (0..1)
-    max_speed_mps : float — velocities are clipped to this speed (a running person)
-    births : {"anywhere", "entry", "none"} — where new people may appear: anywhere in view, only in
-        the scene's entry regions (and on the first frame), or never (tracks only from ``init``)
-    min_blob_fraction : float — unexplained blob area / expected person area to propose a person
-    confirm_within_s : float — a captured person not confirmed within this time is dropped
-    keep_score : float — with ``score="paper"``: a tracked person whose E stays below this for
-        ``lost_after_s`` ends
-    min_support : float — with ``score="symmetric"``: a person whose own pixels (visible, covered by
-        nobody else) are less than this share foreground for ``lost_after_s`` ends — a ghost left
-        beside the person it duplicated, or a track that lost its person; a captured person must
-        reach it to be confirmed
-    min_own_share : float — a captured person, or one tracked for less than ``young_s``, whose
-        visible pixels are more than ``1 − min_own_share`` covered by others for ``lost_after_s``
-        duplicates them and ends. An older track that walks behind someone is kept, unless the
-        tracker has several cameras and at most one of them shows the track's own pixels: a real
-        person hidden behind somebody in one view is seen in another
-    young_s : float
-    min_evidence : float — a tracked person ends when, for ``lost_after_s``, no camera shows at
-        least this share of its ellipse as its own foreground or explained by others (it has
-        slid past the image border or onto empty floor)
-    min_seen_share : float — a captured person is confirmed only once some camera shows at least
-        this share of its ellipse (a sliver at the image border fits anything)
-    confirm_views : int — a captured person that passes the capture tests in a frame while at
-        least this many cameras show enough of its own pixels, all of them foreground-supported,
-        is confirmed at once instead of after ``confirm_frames`` (0 = never)
-    empty_support : float — with ``score="symmetric"``: a failing track whose support is below this
-        (its own pixels nearly all floor) counts two frames toward ``lost_after_s``, so an empty
-        track ends in half the time (0 = never). With the ``min_own_share`` rule for older tracks,
-        crowd-10 MOTA over 80 seeds went from 0.883 to 0.892 (paired gain 0.008 ± 0.003) and the false
-        positives in places only one camera sees fell from 943 to 726 (seeds 0–39)
-    camera_weights : {"current", "candidate"} — how the matching steps combine cameras. Both sum
-        the numerators and the denominators of E over the cameras that see a candidate;
-        "candidate" takes each camera's denominator at the candidate, "current" at the person's
-        place now, so a candidate cannot score higher by sliding out of the view of a camera that
-        fits the person badly (at the image border, or from steeply above), and a camera that no
-        longer sees a candidate counts at its ratio there. Same with one camera; people in capture
-        mode (sliding into their blob) always use "candidate". In the 10-person crowd with two
-        cameras facing each other, "candidate" left tracks 0.5–1 m off along the shared line of
-        sight; "current" raised MOTA over 80 seeds from 0.892 to 0.913 (paired gain
-        0.022 ± 0.004, 60 seeds up, 19 down)
-    lost_after_s : float
-    leave_after_frames : int — frames unseen by every camera before a track ends
-    merge_distance_m : float — two tracks closer than this for 3 frames: the younger ends
-    min_separation_m : float — no new person is proposed, or kept in capture, this close to
-        another (two bodies' centres are rarely nearer)
-    min_depth_m : float — ellipsoids nearer than this to a camera's image plane are not drawn
-    warm_start_frames : int — before reporting frame 0, track the first this many frames forwards
-        and then backwards, and start on frame 0 with the people found, their sizes and height
-        measurements (0 = start empty, as published). People already in the first frame are
-        otherwise missed until confirmed and placed from a few crowded frames; in the 10-person
-        crowd the first 5 frames held 1 in 4 of all misses. Costs a delay of this many frames
-        before the first output (10: 1 s at 10 frames/s), and about twice their tracking time once.
-        In that crowd 10, 15 and 25 frames did equally well (mean MOTA over 40 seeds 0.895, 0.889,
-        0.893, against 0.881 with none). Skipped when the foreground learns from the frames it sees
-        (MOG2/KNN) or people were put on the map by hand
-    """
-
-    step_m: float = 0.05
-    iterations: int = 3
-    ring_px_160: float = 5.0
-    ring_fraction: float = 2.0
-    capture_threshold: float = 0.7
-    capture_threshold_symmetric: float = 0.3
-    confirm_frames: int = 3
-    birth_search_m: float = 1.0
-    rescue_search_m: float = 1.5
-    rescue_gain: float = 0.08
-    rescue_every: int = 10
-    rescue_retry_frames: int = 3
-    target_pixels: int = 1500
-    score: str = "symmetric"
-    adaptive_step: bool = True
-    min_gain: float = 0.002
-    min_step_m: float = 0.025
-    max_step_m: float = 0.4
-    max_iterations: int = 6
-    predict: bool = True
-    measure_height: bool = True
-    height_range_m: tuple[float, float] = (1.3, 2.1)
-    height_samples: int = 25
-    height_deadband_m: float = 0.05
-    height_min_px: int = 60
-    height_ray_gap_m: float = 0.03
-    height_depth_offset_m: float = 1.0
-    velocity_smoothing: float = 0.5
-    max_speed_mps: float = 3.0
-    births: str = "anywhere"
-    min_blob_fraction: float = 0.25
-    confirm_within_s: float = 1.0
-    keep_score: float = 0.2
-    min_support: float = 0.25
-    min_own_share: float = 0.25
-    min_evidence: float = 0.2
-    young_s: float = 3.0
-    min_seen_share: float = 0.3
-    confirm_views: int = 2
-    empty_support: float = 0.1
-    camera_weights: str = "current"
-    lost_after_s: float = 1.0
-    leave_after_frames: int = 2
-    merge_distance_m: float = 0.25
-    min_separation_m: float = 0.4
-    min_depth_m: float = 0.1
-    warm_start_frames: int = 10
-
-    @classmethod
-    def paper(cls, **overrides) -> "EllipsoidConfig":
-        """The method exactly as published: fixed 50 mm steps, K = 3, every pixel, no prediction."""
-        base = cls(adaptive_step=False, predict=False, target_pixels=0, score="paper", birth_search_m=0.0, rescue_search_m=0.0,
-                   measure_height=False,
-                   ring_fraction=0.0, warm_start_frames=0)
-        return replace(base, **overrides)
-
-    def __post_init__(self) -> None:
-        if self.births not in ("anywhere", "entry", "none"):
-            raise ValueError(f"births: expected 'anywhere', 'entry' or 'none', got {self.births!r}")
-        if self.score not in ("paper", "symmetric"):
-            raise ValueError(f"score: expected 'paper' or 'symmetric', got {self.score!r}")
-        if self.camera_weights not in ("current", "candidate"):
-            raise ValueError(f"camera_weights: expected 'current' or 'candidate', got {self.camera_weights!r}")
-        if self.step_m <= 0 or self.iterations < 1:
-            raise ValueError("step_m must be positive and iterations at least 1")
-        if self.confirm_views < 0 or self.rescue_retry_frames < 0 or self.empty_support < 0:
-            raise ValueError("confirm_views, rescue_retry_frames and empty_support must not be negative")
-        if not (isinstance(self.warm_start_frames, (int, np.integer)) and self.warm_start_frames >= 0):
-            raise ValueError(f"warm_start_frames: expected a whole number of frames ≥ 0, got {self.warm_start_frames!r}")
 
 
 @dataclass
@@ -295,22 +115,24 @@ class EllipsoidTracker(TrackerBase):
     def __init__(self, scene: Scene, foregrounds: Mapping[str, Foreground], config: EllipsoidConfig | None = None,
                  position_map: PositionMap | None = None):
         self.scene = scene
-        self.config = config or EllipsoidConfig()
+        self.config = config if config is not None else EllipsoidConfig()
         self.position_map = position_map if position_map is not None else PositionMap()
         self.cams: dict[str, _CameraState] = {}
-        self._draw = DrawArgs(float(self.config.min_depth_m), float(self.config.ring_fraction))
+        self._draw = DrawArgs(float(self.config.score.min_depth_m), float(self.config.score.ring_fraction))
         for cid, fg in foregrounds.items():
             cam = scene.camera(cid)
-            ring = max(1, int(round(self.config.ring_px_160 * math.sqrt(cam.width * cam.height / (160 * 120)))))
+            ring = max(1, int(round(self.config.score.ring_px_160 * math.sqrt(cam.width * cam.height / (160 * 120)))))
             args = camera_args(cam, float(ring), scene.occlusion(cid).floor_distance)
             self.cams[cid] = _CameraState(cam, args, ring, fg, self._draw)
         self._walk_raster = scene.walkable.raster(0.01)
         self._walkable = self._walk_raster.contains
         self._walk_args = Walkable(self._walk_raster.inside, np.asarray(self._walk_raster.origin, float),
                                    float(self._walk_raster.resolution))
-        self._python_rounds = False  # tests switch to the readable rounds to compare
+        self._python_rounds = self.config.match.rounds == "python"
         self._last_t: float | None = None
         self._frame = 0
+        #: The frame interval (s) last seen, for durations on a first frame (learned in a warm start).
+        self._interval = 0.0
         self._close_frames: dict[tuple[int, int], int] = {}
         self._unseen: dict[int, int] = {}
         self._confirmed: set[int] = set()
@@ -333,7 +155,7 @@ class EllipsoidTracker(TrackerBase):
     @property
     def warm_start_frames(self) -> int:
         """Frames :meth:`warm_start` wants before the first :meth:`step` (0 = none: see the config)."""
-        n = self.config.warm_start_frames
+        n = self.config.warm_start.frames
         if n < 2 or self._frame > 0 or len(self.position_map) > 0:
             return 0
         if any(getattr(cs.foreground, "learns", True) for cs in self.cams.values()):
@@ -362,9 +184,11 @@ class EllipsoidTracker(TrackerBase):
         back = self._fresh()
         t_end = frames[-1][0]
         back._adopt(ahead, t_end)
+        back._interval = ahead._interval
         for t, views in reversed(frames):
             back.step(views, 2 * t_end - t)
         self._adopt(back, frames[0][0])
+        self._interval = back._interval
 
     def _fresh(self) -> "EllipsoidTracker":
         """An empty tracker on the same scene, foregrounds and settings (for :meth:`warm_start`)."""
@@ -388,6 +212,8 @@ class EllipsoidTracker(TrackerBase):
         """Update the map with one synchronised bundle of frames; return the confirmed tracks."""
         cfg = self.config
         dt = 0.0 if self._last_t is None else max(t - self._last_t, 1e-6)
+        if dt > 0:
+            self._interval = dt
         real: dict[str, np.ndarray] = {}
         for cid, frame in frames.items():
             if cid not in self.cams:
@@ -401,17 +227,17 @@ class EllipsoidTracker(TrackerBase):
 
         tracks = list(self.position_map)
         prev = {tr.id: (tr.x, tr.y) for tr in tracks}
-        if cfg.predict and dt > 0:
+        if cfg.match.predict and dt > 0:
             moving = [tr for tr in tracks if tr.mode == "tracking"]
             ahead = np.array([[tr.x + tr.vx * dt, tr.y + tr.vy * dt] for tr in moving]).reshape(-1, 2)
             for tr, (x, y), ok in zip(moving, ahead, self._walkable(ahead)):
                 if ok:  # a prediction into a wall or a desk stays where it was
                     tr.x, tr.y = float(x), float(y)
 
-        scores = self._match(tracks, real)
-        births = self._births(real, t) if cfg.births != "none" else []
+        scores = self._match(tracks, real, t)
+        births = self._births(real, t) if cfg.births.where != "none" else []
         if births:
-            scores.update(self._match(births, real, others=tracks))
+            scores.update(self._match(births, real, t, others=tracks))
             tracks = tracks + births
 
         self._update_states(tracks, scores, prev, dt, t)
@@ -420,7 +246,7 @@ class EllipsoidTracker(TrackerBase):
         return [tr.copy() for tr in self.position_map if tr.id in self._confirmed]
 
     # ------------------------------------------------------------------ matching
-    def _match(self, tracks: list[Track], real: dict[str, np.ndarray],
+    def _match(self, tracks: list[Track], real: dict[str, np.ndarray], t: float,
                others: list[Track] | None = None) -> dict[int, tuple[float, float]]:
         """Move each of ``tracks`` in turn to its best candidate; returns {id: (E, denominator)}.
 
@@ -439,32 +265,34 @@ class EllipsoidTracker(TrackerBase):
         state = {cid: Forms(*(a[c] for a in stacked)) for c, cid in enumerate(cids)}
         for k, tr in enumerate(tracks):
             seen_by = tr.extra.pop("seen_by", None)  # births' note for this search only
-            if cfg.birth_search_m > 0 and tr.mode == "capture" and tr.age_frames == 0:
+            if cfg.births.search_m > 0 and tr.mode == "capture" and tr.age_frames == 0:
                 self._search_new(k, xy, hs, ws, state, real, seen_by)
         use_ring = np.array([tr.mode != "capture" for tr in tracks])
         if self._python_rounds:
             best_e, best_den = self._rounds_python(use_ring, xy, hs, ws, state, real)
         else:
-            steps = StepArgs(float(cfg.step_m), float(cfg.min_step_m), float(cfg.max_step_m), int(cfg.iterations),
-                             int(cfg.max_iterations), bool(cfg.adaptive_step), float(cfg.min_gain))
-            scoring = RoundScoring(self._draw, int(cfg.target_pixels), cfg.score == "symmetric",
-                                   cfg.camera_weights == "current")
+            steps = StepArgs(float(cfg.match.step_m), float(cfg.match.min_step_m), float(cfg.match.max_step_m), int(cfg.match.iterations),
+                             int(cfg.match.max_iterations), bool(cfg.match.adaptive_step), float(cfg.match.min_gain))
+            scoring = RoundScoring(self._draw, int(cfg.score.target_pixels), cfg.score.kind == "symmetric",
+                                   cfg.score.camera_weights == "current")
             best_e, best_den = run_rounds(
                 People(xy, hs, ws), n, use_ring, tuple(self.cams[cid].args for cid in cids),
                 tuple(real[cid] for cid in cids), stacked, self._walk_args, steps, scoring)
-        if cfg.rescue_search_m > 0:
+        if cfg.rescue.search_m > 0:
+            every = frames_for(cfg.rescue.every_s, self._interval) if cfg.rescue.every_s > 0 else 0
             for k, tr in enumerate(tracks):
                 # Periodically too, for everyone (``_rescue`` never moves onto somebody else).
-                periodic = cfg.rescue_every > 0 and (self._frame + tr.id) % cfg.rescue_every == 0
-                # A failing track whose search found nothing better waits a few frames before
-                # searching again: the same line of sight a frame later rarely holds a new answer.
-                failing = tr.frames_low > 0 and self._frame >= tr.extra.get("rescue_after", 0)
+                periodic = every > 0 and (self._frame + tr.id) % every == 0
+                # A failing track whose search found nothing better waits a while before searching
+                # again: the same line of sight a frame later rarely holds a new answer. (Half a
+                # frame of slack: time stamps are rounded.)
+                failing = tr.frames_low > 0 and t + 0.5 * self._interval >= tr.extra.get("rescue_after", -np.inf)
                 if tr.mode == "tracking" and (failing or periodic):
                     found = self._rescue(k, xy, hs, ws, state, real)
                     if found is not None:
                         best_e[k], best_den[k] = found
                     elif failing:
-                        tr.extra["rescue_after"] = self._frame + cfg.rescue_retry_frames
+                        tr.extra["rescue_after"] = t + cfg.rescue.retry_s
         for k, tr in enumerate(tracks):
             tr.x, tr.y = float(xy[k, 0]), float(xy[k, 1])
             result[tr.id] = (float(best_e[k]), float(best_den[k]))
@@ -475,11 +303,11 @@ class EllipsoidTracker(TrackerBase):
         """The matching rounds in plain Python: the reference for :func:`ellipsoid_match.run_rounds`."""
         cfg = self.config
         n = len(use_ring)
-        step = np.full(n, cfg.step_m)
+        step = np.full(n, cfg.match.step_m)
         done = np.zeros(n, dtype=bool)
         best_e = np.zeros(n)
         best_den = np.zeros(n)
-        rounds = cfg.max_iterations if cfg.adaptive_step else cfg.iterations
+        rounds = cfg.match.max_iterations if cfg.match.adaptive_step else cfg.match.iterations
         for it in range(rounds):
             for k in range(n):
                 if done[k]:
@@ -490,20 +318,20 @@ class EllipsoidTracker(TrackerBase):
                     best_e[k], best_den[k] = e[STAY], den[STAY]
                     continue
                 b = int(np.argmax(e))
-                if cfg.adaptive_step and e[b] - e[STAY] < cfg.min_gain:
+                if cfg.match.adaptive_step and e[b] - e[STAY] < cfg.match.min_gain:
                     b = STAY
                 best_e[k], best_den[k] = e[b], den[b]
                 if b != STAY:
                     xy[k] = cand[b]
                     _keep(state, forms, k, b)
-                if cfg.adaptive_step:
+                if cfg.match.adaptive_step:
                     if b == STAY:
-                        if step[k] <= cfg.min_step_m * 1.001:
+                        if step[k] <= cfg.match.min_step_m * 1.001:
                             done[k] = True
                         else:
-                            step[k] = max(step[k] / 2, cfg.min_step_m)
-                    elif it >= cfg.iterations - 1:
-                        step[k] = min(step[k] * 2, cfg.max_step_m)
+                            step[k] = max(step[k] / 2, cfg.match.min_step_m)
+                    elif it >= cfg.match.iterations - 1:
+                        step[k] = min(step[k] * 2, cfg.match.max_step_m)
             if done.all():
                 break
         return best_e, best_den
@@ -541,7 +369,7 @@ class EllipsoidTracker(TrackerBase):
             ray = _ray_direction(self.cams[seen_by].camera, xy[k])
             if not np.allclose(ray, axes[0][0]):  # the same camera: nothing new to search
                 axes.append((ray, np.array([-ray[1], ray[0]])))
-        along = np.arange(-cfg.birth_search_m, cfg.birth_search_m + 1e-9, 0.1)
+        along = np.arange(-cfg.births.search_m, cfg.births.search_m + 1e-9, 0.1)
         across = np.array([-0.2, -0.1, 0.0, 0.1, 0.2])
         grid = np.array([(a, c) for a in along for c in across])
         cand = np.concatenate([xy[k] + grid[:, :1] * d[0] + grid[:, 1:] * d[1] for d in axes])
@@ -572,7 +400,7 @@ class EllipsoidTracker(TrackerBase):
         only scores from one call compare. Returns (E, denominator) of the new place, or None.
         """
         cfg = self.config
-        along = np.arange(-cfg.rescue_search_m, cfg.rescue_search_m + 1e-9, 0.15)
+        along = np.arange(-cfg.rescue.search_m, cfg.rescue.search_m + 1e-9, 0.15)
         along = along[np.abs(along) > 0.2]
         # Along every seeing camera's line of sight: with two cameras the error lies along the one
         # that fixes depth worse, not necessarily the one that sees the person largest.
@@ -581,7 +409,7 @@ class EllipsoidTracker(TrackerBase):
         ok = self._walkable(cand)
         if len(others):
             dist = np.min(np.linalg.norm(cand[:, None, :] - others[None, :, :], axis=2), axis=1)
-            ok &= dist >= cfg.min_separation_m
+            ok &= dist >= cfg.births.min_separation_m
         if not ok.any():
             return None
         cand = np.vstack([xy[k], cand[ok]])                   # row 0: where the person is now
@@ -594,7 +422,7 @@ class EllipsoidTracker(TrackerBase):
         e[num < num[0]] = -np.inf
         e[0] = -np.inf
         b = int(np.argmax(e))
-        if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue_gain:
+        if not np.isfinite(e[b]) or e[b] < e_here + cfg.rescue.gain:
             return None
         xy[k] = cand[b]
         _keep(state, forms, k, b)
@@ -638,13 +466,13 @@ class EllipsoidTracker(TrackerBase):
         num = np.zeros((len(state), len(cand)))
         den = np.zeros((len(state), len(cand)))
         forms = {}
-        unexplained = use_ring and cfg.score == "symmetric"
+        unexplained = use_ring and cfg.score.kind == "symmetric"
         for i, (cid, st) in enumerate(state.items()):
             num[i], den[i], ci, cr, cb, cv, cd = score_camera(
                 self.cams[cid].args, real[cid], cand, heights, widths, self._draw, st, k,
-                ScoreArgs(use_ring, int(cfg.target_pixels), unexplained))
+                ScoreArgs(use_ring, int(cfg.score.target_pixels), unexplained))
             forms[cid] = Forms(ci, cr, cb, cv, cd)
-        if current is not None and cfg.camera_weights == "current" and len(state) > 1:
+        if current is not None and cfg.score.camera_weights == "current" and len(state) > 1:
             return held_scores(num, den, current), den.sum(axis=0), forms  # (one camera: the same)
         num, den = num.sum(axis=0), den.sum(axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -716,21 +544,21 @@ class EllipsoidTracker(TrackerBase):
                 if p is None:
                     continue
                 pxy = self._nearest_walkable(p[:2], 0.6)
-                if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
+                if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.births.min_separation_m):
                     continue  # off the floor, or somebody already there
                 # Is the blob big enough to be (the visible part of) a person standing there?
                 expected = _visible_pixels(cs, pxy, h0, w0)
-                if expected <= 0 or area < cfg.min_blob_fraction * expected:
+                if expected <= 0 or area < cfg.births.min_blob_fraction * expected:
                     continue
                 proposals.append((pxy, cid))
         if not proposals:
             return []
-        if cfg.births == "entry" and self._frame > 0 and self.scene.entry_regions:
+        if cfg.births.where == "entry" and self._frame > 0 and self.scene.entry_regions:
             proposals = [(p, cid) for p, cid in proposals if self.scene.entry_region_index([p])[0] >= 0]
         # Each proposal is already clear of the existing people; keep the proposals apart too.
         new: list[Track] = []
         for p, cid in proposals:
-            if any(np.hypot(*(np.array([b.x, b.y]) - p)) < cfg.min_separation_m for b in new):
+            if any(np.hypot(*(np.array([b.x, b.y]) - p)) < cfg.births.min_separation_m for b in new):
                 continue
             tr = self.position_map.add(p[0], p[1], h0, w0, mode="capture", time=t, tentative=True)
             tr.extra["seen_by"] = cid
@@ -766,7 +594,7 @@ class EllipsoidTracker(TrackerBase):
         views = np.zeros(len(tracks), dtype=int)
         for cid, labels in self.last_labels.items():
             cs = self.cams[cid]
-            vis, own, own_fg, area = track_support(cs.args, labels, cs.forms(xy, hs, ws), int(cfg.target_pixels), covers)
+            vis, own, own_fg, area = track_support(cs.args, labels, cs.forms(xy, hs, ws), int(cfg.score.target_pixels), covers)
             visible += vis
             own_total += own
             seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
@@ -783,8 +611,11 @@ class EllipsoidTracker(TrackerBase):
     def _update_states(self, tracks: list[Track], scores: dict[int, tuple[float, float]],
                        prev: dict[int, tuple[float, float]], dt: float, t: float) -> None:
         cfg = self.config
-        fps_frames = (lambda s: max(1, int(round(s / dt)))) if dt > 0 else (lambda s: max(1, int(round(s * 10))))
-        symmetric = cfg.score == "symmetric"
+        interval = dt if dt > 0 else self._interval
+        lost_after = frames_for(cfg.end.lost_after_s, interval)
+        leave_after = frames_for(cfg.end.leave_after_s, interval)
+        held_frames = frames_for(cfg.confirm.held_s, interval)
+        symmetric = cfg.score.kind == "symmetric"
         support = self._support(tracks)
         for tr in tracks:
             e, den = scores.get(tr.id, (0.0, 0.0))
@@ -801,27 +632,27 @@ class EllipsoidTracker(TrackerBase):
                 self._unseen[tr.id] = self._unseen.get(tr.id, 0) + 1
             if tr.mode == "tracking" and tr.id in prev and dt > 0:
                 px, py = prev[tr.id]
-                a = cfg.velocity_smoothing
+                a = cfg.match.velocity_smoothing
                 vx = (1 - a) * tr.vx + a * (tr.x - px) / dt
                 vy = (1 - a) * tr.vy + a * (tr.y - py) / dt
                 speed = math.hypot(vx, vy)
-                scale = min(1.0, cfg.max_speed_mps / speed) if speed > 0 else 1.0
+                scale = min(1.0, cfg.match.max_speed_mps / speed) if speed > 0 else 1.0
                 tr.vx, tr.vy = vx * scale, vy * scale
             if tr.mode == "capture":
-                if self._near_confirmed(tr, cfg.min_separation_m):
+                if self._near_confirmed(tr, cfg.births.min_separation_m):
                     self._end(tr)  # slid onto somebody already tracked
                     continue
                 if symmetric:
                     # Held on foreground for several frames: a person, not a flicker.
-                    ok = (e > cfg.capture_threshold_symmetric and sup >= cfg.min_support
-                          and not own_share < cfg.min_own_share and seen >= cfg.min_seen_share)
+                    ok = (e > cfg.confirm.symmetric_threshold and sup >= cfg.support.min_support
+                          and not own_share < cfg.support.min_own_share and seen >= cfg.support.min_seen_share)
                     tr.extra["held"] = tr.extra.get("held", 0) + 1 if ok else 0
                     # Strong evidence (the paper's own threshold) confirms at once.
                     # So does a person several cameras agree on (a ghost is rarely one in two views).
-                    confirmed = (tr.extra["held"] >= cfg.confirm_frames or (ok and e > cfg.capture_threshold)
-                                 or (ok and cfg.confirm_views > 0 and views >= cfg.confirm_views))
+                    confirmed = (tr.extra["held"] >= held_frames or (ok and e > cfg.confirm.capture_threshold)
+                                 or (ok and cfg.confirm.views > 0 and views >= cfg.confirm.views))
                 else:
-                    confirmed = e > cfg.capture_threshold
+                    confirmed = e > cfg.confirm.capture_threshold
                 if confirmed:
                     tr.extra.pop("held", None)
                     self._promote(tr)
@@ -829,28 +660,28 @@ class EllipsoidTracker(TrackerBase):
                     tr.vx = tr.vy = 0.0  # capture moves are sliding into the blob, not walking
                     self._confirmed.add(tr.id)
                     tr.frames_low = 0
-                elif t - tr.born > cfg.confirm_within_s:
+                elif t - tr.born > cfg.confirm.within_s:
                     self._end(tr)
                     continue
             else:
-                low = (sup < cfg.min_support or evidence < cfg.min_evidence) if symmetric else e < cfg.keep_score
+                low = (sup < cfg.support.min_support or evidence < cfg.support.min_evidence) if symmetric else e < cfg.end.keep_score
                 # A young track living inside someone else's silhouette duplicates them. So does one of
                 # any age that at most one of several cameras shows: a person who walks behind
                 # somebody in one view is still seen in another.
-                if symmetric and own_share < cfg.min_own_share and (
-                        t - tr.born < cfg.young_s or (len(self.cams) >= 2 and views <= 1)):
+                if symmetric and own_share < cfg.support.min_own_share and (
+                        t - tr.born < cfg.end.young_s or (len(self.cams) >= 2 and views <= 1)):
                     low = True
                 # Own pixels that are nearly all floor: a ghost, or a track that lost its person.
-                empty = symmetric and sup < cfg.empty_support
+                empty = symmetric and sup < cfg.support.empty_support
                 tr.frames_low = tr.frames_low + (2 if empty else 1) if low else 0
-                if tr.frames_low >= fps_frames(cfg.lost_after_s):
+                if tr.frames_low >= lost_after:
                     self._end(tr)
                     continue
-            if self._unseen.get(tr.id, 0) >= cfg.leave_after_frames:
+            if self._unseen.get(tr.id, 0) >= leave_after:
                 self._end(tr)
                 continue
         self._flag_measurability(tracks)
-        if cfg.measure_height:
+        if cfg.height.measure:
             self._update_heights(tracks)
         self._merge_duplicates()
 
@@ -873,14 +704,14 @@ class EllipsoidTracker(TrackerBase):
         if not tracks:
             return
         xy, hs, ws = _arrays(tracks)
-        lo, hi = cfg.height_range_m
+        lo, hi = cfg.height.range_m
         samples_now: dict[int, list[float]] = {}
         rays: dict[int, list] = {}
         # Every frame until a person has 10 measurements (or 20 frames were tried: someone always
         # in a group rarely gives one), then one frame in five until ``height_samples`` are in:
         # a person's height does not change, and the median of that many is final.
         due = [k for k, tr in enumerate(tracks) if tr.mode == "tracking"
-               and len(self._heights.get(tr.id, ())) < cfg.height_samples
+               and len(self._heights.get(tr.id, ())) < cfg.height.samples
                and ((len(self._heights.get(tr.id, ())) < 10 and self._height_tries.get(tr.id, 0) < 20)
                     or (self._frame + tr.id) % 5 == 0)]
         if not due:
@@ -922,16 +753,16 @@ class EllipsoidTracker(TrackerBase):
                 # One camera alone: only oblique views that show the person large — from above,
                 # height is neither measurable nor needed; small, it is noise.
                 flat = np.hypot(*(xy[k] - cam.centre[:2]))
-                if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height_min_px:
+                if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < cfg.height.min_px:
                     continue
                 h = measure_height(cam, labels, cs.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
-                                   max_depth_offset_m=cfg.height_depth_offset_m)
+                                   max_depth_offset_m=cfg.height.depth_offset_m)
                 if h is not None:
                     samples_now.setdefault(tr.id, []).append(h)
         for k, tr in enumerate(tracks):
             # Two views of the head from different sides beat any single view.
             head_rays = rays.get(tr.id, [])
-            h3 = triangulate_height(head_rays, xy[k], height_range_m=(lo, hi), max_ray_gap_m=cfg.height_ray_gap_m)
+            h3 = triangulate_height(head_rays, xy[k], height_range_m=(lo, hi), max_ray_gap_m=cfg.height.ray_gap_m)
             if h3 is not None:
                 new = [h3]
             elif len(head_rays) >= 2:
@@ -946,11 +777,11 @@ class EllipsoidTracker(TrackerBase):
                 continue
             samples = self._heights.setdefault(tr.id, [])
             samples.extend(new)
-            del samples[:-cfg.height_samples]
+            del samples[:-cfg.height.samples]
             if len(samples) >= 3:
                 default = self.scene.people.size_of(tr.id)[0]
                 median = float(np.median(samples))
-                tr.height = median if abs(median - default) > cfg.height_deadband_m else default
+                tr.height = median if abs(median - default) > cfg.height.deadband_m else default
 
     def _promote(self, tr: Track) -> None:
         """A confirmed candidate gets its public id (and per-id bookkeeping follows it)."""
@@ -981,10 +812,10 @@ class EllipsoidTracker(TrackerBase):
             for j in range(i + 1, len(tracks)):
                 a, b = tracks[i], tracks[j]
                 key = (min(a.id, b.id), max(a.id, b.id))
-                if math.hypot(a.x - b.x, a.y - b.y) < self.config.merge_distance_m:
+                if math.hypot(a.x - b.x, a.y - b.y) < self.config.end.merge_distance_m:
                     self._close_frames[key] = self._close_frames.get(key, 0) + 1
                     seen_pairs.add(key)
-                    if self._close_frames[key] >= 3:
+                    if self._close_frames[key] >= frames_for(self.config.end.merge_after_s, self._interval):
                         younger = b if (b.born, b.id) > (a.born, a.id) else a
                         self._end(younger)
         for key in list(self._close_frames):
