@@ -168,6 +168,23 @@ class Walkable(NamedTuple):
     resolution: float
 
 
+class Scoring(NamedTuple):
+    """How a frame's candidates are drawn and scored (the same for every person and camera).
+
+    Attributes
+    ----------
+    draw : DrawArgs
+    target_pixels : int — pixels visited per candidate set (0: all)
+    symmetric : bool — count the foreground no ellipse explains, for tracked people
+    held : bool — with several cameras, weigh each camera as at a tracked person's current place
+    """
+
+    draw: DrawArgs
+    target_pixels: int
+    symmetric: bool
+    held: bool
+
+
 class StepArgs(NamedTuple):
     """The matching steps (paper: s = 50 mm, K = 3 rounds) and worldtrack's adaptive steps.
 
@@ -188,5 +205,5 @@ class StepArgs(NamedTuple):
     min_gain: float
 
 
-__all__ = ["CameraArgs", "DrawArgs", "Forms", "NO_GRID", "People", "ScoreArgs", "StepArgs", "Sums", "Walkable",
+__all__ = ["CameraArgs", "DrawArgs", "Forms", "NO_GRID", "People", "ScoreArgs", "Scoring", "StepArgs", "Sums", "Walkable",
            "Window", "camera_args"]

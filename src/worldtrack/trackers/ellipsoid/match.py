@@ -1,39 +1,38 @@
-"""The matching rounds of seed 000 for everybody, in one compiled loop.
+"""The matching rounds of paper 000 (§5): every person in turn to the best of 9 candidates, K times.
 
 Each round moves every person in turn to the best of 9 candidates (−s, 0, +s along the viewing
 direction of the camera that sees them largest and its perpendicular), with everybody else fixed
-in the joint simulated image, and adapts the step (coarse to fine). With several cameras a tracked
-person's candidates are scored with the cameras weighed as at their current place
-(:func:`held_scores`). This is
-``EllipsoidTracker._rounds_python`` — the readable version it is tested against — without the
-Python overhead per person and round, which at 640×480 was ~40 % of the tracker's time.
+in the joint simulated image (:mod:`.joint`), and adapts the step (coarse to fine). With several
+cameras a tracked person's candidates are scored with the cameras weighed as at their current
+place (:func:`held_scores`).
+
+Two implementations, chosen by name (``ellipsoid.match.rounds``) from :data:`ROUNDS`:
+``compiled`` (:func:`run_rounds`, one compiled loop; at 640×480 the Python overhead per person and
+round was ~40 % of the tracker's time) and ``python`` (:func:`rounds_python`, the readable version
+it is tested against: the same tracks).
+
+>>> held_scores_reference(np.array([[6.0, 8.0]]), np.array([[10.0, 10.0]]), 0).tolist()
+[0.6, 0.8]
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numba import njit
 
-from worldtrack.trackers.ellipsoid.args import DrawArgs, Forms, ScoreArgs
+from worldtrack.registry import Registry
+from worldtrack.trackers.ellipsoid.args import Forms, ScoreArgs, StepArgs
 from worldtrack.trackers.ellipsoid.score import score_camera
+
+if TYPE_CHECKING:
+    from worldtrack.trackers.ellipsoid.joint import JointImage
 
 #: The 9 candidate offsets in units of the step, along (viewing direction, perpendicular).
 OFFSETS = np.array([(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1)], dtype=np.float64)
 #: Index of "stay" among the candidates.
 STAY = 4
-
-
-class RoundScoring(NamedTuple):
-    """How the rounds draw and score candidates: ``draw`` (DrawArgs), ``target_pixels`` (int),
-    ``symmetric`` (count the unexplained foreground for tracked people), ``held`` (weigh cameras as
-    at the current place for tracked people, with several cameras)."""
-
-    draw: DrawArgs
-    target_pixels: int
-    symmetric: bool
-    held: bool
 
 
 @njit(cache=True)
@@ -121,7 +120,7 @@ def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scor
         people who move
     walk : Walkable — the walkable raster
     steps : StepArgs
-    scoring : RoundScoring — how candidates are drawn and scored; ``held``: score the candidates
+    scoring : Scoring — how candidates are drawn and scored; ``held``: score the candidates
         of tracked people (not those in capture mode, still sliding into their blob) with
         :func:`held_scores`, cameras weighed as at the current place, instead of Σ num / Σ den
 
@@ -225,3 +224,80 @@ def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scor
         if done.all():
             break
     return best_e, best_den
+
+
+class Rounds(Protocol):
+    """The matching rounds: move people ``0 … n_moving − 1`` of ``joint`` round after round (the
+    others fixed); return E and its denominator at each one's final place, (n_moving,) each."""
+
+    def __call__(self, joint: "JointImage", use_ring: np.ndarray, steps: StepArgs) -> tuple[np.ndarray, np.ndarray]:
+        ...
+
+
+#: The implementations of :class:`Rounds` by name (``ellipsoid.match.rounds``).
+ROUNDS: Registry[Rounds] = Registry("ellipsoid.match.rounds")
+
+
+@ROUNDS.register("compiled")
+def rounds_compiled(joint: "JointImage", use_ring: np.ndarray, steps: StepArgs) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`run_rounds` on a :class:`~.joint.JointImage` (positions and forms updated in place)."""
+    cams = tuple(joint.views[cid].args for cid in joint.cids)
+    reals = tuple(joint.real[cid] for cid in joint.cids)
+    return run_rounds(joint.people, len(use_ring), use_ring, cams, reals, joint.stacked, joint.walk, steps,
+                      joint.settings)
+
+
+@ROUNDS.register("python")
+def rounds_python(joint: "JointImage", use_ring: np.ndarray, steps: StepArgs) -> tuple[np.ndarray, np.ndarray]:
+    """The matching rounds in plain Python: the reference for :func:`run_rounds`."""
+    n = len(use_ring)
+    step = np.full(n, steps.step_m)
+    done = np.zeros(n, dtype=bool)
+    best_e = np.zeros(n)
+    best_den = np.zeros(n)
+    rounds = steps.max_iterations if steps.adaptive else steps.iterations
+    for it in range(rounds):
+        for k in range(n):
+            if done[k]:
+                continue
+            e, den, cand, forms, ok = _score_person(joint, k, step[k], bool(use_ring[k]))
+            if not ok:
+                done[k] = True
+                best_e[k], best_den[k] = e[STAY], den[STAY]
+                continue
+            b = int(np.argmax(e))
+            if steps.adaptive and e[b] - e[STAY] < steps.min_gain:
+                b = STAY
+            best_e[k], best_den[k] = e[b], den[b]
+            if b != STAY:
+                joint.move(k, cand[b], forms, b)
+            if steps.adaptive:
+                if b == STAY:
+                    if step[k] <= steps.min_step_m * 1.001:
+                        done[k] = True
+                    else:
+                        step[k] = max(step[k] / 2, steps.min_step_m)
+                elif it >= steps.iterations - 1:
+                    step[k] = min(step[k] * 2, steps.max_step_m)
+        if done.all():
+            break
+    return best_e, best_den
+
+
+def _score_person(joint: "JointImage", k: int, step: float, use_ring: bool):
+    """E of the 9 candidates of person ``k`` over all cameras: Σ num / Σ den, with the cameras
+    weighed as at the current place for a tracked person (``held``)."""
+    d, e_perp = joint.axes(k)
+    cand = joint.xy[k] + step * (OFFSETS[:, :1] * d + OFFSETS[:, 1:] * e_perp)
+    e, den, forms = joint.score(k, cand, use_ring, current=STAY if use_ring else None)
+    walk = joint.walkable(cand)
+    walk[STAY] = True
+    e[~walk] = -np.inf
+    ok = bool(den[STAY] > 0)
+    if not ok:
+        e[:] = 0.0
+    return e, den, cand, forms, ok
+
+
+__all__ = ["OFFSETS", "ROUNDS", "Rounds", "STAY", "held_scores", "held_scores_reference", "rounds_compiled",
+           "rounds_python", "run_rounds", "walkable_lookup"]

@@ -18,8 +18,16 @@ import math
 import numpy as np
 from numba import njit
 
+from typing import Callable, Mapping, NamedTuple, Sequence
+
+from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.args import CameraArgs, Forms
+from worldtrack.trackers.lifecycle import counts_for
 from worldtrack.trackers.ellipsoid.forms import ideal_position, inside
+
+#: Pixels a person must show (in all cameras together) to count as seen, or as its own.
+MIN_OWN_PIXELS = 40
 
 
 @njit(cache=True)
@@ -129,4 +137,103 @@ def _inside(f: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return f[2] * du * du + 2.0 * f[3] * du * dv + f[4] * dv * dv < 1.0
 
 
-__all__ = ["track_support", "track_support_reference"]
+class Support(NamedTuple):
+    """Per person (N,), over a tracker's cameras.
+
+    Attributes
+    ----------
+    visible : float — pixels of the ellipse in view and not hidden by obstacles, all cameras
+    support : float — share of the person's own pixels (visible, nobody else's) that are
+        foreground, in the camera where it is lowest among those showing at least
+        :data:`MIN_OWN_PIXELS` of them (a real person is foreground in every view; a ghost that
+        explains a tall neighbour's legs in one view stands on floor in another); NaN when no
+        camera shows enough
+    own_share : float — fraction of the visible pixels that nobody else covers
+    seen_share : float — the largest fraction of the whole ellipse some camera shows
+    evidence : float — the largest fraction of the whole ellipse that is own foreground or
+        explained by others (low for a track past the image border or on empty floor)
+    views : int — cameras that show at least :data:`MIN_OWN_PIXELS` own pixels
+    seen_by : tuple of tuple of str — per person, the cameras whose view holds some of it
+    """
+
+    visible: np.ndarray
+    support: np.ndarray
+    own_share: np.ndarray
+    seen_share: np.ndarray
+    evidence: np.ndarray
+    views: np.ndarray
+    seen_by: tuple
+
+
+def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mapping[str, np.ndarray],
+                    target_pixels: int, covers: np.ndarray) -> Support:
+    """:class:`Support` of N people from their ellipses in each camera.
+
+    Parameters
+    ----------
+    cams : {camera_id: (CameraArgs, Forms of the N people)}
+    labels : {camera_id: (H, W) uint8} — the cameras' foreground labels (1 fg, 0 bg, 2 unsure)
+    target_pixels : int — samples per person (0: every pixel)
+    covers : (N,) bool — who takes pixels away from the others (tracked people)
+    """
+    n = len(covers)
+    visible, own_total, seen_share, evidence = (np.zeros(n) for _ in range(4))
+    support = np.full(n, np.nan)
+    views = np.zeros(n, dtype=int)
+    seen: list[list[str]] = [[] for _ in range(n)]
+    for cid, mask in labels.items():
+        args, forms = cams[cid]
+        vis, own, own_fg, area = track_support(args, mask, forms, target_pixels, covers)
+        visible += vis
+        own_total += own
+        seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
+        # Evidence: foreground of its own plus what others explain, over the whole ellipse.
+        evidence = np.maximum(evidence, np.where(area > 0, (own_fg + vis - own) / np.maximum(area, 1), 0.0))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            here = np.where(own >= MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
+        support = np.fmin(support, here)
+        views += own >= MIN_OWN_PIXELS
+        for k in np.flatnonzero(vis > 0):
+            seen[k].append(cid)
+    own_share = np.where(visible > 0, own_total / np.maximum(visible, 1), np.nan)
+    return Support(visible, support, own_share, seen_share, evidence, views, tuple(tuple(s) for s in seen))
+
+
+def flag_unmeasurable(people: Sequence[Person], cameras: Sequence[Camera], occlusion: Callable[[str], object],
+                      t: float) -> None:
+    """Flag people whose head and feet are both hidden in every camera (paper 000 Table 2 (b)).
+
+    Such a person's place along the line of sight is unknown: ``unmeasurable`` with σ = 1 m instead
+    of a confident wrong place; otherwise σ = 0.1 m. Vectorised over people. Trackers sharing a map
+    flag a person only if none of them sees its head or feet at ``t`` (counter ``hidden``).
+
+    Parameters
+    ----------
+    people : the people to flag
+    cameras : the tracker's cameras
+    occlusion : camera id → the scene's occlusion map of that camera (``scene.occlusion``)
+    t : float — time stamp, s
+    """
+    if not people:
+        return
+    n = len(people)
+    pts = np.array([[[p.x, p.y, 0.0], [p.x, p.y, p.height]] for p in people]).reshape(-1, 3)
+    seen = np.zeros(n, dtype=bool)
+    head_or_feet = np.zeros(n, dtype=bool)
+    for cam in cameras:
+        uv = cam.project(pts)
+        inside = cam.in_image(uv)
+        visible = inside & ~occlusion(cam.id).hidden(uv, cam.floor_distance(pts) - 0.05)
+        seen |= inside.reshape(n, 2).any(axis=1)
+        head_or_feet |= visible.reshape(n, 2).any(axis=1)
+    for k, p in enumerate(people):
+        if counts_for(p, "hidden", t, bool(seen[k] and not head_or_feet[k])) > 0:
+            p.flags.add("unmeasurable")
+            p.sigma = 1.0
+        else:
+            p.flags.discard("unmeasurable")
+            p.sigma = 0.1
+
+
+__all__ = ["MIN_OWN_PIXELS", "Support", "flag_unmeasurable", "measure_support", "track_support",
+           "track_support_reference"]
