@@ -66,7 +66,9 @@ def test_no_kernel_writes_the_lens_polynomial_itself():
 
 def test_every_compiled_kernel_has_a_reference_or_a_test_of_its_caller():
     # Each public compiled kernel has a plain version beside it, or is checked through one.
+    # (adapt_step, the adaptive step rule, is shared by both rounds: scalar logic, not a second copy.)
     checked_through = {"ellipse_forms": "score_candidates_reference", "score_camera": "score_candidates_reference",
+                       "adapt_step": "rounds_python",
                        "run_rounds": "rounds_python", "walkable_lookup": "rounds_python",
                        "owner_crop": "owner_map", "inside": "ellipse_crop_reference",
                        "ideal_position": "ellipse_crop_reference", "pixels_by_rows": "score_candidates_reference",

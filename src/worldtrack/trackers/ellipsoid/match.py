@@ -102,6 +102,20 @@ def held_scores_reference(num: np.ndarray, den: np.ndarray, ref: int) -> np.ndar
 
 
 @njit(cache=True)
+def adapt_step(step, moved, it, steps):
+    """The adaptive step after person's move in round ``it``: (new step, done). Halved when "stay"
+    won (done once at ``min_step_m``), doubled up to ``max_step_m`` when still moving after the K
+    rounds (coarse to fine, and fast walkers are followed)."""
+    if not moved:
+        if step <= steps.min_step_m * 1.001:
+            return step, True
+        return max(step / 2, steps.min_step_m), False
+    if it >= steps.iterations - 1:
+        return min(step * 2, steps.max_step_m), False
+    return step, False
+
+
+@njit(cache=True)
 def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scoring):
     """Move people ``0 … n_moving − 1`` round after round; the others stay fixed.
 
@@ -214,13 +228,7 @@ def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scor
                     s_valid[c, k] = f_valid[c, b]
                     s_dist[c, k] = f_dist[c, b]
             if adaptive:
-                if b == STAY:
-                    if step[k] <= steps.min_step_m * 1.001:
-                        done[k] = True
-                    else:
-                        step[k] = max(step[k] / 2, steps.min_step_m)
-                elif it >= steps.iterations - 1:
-                    step[k] = min(step[k] * 2, steps.max_step_m)
+                step[k], done[k] = adapt_step(step[k], b != STAY, it, steps)
         if done.all():
             break
     return best_e, best_den
@@ -272,13 +280,7 @@ def rounds_python(joint: "JointImage", use_ring: np.ndarray, steps: StepArgs) ->
             if b != STAY:
                 joint.move(k, cand[b], forms, b)
             if steps.adaptive:
-                if b == STAY:
-                    if step[k] <= steps.min_step_m * 1.001:
-                        done[k] = True
-                    else:
-                        step[k] = max(step[k] / 2, steps.min_step_m)
-                elif it >= steps.iterations - 1:
-                    step[k] = min(step[k] * 2, steps.max_step_m)
+                step[k], done[k] = adapt_step(step[k], b != STAY, it, steps)
         if done.all():
             break
     return best_e, best_den
@@ -299,5 +301,5 @@ def _score_person(joint: "JointImage", k: int, step: float, use_ring: bool):
     return e, den, cand, forms, ok
 
 
-__all__ = ["OFFSETS", "ROUNDS", "Rounds", "STAY", "held_scores", "held_scores_reference", "rounds_compiled",
+__all__ = ["OFFSETS", "ROUNDS", "Rounds", "STAY", "adapt_step", "held_scores", "held_scores_reference", "rounds_compiled",
            "rounds_python", "run_rounds", "walkable_lookup"]
