@@ -148,3 +148,16 @@ def test_how_evidence_is_judged_is_a_component_chosen_by_the_score():
     assert isinstance(_tracker(config=EllipsoidConfig.paper()).life.evidence, PaperEvidence)
     with pytest.raises(InputError, match=r"^ellipsoid\.score\.kind: expected one of paper, symmetric, got 'x'$"):
         EVIDENCE["x"]
+
+
+def test_trackers_sharing_a_map_update_a_person_once_per_time_stamp():
+    # Two trackers judge the same person at t = 0.1 s (both cameras show them): the velocity is
+    # smoothed once (0.5 x 1 m/s from rest, not 0.75) and the failing-evidence counter counts one frame.
+    tracker = _tracker()
+    person = tracker.position_map.add(0.0, 1.2, mode="tracking", time=0.0)
+    tracker.position_map.advance(0.1)
+    person.x = 0.1                                            # matched 0.1 m on in 0.1 s
+    for _ in range(2):
+        tracker.life.update([person], [(0.5, 100.0)], _measures(support=0.1), 1, 0.1, 0.1, 0.1)
+    assert person.vx == pytest.approx(0.5) and person.vy == 0.0
+    assert person.count("low") == 1 and person.count("unseen") == 0 and person.seen_at == 0.1
