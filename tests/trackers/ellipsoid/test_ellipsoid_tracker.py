@@ -9,6 +9,7 @@ import pytest
 from _ellipsoid_scenes import drawn_frame, noise_backgrounds, one_camera_scene
 
 from worldtrack.config import with_overrides
+from worldtrack.errors import InputError
 from worldtrack.experiment import run_scenario, standing_with_head_and_feet
 from worldtrack.pipeline import make_foregrounds
 from worldtrack.synth import make_scenario
@@ -126,5 +127,8 @@ def test_tracks_carry_output_only_and_the_overlay_gives_mask_and_ring():
     overlay = tr.overlay("cam")
     assert isinstance(overlay, Overlay) and overlay.ring_px == 5 and overlay.mask.sum() > 300
     assert tr.overlay("elsewhere") == Overlay(None, None)
-    with pytest.raises(Exception, match="track id 1 already exists"):
+    with pytest.raises(InputError, match=r"^--init: track id 1 is already on the map$"):
         tr.init_track(0.0, 0.0, track_id=1)
+    placed = tr.init_track(0.5, 2.0, track_id=9, t=0.3)
+    assert (placed.id, placed.x, placed.born, placed.mode) == (9, 0.5, 0.3, "tracking")
+    assert tr.position_map[9].confirmed

@@ -24,6 +24,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from worldtrack.errors import InputError
 from worldtrack.foreground.background import Foreground
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import Frame, Overlay, Person, PositionMap, Track, TrackerBase, frame_image
@@ -100,6 +101,8 @@ class EllipsoidTracker(TrackerBase):
                    mode: str = "tracking") -> Track:
         """Put a person on the map by hand (``worldtrack track --init ID,X,Y``), at floor place
         (x, y) m, time ``t`` s; ``mode="capture"`` to let them slide into their blob first."""
+        if track_id is not None and track_id in self.position_map:
+            raise InputError(f"--init: track id {track_id} is already on the map")
         h, w = self.scene.people.size_of(track_id or 0)
         return self.position_map.add(x, y, h, w, mode=mode, time=t, track_id=track_id).track()
 
