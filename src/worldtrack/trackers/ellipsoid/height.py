@@ -1,5 +1,11 @@
 """Measuring a person's height from a clear view, for the ellipsoid model.
 
+>>> import numpy as np
+>>> o1, o2, head = np.array([0.0, 0.0, 3.5]), np.array([4.0, 0.5, 3.2]), np.array([1.0, 2.0, 1.78])
+>>> rays = [(o, (head - o) / np.linalg.norm(head - o)) for o in (o1, o2)]
+>>> round(triangulate_height(rays, np.array([1.0, 2.0])), 3)        # two views of the head
+1.78
+
 The paper fixes every person at 1.65 m. From an oblique camera a wrong height moves the person
 along the line of sight: the model matches the top of the head at the wrong height, i.e. at the
 wrong distance — about ``Δh · d / (H − h)`` for a camera at height H and a person d metres away
@@ -17,8 +23,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from typing import Mapping, Sequence
+
 from worldtrack.foreground.components import extreme_indices
 from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Person
+from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
+from worldtrack.trackers.ellipsoid.config import HeightConfig
+from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
+
+#: A person's height is measured in a view where others' ellipses cover at most this share of its region.
+MAX_COVERED_FOR_HEIGHT = 0.3
 
 
 def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
@@ -99,50 +114,6 @@ def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.nda
         return None
     origin, d = camera.rays(top[None])
     return (origin, d[0]) if np.isfinite(d).all() else None
-
-
-def pixel_clear(camera: Camera, occ: np.ndarray | None, p: np.ndarray) -> np.ndarray:
-    """Whether point(s) ``p`` (..., 2), rounded to the nearest pixel, are inside the image and
-    (unless ``occ`` is None) not on an obstacle (``occ`` finite there); bool (...).
-
-    Compiled (:func:`_pixels_clear`): it is called for a handful of points at a time, where
-    NumPy's per-call overhead was most of the cost. :func:`pixel_clear_reference` is the plain
-    version.
-    """
-    q = np.asarray(p, dtype=float)
-    flat = np.ascontiguousarray(q.reshape(-1, 2))
-    grid = _NO_OCC if occ is None else occ
-    out = _pixels_clear(flat, camera.width, camera.height, grid, occ is not None)
-    return out.reshape(q.shape[:-1]) if q.ndim > 1 else out[0]
-
-
-#: Stands in for "no obstacle map" in the compiled :func:`_pixels_clear`.
-_NO_OCC = np.zeros((1, 1), np.float32)
-
-
-@njit(cache=True)
-def _pixels_clear(p: np.ndarray, width: int, height: int, occ: np.ndarray, use_occ: bool) -> np.ndarray:
-    """(N,) bool for points ``p`` (N, 2): rounded (half to even) inside the image and, with
-    ``use_occ``, where ``occ`` is not finite."""
-    out = np.empty(p.shape[0], dtype=np.bool_)
-    for i in range(p.shape[0]):
-        u = np.rint(p[i, 0])
-        v = np.rint(p[i, 1])
-        ok = 0 <= u < width and 0 <= v < height
-        if ok and use_occ:
-            ok = not np.isfinite(occ[int(v), int(u)])
-        out[i] = ok
-    return out
-
-
-def pixel_clear_reference(camera: Camera, occ: np.ndarray | None, p: np.ndarray) -> np.ndarray:
-    """:func:`pixel_clear` in plain NumPy, the version it is tested against."""
-    q = np.round(p).astype(int)
-    u, v = q[..., 0], q[..., 1]
-    inside = (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
-    if occ is None:
-        return inside
-    return inside & ~np.isfinite(occ[np.clip(v, 0, camera.height - 1), np.clip(u, 0, camera.width - 1)])
 
 
 def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray, max_offset_m: float = 0.5,
@@ -284,3 +255,125 @@ def extreme_ends_reference(labels: np.ndarray, region: np.ndarray, u0: int, v0: 
     above = np.flatnonzero(along > cut)
     high = np.concatenate([above, np.flatnonzero(along == cut)[:n_end - len(above)]])
     return n, np.array([us[low].mean(), vs[low].mean()]), np.array([us[high].mean(), vs[high].mean()])
+
+
+# ---------------------------------------------------------------- the tracker's running estimate
+
+
+def heights_due(people: Sequence[Person], config: HeightConfig, frame: int) -> list[int]:
+    """Indices of ``people`` whose height is measured this frame (``frame``: the tracker's count).
+
+    Every frame until a person has 10 measurements (or 20 frames were tried: someone always in a
+    group rarely gives one), then one frame in five until ``config.samples`` are in: a person's
+    height does not change, and the median of that many is final.
+    """
+    return [k for k, p in enumerate(people) if p.mode == "tracking"
+            and len(p.height_samples) < config.samples
+            and ((len(p.height_samples) < 10 and p.height_tries < 20) or (frame + p.id) % 5 == 0)]
+
+
+def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[str, CameraView],
+                   labels: Mapping[str, np.ndarray], default_height, config: HeightConfig) -> None:
+    """Measure the heights of ``people[k]`` for ``k`` in ``due``; keep each one's running median.
+
+    In one camera, a tracked person is measured when others' ellipses cover at most
+    :data:`MAX_COVERED_FOR_HEIGHT` of its region (the tallest plausible person's ellipse with its
+    ring), on the pixels nobody else covers; the feet found may be up to ``depth_offset_m`` from
+    the track along the line of sight (a wrong model height puts it there). Head rays of two
+    cameras or more are triangulated instead. The measured median replaces a person's height
+    once 3 samples are in and it differs from ``default_height(id)`` (m) by more than
+    ``deadband_m``; a person never measured keeps the default (the paper's 1.65 m).
+
+    Parameters
+    ----------
+    people : the people on the map this tracker sees (their ellipses own the pixels)
+    due : indices into ``people`` (:func:`heights_due`)
+    views, labels : the tracker's cameras and their foreground labels, by camera id
+    default_height : callable — person id → default height, m
+    config : HeightConfig
+    """
+    if not due:
+        return
+    for k in due:
+        people[k].height_tries += 1
+    xy = np.array([[p.x, p.y] for p in people], dtype=float).reshape(-1, 2)
+    hs = np.array([p.height for p in people], dtype=float)
+    ws = np.array([p.width for p in people], dtype=float)
+    samples_now: dict[int, list[float]] = {}
+    rays: dict[int, list] = {}
+    for cid, image_labels in labels.items():
+        _measure_in_view(views[cid], image_labels, (xy, hs, ws), due, config, len(labels) >= 2, (samples_now, rays))
+    lo, hi = config.range_m
+    for k, p in enumerate(people):
+        # Two views of the head from different sides beat any single view.
+        head_rays = rays.get(k, [])
+        h3 = triangulate_height(head_rays, xy[k], height_range_m=(lo, hi), max_ray_gap_m=config.ray_gap_m)
+        if h3 is not None:
+            new = [h3]
+        elif len(head_rays) >= 2:
+            # Head rays from two views or more that give no height (they miss each other, or meet
+            # off the person or outside the plausible range): some view's "head" is most likely
+            # somebody else's, and that view's single-camera measurement would be no better.
+            new = []
+        else:
+            new = samples_now.get(k, [])
+        if not new:
+            continue
+        samples = p.height_samples
+        samples.extend(new)
+        del samples[:-config.samples]
+        if len(samples) >= 3:
+            default = default_height(p.id)
+            median = float(np.median(samples))
+            p.height = median if abs(median - default) > config.deadband_m else default
+
+
+def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
+                     due: Sequence[int], config: HeightConfig, triangulate: bool,
+                     out: tuple[dict[int, list[float]], dict[int, list]]) -> None:
+    """One camera's height measurements (into ``out[0]``) and head rays (``out[1]``, with
+    ``triangulate``) of the people ``due``, by index; ``people`` = (xy (N, 2), heights, widths)."""
+    samples_now, rays = out
+    xy, hs, ws = people
+    lo, hi = config.range_m
+    cam = view.camera
+    # Where a person's pixels may be: the ellipse of the tallest plausible person (a 1.9 m person
+    # sticks out of a 1.65 m ellipse), with its ring.
+    _, ring, box, valid, _ = view.forms(xy, np.full(len(xy), hi), 1.25 * ws)
+    current = view.forms(xy, hs, ws)
+    for k in due:
+        if not valid[k]:
+            continue
+        b = box[k]
+        u0, u1, v0, v1 = b
+        if u0 >= u1 or v0 >= v1:
+            continue
+        region = ellipse_crop(ring[k], b, view.grid, cam.has_distortion)
+        down = view.down_direction(np.array([(u0 + u1) / 2, (v0 + v1) / 2]))
+        if down is None:
+            continue
+        # Who each pixel of the box belongs to (current ellipses): −1 nobody, −2 several people.
+        owner = owner_crop(b, current, view.grid, cam.has_distortion)
+        free = (owner == k) | (owner == -1)
+        if triangulate:
+            ray = head_ray(cam, labels, view.occ, region & free, tuple(b), down)
+            if ray is not None:
+                rays.setdefault(k, []).append(ray)
+        # Clear enough in this view: others' ellipses cover little of the region; their pixels
+        # are left out of it.
+        if np.count_nonzero(region & ~free) > MAX_COVERED_FOR_HEIGHT * np.count_nonzero(region):
+            continue
+        region = region & free
+        # One camera alone: only oblique views that show the person large — from above, height is
+        # neither measurable nor needed; small, it is noise.
+        flat = np.hypot(*(xy[k] - cam.centre[:2]))
+        if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < config.min_px:
+            continue
+        h = measure_height(cam, labels, view.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
+                           max_depth_offset_m=config.depth_offset_m)
+        if h is not None:
+            samples_now.setdefault(k, []).append(h)
+
+
+__all__ = ["MAX_COVERED_FOR_HEIGHT", "extreme_ends", "extreme_ends_reference", "head_ray", "heights_due",
+           "measure_height", "triangulate_height", "update_heights"]
