@@ -91,11 +91,6 @@ class EllipsoidTracker(TrackerBase):
         self.last_masks: dict[str, np.ndarray] = {}
         self.last_labels: dict[str, np.ndarray] = {}
 
-    @property
-    def cams(self) -> dict[str, CameraView]:
-        """The former name of :attr:`views`."""
-        return self.views
-
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
                    mode: str = "tracking") -> Track:
@@ -155,7 +150,7 @@ class EllipsoidTracker(TrackerBase):
                 continue
             fg = self.views[cid].foreground
             image = frame_image(frame)
-            labels = fg.labels(image) if hasattr(fg, "labels") else fg.mask(image)
+            labels = fg.labels(image)
             self.last_labels[cid] = labels
             self.last_masks[cid] = (labels == 1).astype(np.uint8)
             real[cid] = ternary_real(labels, self.views[cid].ring_px)

@@ -26,7 +26,7 @@ def frames_wanted(tracker: "EllipsoidTracker") -> int:
         return 0
     if set(tracker.position_map.cameras) - set(tracker.views):
         return 0  # a map shared with other trackers: its people are not this tracker's to start
-    if any(getattr(view.foreground, "learns", True) for view in tracker.views.values()):
+    if any(view.foreground.learns for view in tracker.views.values()):
         return 0  # the model would learn the first frames three times, once backwards
     return n
 
