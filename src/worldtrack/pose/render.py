@@ -1,0 +1,259 @@
+"""Rendering a point model with a z-buffer and picking its sparse template (seed 003, §2.2, §4.3).
+
+To estimate the pose at time t the model is drawn at the pose of t−1 with hidden surfaces removed
+(a z-buffer over the model's surface points), and only the points where the rendered intensity is
+a local maximum or minimum are kept (the *sparse template*, N ≤ 1024 for a face, N = 128 for a
+body). For RGB-D the z-buffer's own local extrema give the depth template (N′ points).
+
+:func:`splat` is the compiled z-buffer; :func:`splat_reference` is the same in plain NumPy (tests
+check they agree).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import cv2
+import numpy as np
+from numba import njit
+
+
+class Intrinsics(NamedTuple):
+    """Pinhole intrinsics (pixels): ``u = fx·x/z + cx``, ``v = fy·y/z + cy``; image ``width × height``."""
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+
+    @classmethod
+    def from_matrix(cls, K: np.ndarray, width: int, height: int) -> "Intrinsics":
+        """From a 3×3 camera matrix ``K`` and the image size (pixels)."""
+        K = np.asarray(K, float)
+        return cls(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), int(width), int(height))
+
+    def matrix(self) -> np.ndarray:
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def scaled(self, s: float) -> "Intrinsics":
+        """The same camera at ``s`` times the resolution (pixel centres stay at integers)."""
+        return Intrinsics(self.fx * s, self.fy * s, (self.cx + 0.5) * s - 0.5, (self.cy + 0.5) * s - 0.5,
+                          int(round(self.width * s)), int(round(self.height * s)))
+
+
+class Rendering(NamedTuple):
+    """A z-buffered view of a model. ``depth`` (H, W) float32 metres (inf where empty);
+    ``index`` (H, W) int32, the model point drawn at each pixel (−1 where empty)."""
+
+    depth: np.ndarray
+    index: np.ndarray
+
+
+@njit(cache=True)
+def _splat_kernel(xyz, fx, fy, cx, cy, footprint, depth, index):  # pragma: no cover - compiled
+    h, w = depth.shape
+    for i in range(xyz.shape[0]):
+        z = xyz[i, 2]
+        if z <= 1e-6:
+            continue
+        u = fx * xyz[i, 0] / z + cx
+        v = fy * xyz[i, 1] / z + cy
+        if footprint == 1:
+            u0 = int(np.floor(u + 0.5))
+            v0 = int(np.floor(v + 0.5))
+        else:
+            u0 = int(np.floor(u))
+            v0 = int(np.floor(v))
+        for dv in range(footprint):
+            for du in range(footprint):
+                uu = u0 + du
+                vv = v0 + dv
+                if uu < 0 or vv < 0 or uu >= w or vv >= h:
+                    continue
+                if z < depth[vv, uu]:
+                    depth[vv, uu] = z
+                    index[vv, uu] = i
+
+
+def splat(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Rendering:
+    """Z-buffer camera-frame points into an image: each pixel keeps its nearest point.
+
+    Parameters
+    ----------
+    xyz : (M, 3) float, metres, camera frame (z forward)
+    intr : Intrinsics
+    footprint : 1 — a point covers the pixel it falls in; 2 — the 2×2 pixels around it (no holes
+        when neighbouring points are up to 2 px apart; for dense synthetic rendering)
+
+    Returns
+    -------
+    Rendering
+
+    >>> r = splat(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 2.0]]), Intrinsics(100, 100, 2, 2, 5, 5))
+    >>> int(r.index[2, 2]), float(r.depth[2, 2])
+    (0, 1.0)
+    """
+    depth = np.full((intr.height, intr.width), np.inf, np.float32)
+    index = np.full((intr.height, intr.width), -1, np.int32)
+    _splat_kernel(np.ascontiguousarray(xyz, np.float64), intr.fx, intr.fy, intr.cx, intr.cy, int(footprint),
+                  depth, index)
+    return Rendering(depth, index)
+
+
+def splat_reference(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Rendering:
+    """:func:`splat` in NumPy: sort by depth and keep each pixel's first (nearest) point."""
+    xyz = np.asarray(xyz, np.float64)
+    z = xyz[:, 2]
+    ok = z > 1e-6
+    idx = np.flatnonzero(ok)
+    u = intr.fx * xyz[ok, 0] / z[ok] + intr.cx
+    v = intr.fy * xyz[ok, 1] / z[ok] + intr.cy
+    if footprint == 1:
+        us, vs, ids = [np.floor(u + 0.5)], [np.floor(v + 0.5)], [idx]
+    else:
+        us = [np.floor(u) + du for dv in range(footprint) for du in range(footprint)]
+        vs = [np.floor(v) + dv for dv in range(footprint) for du in range(footprint)]
+        ids = [idx] * (footprint * footprint)
+    uu, vv, ii = (np.concatenate(a) for a in (us, vs, ids))
+    inside = (uu >= 0) & (vv >= 0) & (uu < intr.width) & (vv < intr.height)
+    uu, vv, ii = uu[inside].astype(np.int64), vv[inside].astype(np.int64), ii[inside]
+    flat = vv * intr.width + uu
+    order = np.lexsort((ii, z[ii], flat))          # by pixel, then depth, then point order
+    first = np.unique(flat[order], return_index=True)[1]
+    depth = np.full(intr.height * intr.width, np.inf, np.float32)
+    index = np.full(intr.height * intr.width, -1, np.int32)
+    depth[flat[order][first]] = z[ii[order][first]]
+    index[flat[order][first]] = ii[order][first]
+    return Rendering(depth.reshape(intr.height, intr.width), index.reshape(intr.height, intr.width))
+
+
+def local_extrema(image: np.ndarray, valid: np.ndarray, radius: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels of ``image`` that are a maximum or a minimum of their (2r+1)² neighbourhood.
+
+    Only pixels whose whole neighbourhood is ``valid`` count (no extrema on the silhouette).
+    Returns ``(rows, cols)`` of the extrema and their strength ``|I − local mean|`` as (n,) arrays
+    packed as ``(np.stack([rows, cols], 1), strength)``.
+    """
+    img = np.where(valid, image, 0).astype(np.float32)
+    k = np.ones((2 * radius + 1, 2 * radius + 1), np.uint8)
+    inner = cv2.erode(valid.astype(np.uint8), k, borderValue=0).astype(bool)
+    hi = cv2.dilate(np.where(valid, img, -np.inf).astype(np.float32), k)
+    lo = cv2.erode(np.where(valid, img, np.inf).astype(np.float32), k)
+    mean = cv2.blur(img, (2 * radius + 3, 2 * radius + 3))
+    # A flat patch is both its own max and min: require a real difference to the neighbourhood.
+    ext = inner & ((img >= hi) | (img <= lo)) & (hi > lo)
+    rc = np.argwhere(ext)
+    strength = np.abs(img - mean)[ext]
+    return rc, strength
+
+
+def _crop(uv: np.ndarray, intr: Intrinsics, margin: int = 4) -> tuple[Intrinsics, int, int] | None:
+    """Intrinsics of the image window around projected points ``uv`` (n, 2); None if off-image."""
+    lo = np.floor(uv.min(0)).astype(int) - margin
+    hi = np.ceil(uv.max(0)).astype(int) + margin
+    u0, v0 = max(lo[0], 0), max(lo[1], 0)
+    u1, v1 = min(hi[0], intr.width - 1), min(hi[1], intr.height - 1)
+    if u1 <= u0 or v1 <= v0:
+        return None
+    return Intrinsics(intr.fx, intr.fy, intr.cx - u0, intr.cy - v0, u1 - u0 + 1, v1 - v0 + 1), u0, v0
+
+
+def _strongest(rc: np.ndarray, strength: np.ndarray, n: int) -> np.ndarray:
+    return rc[np.argsort(-strength, kind="stable")[:n]]
+
+
+def _grid_fill(valid: np.ndarray, taken: np.ndarray, n: int) -> np.ndarray:
+    """Up to ``n`` pixels of ``valid`` not in ``taken`` on an even grid (rows, cols)."""
+    free = valid.copy()
+    if len(taken):
+        free[taken[:, 0], taken[:, 1]] = False
+    rc = np.argwhere(free)
+    if len(rc) <= n:
+        return rc
+    return rc[np.linspace(0, len(rc) - 1, n).astype(int)]
+
+
+def smooth_valid(image: np.ndarray, valid: np.ndarray, sigma: float) -> np.ndarray:
+    """Gaussian smoothing of ``image`` over ``valid`` pixels only (normalised convolution); fills
+    the small holes a point z-buffer leaves. NaN where no valid pixel is near."""
+    v = valid.astype(np.float32)
+    num = cv2.GaussianBlur(np.where(valid, image, 0).astype(np.float32), (0, 0), sigma)
+    den = cv2.GaussianBlur(v, (0, 0), sigma)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0.2, num / den, np.nan)
+
+
+class TemplatePixels(NamedTuple):
+    """A sparse template at one pose: model point indices of the colour template, their grey
+    level as drawn (smoothed like the input), and the model point indices of the depth template."""
+
+    colour: np.ndarray
+    value: np.ndarray
+    depth: np.ndarray
+
+
+def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics, n_colour: int,
+                           n_depth: int = 0, radius: int = 1, sigma: float = 1.0) -> TemplatePixels:
+    """The sparse template of a model drawn at one pose (§2.2, §4.3).
+
+    Parameters
+    ----------
+    albedo : (M,) grey level of the model points, NaN = unknown
+    xyz : (M, 3) the model points in the camera frame at the previous pose
+    n_colour : at most this many points where the drawn intensity (smoothed by ``sigma`` px, as
+        the input is) is a local max/min, strongest ``|I − local mean|`` first
+    n_depth : this many points where the z-buffer depth is a local max/min, filled up on an even
+        grid over the visible surface when there are fewer (planar faces have none)
+
+    Returns
+    -------
+    TemplatePixels
+    """
+    empty = TemplatePixels(np.zeros(0, int), np.zeros(0), np.zeros(0, int))
+    z = xyz[:, 2]
+    front = z > 1e-6
+    if not front.any():
+        return empty
+    uv = np.column_stack([intr.fx * xyz[front, 0] / z[front] + intr.cx, intr.fy * xyz[front, 1] / z[front] + intr.cy])
+    win = _crop(uv, intr)
+    if win is None:
+        return empty
+    r = splat(xyz, win[0])
+    drawn = r.index >= 0
+    k = np.ones((3, 3), np.uint8)
+    surface = cv2.morphologyEx(drawn.astype(np.uint8), cv2.MORPH_CLOSE, k).astype(bool)   # z-buffer holes closed
+    raw = np.where(drawn, albedo[np.maximum(r.index, 0)], np.nan)
+    intensity = smooth_valid(np.nan_to_num(raw), drawn & np.isfinite(raw), sigma)
+    known = surface & np.isfinite(intensity)
+    known = cv2.erode(known.astype(np.uint8), k, iterations=2, borderValue=0).astype(bool)   # off the silhouette
+    rc, strength = local_extrema(np.nan_to_num(intensity), known, radius)
+    rc = _strongest(rc, strength, n_colour) if len(rc) else rc
+    index = _nearest_point(r.index, drawn, rc)
+    colour, value = index, intensity[tuple(rc.T)] if len(rc) else np.zeros(0)
+    depth_idx = np.zeros(0, int)
+    if n_depth > 0:
+        inner = cv2.erode(drawn.astype(np.uint8), k, iterations=2, borderValue=0).astype(bool)
+        rc_d, s_d = local_extrema(np.where(drawn, r.depth, 0), drawn, radius)
+        pick = _strongest(rc_d, s_d, n_depth)
+        pick = np.concatenate([pick, _grid_fill(inner, pick, n_depth - len(pick))]) if len(pick) < n_depth else pick
+        depth_idx = r.index[tuple(pick.T)] if len(pick) else depth_idx
+    keep = colour >= 0
+    return TemplatePixels(colour[keep], np.asarray(value, float)[keep], np.asarray(depth_idx, int))
+
+
+def _nearest_point(index: np.ndarray, drawn: np.ndarray, rc: np.ndarray) -> np.ndarray:
+    """Model point drawn at each pixel ``rc``, or at its nearest drawn 3×3 neighbour (−1: none)."""
+    if len(rc) == 0:
+        return np.zeros(0, int)
+    out = index[rc[:, 0], rc[:, 1]].astype(int)
+    h, w = index.shape
+    for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (-1, -1), (1, -1), (-1, 1)):
+        miss = out < 0
+        if not miss.any():
+            break
+        rr = np.clip(rc[miss, 0] + dr, 0, h - 1)
+        cc = np.clip(rc[miss, 1] + dc, 0, w - 1)
+        out[miss] = index[rr, cc]
+    return out
