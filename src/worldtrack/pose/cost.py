@@ -117,7 +117,7 @@ def project_sample(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template
 def camera_points(T: np.ndarray, template: SparseTemplate) -> np.ndarray:
     """(K, N, 3) camera-frame template points under each candidate."""
     Tp = np.asarray(T, float)[:, template.part]                 # (K, N, 3, 4)
-    return np.einsum("knij,nj->kni", Tp[..., :3], template.points) + Tp[..., 3]
+    return (Tp[..., :3] @ np.asarray(template.points, float)[..., None])[..., 0] + Tp[..., 3]
 
 
 def project_sample_reference(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template: SparseTemplate,

@@ -80,8 +80,9 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
     M = space.dim
     for _ in range(int(iterations)):
         J = jacobian(X, r) if jacobian is not None else central_difference_jacobian(space, residuals, X)
-        A = np.einsum("kni,knj->kij", J, J) + C[:, None, None] * np.eye(M)   # JᵀJ + C·I
-        g = np.einsum("kni,kn->ki", J, r)                                    # Jᵀr
+        Jt = np.swapaxes(J, 1, 2)
+        A = Jt @ J + C[:, None, None] * np.eye(M)                          # JᵀJ + C·I
+        g = (Jt @ r[..., None])[..., 0]                                    # Jᵀr
         delta = -np.linalg.solve(A, g[..., None])[..., 0]
         X_try = space.retract(X, delta)
         r_try = residuals(X_try)

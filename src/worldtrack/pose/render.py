@@ -52,7 +52,10 @@ class Rendering(NamedTuple):
 
 
 @njit(cache=True)
-def _splat_kernel(xyz, fx, fy, cx, cy, footprint, depth, index):  # pragma: no cover - compiled
+def _splat_kernel(xyz, fx, fy, cx, cy, footprint, centre_weight, depth, key, index):  # pragma: no cover - compiled
+    # Each pixel keeps the point with the least key = z + centre_weight·(distance to the pixel centre)²:
+    # the nearest surface wins, and on one surface the point nearest the pixel centre (no shift of
+    # the drawn texture towards the camera-near side).
     h, w = depth.shape
     for i in range(xyz.shape[0]):
         z = xyz[i, 2]
@@ -72,12 +75,14 @@ def _splat_kernel(xyz, fx, fy, cx, cy, footprint, depth, index):  # pragma: no c
                 vv = v0 + dv
                 if uu < 0 or vv < 0 or uu >= w or vv >= h:
                     continue
-                if z < depth[vv, uu]:
+                kz = z + centre_weight * ((uu - u) ** 2 + (vv - v) ** 2)
+                if kz < key[vv, uu]:
+                    key[vv, uu] = kz
                     depth[vv, uu] = z
                     index[vv, uu] = i
 
 
-def splat(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Rendering:
+def splat(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1, centre_weight: float = 0.002) -> Rendering:
     """Z-buffer camera-frame points into an image: each pixel keeps its nearest point.
 
     Parameters
@@ -86,6 +91,8 @@ def splat(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Rendering:
     intr : Intrinsics
     footprint : 1 — a point covers the pixel it falls in; 2 — the 2×2 pixels around it (no holes
         when neighbouring points are up to 2 px apart; for dense synthetic rendering)
+    centre_weight : metres per pixel² — a pixel keeps the point of least ``z + w·(distance to the
+        pixel centre)²``: the nearest surface, and on it the point nearest the centre
 
     Returns
     -------
@@ -96,14 +103,15 @@ def splat(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Rendering:
     (0, 1.0)
     """
     depth = np.full((intr.height, intr.width), np.inf, np.float32)
+    key = np.full((intr.height, intr.width), np.inf)
     index = np.full((intr.height, intr.width), -1, np.int32)
     _splat_kernel(np.ascontiguousarray(xyz, np.float64), intr.fx, intr.fy, intr.cx, intr.cy, int(footprint),
-                  depth, index)
+                  float(centre_weight), depth, key, index)
     return Rendering(depth, index)
 
 
-def splat_reference(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Rendering:
-    """:func:`splat` in NumPy: sort by depth and keep each pixel's first (nearest) point."""
+def splat_reference(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1, centre_weight: float = 0.002) -> Rendering:
+    """:func:`splat` in NumPy: sort by key and keep each pixel's first point."""
     xyz = np.asarray(xyz, np.float64)
     z = xyz[:, 2]
     ok = z > 1e-6
@@ -118,9 +126,12 @@ def splat_reference(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1) -> Re
         ids = [idx] * (footprint * footprint)
     uu, vv, ii = (np.concatenate(a) for a in (us, vs, ids))
     inside = (uu >= 0) & (vv >= 0) & (uu < intr.width) & (vv < intr.height)
-    uu, vv, ii = uu[inside].astype(np.int64), vv[inside].astype(np.int64), ii[inside]
+    uf, vf = (np.concatenate([u] * (1 if footprint == 1 else footprint * footprint)),
+              np.concatenate([v] * (1 if footprint == 1 else footprint * footprint)))
+    kz = z[ii] + centre_weight * ((uu - uf) ** 2 + (vv - vf) ** 2)
+    uu, vv, ii, kz = uu[inside].astype(np.int64), vv[inside].astype(np.int64), ii[inside], kz[inside]
     flat = vv * intr.width + uu
-    order = np.lexsort((ii, z[ii], flat))          # by pixel, then depth, then point order
+    order = np.lexsort((ii, kz, flat))             # by pixel, then key, then point order
     first = np.unique(flat[order], return_index=True)[1]
     depth = np.full(intr.height * intr.width, np.inf, np.float32)
     index = np.full(intr.height * intr.width, -1, np.int32)
@@ -195,7 +206,8 @@ class TemplatePixels(NamedTuple):
 
 
 def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics, n_colour: int,
-                           n_depth: int = 0, radius: int = 1, sigma: float = 1.0) -> TemplatePixels:
+                           n_depth: int = 0, radius: int = 1, sigma: float = 1.0,
+                           select_sigma: float = 0.5) -> TemplatePixels:
     """The sparse template of a model drawn at one pose (§2.2, §4.3).
 
     Parameters
@@ -204,6 +216,8 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     xyz : (M, 3) the model points in the camera frame at the previous pose
     n_colour : at most this many points where the drawn intensity (smoothed by ``sigma`` px, as
         the input is) is a local max/min, strongest ``|I − local mean|`` first
+    sigma, select_sigma : Gaussian σ (px) of the drawing the values are read from, and of the one
+        whose extrema are picked
     n_depth : this many points where the z-buffer depth is a local max/min, filled up on an even
         grid over the visible surface when there are fewer (planar faces have none)
 
@@ -228,10 +242,12 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     intensity = smooth_valid(np.nan_to_num(raw), drawn & np.isfinite(raw), sigma)
     known = surface & np.isfinite(intensity)
     known = cv2.erode(known.astype(np.uint8), k, iterations=2, borderValue=0).astype(bool)   # off the silhouette
-    rc, strength = local_extrema(np.nan_to_num(intensity), known, radius)
+    # Extrema of the lightly smoothed drawing (more of them, N ≤ n_colour); values from the smoothed one.
+    fine = smooth_valid(np.nan_to_num(raw), drawn & np.isfinite(raw), select_sigma) if select_sigma > 0 else raw
+    rc, strength = local_extrema(np.nan_to_num(fine), known & np.isfinite(fine), radius)
     rc = _strongest(rc, strength, n_colour) if len(rc) else rc
-    index = _nearest_point(r.index, drawn, rc)
-    colour, value = index, intensity[tuple(rc.T)] if len(rc) else np.zeros(0)
+    colour = _nearest_point(r.index, drawn, rc)
+    value = _bilinear(np.nan_to_num(intensity), xyz[np.maximum(colour, 0)], win[0])   # at the point's projection
     depth_idx = np.zeros(0, int)
     if n_depth > 0:
         inner = cv2.erode(drawn.astype(np.uint8), k, iterations=2, borderValue=0).astype(bool)
@@ -241,6 +257,14 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
         depth_idx = r.index[tuple(pick.T)] if len(pick) else depth_idx
     keep = colour >= 0
     return TemplatePixels(colour[keep], np.asarray(value, float)[keep], np.asarray(depth_idx, int))
+
+
+def _bilinear(image: np.ndarray, xyz: np.ndarray, intr: Intrinsics) -> np.ndarray:
+    """``image`` read bilinearly where camera points (n, 3) project."""
+    u = intr.fx * xyz[:, 0] / xyz[:, 2] + intr.cx
+    v = intr.fy * xyz[:, 1] / xyz[:, 2] + intr.cy
+    return cv2.remap(image.astype(np.float32), u.astype(np.float32)[None], v.astype(np.float32)[None],
+                     cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[0].astype(float)
 
 
 def _nearest_point(index: np.ndarray, drawn: np.ndarray, rc: np.ndarray) -> np.ndarray:

@@ -94,7 +94,7 @@ def face_jacobian(cost: EigenTemplateCost, space: RigidSpace, grads: np.ndarray,
     d = cost.differences(V)
     miss = np.isnan(d)
     R, t = state_pose(X)
-    RM = np.einsum("kij,nj->kni", R, cost.template.points)        # (K, N, 3)
+    RM = cost.template.points @ np.swapaxes(R, 1, 2)             # (K, N, 3) = R·M
     xc = RM + t[:, None]
     x, y, z = xc[..., 0], xc[..., 1], np.maximum(xc[..., 2], 1e-6)
     Ix, Iy = np.nan_to_num(vals[:, 1]), np.nan_to_num(vals[:, 2])
@@ -105,7 +105,7 @@ def face_jacobian(cost: EigenTemplateCost, space: RigidSpace, grads: np.ndarray,
     Nmat = np.concatenate([n_t, n_q], -1)                           # (K, N, 6)
     Nmat[miss] = 0.0
     Q = cost.Q
-    PN = np.einsum("nb,kbm->knm", Q, np.einsum("nb,knm->kbm", Q, Nmat)) - Nmat   # (Φ̃Φ̃⁺ − I)·N
+    PN = Q @ (Q.T @ Nmat) - Nmat                                  # (Φ̃Φ̃⁺ − I)·N
     c2 = cost.c ** 2
     w = np.where(miss, 0.0, c2 / (np.nan_to_num(d) ** 2 + c2) ** 1.5)          # W
     return w[..., None] * PN

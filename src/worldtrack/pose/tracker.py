@@ -47,6 +47,8 @@ class TrackerConfig:
     c_depth_mm : depth scale c′ (mm); lam : λ, share of the depth term
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
     smooth_px : Gaussian σ (pixels) applied to the input and to the drawn template alike
+    camera_blur_px : the camera's own blur (σ, pixels), added to the drawn template's smoothing
+    shading_vectors : eigenvectors Φ of the eigen-template besides the mean v̄
     """
 
     stages: int = 1
@@ -62,6 +64,8 @@ class TrackerConfig:
     lam: float = 0.9
     jacobian: str = "analytic"
     smooth_px: float = 1.0
+    camera_blur_px: float = 0.6
+    shading_vectors: int = 9
     seed: int = 0
 
 
@@ -106,7 +110,7 @@ class RigidTracker:
             raise InputError(f"cost: expected eigen or colour-depth, got {self.cost!r}")
         self.space = RigidSpace(length=max(self.model.radius, 1e-3))
         self.sigma = self.space.increment_sigma(self.config.sigma_mm, self.config.sigma_deg)
-        self.basis = shading_basis(self.model.normals) if self.cost == "eigen" else None
+        self.basis = shading_basis(self.model.normals, n_vectors=self.config.shading_vectors) if self.cost == "eigen" else None
         self.rng = np.random.default_rng(self.config.seed)
         self.reset(self.R0, self.t0)
 
@@ -120,8 +124,8 @@ class RigidTracker:
         R, t = state_pose(state)
         xyz = self.model.points @ R.T + t
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
-        return sparse_template_pixels(self.model.albedo, xyz, self.intr, self.config.n_template, n_depth,
-                                      sigma=self.config.smooth_px)
+        sigma = float(np.hypot(self.config.smooth_px, self.config.camera_blur_px))
+        return sparse_template_pixels(self.model.albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma)
 
     def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray):
         """The cost object for a (smoothed) grey frame, with the template taken at ``state``."""

@@ -240,7 +240,7 @@ class FaceSequence:
         """Frame ``k``: supersampled z-buffer, shading, area averaging, blur, noise."""
         R, t = self.R[k], self.t[k]
         xyz = self._pts @ R.T + t
-        shade = self.ambient[k] + self.direct[k] * np.maximum((self._nrm @ R.T) @ -self.light_dir[k], 0.0)
+        shade = self.ambient[k] + self.direct[k] * np.maximum((self._nrm @ R.T) @ self.light_dir[k], 0.0)
         rad = self._alb * shade[:, None]
         big = self.intr.scaled(2)
         r = splat(xyz, big, footprint=2)
