@@ -47,24 +47,24 @@ class SparseTemplate(NamedTuple):
     value: np.ndarray
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=True)
 def _project_sample_kernel(images, fx, fy, cx, cy, T, X, part, mode, vals, zout):  # pragma: no cover
+    # One pass over candidates × points: transform, project, read (bilinear or nearest-positive).
+    # fastmath is safe here: NaN only comes in through the image (depth holes are tested as > 0).
     n_ch, h, w = images.shape
     for k in range(T.shape[0]):
         for i in range(X.shape[0]):
             p = part[i]
-            x = T[k, p, 0, 0] * X[i, 0] + T[k, p, 0, 1] * X[i, 1] + T[k, p, 0, 2] * X[i, 2] + T[k, p, 0, 3]
-            y = T[k, p, 1, 0] * X[i, 0] + T[k, p, 1, 1] * X[i, 1] + T[k, p, 1, 2] * X[i, 2] + T[k, p, 1, 3]
-            z = T[k, p, 2, 0] * X[i, 0] + T[k, p, 2, 1] * X[i, 1] + T[k, p, 2, 2] * X[i, 2] + T[k, p, 2, 3]
+            a0 = X[i, 0]
+            a1 = X[i, 1]
+            a2 = X[i, 2]
+            z = T[k, p, 2, 0] * a0 + T[k, p, 2, 1] * a1 + T[k, p, 2, 2] * a2 + T[k, p, 2, 3]
             zout[k, i] = z
-            if z <= 1e-6:
-                for ch in range(n_ch):
-                    vals[k, ch, i] = np.nan
-                continue
-            u = fx * x / z + cx
-            v = fy * y / z + cy
+            inv = 1.0 / max(z, 1e-6)
+            u = fx * (T[k, p, 0, 0] * a0 + T[k, p, 0, 1] * a1 + T[k, p, 0, 2] * a2 + T[k, p, 0, 3]) * inv + cx
+            v = fy * (T[k, p, 1, 0] * a0 + T[k, p, 1, 1] * a1 + T[k, p, 1, 2] * a2 + T[k, p, 1, 3]) * inv + cy
             if mode == 0:
-                if not (u >= 0.0 and v >= 0.0 and u <= w - 1.0 and v <= h - 1.0):
+                if z <= 1e-6 or not (u >= 0.0 and v >= 0.0 and u <= w - 1.0 and v <= h - 1.0):
                     for ch in range(n_ch):
                         vals[k, ch, i] = np.nan
                     continue
@@ -73,16 +73,48 @@ def _project_sample_kernel(images, fx, fy, cx, cy, T, X, part, mode, vals, zout)
                 a = u - u0
                 b = v - v0
                 for ch in range(n_ch):
-                    vals[k, ch, i] = ((1 - a) * (1 - b) * images[ch, v0, u0] + a * (1 - b) * images[ch, v0, u0 + 1]
-                                      + (1 - a) * b * images[ch, v0 + 1, u0] + a * b * images[ch, v0 + 1, u0 + 1])
+                    top = images[ch, v0, u0] + a * (images[ch, v0, u0 + 1] - images[ch, v0, u0])
+                    bot = images[ch, v0 + 1, u0] + a * (images[ch, v0 + 1, u0 + 1] - images[ch, v0 + 1, u0])
+                    vals[k, ch, i] = top + b * (bot - top)
             else:
                 uu = int(np.floor(u + 0.5))
                 vv = int(np.floor(v + 0.5))
                 for ch in range(n_ch):
-                    if uu < 0 or vv < 0 or uu >= w or vv >= h or not images[ch, vv, uu] > 0:
+                    if z <= 1e-6 or uu < 0 or vv < 0 or uu >= w or vv >= h or not images[ch, vv, uu] > 0:
                         vals[k, ch, i] = np.nan
                     else:
                         vals[k, ch, i] = images[ch, vv, uu]
+
+
+@njit(cache=True)
+def _eigen_epsilon_kernel(V, Q, c):  # pragma: no cover - compiled
+    # ε_k = Σ_i ρ_c(d_i), d = (Q·Qᵀ − I)·V per candidate; an unread point (NaN) counts ρ = 1.
+    K, N = V.shape
+    B = Q.shape[1]
+    eps = np.zeros(K)
+    coef = np.zeros(B)
+    c2 = c * c
+    for k in range(K):
+        miss = 0
+        coef[:] = 0.0
+        for i in range(N):
+            x = V[k, i]
+            if np.isnan(x):
+                miss += 1
+                continue
+            for b in range(B):
+                coef[b] += Q[i, b] * x
+        total = float(miss)
+        for i in range(N):
+            x = V[k, i]
+            if np.isnan(x):
+                continue
+            d = -x
+            for b in range(B):
+                d += Q[i, b] * coef[b]
+            total += d * d / (c2 + d * d)
+        eps[k] = total
+    return eps
 
 
 def project_sample(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template: SparseTemplate,
@@ -182,6 +214,11 @@ class EigenTemplateCost:
         vals, _ = project_sample(self.images, self.intr, T, self.template)
         return robust_residual(self.differences(vals[:, 0].astype(float)), self.c)
 
+    def epsilon(self, T: np.ndarray) -> np.ndarray:
+        """(K,) ε = Σ ρ_c(d_i) (eq. 3) of K candidates, without forming the residual matrix."""
+        vals, _ = project_sample(self.images, self.intr, T, self.template)
+        return _eigen_epsilon_kernel(vals[:, 0], self.Q, self.c)
+
 
 class ColourDepthCost:
     """Colour (eq. 16, brightness normalised) and depth (eq. 17) terms mixed by λ (eqs. 18–19).
@@ -231,3 +268,8 @@ class ColourDepthCost:
         zhat, z = project_sample(self.depth_image, self.intr, T, self.depth, NEAREST_POSITIVE)
         rd = np.sqrt(self.lam) * robust_residual(zhat[:, 0] - z, self.c_depth)   # d′ = Ẑ − Z
         return np.concatenate([r, rd], 1)
+
+    def epsilon(self, T: np.ndarray) -> np.ndarray:
+        """(K,) ε = (1 − λ)·ε_C + λ·ε_D (eq. 18)."""
+        r = self.residuals(T)
+        return (r * r).sum(1)

@@ -20,6 +20,7 @@ import numpy as np
 
 Residuals = Callable[[np.ndarray], np.ndarray]                # states (K, S) → r (K, N)
 Jacobian = Callable[[np.ndarray, np.ndarray], np.ndarray]     # states, r → J (K, N, M)
+NormalEquations = Callable[[np.ndarray], tuple]               # states → (JᵀJ (K,M,M), Jᵀr (K,M), ε (K,))
 
 
 class PoseSpace(Protocol):
@@ -55,7 +56,9 @@ def central_difference_jacobian(space: PoseSpace, residuals: Residuals, X: np.nd
 
 
 def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, iterations: int,
-                        jacobian: Jacobian | None = None, damping: float = 1e-5) -> LMResult:
+                        jacobian: Jacobian | None = None, damping: float = 1e-5,
+                        normal_equations: NormalEquations | None = None,
+                        epsilon: Callable[[np.ndarray], np.ndarray] | None = None) -> LMResult:
     """Refine K candidate states together.
 
     Parameters
@@ -66,12 +69,16 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
     iterations : number of LM iterations (0 returns X0 with its cost)
     jacobian : optional analytic Jacobian ``(X, r) → (K, N, M)``; default central differences
     damping : initial C (1e-5)
+    normal_equations, epsilon : optional compiled ``X → (JᵀJ, Jᵀr, ε)`` and ``X → ε``; with them
+        no residual matrix is formed (the face's fused kernel)
 
     Returns
     -------
     LMResult
     """
     X = np.array(X0, float)
+    if normal_equations is not None:
+        return _lm_normal(space, normal_equations, epsilon, X, iterations, damping)
     r = residuals(X)
     cost = (r * r).sum(1)
     C = np.full(len(X), float(damping))
@@ -92,6 +99,29 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
         C = np.where(better, C / 10.0, C * 10.0)
         taken += better
         history.append(cost.copy())
+    return LMResult(X, cost, C, taken, np.array(history))
+
+
+def _lm_normal(space: PoseSpace, normal_equations: NormalEquations, epsilon, X: np.ndarray, iterations: int,
+               damping: float) -> LMResult:
+    """:func:`levenberg_marquardt` driven by compiled normal equations."""
+    C = np.full(len(X), float(damping))
+    taken = np.zeros(len(X), int)
+    A0, g, cost = normal_equations(X)
+    history = [cost.copy()]
+    eye = np.eye(space.dim)
+    for it in range(int(iterations)):
+        delta = -np.linalg.solve(A0 + C[:, None, None] * eye, g[..., None])[..., 0]   # eq. 6
+        X_try = space.retract(X, delta)
+        cost_try = epsilon(X_try)
+        better = cost_try < cost
+        X[better], cost[better] = X_try[better], cost_try[better]
+        C = np.where(better, C / 10.0, C * 10.0)
+        taken += better
+        history.append(cost.copy())
+        if better.any() and it + 1 < iterations:
+            A0n, gn, _ = normal_equations(X[better])
+            A0[better], g[better] = A0n, gn
     return LMResult(X, cost, C, taken, np.array(history))
 
 

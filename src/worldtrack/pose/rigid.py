@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from worldtrack.pose.cost import EigenTemplateCost, project_sample
 from worldtrack.pose.models import retract, state_pose
@@ -109,3 +110,94 @@ def face_jacobian(cost: EigenTemplateCost, space: RigidSpace, grads: np.ndarray,
     c2 = cost.c ** 2
     w = np.where(miss, 0.0, c2 / (np.nan_to_num(d) ** 2 + c2) ** 1.5)          # W
     return w[..., None] * PN
+
+
+@njit(cache=True, fastmath=True)
+def _face_normal_equations_kernel(grads, intr4, R, t, X, Q, c, length, JtJ, Jtr, eps):  # pragma: no cover
+    # Per candidate k: sample I, Ix, Iy at the projected template points, d = (QQᵀ − I)V,
+    # n_i = ∇I·∂u/∂δ, J = W·(QQᵀ − I)·N (eq. 10), and accumulate JᵀJ, Jᵀr, ε = Σ ρ.
+    # The same quantities as face_jacobian (the NumPy reference), without (K, N, 6) temporaries.
+    fx, fy, cx, cy = intr4[0], intr4[1], intr4[2], intr4[3]
+    _, h, w = grads.shape
+    N, B = Q.shape
+    V = np.zeros(N)
+    Nm = np.zeros((N, 6))
+    ok = np.zeros(N, np.bool_)
+    coef = np.zeros(B)
+    QN = np.zeros((B, 6))
+    c2 = c * c
+    for k in range(R.shape[0]):
+        coef[:] = 0.0
+        QN[:, :] = 0.0
+        miss = 0
+        for i in range(N):
+            m0, m1, m2 = X[i, 0], X[i, 1], X[i, 2]
+            rm0 = R[k, 0, 0] * m0 + R[k, 0, 1] * m1 + R[k, 0, 2] * m2
+            rm1 = R[k, 1, 0] * m0 + R[k, 1, 1] * m1 + R[k, 1, 2] * m2
+            rm2 = R[k, 2, 0] * m0 + R[k, 2, 1] * m1 + R[k, 2, 2] * m2
+            x, y, z = rm0 + t[k, 0], rm1 + t[k, 1], rm2 + t[k, 2]
+            u = fx * x / max(z, 1e-6) + cx
+            v = fy * y / max(z, 1e-6) + cy
+            ok[i] = z > 1e-6 and u >= 0.0 and v >= 0.0 and u <= w - 1.0 and v <= h - 1.0
+            if not ok[i]:
+                miss += 1
+                continue
+            u0, v0 = min(int(u), w - 2), min(int(v), h - 2)
+            a, b = u - u0, v - v0
+            s = np.zeros(3)
+            for ch in range(3):
+                top = grads[ch, v0, u0] + a * (grads[ch, v0, u0 + 1] - grads[ch, v0, u0])
+                bot = grads[ch, v0 + 1, u0] + a * (grads[ch, v0 + 1, u0 + 1] - grads[ch, v0 + 1, u0])
+                s[ch] = top + b * (bot - top)
+            V[i] = s[0]
+            g0, g1 = s[1] * fx / z, s[2] * fy / z
+            g2 = -(s[1] * fx * x + s[2] * fy * y) / (z * z)
+            Nm[i, 0], Nm[i, 1], Nm[i, 2] = g0 * length, g1 * length, g2 * length
+            Nm[i, 3] = 2.0 * (rm1 * g2 - rm2 * g1)                     # 2·(RM × g)
+            Nm[i, 4] = 2.0 * (rm2 * g0 - rm0 * g2)
+            Nm[i, 5] = 2.0 * (rm0 * g1 - rm1 * g0)
+            for bb in range(B):
+                coef[bb] += Q[i, bb] * s[0]
+                for j in range(6):
+                    QN[bb, j] += Q[i, bb] * Nm[i, j]
+        JtJ[k, :, :] = 0.0
+        Jtr[k, :] = 0.0
+        total = float(miss)
+        row = np.zeros(6)
+        for i in range(N):
+            if not ok[i]:
+                continue
+            d = -V[i]
+            for bb in range(B):
+                d += Q[i, bb] * coef[bb]
+            den = c2 + d * d
+            r = d / np.sqrt(den)
+            total += r * r
+            wgt = c2 / (den * np.sqrt(den))
+            for j in range(6):
+                acc = -Nm[i, j]
+                for bb in range(B):
+                    acc += Q[i, bb] * QN[bb, j]
+                row[j] = wgt * acc
+            for j in range(6):
+                Jtr[k, j] += row[j] * r
+                for l in range(6):
+                    JtJ[k, j, l] += row[j] * row[l]
+        eps[k] = total
+
+
+def face_normal_equations(cost: EigenTemplateCost, space: RigidSpace, grads: np.ndarray,
+                          X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(JᵀJ (K, 6, 6), Jᵀr (K, 6), ε (K,))`` of the eigen-template cost at states X, compiled.
+
+    The same J as :func:`face_jacobian` (eq. 10), which is its readable reference.
+    """
+    R, t = state_pose(X)
+    K = len(X)
+    JtJ, Jtr, eps = np.zeros((K, 6, 6)), np.zeros((K, 6)), np.zeros(K)
+    intr = cost.intr
+    _face_normal_equations_kernel(np.ascontiguousarray(grads, np.float32),
+                                  np.array([intr.fx, intr.fy, intr.cx, intr.cy]), R, t,
+                                  np.ascontiguousarray(cost.template.points, np.float64), np.ascontiguousarray(cost.Q),
+                                  float(cost.c), float(space.length), JtJ, Jtr, eps)
+    return JtJ, Jtr, eps

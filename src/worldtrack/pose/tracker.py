@@ -35,7 +35,7 @@ from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
 from worldtrack.pose.models import PointModel, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics, sparse_template_pixels
-from worldtrack.pose.rigid import RigidSpace, face_jacobian, gradient_images, shading_basis
+from worldtrack.pose.rigid import RigidSpace, face_normal_equations, gradient_images, shading_basis
 
 
 @dataclass(frozen=True)
@@ -149,13 +149,14 @@ class RigidTracker:
         if cost.size == 0:
             raise InputError("the model shows no textured point at the current pose (is it in view?)")
         residuals = lambda X: cost.residuals(self.space.transforms(X))
-        eps = lambda X: (lambda r: (r * r).sum(1))(residuals(X))
+        eps = lambda X: cost.epsilon(self.space.transforms(X))
         kept = coarse_to_fine(self.space, eps, self.kept, self.sigma, cfg.stages, cfg.n_candidates, cfg.n_keep, self.rng)
-        jac = None
+        normal = None
         if self.cost == "eigen" and cfg.jacobian == "analytic":
             grads = gradient_images(grey)
-            jac = lambda X, r: face_jacobian(cost, self.space, grads, X)
-        res = levenberg_marquardt(self.space, residuals, kept.states, cfg.lm_iterations, jac)
+            normal = lambda X: face_normal_equations(cost, self.space, grads, X)
+        res = levenberg_marquardt(self.space, residuals, kept.states, cfg.lm_iterations,
+                                  normal_equations=normal, epsilon=eps)
         w = candidate_weights(res.cost)
         R, t = state_pose(res.states)
         Rm, tm = mean_rotation(R, w), (w[:, None] * t).sum(0)

@@ -241,15 +241,17 @@ class FaceSequence:
         R, t = self.R[k], self.t[k]
         xyz = self._pts @ R.T + t
         shade = self.ambient[k] + self.direct[k] * np.maximum((self._nrm @ R.T) @ self.light_dir[k], 0.0)
-        rad = self._alb * shade[:, None]
+        rad = (self._alb * shade[:, None]).astype(np.float32)
         big = self.intr.scaled(2)
         r = splat(xyz, big, footprint=2)
-        wall = self._wall * (self.ambient[k] + 0.6 * self.direct[k])
-        img = np.where((r.index >= 0)[..., None], rad[np.maximum(r.index, 0)], wall).astype(np.float32)
+        img = self._wall * np.float32(self.ambient[k] + 0.6 * self.direct[k])
+        hit = r.index >= 0
+        img[hit] = rad[r.index[hit]]
         img = cv2.resize(img, (self.intr.width, self.intr.height), interpolation=cv2.INTER_AREA)
         img = cv2.GaussianBlur(img, (0, 0), 0.5)
         rng = np.random.default_rng([self.seed, self.face.identity, k, 37])
-        img = np.clip(img + rng.normal(0, self.noise, img.shape) + 0.5, 0, 255).astype(np.uint8)
+        img += rng.standard_normal(img.shape, dtype=np.float32) * np.float32(self.noise) + np.float32(0.5)
+        img = np.clip(img, 0, 255).astype(np.uint8)
         d = np.where(np.isfinite(r.depth), r.depth, 1.4)[::2, ::2]
         depth = (np.round(d * 1000) / 1000).astype(np.float32)
         return FaceFrame(img, depth, R.copy(), t.copy(), k / self.fps, (float(self.ambient[k]), float(self.direct[k])))
