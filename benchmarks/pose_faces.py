@@ -8,7 +8,9 @@ at the true pose, and the cell's mean includes the frames until then). Rows ``Ti
 median ms per frame of the tracker's step (this process pinned to one core), beside one MOG2
 ``apply`` at the same size measured in the same run; ``trans`` is the mean translation error (mm).
 
-KLT + solvePnP (``worldtrack.pose.baselines``) runs on the same frames as a second baseline.
+``PFsLMn`` is the paper's method (random-walk particle filter, s stages, n LM iterations);
+``PF1LM10+v`` adds worldtrack's constant-velocity start (the tracker's default). KLT + solvePnP
+(``worldtrack.pose.baselines``) runs on the same frames as a second baseline.
 
 Seeds: 200–204 are held out (development used seed 100).
 
@@ -46,9 +48,11 @@ PAPER_SIM2 = {"PF1LM0": [F, 5.480, 5.053, 4.317, F, F, F, 4.506, 5.237],
 PAPER_SIM2_MS = {"PF1LM0": 30, "PF1LM10": 45, "PF1LM30": 60}
 
 
-def config(name: str) -> TrackerConfig:
-    s, l = name[2:].split("LM")
-    return TrackerConfig(stages=int(s), lm_iterations=int(l))
+def config(name: str, seed: int = 0) -> TrackerConfig:
+    """``PFsLMn`` — the paper's method (random walk); ``PFsLMn+v`` — with worldtrack's constant-velocity start."""
+    s, l = name[2:].removesuffix("+v").split("LM")
+    return TrackerConfig(stages=int(s), lm_iterations=int(l), motion="velocity" if name.endswith("+v") else "none",
+                         seed=seed)
 
 
 def run(face, frames, intr, method: str, seed: int) -> dict:
@@ -58,7 +62,7 @@ def run(face, frames, intr, method: str, seed: int) -> dict:
     if method == "KLT+PnP":
         tr = KltPnpTracker(model, intr, f0.R, f0.t, f0.image)
     else:
-        tr = RigidTracker(model, intr, f0.R, f0.t, config(method).__class__(**{**config(method).__dict__, "seed": seed}))
+        tr = RigidTracker(model, intr, f0.R, f0.t, config(method, seed))
     rule = FailureRule(10.0, 5)
     err, terr, ms = [], [], []
     for f in frames[1:]:
@@ -137,11 +141,11 @@ def main() -> None:
            f"Reference in this run: one MOG2 apply at 640×480 = {mog2:.1f} ms.\n"]
     summaries = {}
     if a.motion in ("sim1", "both"):
-        txt, summaries["sim1"] = table("sim1", ["PF1LM0", "PF3LM0", "PF1LM10", "PF3LM10", "KLT+PnP"], faces,
+        txt, summaries["sim1"] = table("sim1", ["PF1LM0", "PF3LM0", "PF1LM10", "PF3LM10", "PF1LM10+v", "KLT+PnP"], faces,
                                        sim1_seeds, n, PAPER_SIM1, PAPER_SIM1_MS)
         out += [f"## Table 3 — Simulation 1 (small motion), seeds {sim1_seeds}\n", txt, ""]
     if a.motion in ("sim2", "both"):
-        txt, summaries["sim2"] = table("sim2", ["PF1LM0", "PF1LM10", "PF1LM30", "KLT+PnP"], faces, seeds, n,
+        txt, summaries["sim2"] = table("sim2", ["PF1LM0", "PF1LM10", "PF1LM30", "PF1LM10+v", "KLT+PnP"], faces, seeds, n,
                                        PAPER_SIM2, PAPER_SIM2_MS)
         out += [f"## Table 4 — Simulation 2 (large motion), seeds {seeds}\n", txt, ""]
     lines = []

@@ -120,6 +120,15 @@ def retract(X: np.ndarray, delta: np.ndarray, length: float = 1.0) -> np.ndarray
     return np.concatenate([t, q * np.where(q[..., :1] < 0, -1.0, 1.0)], -1)
 
 
+def increment_between(X0: np.ndarray, X1: np.ndarray, length: float = 1.0) -> np.ndarray:
+    """The increment δ (6,) with ``retract(X0, δ, length) = X1`` (rigid states (7,))."""
+    X0, X1 = np.asarray(X0, float), np.asarray(X1, float)
+    q0 = X0[3:7] * np.array([1.0, -1.0, -1.0, -1.0])                 # inverse of a unit quaternion
+    dq = quat_multiply(X1[3:7], q0)
+    dq = dq * (1.0 if dq[0] >= 0 else -1.0)
+    return np.concatenate([(X1[:3] - X0[:3]) / length, dq[1:]])
+
+
 # -------------------------------------------------------------------------------- building models
 
 def box_model(half_size: tuple[float, float, float], spacing: float) -> PointModel:

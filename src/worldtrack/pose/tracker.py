@@ -32,7 +32,7 @@ from worldtrack.errors import InputError
 from worldtrack.pose.cost import ColourDepthCost, EigenTemplateCost, SparseTemplate
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
-from worldtrack.pose.models import PointModel, rigid_state, state_pose
+from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics, sparse_template_pixels
 from worldtrack.pose.rigid import RigidSpace, face_normal_equations, gradient_images, shading_basis
@@ -46,6 +46,8 @@ class TrackerConfig:
     c : Geman–McClure scale — grey levels for ``eigen``; None = 0.5/N for ``colour-depth``
     c_depth_mm : depth scale c′ (mm); lam : λ, share of the depth term
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
+    motion : "velocity" — the kept candidates are first moved by the last frame's change of pose
+        (constant velocity; worldtrack's addition); "none" — the paper's random walk
     smooth_px : Gaussian σ (pixels) applied to the input and to the drawn template alike
     camera_blur_px : the camera's own blur (σ, pixels), added to the drawn template's smoothing
     shading_vectors : eigenvectors Φ of the eigen-template besides the mean v̄
@@ -66,6 +68,7 @@ class TrackerConfig:
     smooth_px: float = 1.0
     camera_blur_px: float = 0.6
     shading_vectors: int = 9
+    motion: str = "velocity"
     seed: int = 0
 
 
@@ -106,6 +109,8 @@ class RigidTracker:
     cost: str = "eigen"
 
     def __post_init__(self):
+        if self.config.motion not in ("velocity", "none"):
+            raise InputError(f"motion: expected velocity or none, got {self.config.motion!r}")
         if self.cost not in ("eigen", "colour-depth"):
             raise InputError(f"cost: expected eigen or colour-depth, got {self.cost!r}")
         self.space = RigidSpace(length=max(self.model.radius, 1e-3))
@@ -118,22 +123,25 @@ class RigidTracker:
         """(Re-)initialise at a known pose."""
         self.state = rigid_state(np.asarray(R, float), np.asarray(t, float))
         self.kept = self.state[None].copy()
+        self.velocity = np.zeros(6)
 
     def template(self, state: np.ndarray):
         """The sparse template (:class:`~worldtrack.pose.render.TemplatePixels`) at ``state``."""
         R, t = state_pose(state)
         xyz = self.model.points @ R.T + t
+        albedo = self.model.albedo
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
         sigma = float(np.hypot(self.config.smooth_px, self.config.camera_blur_px))
-        return sparse_template_pixels(self.model.albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma)
+        return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma)
 
-    def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray):
-        """The cost object for a (smoothed) grey frame, with the template taken at ``state``."""
-        tp = self.template(state)
+    def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray, tp=None):
+        """The cost object for a (smoothed) grey frame, with the template taken at ``state`` (or ``tp``)."""
+        tp = self.template(state) if tp is None else tp
         m = self.model
-        colour = SparseTemplate(m.points[tp.colour], np.zeros(len(tp.colour), int), tp.value)
+        value = tp.value
+        colour = SparseTemplate(m.points[tp.colour], np.zeros(len(tp.colour), int), value)
         if self.cost == "eigen":
-            basis = tp.value[:, None] * self.basis[tp.colour]          # Φ̃ = diag(a)·Ψ
+            basis = value[:, None] * self.basis[tp.colour]             # Φ̃ = diag(a)·Ψ
             return EigenTemplateCost(colour, basis, grey, self.intr, 10.0 if self.config.c is None else self.config.c)
         R, t = state_pose(state)
         zd = (m.points[tp.depth] @ R.T + t)[:, 2]
@@ -141,26 +149,35 @@ class RigidTracker:
         return ColourDepthCost(colour, dt, grey, depth, self.intr, self.config.c, self.config.c_depth_mm / 1000,
                                self.config.lam)
 
+    def _lm(self, cost, states: np.ndarray, iterations: int):
+        """Batched LM of the kept candidates on one cost (compiled normal equations for the face)."""
+        residuals = lambda X: cost.residuals(self.space.transforms(X))
+        eps = lambda X: cost.epsilon(self.space.transforms(X))
+        normal = None
+        if self.cost == "eigen" and self.config.jacobian == "analytic":
+            grads = gradient_images(cost.images[0])
+            normal = lambda X: face_normal_equations(cost, self.space, grads, X)
+        return levenberg_marquardt(self.space, residuals, states, iterations, normal_equations=normal, epsilon=eps)
+
     def step(self, image: np.ndarray, depth: np.ndarray | None = None) -> PoseEstimate:
         """Track one frame: ``image`` BGR uint8 or grey; ``depth`` (H, W) metres, 0 = none."""
         grey = cv2.GaussianBlur(to_grey(image), (0, 0), self.config.smooth_px)
         cfg = self.config
-        cost = self.make_cost(grey, depth, self.state)
+        tp = self.template(self.state)
+        cost = self.make_cost(grey, depth, self.state, tp)
         if cost.size == 0:
             raise InputError("the model shows no textured point at the current pose (is it in view?)")
-        residuals = lambda X: cost.residuals(self.space.transforms(X))
         eps = lambda X: cost.epsilon(self.space.transforms(X))
-        kept = coarse_to_fine(self.space, eps, self.kept, self.sigma, cfg.stages, cfg.n_candidates, cfg.n_keep, self.rng)
-        normal = None
-        if self.cost == "eigen" and cfg.jacobian == "analytic":
-            grads = gradient_images(grey)
-            normal = lambda X: face_normal_equations(cost, self.space, grads, X)
-        res = levenberg_marquardt(self.space, residuals, kept.states, cfg.lm_iterations,
-                                  normal_equations=normal, epsilon=eps)
+        start = self.space.retract(self.kept, np.broadcast_to(self.velocity, (len(self.kept), 6)))
+        kept = coarse_to_fine(self.space, eps, start, self.sigma, cfg.stages, cfg.n_candidates, cfg.n_keep, self.rng)
+        res = self._lm(cost, kept.states, cfg.lm_iterations)
         w = candidate_weights(res.cost)
         R, t = state_pose(res.states)
         Rm, tm = mean_rotation(R, w), (w[:, None] * t).sum(0)
-        self.state = rigid_state(Rm, tm)
+        new_state = rigid_state(Rm, tm)
+        if cfg.motion == "velocity":
+            self.velocity = increment_between(self.state, new_state, self.space.length)
+        self.state = new_state
         self.kept = res.states
         mean_cost = float(eps(self.state[None])[0]) / cost.size
         return PoseEstimate(Rm, tm, mean_cost, cost.size)

@@ -191,7 +191,7 @@ class FaceFrame(NamedTuple):
 
 MOTIONS = {  # peak yaw, pitch, roll (deg); peak x, y, z (m); frequency range (Hz)
     "sim1": ((8.0, 6.0, 4.0), (0.012, 0.010, 0.02), (0.08, 0.3)),
-    "sim2": ((40.0, 25.0, 15.0), (0.04, 0.03, 0.06), (0.15, 0.45)),
+    "sim2": ((60.0, 35.0, 25.0), (0.06, 0.05, 0.1), (0.3, 0.65)),
 }
 DEFAULT_SIZE = (640, 480)
 DEFAULT_DISTANCE = 0.6
