@@ -31,20 +31,24 @@ class PointModel:
     normals : (M, 3) float, unit outward normals
     albedo : (M,) float32, grey level 0–255 under unit light; NaN where unknown
     spacing : float, metres — distance between neighbouring points
+    from_image : bool — the albedo was read from a camera image (so it already holds the camera's
+        blur; see :func:`worldtrack.pose.render.learn_appearance`)
     """
 
     points: np.ndarray
     normals: np.ndarray
     albedo: np.ndarray
     spacing: float
+    from_image: bool = False
 
     @property
     def radius(self) -> float:
         """Largest distance of a point from the object origin (m)."""
         return float(np.sqrt((self.points ** 2).sum(1).max()))
 
-    def with_albedo(self, albedo: np.ndarray) -> "PointModel":
-        return replace(self, albedo=np.asarray(albedo, np.float32))
+    def with_albedo(self, albedo: np.ndarray, from_image: bool = True) -> "PointModel":
+        """The same model with another appearance (by default one read from a camera image)."""
+        return replace(self, albedo=np.asarray(albedo, np.float32), from_image=from_image)
 
 
 # ----------------------------------------------------------------------------------- rotations

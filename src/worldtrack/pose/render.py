@@ -281,3 +281,22 @@ def _nearest_point(index: np.ndarray, drawn: np.ndarray, rc: np.ndarray) -> np.n
         cc = np.clip(rc[miss, 1] + dc, 0, w - 1)
         out[miss] = index[rr, cc]
     return out
+
+
+def learn_appearance(points: np.ndarray, normals: np.ndarray, grey: np.ndarray, intr: Intrinsics,
+                     R: np.ndarray, t: np.ndarray, min_facing: float = 0.2) -> np.ndarray:
+    """Albedo (M,) of model points read from a frame where the model's pose is known.
+
+    What the paper takes from its KinectFusion model, learnt here from one frame: each point the
+    z-buffer shows (and that faces the camera by more than ``min_facing`` = cos of the view angle)
+    gets the grey level under its projection; hidden points stay NaN (unknown).
+    """
+    xyz = np.asarray(points, float) @ np.asarray(R, float).T + np.asarray(t, float)
+    r = splat(xyz, intr)
+    seen = np.zeros(len(xyz), bool)
+    seen[r.index[r.index >= 0]] = True
+    view = -xyz / np.linalg.norm(xyz, axis=1, keepdims=True)
+    seen &= ((np.asarray(normals) @ np.asarray(R, float).T) * view).sum(1) > min_facing
+    albedo = np.full(len(xyz), np.nan, np.float32)
+    albedo[seen] = _bilinear(np.asarray(grey, np.float32), xyz[seen], intr)
+    return albedo

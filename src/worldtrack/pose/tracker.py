@@ -50,6 +50,7 @@ class TrackerConfig:
         (constant velocity; worldtrack's addition); "none" — the paper's random walk
     smooth_px : Gaussian σ (pixels) applied to the input and to the drawn template alike
     camera_blur_px : the camera's own blur (σ, pixels), added to the drawn template's smoothing
+        (not for appearance read from an image, which holds it already)
     shading_vectors : eigenvectors Φ of the eigen-template besides the mean v̄
     """
 
@@ -124,6 +125,24 @@ class RigidTracker:
         self.state = rigid_state(np.asarray(R, float), np.asarray(t, float))
         self.kept = self.state[None].copy()
         self.velocity = np.zeros(6)
+        self.depth_offset = getattr(self, "depth_offset", 0.0)
+
+    def learn_depth_offset(self, depth: np.ndarray) -> float:
+        """Learn the depth sensor's offset (m) on a frame taken at the current (known) pose.
+
+        The median of ``Ẑ − Z`` over the depth template; later depth readings are corrected by it
+        (a real RGB-D camera read the ViSP cube 4 mm too far). Returns the offset.
+        """
+        from worldtrack.pose.cost import NEAREST_POSITIVE, project_sample
+
+        tp = self.template(self.state)
+        R, t = state_pose(self.state)
+        pts = self.model.points[tp.depth]
+        z_hat, z = project_sample(np.asarray(depth, np.float32), self.intr, self.space.transforms(self.state[None]),
+                                  SparseTemplate(pts, np.zeros(len(pts), int), np.zeros(len(pts))), NEAREST_POSITIVE)
+        d = z_hat[0, 0] - z[0]
+        self.depth_offset = float(np.nanmedian(d)) if np.isfinite(d).any() else 0.0
+        return self.depth_offset
 
     def template(self, state: np.ndarray):
         """The sparse template (:class:`~worldtrack.pose.render.TemplatePixels`) at ``state``."""
@@ -131,7 +150,7 @@ class RigidTracker:
         xyz = self.model.points @ R.T + t
         albedo = self.model.albedo
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
-        sigma = float(np.hypot(self.config.smooth_px, self.config.camera_blur_px))
+        sigma = float(np.hypot(self.config.smooth_px, 0.0 if self.model.from_image else self.config.camera_blur_px))
         return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma)
 
     def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray, tp=None):
@@ -146,6 +165,8 @@ class RigidTracker:
         R, t = state_pose(state)
         zd = (m.points[tp.depth] @ R.T + t)[:, 2]
         dt = SparseTemplate(m.points[tp.depth], np.zeros(len(tp.depth), int), zd)
+        if depth is not None and self.depth_offset:
+            depth = np.where(depth > 0, depth - np.float32(self.depth_offset), 0).astype(np.float32)
         return ColourDepthCost(colour, dt, grey, depth, self.intr, self.config.c, self.config.c_depth_mm / 1000,
                                self.config.lam)
 

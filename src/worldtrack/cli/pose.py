@@ -1,0 +1,259 @@
+"""``worldtrack pose track``: track the 6-DoF pose of a face or a rigid object (seed 003).
+
+    worldtrack pose track --model face|upper-body|MODEL.obj --rgb DIR [--depth DIR] \\
+        --camera K.yaml --init POSE --out DIR
+
+Writes ``DIR/pose.csv`` (one row per frame, flushed as it goes: the pose of the model in the
+camera frame — translation in metres, quaternion, ZYX angles in degrees — the synthetic
+ground truth's columns, plus the per-frame cost), ``DIR/annotated.mp4`` (model outline and axes)
+and ``DIR/cost.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+from worldtrack.errors import InputError
+from worldtrack.pose.models import PointModel, load_obj
+from worldtrack.pose.render import Intrinsics, learn_appearance
+from worldtrack.pose.tracker import RigidTracker, TrackerConfig, to_grey
+
+IMAGE_EXT = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+DEPTH_EXT = (".png", ".tif", ".tiff", ".npz", ".npy")
+COLUMNS = ["frame", "time", "id", "tx", "ty", "tz", "qw", "qx", "qy", "qz", "rz_deg", "ry_deg", "rx_deg",
+           "cost", "n_template"]
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("pose", help="track the pose of a face, an upper body or a rigid object (seed 003)",
+                       description="Pose tracking by particle filter + Levenberg-Marquardt (seed 003).")
+    verbs = p.add_subparsers(dest="pose_command", metavar="<verb>")
+    t = verbs.add_parser("track", help="track a model through a folder of frames",
+                         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "))
+    t.add_argument("--model", required=True, help="face, upper-body, or a Wavefront OBJ mesh in metres")
+    t.add_argument("--rgb", required=True, metavar="DIR", help="folder of colour frames (sorted by name)")
+    t.add_argument("--depth", metavar="DIR", help="folder of depth frames (16-bit PNG or .npz/.npy), one per colour frame")
+    t.add_argument("--depth-scale", type=float, default=0.001, help="depth units in metres (default 0.001: mm)")
+    t.add_argument("--camera", required=True, metavar="K.yaml",
+                   help="intrinsics: YAML/JSON with K (3x3) or fx, fy, cx, cy (or ViSP's px, py, u0, v0)")
+    t.add_argument("--init", required=True, metavar="POSE",
+                   help="pose at the first frame: a file holding a 4x4 object-to-camera matrix (metres), or "
+                        "'x,y,z,rx,ry,rz' (metres; rotation vector in degrees)")
+    t.add_argument("--out", default="pose_out", metavar="DIR", help="output folder (default pose_out)")
+    t.add_argument("--stages", type=int, default=1, help="coarse-to-fine particle-filter stages (PFx, default 1)")
+    t.add_argument("--lm-iterations", type=int, default=10, help="LM iterations per frame (LMx, default 10)")
+    t.add_argument("--candidates", type=int, default=1000, help="candidates per stage (default 1000)")
+    t.add_argument("--face-identity", type=int, default=0, help="built-in face model to use with --model face")
+    t.add_argument("--lam", type=float, default=0.9, help="share of the depth term (λ, default 0.9)")
+    t.add_argument("--fps", type=float, default=30.0, help="frame rate for time stamps (default 30)")
+    t.add_argument("--seed", type=int, default=0, help="random seed of the particle filter")
+    t.add_argument("--no-video", action="store_true", help="do not write annotated.mp4")
+    t.add_argument("--quiet", action="store_true", help="no progress bar")
+    t.set_defaults(func=run)
+    p.set_defaults(func=lambda a: (p.print_help(), 2)[1])
+
+
+def read_camera(path: str) -> dict:
+    """Intrinsics from YAML/JSON: ``{fx, fy, cx, cy, width?, height?}`` (pixels)."""
+    try:
+        data = yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError, UnicodeDecodeError) as e:
+        raise InputError(f"--camera {path}: cannot read ({getattr(e, 'strerror', None) or e})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"--camera {path}: expected a mapping with K or fx, fy, cx, cy")
+    try:
+        if "K" in data or "camera_matrix" in data:
+            K = np.asarray(data.get("K", data.get("camera_matrix")), float).reshape(3, 3)
+            cam = {"fx": K[0, 0], "fy": K[1, 1], "cx": K[0, 2], "cy": K[1, 2]}
+        elif "px" in data:
+            cam = {"fx": data["px"], "fy": data["py"], "cx": data["u0"], "cy": data["v0"]}
+        else:
+            cam = {k: data[k] for k in ("fx", "fy", "cx", "cy")}
+        cam = {k: float(v) for k, v in cam.items()}
+    except (KeyError, ValueError, TypeError) as e:
+        raise InputError(f"--camera {path}: expected K (3x3) or fx, fy, cx, cy in pixels ({e})") from None
+    if not (cam["fx"] > 0 and cam["fy"] > 0):
+        raise InputError(f"--camera {path}: focal lengths must be positive, got fx={cam['fx']}, fy={cam['fy']}")
+    for a, b in (("width", "w"), ("height", "h")):
+        if a in data or b in data:
+            cam[a] = int(data.get(a, data.get(b)))
+    return cam
+
+
+def read_pose(text: str) -> tuple[np.ndarray, np.ndarray]:
+    """(R, t) from a file with a 4×4 (or 3×4) matrix, or from ``x,y,z,rx,ry,rz`` (m, degrees)."""
+    p = Path(text)
+    if p.is_file():
+        raw = p.read_text()
+        try:
+            data = yaml.safe_load(raw)
+            nums = np.asarray(data, float).ravel() if not isinstance(data, (dict, str)) else None
+        except (yaml.YAMLError, ValueError, TypeError):
+            nums = None
+        if nums is None:
+            try:
+                nums = np.array([float(x) for x in raw.replace(",", " ").replace("[", " ").replace("]", " ").split()])
+            except ValueError:
+                raise InputError(f"--init {text}: expected a 4x4 pose matrix (numbers)") from None
+        if nums.size not in (12, 16):
+            raise InputError(f"--init {text}: expected a 4x4 or 3x4 matrix, got {nums.size} numbers")
+        M = nums[:12].reshape(3, 4)
+        U, _, Vt = np.linalg.svd(M[:, :3])
+        return U @ np.diag([1, 1, np.linalg.det(U @ Vt)]) @ Vt, M[:, 3].copy()
+    try:
+        v = [float(x) for x in text.split(",")]
+    except ValueError:
+        v = []
+    if len(v) != 6 or not all(math.isfinite(x) for x in v):
+        raise InputError(f"--init {text!r}: expected a pose file or x,y,z,rx,ry,rz (metres, degrees)")
+    return cv2.Rodrigues(np.radians(np.array(v[3:])))[0], np.array(v[:3])
+
+
+def _listing(folder: str, ext: tuple, flag: str) -> list[Path]:
+    d = Path(folder)
+    if not d.is_dir():
+        raise InputError(f"{flag} {folder}: no such folder")
+    files = sorted(f for f in d.iterdir() if f.suffix.lower() in ext)
+    if not files:
+        raise InputError(f"{flag} {folder}: no frames ({', '.join(ext)}) in the folder")
+    return files
+
+
+def read_depth(path: Path, scale: float) -> np.ndarray:
+    """Depth in metres (0 = no measurement) from a 16-bit PNG/TIFF, ``.npz`` (array ``data``) or ``.npy``."""
+    try:
+        if path.suffix == ".npz":
+            with np.load(path, allow_pickle=False) as z:
+                raw = z["data"] if "data" in z.files else z[z.files[0]]
+        elif path.suffix == ".npy":
+            raw = np.load(path, allow_pickle=False)
+        else:
+            raw = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH)
+    except (OSError, ValueError, KeyError, IndexError) as e:
+        raise InputError(f"{path}: cannot read depth ({e})") from None
+    if raw is None or raw.ndim != 2:
+        raise InputError(f"{path}: cannot read depth (expected a single-channel image or array)")
+    return np.nan_to_num(raw.astype(np.float32) * np.float32(scale))
+
+
+def _model(args, first: np.ndarray, intr: Intrinsics, R0, t0) -> tuple[PointModel, str]:
+    if args.model == "face":
+        from worldtrack.synth.faces import face_model, make_face
+        return face_model(make_face(args.face_identity)), "eigen"
+    if args.model == "upper-body":
+        raise InputError("--model upper-body: the 14-DoF body is tracked by benchmarks/pose_body.py; "
+                         "the command line tracks rigid models (face or an OBJ mesh)")
+    model = load_obj(args.model)
+    albedo = learn_appearance(model.points, model.normals, to_grey(first), intr, R0, t0)
+    if not np.isfinite(albedo).any():
+        raise InputError(f"--init: the model {args.model} is not in view of the first frame at this pose")
+    return model.with_albedo(albedo), "colour-depth"
+
+
+def run(args: argparse.Namespace) -> int:
+    colour = _listing(args.rgb, IMAGE_EXT, "--rgb")
+    depths = _listing(args.depth, DEPTH_EXT, "--depth") if args.depth else None
+    if depths is not None and len(depths) != len(colour):
+        raise InputError(f"--depth {args.depth}: {len(depths)} depth frames for {len(colour)} colour frames")
+    cam = read_camera(args.camera)
+    R0, t0 = read_pose(args.init)
+    first = cv2.imread(str(colour[0]), cv2.IMREAD_COLOR)
+    if first is None:
+        raise InputError(f"{colour[0]}: cannot read the image")
+    h, w = first.shape[:2]
+    if ("width" in cam and cam["width"] != w) or ("height" in cam and cam["height"] != h):
+        raise InputError(f"--camera {args.camera}: made for {cam.get('width')}x{cam.get('height')} images, "
+                         f"but {colour[0].name} is {w}x{h}")
+    intr = Intrinsics(cam["fx"], cam["fy"], cam["cx"], cam["cy"], w, h)
+    model, cost = _model(args, first, intr, R0, t0)
+    z = (model.points @ R0.T + t0)[:, 2]
+    if z.min() <= 0.01:
+        raise InputError(f"--init: the pose puts the model behind the camera (nearest point at z = {z.min():.3f} m)")
+    config = TrackerConfig(stages=args.stages, lm_iterations=args.lm_iterations, n_candidates=args.candidates,
+                           lam=args.lam, seed=args.seed)
+    tracker = RigidTracker(model, intr, R0, t0, config, cost=cost)
+    return _track(args, colour, depths, tracker, intr, model, (R0, t0), (w, h))
+
+
+def _row(k: int, fps: float, R: np.ndarray, t: np.ndarray, cost: float, n: int) -> list:
+    from scipy.spatial.transform import Rotation
+
+    x, y, zq, wq = Rotation.from_matrix(R).as_quat()
+    if wq < 0:
+        x, y, zq, wq = -x, -y, -zq, -wq
+    rz, ry, rx = Rotation.from_matrix(R).as_euler("ZYX", degrees=True)
+    vals = [k, round(k / fps, 6), 1, *np.round(t, 6), *np.round([wq, x, y, zq], 8), *np.round([rz, ry, rx], 5)]
+    return vals + ["" if not math.isfinite(cost) else round(cost, 6), n]
+
+
+def _track(args, colour: list[Path], depths, tracker: RigidTracker, intr: Intrinsics, model: PointModel,
+           pose0: tuple, size: tuple) -> int:
+    from tqdm import tqdm
+
+    from worldtrack.io.video import VideoWriter
+    from worldtrack.viz.pose_overlay import draw_pose
+
+    out = Path(args.out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"--out {out}: cannot create the folder ({e.strerror})") from None
+    video = None if args.no_video else VideoWriter(out / "annotated.mp4", args.fps)
+    costs = []
+    with open(out / "pose.csv", "w", newline="") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(COLUMNS)
+        try:
+            for k, path in enumerate(tqdm(colour, desc="pose", unit="frame", disable=args.quiet)):
+                image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+                if image is None:
+                    raise InputError(f"{path}: cannot read the image")
+                if image.shape[:2] != (size[1], size[0]):
+                    raise InputError(f"{path}: {image.shape[1]}x{image.shape[0]}, expected {size[0]}x{size[1]} "
+                                     "like the first frame")
+                depth = read_depth(depths[k], args.depth_scale) if depths is not None else None
+                if depth is not None and depth.shape != image.shape[:2]:
+                    raise InputError(f"{depths[k]}: depth is {depth.shape[1]}x{depth.shape[0]} but the colour "
+                                     f"frame {path.name} is {image.shape[1]}x{image.shape[0]}")
+                if k == 0:
+                    R, t, c, n = *pose0, float("nan"), 0
+                else:
+                    est = tracker.step(image, depth)
+                    R, t, c, n = est.R, est.t, est.cost, est.n_template
+                costs.append(c)
+                writer.writerow(_row(k, args.fps, R, t, c, n))
+                f.flush()
+                if video is not None:
+                    video.write(draw_pose(image, model.points, R, t, intr, model.radius * 0.8,
+                                          label=f"frame {k}  cost {c:.3f}"))
+        finally:
+            if video is not None:
+                video.close()
+            _cost_plot(out / "cost.png", costs, args.fps)
+    print(f"wrote {out / 'pose.csv'} ({len(costs)} frames)" + ("" if video is None else f", {out / 'annotated.mp4'}"))
+    return 0
+
+
+def _cost_plot(path: Path, costs: list[float], fps: float) -> None:
+    if len(costs) < 2:
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 2.5))
+    ax.plot(np.arange(len(costs)) / fps, costs)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("mean ρ over the template")
+    ax.set_title("per-frame cost")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
