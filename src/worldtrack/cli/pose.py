@@ -143,18 +143,23 @@ def read_depth(path: Path, scale: float) -> np.ndarray:
     return np.nan_to_num(raw.astype(np.float32) * np.float32(scale))
 
 
-def _model(args, first: np.ndarray, intr: Intrinsics, R0, t0) -> tuple[PointModel, str]:
+def _model(args) -> tuple[PointModel, str]:
+    """The model (geometry; albedo for the face) and its cost."""
     if args.model == "face":
         from worldtrack.synth.faces import face_model, make_face
         return face_model(make_face(args.face_identity)), "eigen"
     if args.model == "upper-body":
         raise InputError("--model upper-body: the 14-DoF body is tracked by benchmarks/pose_body.py; "
                          "the command line tracks rigid models (face or an OBJ mesh)")
-    model = load_obj(args.model)
+    return load_obj(args.model), "colour-depth"
+
+
+def _learn(args, model: PointModel, first: np.ndarray, intr: Intrinsics, R0, t0) -> PointModel:
+    """An OBJ model's appearance, read from the first frame at the initial pose."""
     albedo = learn_appearance(model.points, model.normals, to_grey(first), intr, R0, t0)
     if not np.isfinite(albedo).any():
         raise InputError(f"--init: the model {args.model} is not in view of the first frame at this pose")
-    return model.with_albedo(albedo), "colour-depth"
+    return model.with_albedo(albedo)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -172,10 +177,17 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--camera {args.camera}: made for {cam.get('width')}x{cam.get('height')} images, "
                          f"but {colour[0].name} is {w}x{h}")
     intr = Intrinsics(cam["fx"], cam["fy"], cam["cx"], cam["cy"], w, h)
-    model, cost = _model(args, first, intr, R0, t0)
+    if depths is not None:
+        d0 = read_depth(depths[0], args.depth_scale)
+        if d0.shape != (h, w):
+            raise InputError(f"{depths[0]}: depth is {d0.shape[1]}x{d0.shape[0]} but the colour frame "
+                             f"{colour[0].name} is {w}x{h}")
+    model, cost = _model(args)
     z = (model.points @ R0.T + t0)[:, 2]
     if z.min() <= 0.01:
         raise InputError(f"--init: the pose puts the model behind the camera (nearest point at z = {z.min():.3f} m)")
+    if cost == "colour-depth":
+        model = _learn(args, model, first, intr, R0, t0)
     config = TrackerConfig(stages=args.stages, lm_iterations=args.lm_iterations, n_candidates=args.candidates,
                            lam=args.lam, seed=args.seed)
     tracker = RigidTracker(model, intr, R0, t0, config, cost=cost)

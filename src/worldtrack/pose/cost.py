@@ -50,19 +50,27 @@ class SparseTemplate(NamedTuple):
 @njit(cache=True, fastmath=True)
 def _project_sample_kernel(images, fx, fy, cx, cy, T, X, part, mode, vals, zout):  # pragma: no cover
     # One pass over candidates × points: transform, project, read (bilinear or nearest-positive).
+    # The part's 3×4 transform is held in locals while consecutive points share a part.
     # fastmath is safe here: NaN only comes in through the image (depth holes are tested as > 0).
     n_ch, h, w = images.shape
     for k in range(T.shape[0]):
+        p_prev = -1
+        r00 = r01 = r02 = t0 = r10 = r11 = r12 = t1 = r20 = r21 = r22 = t2 = 0.0
         for i in range(X.shape[0]):
             p = part[i]
+            if p != p_prev:
+                r00, r01, r02, t0 = T[k, p, 0, 0], T[k, p, 0, 1], T[k, p, 0, 2], T[k, p, 0, 3]
+                r10, r11, r12, t1 = T[k, p, 1, 0], T[k, p, 1, 1], T[k, p, 1, 2], T[k, p, 1, 3]
+                r20, r21, r22, t2 = T[k, p, 2, 0], T[k, p, 2, 1], T[k, p, 2, 2], T[k, p, 2, 3]
+                p_prev = p
             a0 = X[i, 0]
             a1 = X[i, 1]
             a2 = X[i, 2]
-            z = T[k, p, 2, 0] * a0 + T[k, p, 2, 1] * a1 + T[k, p, 2, 2] * a2 + T[k, p, 2, 3]
+            z = r20 * a0 + r21 * a1 + r22 * a2 + t2
             zout[k, i] = z
             inv = 1.0 / max(z, 1e-6)
-            u = fx * (T[k, p, 0, 0] * a0 + T[k, p, 0, 1] * a1 + T[k, p, 0, 2] * a2 + T[k, p, 0, 3]) * inv + cx
-            v = fy * (T[k, p, 1, 0] * a0 + T[k, p, 1, 1] * a1 + T[k, p, 1, 2] * a2 + T[k, p, 1, 3]) * inv + cy
+            u = fx * (r00 * a0 + r01 * a1 + r02 * a2 + t0) * inv + cx
+            v = fy * (r10 * a0 + r11 * a1 + r12 * a2 + t1) * inv + cy
             if mode == 0:
                 if z <= 1e-6 or not (u >= 0.0 and v >= 0.0 and u <= w - 1.0 and v <= h - 1.0):
                     for ch in range(n_ch):
@@ -194,7 +202,8 @@ class EigenTemplateCost:
     def __init__(self, template: SparseTemplate, basis: np.ndarray, grey: np.ndarray, intr: Intrinsics,
                  c: float = 10.0):
         self.template = template
-        self.Q = np.linalg.qr(np.asarray(basis, float))[0]          # Φ̃Φ̃⁺ = Q·Qᵀ
+        self.basis = np.asarray(basis, float)
+        self.Q = np.linalg.qr(self.basis)[0]                         # Φ̃Φ̃⁺ = Q·Qᵀ
         self.images = np.ascontiguousarray(grey, np.float32)[None]
         self.intr, self.c = intr, float(c)
 
@@ -218,6 +227,13 @@ class EigenTemplateCost:
         """(K,) ε = Σ ρ_c(d_i) (eq. 3) of K candidates, without forming the residual matrix."""
         vals, _ = project_sample(self.images, self.intr, T, self.template)
         return _eigen_epsilon_kernel(vals[:, 0], self.Q, self.c)
+
+    def subset(self, n: int) -> "EigenTemplateCost":
+        """The same cost on the first ``n`` template points (the strongest extrema come first)."""
+        t = self.template
+        sub = EigenTemplateCost(SparseTemplate(t.points[:n], t.part[:n], t.value[:n]), self.basis[:n],
+                                self.images[0], self.intr, self.c)
+        return sub
 
 
 class ColourDepthCost:
@@ -273,3 +289,12 @@ class ColourDepthCost:
         """(K,) ε = (1 − λ)·ε_C + λ·ε_D (eq. 18)."""
         r = self.residuals(T)
         return (r * r).sum(1)
+
+    def subset(self, n: int) -> "ColourDepthCost":
+        """The same cost on the first ``n`` colour and depth points (strongest extrema first)."""
+        c, d = self.colour, self.depth
+        sub = ColourDepthCost(SparseTemplate(c.points[:n], c.part[:n], c.value[:n]),
+                              None if d is None else SparseTemplate(d.points[:n], d.part[:n], d.value[:n]),
+                              self.images[0], None if self.depth_image is None else self.depth_image[0], self.intr,
+                              self.c * len(c.points) / max(min(n, len(c.points)), 1), self.c_depth, self.lam)
+        return sub

@@ -141,7 +141,7 @@ def splat_reference(xyz: np.ndarray, intr: Intrinsics, footprint: int = 1, centr
 
 
 def local_extrema(image: np.ndarray, valid: np.ndarray, radius: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """Pixels of ``image`` that are a maximum or a minimum of their (2r+1)² neighbourhood.
+    """Pixels of ``image`` strictly above or below all others of their (2r+1)² neighbourhood.
 
     Only pixels whose whole neighbourhood is ``valid`` count (no extrema on the silhouette).
     Returns ``(rows, cols)`` of the extrema and their strength ``|I − local mean|`` as (n,) arrays
@@ -150,11 +150,12 @@ def local_extrema(image: np.ndarray, valid: np.ndarray, radius: int = 1) -> tupl
     img = np.where(valid, image, 0).astype(np.float32)
     k = np.ones((2 * radius + 1, 2 * radius + 1), np.uint8)
     inner = cv2.erode(valid.astype(np.uint8), k, borderValue=0).astype(bool)
-    hi = cv2.dilate(np.where(valid, img, -np.inf).astype(np.float32), k)
-    lo = cv2.erode(np.where(valid, img, np.inf).astype(np.float32), k)
+    ring = k.copy()
+    ring[radius, radius] = 0                                         # the neighbours, not the pixel itself
+    hi = cv2.dilate(np.where(valid, img, -np.inf).astype(np.float32), ring)
+    lo = cv2.erode(np.where(valid, img, np.inf).astype(np.float32), ring)
     mean = cv2.blur(img, (2 * radius + 3, 2 * radius + 3))
-    # A flat patch is both its own max and min: require a real difference to the neighbourhood.
-    ext = inner & ((img >= hi) | (img <= lo)) & (hi > lo)
+    ext = inner & ((img > hi) | (img < lo))                          # strictly above / below every neighbour
     rc = np.argwhere(ext)
     strength = np.abs(img - mean)[ext]
     return rc, strength
@@ -261,6 +262,8 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
 
 def _bilinear(image: np.ndarray, xyz: np.ndarray, intr: Intrinsics) -> np.ndarray:
     """``image`` read bilinearly where camera points (n, 3) project."""
+    if len(xyz) == 0:
+        return np.zeros(0)
     u = intr.fx * xyz[:, 0] / xyz[:, 2] + intr.cx
     v = intr.fy * xyz[:, 1] / xyz[:, 2] + intr.cy
     return cv2.remap(image.astype(np.float32), u.astype(np.float32)[None], v.astype(np.float32)[None],
@@ -296,7 +299,7 @@ def learn_appearance(points: np.ndarray, normals: np.ndarray, grey: np.ndarray, 
     seen = np.zeros(len(xyz), bool)
     seen[r.index[r.index >= 0]] = True
     view = -xyz / np.linalg.norm(xyz, axis=1, keepdims=True)
-    seen &= ((np.asarray(normals) @ np.asarray(R, float).T) * view).sum(1) > min_facing
+    seen &= np.abs(((np.asarray(normals) @ np.asarray(R, float).T) * view).sum(1)) > min_facing   # either winding
     albedo = np.full(len(xyz), np.nan, np.float32)
     albedo[seen] = _bilinear(np.asarray(grey, np.float32), xyz[seen], intr)
     return albedo

@@ -46,6 +46,8 @@ class TrackerConfig:
     c : Geman–McClure scale — grey levels for ``eigen``; None = 0.5/N for ``colour-depth``
     c_depth_mm : depth scale c′ (mm); lam : λ, share of the depth term
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
+    pf_points : rank the particle filter's candidates on only the strongest ``pf_points`` template
+        points (LM then uses them all); None: all, as the paper
     motion : "velocity" — the kept candidates are first moved by the last frame's change of pose
         (constant velocity; worldtrack's addition); "none" — the paper's random walk
     smooth_px : Gaussian σ (pixels) applied to the input and to the drawn template alike
@@ -70,6 +72,7 @@ class TrackerConfig:
     camera_blur_px: float = 0.6
     shading_vectors: int = 9
     motion: str = "velocity"
+    pf_points: int | None = None
     seed: int = 0
 
 
@@ -189,8 +192,10 @@ class RigidTracker:
         if cost.size == 0:
             raise InputError("the model shows no textured point at the current pose (is it in view?)")
         eps = lambda X: cost.epsilon(self.space.transforms(X))
+        pf_cost = cost.subset(cfg.pf_points) if cfg.pf_points else cost
+        pf_eps = lambda X: pf_cost.epsilon(self.space.transforms(X))
         start = self.space.retract(self.kept, np.broadcast_to(self.velocity, (len(self.kept), 6)))
-        kept = coarse_to_fine(self.space, eps, start, self.sigma, cfg.stages, cfg.n_candidates, cfg.n_keep, self.rng)
+        kept = coarse_to_fine(self.space, pf_eps, start, self.sigma, cfg.stages, cfg.n_candidates, cfg.n_keep, self.rng)
         res = self._lm(cost, kept.states, cfg.lm_iterations)
         w = candidate_weights(res.cost)
         R, t = state_pose(res.states)
