@@ -47,7 +47,7 @@ class TrackerConfig:
     c_depth_mm : depth scale c′ (mm); lam : λ, share of the depth term
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
     pf_points : rank the particle filter's candidates on only the strongest ``pf_points`` template
-        points (LM then uses them all); None: all, as the paper
+        points (LM then uses them all; worldtrack's default 256, for speed); None: all, as the paper
     motion : "velocity" — the kept candidates are first moved by the last frame's change of pose
         (constant velocity; worldtrack's addition); "none" — the paper's random walk
     smooth_px : Gaussian σ (pixels) applied to the input and to the drawn template alike
@@ -72,7 +72,7 @@ class TrackerConfig:
     camera_blur_px: float = 0.6
     shading_vectors: int = 9
     motion: str = "velocity"
-    pf_points: int | None = None
+    pf_points: int | None = 256
     seed: int = 0
 
 
