@@ -208,7 +208,8 @@ class TemplatePixels(NamedTuple):
 
 def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics, n_colour: int,
                            n_depth: int = 0, radius: int = 1, sigma: float = 1.0,
-                           select_sigma: float = 0.5) -> TemplatePixels:
+                           select_sigma: float = 0.5, normals: np.ndarray | None = None,
+                           groups: np.ndarray | None = None) -> TemplatePixels:
     """The sparse template of a model drawn at one pose (§2.2, §4.3).
 
     Parameters
@@ -219,6 +220,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
         the input is) is a local max/min, strongest ``|I − local mean|`` first
     sigma, select_sigma : Gaussian σ (px) of the drawing the values are read from, and of the one
         whose extrema are picked
+    normals : (M, 3) camera-frame normals — points facing away are not drawn (back-face culling,
+        so a back surface cannot show through the gaps between a sparse model's points)
+    groups : (M,) int part of each point — then every part drawn gets an equal share of
+        ``n_colour`` and ``n_depth`` (a share a part cannot fill goes to the others)
     n_depth : this many points where the z-buffer depth is a local max/min, filled up on an even
         grid over the visible surface when there are fewer (planar faces have none)
 
@@ -227,6 +232,9 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     TemplatePixels
     """
     empty = TemplatePixels(np.zeros(0, int), np.zeros(0), np.zeros(0, int))
+    if normals is not None:
+        away = (np.asarray(normals) * xyz).sum(1) > 0
+        xyz = np.where(away[:, None], np.array([0.0, 0.0, -1.0]), xyz)    # behind the camera: not drawn
     z = xyz[:, 2]
     front = z > 1e-6
     if not front.any():
@@ -246,15 +254,24 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     # Extrema of the lightly smoothed drawing (more of them, N ≤ n_colour); values from the smoothed one.
     fine = smooth_valid(np.nan_to_num(raw), drawn & np.isfinite(raw), select_sigma) if select_sigma > 0 else raw
     rc, strength = local_extrema(np.nan_to_num(fine), known & np.isfinite(fine), radius)
-    rc = _strongest(rc, strength, n_colour) if len(rc) else rc
+    if groups is None:
+        rc = _strongest(rc, strength, n_colour) if len(rc) else rc
+    else:
+        rc = _by_group(rc, strength, groups[np.maximum(r.index[tuple(rc.T)], 0)], n_colour)
     colour = _nearest_point(r.index, drawn, rc)
     value = _bilinear(np.nan_to_num(intensity), xyz[np.maximum(colour, 0)], win[0])   # at the point's projection
     depth_idx = np.zeros(0, int)
     if n_depth > 0:
         inner = cv2.erode(drawn.astype(np.uint8), k, iterations=2, borderValue=0).astype(bool)
         rc_d, s_d = local_extrema(np.where(drawn, r.depth, 0), drawn, radius)
-        pick = _strongest(rc_d, s_d, n_depth)
-        pick = np.concatenate([pick, _grid_fill(inner, pick, n_depth - len(pick))]) if len(pick) < n_depth else pick
+        if groups is None:
+            pick = _strongest(rc_d, s_d, n_depth)
+            pick = np.concatenate([pick, _grid_fill(inner, pick, n_depth - len(pick))]) if len(pick) < n_depth else pick
+        else:
+            grid = _grid_fill(inner, rc_d, 4 * n_depth)
+            cand = np.concatenate([rc_d, grid])
+            score = np.concatenate([s_d + 1.0, np.zeros(len(grid))])          # extrema first, then the grid
+            pick = _by_group(cand, score, groups[np.maximum(r.index[tuple(cand.T)], 0)], n_depth)
         depth_idx = r.index[tuple(pick.T)] if len(pick) else depth_idx
     keep = colour >= 0
     return TemplatePixels(colour[keep], np.asarray(value, float)[keep], np.asarray(depth_idx, int))
@@ -268,6 +285,32 @@ def _bilinear(image: np.ndarray, xyz: np.ndarray, intr: Intrinsics) -> np.ndarra
     v = intr.fy * xyz[:, 1] / xyz[:, 2] + intr.cy
     return cv2.remap(image.astype(np.float32), u.astype(np.float32)[None], v.astype(np.float32)[None],
                      cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[0].astype(float)
+
+
+def _by_group(rc: np.ndarray, strength: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
+    """Up to ``n`` pixels, strongest first within each group, the groups sharing ``n`` equally."""
+    if len(rc) == 0:
+        return rc
+    order = np.argsort(-strength, kind="stable")
+    rc, group = rc[order], group[order]
+    names = np.unique(group)
+    rank = np.zeros(len(rc), int)
+    for g in names:
+        rank[group == g] = np.arange((group == g).sum())
+    counts = np.array([(group == g).sum() for g in names])
+    quota = np.zeros(len(names), int)
+    left = n
+    while left > 0 and (quota < counts).any():                      # water-filling: equal shares
+        open_ = quota < counts
+        share = max(left // open_.sum(), 1)
+        add = np.minimum(counts - quota, share) * open_
+        add = np.minimum(add, left - np.concatenate([[0], np.cumsum(add)[:-1]]).clip(0))
+        quota += add
+        left -= add.sum()
+        if add.sum() == 0:
+            break
+    q = quota[np.searchsorted(names, group)]
+    return rc[rank < q]
 
 
 def _nearest_point(index: np.ndarray, drawn: np.ndarray, rc: np.ndarray) -> np.ndarray:

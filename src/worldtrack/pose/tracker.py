@@ -154,7 +154,8 @@ class RigidTracker:
         albedo = self.model.albedo
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
         sigma = float(np.hypot(self.config.smooth_px, 0.0 if self.model.from_image else self.config.camera_blur_px))
-        return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma)
+        return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma,
+                                      normals=self.model.normals @ R.T)
 
     def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray, tp=None):
         """The cost object for a (smoothed) grey frame, with the template taken at ``state`` (or ``tp``)."""
