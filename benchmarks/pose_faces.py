@@ -129,6 +129,8 @@ def main() -> None:
     ap.add_argument("--faces", default="0-8")
     ap.add_argument("--frames", type=int, default=100)
     ap.add_argument("--motion", choices=("sim1", "sim2", "both"), default="both")
+    ap.add_argument("--methods", default=None, help="comma list, e.g. PF1LM0,PF1LM10 (default: the table's)")
+    ap.add_argument("--tag", default="", help="suffix of the results file name")
     ap.add_argument("--quick", action="store_true")
     a = ap.parse_args()
     rng = lambda s: (list(range(int(s.split("-")[0]), int(s.split("-")[1]) + 1)) if "-" in s
@@ -146,11 +148,13 @@ def main() -> None:
            f"Reference in this run: one MOG2 apply at 640×480 = {mog2:.1f} ms.\n"]
     summaries = {}
     if a.motion in ("sim1", "both"):
-        txt, summaries["sim1"] = table("sim1", ["PF1LM0", "PF3LM0", "PF1LM10", "PF3LM10", "PF1LM10+v", "KLT+PnP"], faces,
+        txt, summaries["sim1"] = table("sim1", a.methods.split(",") if a.methods else
+                                       ["PF1LM0", "PF3LM0", "PF1LM10", "PF3LM10", "PF1LM10+v", "KLT+PnP"], faces,
                                        sim1_seeds, n, PAPER_SIM1, PAPER_SIM1_MS)
         out += [f"## Table 3 — Simulation 1 (small motion), seeds {sim1_seeds}\n", txt, ""]
     if a.motion in ("sim2", "both"):
-        txt, summaries["sim2"] = table("sim2", ["PF1LM0", "PF1LM10", "PF1LM30", "PF1LM10+v", "KLT+PnP"], faces, seeds, n,
+        txt, summaries["sim2"] = table("sim2", a.methods.split(",") if a.methods else
+                                       ["PF1LM0", "PF1LM10", "PF1LM30", "PF1LM10+v", "KLT+PnP"], faces, seeds, n,
                                        PAPER_SIM2, PAPER_SIM2_MS)
         out += [f"## Table 4 — Simulation 2 (large motion), seeds {seeds}\n", txt, ""]
     lines = []
@@ -167,7 +171,7 @@ def main() -> None:
                     time.time() - t0)
     elif not a.quick:                                   # one table: its own file, the real command line
         args = " ".join(shlex.quote(x) for x in sys.argv[1:])
-        path = write_result(f"pose_faces_{a.motion}", "Seed 003: face pose tracking on synthetic faces",
+        path = write_result(f"pose_faces_{a.motion}{a.tag}", "Seed 003: face pose tracking on synthetic faces",
                             f"Command: `.venv/bin/python benchmarks/pose_faces.py {args}` ({time.time() - t0:.0f} s)"
                             f"\n\n{text}")
         print(f"wrote {path}", file=sys.stderr)
