@@ -57,3 +57,21 @@ def test_eigen_epsilon_kernel_matches_residuals():
     r = cost.residuals(T)
     vals, _ = project_sample(cost.images, INTR, T, tpl)
     np.testing.assert_allclose(_eigen_epsilon_kernel(vals[:, 0], cost.Q, cost.c), (r * r).sum(1), rtol=1e-9)
+
+
+def test_colour_depth_epsilon_kernel_matches_residuals():
+    from worldtrack.pose.cost import ColourDepthCost
+
+    rng = np.random.default_rng(4)
+    grey = rng.uniform(0, 255, (48, 64)).astype(np.float32)
+    depth = rng.uniform(0.5, 1.0, (48, 64)).astype(np.float32)
+    depth[:, :20] = 0                                                  # holes: ρ = 1
+    col = SparseTemplate(rng.normal(0, 0.05, (120, 3)), np.zeros(120, int), rng.uniform(50, 200, 120))
+    dep = SparseTemplate(rng.normal(0, 0.05, (80, 3)), np.zeros(80, int), np.zeros(80))
+    T = np.zeros((6, 1, 3, 4))
+    T[..., :3, :3] = np.eye(3)
+    T[..., 2, 3] = 0.5 + 0.1 * np.arange(6)[:, None]
+    for lam, d_img in ((0.9, depth), (0.3, depth), (0.5, None)):
+        cost = ColourDepthCost(col, dep, grey, d_img, INTR, lam=lam)
+        r = cost.residuals(T)
+        np.testing.assert_allclose(cost.epsilon(T), (r * r).sum(1), rtol=1e-9)

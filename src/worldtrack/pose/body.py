@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from worldtrack.geometry.rotation import euler_zyx, rot_y, rot_z
+from worldtrack.geometry.rotation import euler_zyx, rot_x, rot_y, rot_z
 from worldtrack.pose.models import PointModel
 
 PARTS = ("torso", "l_upper_arm", "l_forearm", "r_upper_arm", "r_forearm")
@@ -46,26 +46,50 @@ def arm_rest_rotations() -> np.ndarray:
     return np.stack([np.eye(3), rot_z(np.pi)])
 
 
+def rz_ry(theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """``Rz(θ)·Ry(φ)`` (K, 3, 3), written out (the joints of eqs. 14–15)."""
+    ct, st, cp, sp = np.cos(theta), np.sin(theta), np.cos(phi), np.sin(phi)
+    R = np.empty(np.shape(theta) + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 0, 2] = ct * cp, -st, ct * sp
+    R[..., 1, 0], R[..., 1, 1], R[..., 1, 2] = st * cp, ct, st * sp
+    R[..., 2, 0], R[..., 2, 1], R[..., 2, 2] = -sp, 0.0, cp
+    return R
+
+
 def body_transforms(p: np.ndarray, model: BodyModel) -> np.ndarray:
     """Part → camera transforms (K, 5, 3, 4) of parameter vectors ``p`` (K, 14) (eqs. 11–15)."""
     p = np.atleast_2d(np.asarray(p, float))
     K = len(p)
-    D = np.zeros((K, 5, 4, 4))
-    D[..., 3, 3] = 1.0
-    D[:, 0, :3, :3] = euler_zyx(p[:, 3], p[:, 4], p[:, 5])                 # eq. 13: Rz·Ry·Rx
-    D[:, 0, :3, 3] = p[:, :3]
+    out = np.empty((K, 5, 3, 4))
+    R0 = rz_ry(p[:, 3], p[:, 4]) @ rot_x(p[:, 5])                       # eq. 13: Rz·Ry·Rx
+    out[:, 0, :, :3], out[:, 0, :, 3] = R0, p[:, :3]
     for side, base in ((0, 6), (1, 10)):
-        DOU = np.zeros((K, 4, 4))
-        DOU[:, 3, 3] = 1.0
-        DOU[:, :3, :3] = model.rest[side] @ rot_z(p[:, base]) @ rot_y(p[:, base + 1])       # eq. 14
-        DOU[:, :3, 3] = model.shoulder[side]
-        DUL = np.zeros((K, 4, 4))
-        DUL[:, 3, 3] = 1.0
-        DUL[:, :3, :3] = rot_z(p[:, base + 2]) @ rot_y(p[:, base + 3])                      # eq. 15
-        DUL[:, :3, 3] = model.elbow[side]
-        D[:, 1 + 2 * side] = D[:, 0] @ DOU                                                  # eq. 11
-        D[:, 2 + 2 * side] = D[:, 0] @ DOU @ DUL                                            # eq. 12
-    return D[:, :, :3, :]
+        Rs = model.rest[side] @ rz_ry(p[:, base], p[:, base + 1])       # eq. 14: B·Rz·Ry
+        Re = rz_ry(p[:, base + 2], p[:, base + 3])                      # eq. 15: Rz·Ry
+        Ru = R0 @ Rs                                                    # eq. 11: D·D_OU
+        tu = (R0 @ model.shoulder[side]) + p[:, :3]
+        out[:, 1 + 2 * side, :, :3], out[:, 1 + 2 * side, :, 3] = Ru, tu
+        out[:, 2 + 2 * side, :, :3] = Ru @ Re                           # eq. 12: D·D_OU·D_UL
+        out[:, 2 + 2 * side, :, 3] = (Ru @ model.elbow[side]) + tu
+    return out
+
+
+def body_transforms_reference(p: np.ndarray, model: BodyModel) -> np.ndarray:
+    """:func:`body_transforms` as products of 4×4 matrices, one candidate at a time (for tests)."""
+    out = []
+    for q in np.atleast_2d(np.asarray(p, float)):
+        def D(R, t):
+            M = np.eye(4)
+            M[:3, :3], M[:3, 3] = R, t
+            return M
+        torso = D(euler_zyx(q[3], q[4], q[5]), q[:3])
+        parts = [torso]
+        for side, base in ((0, 6), (1, 10)):
+            DOU = D(model.rest[side] @ rot_z(q[base]) @ rot_y(q[base + 1]), model.shoulder[side])
+            DUL = D(rot_z(q[base + 2]) @ rot_y(q[base + 3]), model.elbow[side])
+            parts += [torso @ DOU, torso @ DOU @ DUL]
+        out.append(np.stack(parts)[:, :3, :])
+    return np.stack(out)
 
 
 def limb_axes(p: np.ndarray, model: BodyModel) -> dict[str, np.ndarray]:

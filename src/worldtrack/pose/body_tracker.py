@@ -103,6 +103,8 @@ class BodyTracker:
         self.sigma = self.space.increment_sigma(config.sigma_mm, config.sigma_deg)
         self.points, self.normals, self.albedo, self.part = stacked_points(model)
         self.local = self.points                                       # part-frame coordinates
+        ends = np.cumsum([0] + [len(m.points) for m in model.parts])
+        self.part_slices = [slice(a, b) for a, b in zip(ends[:-1], ends[1:])]
         self.from_image = bool(model.parts[0].from_image)
         self.rng = np.random.default_rng(config.seed)
         self.reset(p0)
@@ -113,9 +115,13 @@ class BodyTracker:
 
     def _camera_points(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Camera-frame points and normals (M, 3) of the whole body at ``p``."""
-        T = self.space.transforms(p[None])[0][self.part]
-        return ((T[:, :, :3] @ self.local[:, :, None])[:, :, 0] + T[:, :, 3],
-                (T[:, :, :3] @ self.normals[:, :, None])[:, :, 0])
+        T = self.space.transforms(p[None])[0]
+        xyz, nrm = np.empty_like(self.local), np.empty_like(self.normals)
+        for k in range(len(T)):
+            sel = self.part_slices[k]
+            xyz[sel] = self.local[sel] @ T[k, :, :3].T + T[k, :, 3]
+            nrm[sel] = self.normals[sel] @ T[k, :, :3].T
+        return xyz, nrm
 
     def make_cost(self, grey: np.ndarray, depth: np.ndarray | None) -> ColourDepthCost:
         cfg = self.config

@@ -125,6 +125,46 @@ def _eigen_epsilon_kernel(V, Q, c):  # pragma: no cover - compiled
     return eps
 
 
+@njit(cache=True)
+def _colour_depth_epsilon_kernel(vals, I, alpha, c, zhat, z, c_depth, lam):  # pragma: no cover - compiled
+    # ε_k = (1 − λ)·Σ ρ_c(β_k Î − α I) + λ·Σ ρ_c′(Ẑ − Z) (eqs. 16–18), an unread point counting ρ = 1:
+    # ColourDepthCost.residuals summed, without the (K, N) temporaries.
+    K, N = vals.shape
+    eps = np.zeros(K)
+    c2, cd2 = c * c, c_depth * c_depth
+    for k in range(K):
+        num = 0.0
+        den = 0.0
+        miss = 0
+        for i in range(N):
+            x = vals[k, i]
+            if np.isnan(x):
+                miss += 1
+            else:
+                num += I[i] * I[i]
+                den += I[i] * x
+        beta = alpha * num / max(den, 1e-9)
+        total = float(miss)
+        for i in range(N):
+            x = vals[k, i]
+            if not np.isnan(x):
+                d = beta * x - alpha * I[i]
+                total += d * d / (c2 + d * d)
+        e = (1.0 - lam) * total
+        if zhat.shape[0] > 0:
+            td = 0.0
+            for i in range(zhat.shape[1]):
+                x = zhat[k, i]
+                if np.isnan(x):
+                    td += 1.0
+                else:
+                    d = x - z[k, i]
+                    td += d * d / (cd2 + d * d)
+            e += lam * td
+        eps[k] = e
+    return eps
+
+
 def project_sample(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template: SparseTemplate,
                    mode: int = BILINEAR) -> tuple[np.ndarray, np.ndarray]:
     """Project template points under K candidate poses and read the images there.
@@ -286,9 +326,15 @@ class ColourDepthCost:
         return np.concatenate([r, rd], 1)
 
     def epsilon(self, T: np.ndarray) -> np.ndarray:
-        """(K,) ε = (1 − λ)·ε_C + λ·ε_D (eq. 18)."""
-        r = self.residuals(T)
-        return (r * r).sum(1)
+        """(K,) ε = (1 − λ)·ε_C + λ·ε_D (eq. 18), compiled (equal to ``(residuals(T)**2).sum(1)``)."""
+        vals, _ = project_sample(self.images, self.intr, T, self.colour)
+        if self.depth is None:
+            zhat, z = np.zeros((0, 0), np.float32), np.zeros((0, 0))
+        else:
+            zhat, z = project_sample(self.depth_image, self.intr, T, self.depth, NEAREST_POSITIVE)
+            zhat = zhat[:, 0]
+        return _colour_depth_epsilon_kernel(vals[:, 0], np.asarray(self.colour.value, float), self.alpha, self.c,
+                                            zhat, z, self.c_depth, self.lam)
 
     def subset(self, n: int) -> "ColourDepthCost":
         """The same cost on the first ``n`` colour and depth points (strongest extrema first)."""
