@@ -106,3 +106,37 @@ def test_bad_init_and_camera(face_dir, tmp_path, capsys):
     err = _error(capsys, ["pose", "track", "--model", "face", "--rgb", str(root / "rgb"), "--camera", str(wrong),
                           "--init", str(root / "init.txt"), "--out", str(tmp_path / "o")])
     assert "640x480" in err and "320x240" in err
+
+
+def test_pose_track_upper_body(tmp_path, capsys):
+    from worldtrack.pose.body import limb_axes
+    from worldtrack.pose import axis_angle_deg
+    from worldtrack.synth.upper_body import body_sequence
+
+    seq = body_sequence(3, n_frames=4, size=(640, 480))
+    (tmp_path / "rgb").mkdir()
+    (tmp_path / "depth").mkdir()
+    frames = [seq.render(k) for k in range(4)]
+    for k, f in enumerate(frames):
+        cv2.imwrite(str(tmp_path / "rgb" / f"{k:03d}.png"), f.image)
+        cv2.imwrite(str(tmp_path / "depth" / f"{k:03d}.png"), np.round(f.depth * 1000).astype(np.uint16))
+    i = seq.intr
+    (tmp_path / "K.yaml").write_text(f"K: [[{i.fx}, 0, {i.cx}], [0, {i.fy}, {i.cy}], [0, 0, 1]]\n")
+    p0 = frames[0].params
+    init = ",".join(f"{v:.6f}" for v in np.r_[p0[:3], np.degrees(p0[3:])])
+    base = ["pose", "track", "--model", "upper-body", "--rgb", str(tmp_path / "rgb"), "--camera",
+            str(tmp_path / "K.yaml"), "--out", str(tmp_path / "out"), "--quiet", "--candidates", "300"]
+    err = _error(capsys, base + ["--init", init])
+    assert "needs --depth" in err
+    assert main(base + ["--init", init, "--depth", str(tmp_path / "depth")]) == 0
+    with open(tmp_path / "out" / "pose.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 4 and "r_elbow_ry_deg" in rows[0]
+    last = rows[-1]
+    p = np.array([float(last[k]) for k in list(last)[3:17]])
+    p[3:] = np.radians(p[3:])
+    est, true = limb_axes(p[None], seq.true_model), frames[-1].axes
+    errs = {n: float(axis_angle_deg(true[n], est[n][0])) for n in true}
+    assert max(errs.values()) < 6.0, errs
+    behind = ",".join(["0", "0", "-2"] + ["0"] * 11)
+    assert "behind the camera" in _error(capsys, base + ["--init", behind, "--depth", str(tmp_path / "depth")])

@@ -4,9 +4,11 @@
         --camera K.yaml --init POSE --out DIR
 
 Writes ``DIR/pose.csv`` (one row per frame, flushed as it goes: the pose of the model in the
-camera frame — translation in metres, quaternion, ZYX angles in degrees — the synthetic
-ground truth's columns, plus the per-frame cost), ``DIR/annotated.mp4`` (model outline and axes)
-and ``DIR/cost.png``.
+camera frame — translation in metres, quaternion, ZYX angles in degrees; for upper-body the 14
+parameters — the synthetic ground truth's columns, plus the per-frame cost), ``DIR/annotated.mp4``
+(model outline and axes) and ``DIR/cost.png``. A face uses the built-in face model and its
+eigen-template (RGB); an OBJ mesh and the upper body (default proportions) learn their appearance
+from the first frame at ``--init`` and use colour and, with ``--depth``, depth.
 """
 
 from __future__ import annotations
@@ -45,11 +47,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="intrinsics: YAML/JSON with K (3x3) or fx, fy, cx, cy (or ViSP's px, py, u0, v0)")
     t.add_argument("--init", required=True, metavar="POSE",
                    help="pose at the first frame: a file holding a 4x4 object-to-camera matrix (metres), or "
-                        "'x,y,z,rx,ry,rz' (metres; rotation vector in degrees)")
+                        "'x,y,z,rx,ry,rz' (metres; rotation vector in degrees); for upper-body 14 numbers: "
+                        "torso tx,ty,tz (m), torso rz,ry,rx, then left shoulder, left elbow, right shoulder, "
+                        "right elbow rz,ry (degrees)")
     t.add_argument("--out", default="pose_out", metavar="DIR", help="output folder (default pose_out)")
     t.add_argument("--stages", type=int, default=1, help="coarse-to-fine particle-filter stages (PFx, default 1)")
-    t.add_argument("--lm-iterations", type=int, default=10, help="LM iterations per frame (LMx, default 10)")
-    t.add_argument("--candidates", type=int, default=1000, help="candidates per stage (default 1000)")
+    t.add_argument("--lm-iterations", type=int, default=None,
+                   help="LM iterations per frame (LMx, default 10; 15 for upper-body)")
+    t.add_argument("--candidates", type=int, default=None,
+                   help="candidates per stage (default 1000; 1500 for upper-body)")
     t.add_argument("--face-identity", type=int, default=0, help="built-in face model to use with --model face")
     t.add_argument("--lam", type=float, default=0.9, help="share of the depth term (λ, default 0.9)")
     t.add_argument("--fps", type=float, default=30.0, help="frame rate for time stamps (default 30)")
@@ -148,9 +154,6 @@ def _model(args) -> tuple[PointModel, str]:
     if args.model == "face":
         from worldtrack.synth.faces import face_model, make_face
         return face_model(make_face(args.face_identity)), "eigen"
-    if args.model == "upper-body":
-        raise InputError("--model upper-body: the 14-DoF body is tracked by benchmarks/pose_body.py; "
-                         "the command line tracks rigid models (face or an OBJ mesh)")
     return load_obj(args.model), "colour-depth"
 
 
@@ -168,7 +171,6 @@ def run(args: argparse.Namespace) -> int:
     if depths is not None and len(depths) != len(colour):
         raise InputError(f"--depth {args.depth}: {len(depths)} depth frames for {len(colour)} colour frames")
     cam = read_camera(args.camera)
-    R0, t0 = read_pose(args.init)
     first = cv2.imread(str(colour[0]), cv2.IMREAD_COLOR)
     if first is None:
         raise InputError(f"{colour[0]}: cannot read the image")
@@ -182,16 +184,73 @@ def run(args: argparse.Namespace) -> int:
         if d0.shape != (h, w):
             raise InputError(f"{depths[0]}: depth is {d0.shape[1]}x{d0.shape[0]} but the colour frame "
                              f"{colour[0].name} is {w}x{h}")
+    if args.model == "upper-body":
+        return _run_body(args, colour, depths, first, intr)
+    R0, t0 = read_pose(args.init)
     model, cost = _model(args)
     z = (model.points @ R0.T + t0)[:, 2]
     if z.min() <= 0.01:
         raise InputError(f"--init: the pose puts the model behind the camera (nearest point at z = {z.min():.3f} m)")
     if cost == "colour-depth":
         model = _learn(args, model, first, intr, R0, t0)
-    config = TrackerConfig(stages=args.stages, lm_iterations=args.lm_iterations, n_candidates=args.candidates,
-                           lam=args.lam, seed=args.seed)
+    config = TrackerConfig(stages=args.stages, lm_iterations=10 if args.lm_iterations is None else args.lm_iterations,
+                           n_candidates=1000 if args.candidates is None else args.candidates, lam=args.lam, seed=args.seed)
     tracker = RigidTracker(model, intr, R0, t0, config, cost=cost)
-    return _track(args, colour, depths, tracker, intr, model, (R0, t0), (w, h))
+    return _track_rigid(args, colour, depths, tracker, intr, model, (R0, t0), (w, h))
+
+
+BODY_COLUMNS = (["frame", "time", "id", "torso_tx", "torso_ty", "torso_tz", "torso_rz_deg", "torso_ry_deg",
+                 "torso_rx_deg"] + [f"{s}_{j}_{a}_deg" for s in "lr" for j in ("shoulder", "elbow") for a in ("rz", "ry")]
+                + ["cost", "n_template"])
+
+
+def read_body_pose(text: str) -> np.ndarray:
+    """14 parameters from ``tx,ty,tz`` (m) and 11 angles (degrees), given inline or in a file."""
+    raw = Path(text).read_text() if Path(text).is_file() else text
+    try:
+        v = np.array([float(x) for x in raw.replace(",", " ").split()])
+    except ValueError:
+        v = np.zeros(0)
+    if v.size != 14 or not np.isfinite(v).all():
+        raise InputError(f"--init {text!r}: for upper-body expected 14 numbers: tx,ty,tz (m), torso rz,ry,rx, "
+                         "left shoulder rz,ry, left elbow rz,ry, right shoulder rz,ry, right elbow rz,ry (degrees)")
+    return np.r_[v[:3], np.radians(v[3:])]
+
+
+def _run_body(args, colour, depths, first, intr: Intrinsics) -> int:
+    """``--model upper-body``: the 14-DoF tracker, a default body shape, appearance from frame 0."""
+    from worldtrack.pose.body import body_geometry, body_transforms, model_points_camera, with_part_albedo
+    from worldtrack.pose.body_tracker import BodyConfig, BodyTracker
+    from worldtrack.viz.pose_overlay import draw_pose
+
+    if depths is None:
+        raise InputError("--model upper-body needs --depth (the body is tracked with colour and depth)")
+    p0 = read_body_pose(args.init)
+    shape = body_geometry(0.003)
+    xyz = model_points_camera(p0, shape)
+    if xyz[:, 2].min() <= 0.01:
+        raise InputError(f"--init: the pose puts the model behind the camera (nearest point at z = {xyz[:, 2].min():.3f} m)")
+    T = body_transforms(p0[None], shape)[0]
+    normals = np.concatenate([m.normals @ T[k, :, :3].T for k, m in enumerate(shape.parts)])
+    model = with_part_albedo(shape, learn_appearance(xyz, normals, to_grey(first), intr, np.eye(3), np.zeros(3)))
+    config = BodyConfig(stages=args.stages, lm_iterations=15 if args.lm_iterations is None else args.lm_iterations,
+                        n_candidates=1500 if args.candidates is None else args.candidates, lam=args.lam, seed=args.seed)
+    tracker = BodyTracker(model, intr, p0, config)
+
+    def step(image, depth):
+        est = tracker.step(image, depth)
+        return est.params, est.cost, est.n_template
+
+    def row(k, p, c, n):
+        vals = [k, round(k / args.fps, 6), 1, *np.round(p[:3], 6), *np.round(np.degrees(p[3:]), 5)]
+        return vals + ["" if not math.isfinite(c) else round(c, 6), n]
+
+    def draw(image, p, label):
+        out = draw_pose(image, model_points_camera(p, model), np.eye(3), np.zeros(3), intr, 0.0)
+        T0 = body_transforms(p[None], model)[0, 0]
+        return draw_pose(out, np.zeros((0, 3)), T0[:, :3], T0[:, 3], intr, 0.15, label=label)
+
+    return _loop(args, colour, depths, (intr.width, intr.height), BODY_COLUMNS, p0, step, row, draw)
 
 
 def _row(k: int, fps: float, R: np.ndarray, t: np.ndarray, cost: float, n: int) -> list:
@@ -205,12 +264,13 @@ def _row(k: int, fps: float, R: np.ndarray, t: np.ndarray, cost: float, n: int) 
     return vals + ["" if not math.isfinite(cost) else round(cost, 6), n]
 
 
-def _track(args, colour: list[Path], depths, tracker: RigidTracker, intr: Intrinsics, model: PointModel,
-           pose0: tuple, size: tuple) -> int:
+def _loop(args, colour: list[Path], depths, size: tuple, columns: list[str], pose0, step, row, draw) -> int:
+    """Read the frames, call ``step(image, depth) → (pose, cost, n)`` from frame 1 on, write
+    ``row(k, pose, cost, n)`` to pose.csv (flushed per frame) and ``draw(image, pose, label)`` to
+    the video; the outputs written so far stay valid when a frame is bad or on Ctrl-C."""
     from tqdm import tqdm
 
     from worldtrack.io.video import VideoWriter
-    from worldtrack.viz.pose_overlay import draw_pose
 
     out = Path(args.out)
     try:
@@ -221,7 +281,7 @@ def _track(args, colour: list[Path], depths, tracker: RigidTracker, intr: Intrin
     costs = []
     with open(out / "pose.csv", "w", newline="") as f:
         writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(COLUMNS)
+        writer.writerow(columns)
         try:
             for k, path in enumerate(tqdm(colour, desc="pose", unit="frame", disable=args.quiet)):
                 image = cv2.imread(str(path), cv2.IMREAD_COLOR)
@@ -234,23 +294,30 @@ def _track(args, colour: list[Path], depths, tracker: RigidTracker, intr: Intrin
                 if depth is not None and depth.shape != image.shape[:2]:
                     raise InputError(f"{depths[k]}: depth is {depth.shape[1]}x{depth.shape[0]} but the colour "
                                      f"frame {path.name} is {image.shape[1]}x{image.shape[0]}")
-                if k == 0:
-                    R, t, c, n = *pose0, float("nan"), 0
-                else:
-                    est = tracker.step(image, depth)
-                    R, t, c, n = est.R, est.t, est.cost, est.n_template
+                pose, c, n = (pose0, float("nan"), 0) if k == 0 else step(image, depth)
                 costs.append(c)
-                writer.writerow(_row(k, args.fps, R, t, c, n))
+                writer.writerow(row(k, pose, c, n))
                 f.flush()
                 if video is not None:
-                    video.write(draw_pose(image, model.points, R, t, intr, model.radius * 0.8,
-                                          label=f"frame {k}  cost {c:.3f}"))
+                    video.write(draw(image, pose, f"frame {k}  cost {c:.3f}"))
         finally:
             if video is not None:
                 video.close()
             _cost_plot(out / "cost.png", costs, args.fps)
     print(f"wrote {out / 'pose.csv'} ({len(costs)} frames)" + ("" if video is None else f", {out / 'annotated.mp4'}"))
     return 0
+
+
+def _track_rigid(args, colour, depths, tracker: RigidTracker, intr: Intrinsics, model: PointModel, pose0, size) -> int:
+    from worldtrack.viz.pose_overlay import draw_pose
+
+    def step(image, depth):
+        est = tracker.step(image, depth)
+        return (est.R, est.t), est.cost, est.n_template
+
+    return _loop(args, colour, depths, size, COLUMNS, pose0, step,
+                 lambda k, pose, c, n: _row(k, args.fps, *pose, c, n),
+                 lambda image, pose, label: draw_pose(image, model.points, *pose, intr, model.radius * 0.8, label=label))
 
 
 def _cost_plot(path: Path, costs: list[float], fps: float) -> None:
