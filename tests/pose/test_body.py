@@ -52,3 +52,13 @@ def test_tracks_a_synthetic_upper_body():
     errs = np.array(errs)
     assert errs.mean() < 3.0 and errs.max() < 8.0, errs
     assert abs(est.params[2] - frames[-1].params[2]) < 0.02
+
+
+def test_elbow_limit_keeps_the_forearm_off_the_upper_arm():
+    from worldtrack.pose.body import BodySpace
+
+    space = BodySpace(model=body_geometry(0.05), elbow_limit=np.radians(150))
+    X = np.zeros((1, 14))
+    out = space.retract(X, np.r_[[0] * 8, np.radians(170), 0, 0, 0, np.radians(-200), np.radians(30)][None])
+    np.testing.assert_allclose(np.degrees(out[0, [8, 12, 13]]), [150, -150, 30])
+    assert BodySpace(model=body_geometry(0.05)).retract(X, np.full((1, 14), 4.0))[0, 8] == 4.0   # no limit

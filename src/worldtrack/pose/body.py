@@ -28,6 +28,7 @@ PARTS = ("torso", "l_upper_arm", "l_forearm", "r_upper_arm", "r_forearm")
 LIMBS = {"r_upper_arm": 3, "l_upper_arm": 1, "r_forearm": 4, "l_forearm": 2}     # the paper's table order
 N_PARAMS = 14
 TORSO, LEFT_ARM, RIGHT_ARM = slice(0, 6), slice(6, 10), slice(10, 14)
+ELBOWS = [8, 9, 12, 13]
 
 
 class BodyModel(NamedTuple):
@@ -101,16 +102,22 @@ def limb_axes(p: np.ndarray, model: BodyModel) -> dict[str, np.ndarray]:
 @dataclass
 class BodySpace:
     """The 14-DoF pose space: increments are added (translation in units of ``length`` metres,
-    angles in radians). ``active`` limits the increment to some parameters (the cascade)."""
+    angles in radians). ``elbow_limit`` (rad): a joint limit on both elbow angles — an elbow cannot
+    fold the forearm back onto the upper arm (worldtrack's addition; None: no limit)."""
 
     length: float = 0.3
     fd_step: np.ndarray = field(default_factory=lambda: np.array([2e-3] * 3 + [2e-3] * 11))
     model: BodyModel | None = None
+    elbow_limit: float | None = None
     dim: int = N_PARAMS
 
     def retract(self, X: np.ndarray, delta: np.ndarray) -> np.ndarray:
+        """``X + δ`` (translation in ``length`` units), elbows kept within ±``elbow_limit`` rad."""
         scale = np.r_[[self.length] * 3, [1.0] * 11]
-        return np.asarray(X, float) + np.asarray(delta, float) * scale
+        out = np.asarray(X, float) + np.asarray(delta, float) * scale
+        if self.elbow_limit is not None:
+            out[..., ELBOWS] = np.clip(out[..., ELBOWS], -self.elbow_limit, self.elbow_limit)
+        return out
 
     def transforms(self, X: np.ndarray) -> np.ndarray:
         return body_transforms(X, self.model)

@@ -56,6 +56,7 @@ class BodyConfig:
     smooth_px: float = 1.0
     camera_blur_px: float = 0.6
     pf: str = "cascade"
+    elbow_limit_deg: float | None = 150.0
     seed: int = 0
 
 
@@ -99,7 +100,8 @@ class BodyTracker:
 
     def __init__(self, model: BodyModel, intr: Intrinsics, p0: np.ndarray, config: BodyConfig = BodyConfig()):
         self.model, self.intr, self.config = model, intr, config
-        self.space = BodySpace(model=model)
+        self.space = BodySpace(model=model, elbow_limit=None if config.elbow_limit_deg is None
+                               else np.radians(config.elbow_limit_deg))
         self.sigma = self.space.increment_sigma(config.sigma_mm, config.sigma_deg)
         self.points, self.normals, self.albedo, self.part = stacked_points(model)
         self.local = self.points                                       # part-frame coordinates
