@@ -28,7 +28,7 @@ def rotation_error_deg(R_true: np.ndarray, R_est: np.ndarray) -> np.ndarray:
 def axis_angle_deg(a_true: np.ndarray, a_est: np.ndarray) -> np.ndarray:
     """Angle (degrees) between axes (..., 3) (need not be unit length).
 
-    >>> float(axis_angle_deg(np.array([1.0, 0, 0]), np.array([1.0, 1.0, 0])))
+    >>> round(float(axis_angle_deg(np.array([1.0, 0, 0]), np.array([1.0, 1.0, 0]))), 9)
     45.0
     """
     a, b = np.asarray(a_true, float), np.asarray(a_est, float)
