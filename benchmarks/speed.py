@@ -59,7 +59,7 @@ from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # 
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 from worldtrack.trackers.ellipsoid_score import ternary_real  # noqa: E402
-from worldtrack.trackers.particle_likelihood import hit_image, hit_labels  # noqa: E402
+from worldtrack.foreground.shadows import hit_image, hit_labels  # noqa: E402
 
 SEED = 0
 SIZES = ((160, 120), (640, 480))
