@@ -43,7 +43,7 @@ from worldtrack.foreground.background import StaticBackground  # noqa: E402
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box  # noqa: E402
-from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
+from worldtrack.trackers.particle.likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
                                                      floor_pixels, hit_image, hit_labels, hit_labels_reference,
                                                      owner_image, top_edge_offsets)
 

@@ -24,10 +24,10 @@ from worldtrack.trackers.base import Frame
 from worldtrack.scene import scene_from_dict
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box, image_boxes
-from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, hit_image,
+from worldtrack.trackers.particle.likelihood import (CameraLikelihood, column_counts_reference, hit_image,
                                                      occluder_layers, owner_image, point_values_reference,
                                                      hit_labels, thresholded_difference)
-from worldtrack.trackers.particle_sampling import (FloorRegion, _lookup, _valley, _valley_reference, bimodal_split,
+from worldtrack.trackers.particle.sampling import (FloorRegion, _lookup, _valley, _valley_reference, bimodal_split,
                                                    polygon_distance, splittable, stratified_resample,
                                                    systematic_resample)
 
@@ -773,7 +773,7 @@ def test_tracks_csv_gets_the_object_region_columns(tmp_path):
 
 
 def test_shadow_kernel_agrees_with_reference():
-    from worldtrack.trackers.particle_likelihood import hit_labels_reference
+    from worldtrack.trackers.particle.likelihood import hit_labels_reference
     rng = np.random.default_rng(3)
     bg = texture(1)
     img = np.clip(bg * rng.uniform(0.4, 1.1, (H, W, 1)) + rng.normal(0, 6, (H, W, 3)), 0, 255).astype(np.uint8)

@@ -12,13 +12,13 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_particle import CAM, COLOURS, FLOOR, make_scene, render, run, tracker_for  # noqa: E402
 
-from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
+from worldtrack.trackers.particle.appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
                                                      SAT_BINS, ColourModel, colour_bins, colour_bins_compiled,
                                                      colour_bins_reference, colour_log_ratio, column_bins,
                                                      column_bins_reference, column_penalties)
 from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
-from worldtrack.trackers.particle_likelihood import CameraLikelihood  # noqa: E402
+from worldtrack.trackers.particle.likelihood import CameraLikelihood  # noqa: E402
 
 
 def bgr(*colours) -> np.ndarray:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference, occluder_layers,
+from worldtrack.trackers.particle.likelihood import (CameraLikelihood, column_counts_reference, occluder_layers,
                                                      owner_image)
 
 from test_particle import CAM, H, W, make_scene

@@ -10,11 +10,11 @@ import cv2
 import pytest
 import numpy as np
 
-from worldtrack.trackers.particle_likelihood import (CameraLikelihood, add_camera, add_camera_reference,
+from worldtrack.trackers.particle.likelihood import (CameraLikelihood, add_camera, add_camera_reference,
                                                      column_counts_reference, occluder_layers,
                                                      occluder_layers_reference, owner_image, read_codes,
                                                      read_codes_reference, top_edge_terms_reference)
-from worldtrack.trackers.particle_sampling import raster_contains
+from worldtrack.trackers.particle.sampling import raster_contains
 
 from test_particle import CAM, H, W, make_scene
 
@@ -133,7 +133,7 @@ def test_raster_contains_agrees_with_walkable_raster():
 def test_bimodal_split_with_splittables_principal_is_the_same():
     """The split check reuses the principal axes that ``splittable`` computed for all clouds at once:
     the same sides (and the same None) as computing them for each cloud alone."""
-    from worldtrack.trackers.particle_sampling import bimodal_split, splittable
+    from worldtrack.trackers.particle.sampling import bimodal_split, splittable
 
     rng = np.random.default_rng(6)
     clouds = []
@@ -159,7 +159,7 @@ def test_bimodal_split_with_splittables_principal_is_the_same():
 def test_resampling_kernel_agrees_with_reference():
     """Systematic and stratified resampling (cumulative weights, normalised, points merged in one
     kernel) draw the NumPy lookup's indices: ties, zero weights and a row with one weight included."""
-    from worldtrack.trackers.particle_sampling import _draw_rows, resample_reference, stratified_resample, systematic_resample
+    from worldtrack.trackers.particle.sampling import _draw_rows, resample_reference, stratified_resample, systematic_resample
 
     rng = np.random.default_rng(7)
     for trial in range(30):
@@ -181,7 +181,7 @@ def test_resampling_kernel_agrees_with_reference():
 
 
 def test_take_rows_agrees_with_take_along_axis():
-    from worldtrack.trackers.particle_sampling import take_rows
+    from worldtrack.trackers.particle.sampling import take_rows
 
     rng = np.random.default_rng(8)
     idx = rng.integers(0, 50, (4, 70))
@@ -197,7 +197,7 @@ def test_columns_beside_and_boxes_apart_agree_with_numpy():
     """Where a filter learns its colours: the columns beside its centre (kernel against floor_rays),
     and which boxes overlap no other (integers against _overlaps)."""
     from worldtrack.trackers.particle import _overlaps
-    from worldtrack.trackers.particle_likelihood import boxes_apart, columns_beside_reference
+    from worldtrack.trackers.particle.likelihood import boxes_apart, columns_beside_reference
 
     cam = make_scene().cameras["cam"]
     cl = CameraLikelihood(cam)
@@ -224,7 +224,7 @@ def test_columns_beside_and_boxes_apart_agree_with_numpy():
 
 
 def test_colour_learning_kernel_agrees_with_numpy():
-    from worldtrack.trackers.particle_appearance import MIN_LEARN_SAMPLES, N_BINS, ColourModel
+    from worldtrack.trackers.particle.appearance import MIN_LEARN_SAMPLES, N_BINS, ColourModel
 
     rng = np.random.default_rng(10)
     fast, slow = ColourModel(), ColourModel()
@@ -242,7 +242,7 @@ def test_colour_learning_kernel_agrees_with_numpy():
 
 
 def test_order_statistic_agrees_with_partition():
-    from worldtrack.trackers.particle_sampling import order_statistic
+    from worldtrack.trackers.particle.sampling import order_statistic
 
     rng = np.random.default_rng(11)
     for f, n, top in ((1, 1, 3), (4, 500, 27), (3, 37, 5), (2, 9, 5000)):      # 5000: the partition fallback
@@ -259,7 +259,7 @@ def test_boxes_on_one_object_agrees_with_reference():
     """The merge's test of two filters on one object (boxes overlapping by ``merge_overlap`` in
     every camera that sees both), integers against the NumPy ratios of _overlaps."""
     from worldtrack.trackers.particle import _overlaps
-    from worldtrack.trackers.particle_likelihood import boxes_on_one_object, boxes_on_one_object_reference
+    from worldtrack.trackers.particle.likelihood import boxes_on_one_object, boxes_on_one_object_reference
 
     rng = np.random.default_rng(12)
     found = 0
@@ -283,7 +283,7 @@ def test_boxes_on_one_object_agrees_with_reference():
 def test_owner_image_agrees_with_reference_and_reused_equals_fresh():
     """The owner image (a kernel over the boxes, Python's slice rules, saturating at 255) against the
     box-by-box NumPy code, fresh and reusing the last image."""
-    from worldtrack.trackers.particle_likelihood import owner_image_reference
+    from worldtrack.trackers.particle.likelihood import owner_image_reference
 
     rng = np.random.default_rng(13)
     buf, previous = None, ()
@@ -307,7 +307,7 @@ def test_owner_image_agrees_with_reference_and_reused_equals_fresh():
 
 def test_split_sides_kernel_agrees_with_reference():
     """The end of bimodal_split (valley, sides, each side's mass) in one kernel, against NumPy."""
-    from worldtrack.trackers.particle_sampling import _sides, _sides_reference
+    from worldtrack.trackers.particle.sampling import _sides, _sides_reference
 
     rng = np.random.default_rng(14)
     found = 0
@@ -341,7 +341,7 @@ def test_kernels_read_the_floor_columns_of_xyz():
 def test_gather_particles_and_principal_agree_with_numpy():
     """The resampled particles gathered in one kernel (heights drawn below the column tops) equal
     take_rows and the NumPy product; the covariance tail of _principal equals its NumPy code."""
-    from worldtrack.trackers.particle_sampling import _principal, _principal_reference, gather_particles, take_rows
+    from worldtrack.trackers.particle.sampling import _principal, _principal_reference, gather_particles, take_rows
 
     rng = np.random.default_rng(16)
     f, m, n = 5, 300, 280
@@ -364,7 +364,7 @@ def test_gather_particles_and_principal_agree_with_numpy():
     np.testing.assert_array_equal(c, c_ref)
     for a, b in zip(stats, stats_ref):
         np.testing.assert_array_equal(a, b)
-    from worldtrack.trackers.particle_sampling import _wide_enough, splittable
+    from worldtrack.trackers.particle.sampling import _wide_enough, splittable
     wide = splittable(xy, 0.35, 0.2)
     np.testing.assert_array_equal(wide, _wide_enough(stats_ref[3], 0.35, 0.2))
     assert wide.sum() == 6 and not wide[3]
@@ -374,7 +374,7 @@ def test_particle_weights_agree_with_numpy_bit_for_bit():
     """Eq. 8's weights from the kernel's max and exponents against weights_reference: equal bit for bit
     for rows of filters and for one filter's row, a row of zero likelihood (-inf everywhere) weighs 1
     throughout and is resampled uniformly, and so does a row with a NaN (np.max's NaN is not finite)."""
-    from worldtrack.trackers.particle_sampling import particle_weights, systematic_resample, weights_reference
+    from worldtrack.trackers.particle.sampling import particle_weights, systematic_resample, weights_reference
 
     rng = np.random.default_rng(17)
     logpi = rng.normal(0, 20, (4, 300))
@@ -396,7 +396,7 @@ def test_particle_weights_agree_with_numpy_bit_for_bit():
 
 def test_region_sizes_and_row_means_agree_with_numpy():
     from worldtrack.trackers.particle import _mean_rows
-    from worldtrack.trackers.particle_sampling import region_sizes, region_sizes_reference
+    from worldtrack.trackers.particle.sampling import region_sizes, region_sizes_reference
 
     rng = np.random.default_rng(18)
     sd = rng.uniform(0, 0.5, (9, 3))
@@ -418,8 +418,8 @@ def test_observe_column_equals_the_calls_one_by_one(offset):
     """One camera's share of the column likelihood in one compiled call (near surface, column kernel,
     colour penalties, sums) equals near_surface, CameraLikelihood.column, column_penalties and
     add_camera one after the other; with and without a colour image, and close_sums its NumPy code."""
-    from worldtrack.trackers.particle_appearance import ColourModel, N_BINS, column_penalties, observe_column
-    from worldtrack.trackers.particle_sampling import close_sums, close_sums_reference
+    from worldtrack.trackers.particle.appearance import ColourModel, N_BINS, column_penalties, observe_column
+    from worldtrack.trackers.particle.sampling import close_sums, close_sums_reference
 
     scene = make_scene()
     cam = scene.cameras["cam"]
@@ -463,7 +463,7 @@ def test_observe_column_equals_the_calls_one_by_one(offset):
 
 
 def test_predict_walk_is_prediction_then_height_walk():
-    from worldtrack.trackers.particle_sampling import predict_state_reference, predict_walk, reflect_reference
+    from worldtrack.trackers.particle.sampling import predict_state_reference, predict_walk, reflect_reference
 
     rng = np.random.default_rng(20)
     f, n = 3, 400
@@ -487,7 +487,7 @@ def test_raster_blocks_answer_as_the_cells_do():
     """A walkable raster with holes and a ragged edge: with its blocks of all-walkable cells the
     look-up answers as WalkableRaster.contains, for points everywhere (and NaN)."""
     from worldtrack.scene.floor import WalkableRaster
-    from worldtrack.trackers.particle_sampling import close_sums, close_sums_reference, raster_blocks
+    from worldtrack.trackers.particle.sampling import close_sums, close_sums_reference, raster_blocks
 
     rng = np.random.default_rng(21)
     inside = np.ones((250, 333), dtype=bool)
@@ -546,8 +546,8 @@ def test_learn_columns_equals_the_calls_one_by_one():
     """Colour learning in one compiled call: the same models (histograms, frames) as box_array,
     boxes_apart, beside, column_bins and ColourModel.learn one after the other; filters whose boxes
     overlap another's, or that are not learners, are not taught."""
-    from worldtrack.trackers.particle_appearance import ColourModel, N_BINS, column_bins, learn_columns
-    from worldtrack.trackers.particle_likelihood import boxes_apart
+    from worldtrack.trackers.particle.appearance import ColourModel, N_BINS, column_bins, learn_columns
+    from worldtrack.trackers.particle.likelihood import boxes_apart
 
     cam = make_scene().cameras["cam"]
     cl = CameraLikelihood(cam)
@@ -599,7 +599,7 @@ def test_bimodal_split_width_test_is_wide_enough():
     IEEE operations of _wide_enough): a two-lump cloud is split with its own variance, and is one
     object with a variance below the limit or NaN."""
     import math
-    from worldtrack.trackers.particle_sampling import _principal, _wide_enough, bimodal_split
+    from worldtrack.trackers.particle.sampling import _principal, _wide_enough, bimodal_split
 
     rng = np.random.default_rng(25)
     xy = rng.normal(0, 0.05, (500, 2))
@@ -614,7 +614,7 @@ def test_bimodal_split_width_test_is_wide_enough():
 
 
 def test_inverse_lengths_agree_with_numpy():
-    from worldtrack.trackers.particle_sampling import inverse_lengths, inverse_lengths_reference
+    from worldtrack.trackers.particle.sampling import inverse_lengths, inverse_lengths_reference
 
     rng = np.random.default_rng(26)
     uv = rng.normal(300, 80, (2, 200, 2))

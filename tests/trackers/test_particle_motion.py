@@ -89,7 +89,7 @@ def test_prediction_kernel_equals_numpy_reference():
     """The compiled prediction (``velocity="state"``: the velocity walk, then ``x + a·noise + v·dt``)
     gives the NumPy code's values bit for bit, clipped speeds, stopped walks (scale 0) and the
     vertical component included."""
-    from worldtrack.trackers.particle_sampling import predict_state, predict_state_reference
+    from worldtrack.trackers.particle.sampling import predict_state, predict_state_reference
 
     rng = np.random.default_rng(3)
     for f, n in ((1, 7), (6, 500)):
@@ -111,7 +111,7 @@ def test_prediction_kernel_equals_numpy_reference():
 def test_height_walk_kernel_equals_numpy_reflection():
     """The heights' random walk folded into [lo, hi] (np.mod's sign rules, values far outside and
     on the ends included) is the NumPy expression's, bit for bit."""
-    from worldtrack.trackers.particle_sampling import jitter_reflect, reflect_reference
+    from worldtrack.trackers.particle.sampling import jitter_reflect, reflect_reference
 
     rng = np.random.default_rng(4)
     h, a = rng.uniform(-5, 8, (7, 1000)), rng.normal(0, 3, (7, 1000))

@@ -13,7 +13,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import colour_distance
 from worldtrack.trackers.particle import ParticleConfig
-from worldtrack.trackers.particle_likelihood import CameraLikelihood, column_counts_reference, hit_image
+from worldtrack.trackers.particle.likelihood import CameraLikelihood, column_counts_reference, hit_image
 
 from test_particle import CAM, HEIGHT, H, W, make_scene, render, tracker_for
 

@@ -9,7 +9,7 @@ One particle filter per object, in world coordinates (metres, Z up). Every frame
    with ``v`` each particle's own velocity state (default, ``velocity="state"``: constant
    velocity, walking by ``noise_v``, which stops while the filter's columns are mostly hidden),
    each particle's own ``(x_{t−1} − x_{t−2}) / dt`` (the paper) or the object's;
-2. **observes** the likelihood π_i of each particle (:mod:`~worldtrack.trackers.particle_likelihood`:
+2. **observes** the likelihood π_i of each particle (:mod:`~worldtrack.trackers.particle.likelihood`:
    the height column of eq. 11 or the point of eq. 7, multiplied over the cameras that see the
    particle; 0 off the walkable floor or out of every view) and weights ``g_i = π_i / Σ π`` (eq. 8);
 3. **resamples** in proportion to the weights (systematic, see :class:`ParticleConfig`);
@@ -91,12 +91,12 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track, TrackerBase
-from worldtrack.trackers.particle_config import ParticleConfig
-from worldtrack.trackers.particle_appearance import ColourModel, column_penalties, learn_columns, observe_column
-from worldtrack.trackers.particle_likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_on_one_object,
+from worldtrack.trackers.particle.config import ParticleConfig
+from worldtrack.trackers.particle.appearance import ColourModel, column_penalties, learn_columns, observe_column
+from worldtrack.trackers.particle.likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_on_one_object,
                                                      floor_pixels, hit_image, hit_labels, occluder_layers, owner_image,
                                                      thresholded_difference, top_edge_offsets)
-from worldtrack.trackers.particle_sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
+from worldtrack.trackers.particle.sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
                                                    gather_particles, inverse_lengths, jitter_reflect, order_statistic,
                                                    polygon_distance, predict_walk, raster_blocks, raster_contains,
                                                    particle_weights, region_sizes, resampler, splittable,
@@ -489,7 +489,7 @@ class ParticleTracker(TrackerBase):
             rather than background
         colours : {camera_id: ColourModel}, optional — the object's learnt colours: each particle
             adds ``appearance_weight`` times the colour log-ratio of its colour column (see
-            :mod:`~worldtrack.trackers.particle_appearance`)
+            :mod:`~worldtrack.trackers.particle.appearance`)
         which : (N,) int, optional — each particle's filter, 0 … F − 1, for the particles of F
             filters: then ``boxes`` maps each camera to a sequence of F boxes (or None), ``me`` is a
             sequence of F indices and ``colours`` a sequence of F mappings (or None), one per filter
@@ -1015,11 +1015,11 @@ class ParticleTracker(TrackerBase):
     def _two_objects(self, xy: np.ndarray, principal: tuple | None = None) -> np.ndarray | None:
         """Which side of a two-lump cloud each particle is on, or None for one object.
 
-        Two lumps (:func:`~worldtrack.trackers.particle_sampling.bimodal_split`) are two objects only
+        Two lumps (:func:`~worldtrack.trackers.particle.sampling.bimodal_split`) are two objects only
         if the cameras can tell them apart: their image boxes must overlap less than
         ``merge_overlap`` in some camera that sees both (lumps one behind the other on a single
         camera's line of sight are the depth ambiguity of one object, not two objects). ``principal``:
-        the cloud's row of :func:`~worldtrack.trackers.particle_sampling.splittable`'s, if at hand.
+        the cloud's row of :func:`~worldtrack.trackers.particle.sampling.splittable`'s, if at hand.
         """
         cfg = self.config
         side = bimodal_split(xy, cfg.split_distance, cfg.split_dip, cfg.split_min_mass, principal=principal)
@@ -1036,7 +1036,7 @@ class ParticleTracker(TrackerBase):
     # ------------------------------------------------------------------ split and merge
     def _split(self, t: float) -> None:
         """:meth:`_maybe_split` every tracking filter; the cheap first test of the two-lump check
-        (:func:`~worldtrack.trackers.particle_sampling.splittable`) for all of them at once."""
+        (:func:`~worldtrack.trackers.particle.sampling.splittable`) for all of them at once."""
         cfg = self.config
         fs = list(self.filters)
         if fs:
@@ -1047,7 +1047,7 @@ class ParticleTracker(TrackerBase):
 
     def _maybe_split(self, f: _Filter, t: float, wide: bool = True, principal: tuple | None = None) -> None:
         """Split a filter whose particles have been two lumps for ``split_frames`` frames (``wide``
-        False: its cloud failed :func:`~worldtrack.trackers.particle_sampling.splittable`, one lump;
+        False: its cloud failed :func:`~worldtrack.trackers.particle.sampling.splittable`, one lump;
         ``principal``: its cloud's row of splittable's, if at hand)."""
         cfg = self.config
         side = self._two_objects(f.xyz[:, :2], principal) if wide else None
@@ -1126,7 +1126,7 @@ def image_boxes(camera: Camera, xy: np.ndarray, widths: np.ndarray, heights: np.
     farther along the line of sight together.
 
     Written plainly with :meth:`Camera.project`; the tracker uses the Numba kernel of the same,
-    :meth:`CameraLikelihood.boxes <worldtrack.trackers.particle_likelihood.CameraLikelihood.boxes>`
+    :meth:`CameraLikelihood.boxes <worldtrack.trackers.particle.likelihood.CameraLikelihood.boxes>`
     (~8× faster for a few objects; the tests check that they agree).
     """
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
@@ -1205,7 +1205,7 @@ _NO_WIDTHS = np.zeros(0)
 
 
 def _mean_sd(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~worldtrack.trackers.particle_sampling.cloud_mean` and the standard deviation over the particles of each filter, two (F, C)."""
+    """:func:`~worldtrack.trackers.particle.sampling.cloud_mean` and the standard deviation over the particles of each filter, two (F, C)."""
     mean = cloud_mean(x)
     d = x - mean[:, None, :]
     return mean, np.sqrt(cloud_mean(d * d))

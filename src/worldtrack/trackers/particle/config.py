@@ -14,8 +14,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.trackers.particle_likelihood import column_heights
-from worldtrack.trackers.particle_sampling import RESAMPLERS
+from worldtrack.trackers.particle.likelihood import column_heights
+from worldtrack.trackers.particle.sampling import RESAMPLERS
 
 LIKELIHOODS = ("column", "point")
 WEIGHTINGS = ("ratio", "count")
@@ -211,7 +211,7 @@ class ParticleConfig:
     shadows : {"background", "unknown", "object"}
         How cast shadows read. A pixel whose background is the walkable floor, that looks like it
         darkened without a change of colour and through which the floor's texture still shows
-        (:func:`~worldtrack.trackers.particle_likelihood.hit_labels`; needs a foreground model with
+        (:func:`~worldtrack.trackers.particle.likelihood.hit_labels`; needs a foreground model with
         a background image) is a shadow: ``background`` (default) — a shadow on the floor otherwise
         looks like a taller object standing on it and pulls the estimate towards the camera by up
         to its length; ``unknown`` — no evidence either way (a column that stands in its object's
@@ -272,7 +272,7 @@ class ParticleConfig:
         object pixels on its column in frames where its image box overlaps no other track's (a
         running average with weight ``appearance_rate``, 0.1), and a particle's log-likelihood
         loses ``appearance_weight`` (1.0) times the log-ratio of every column colour its object
-        rarely shows (:mod:`~worldtrack.trackers.particle_appearance`). It keeps a filter from
+        rarely shows (:mod:`~worldtrack.trackers.particle.appearance`). It keeps a filter from
         going on with another person when two cross in one camera's image: on the entry scenario
         tracks per person 2.0 → 1.73, IDF1 0.59 → 0.68, mean error 0.144 → 0.132 m. 0 = off (the
         paper preset).

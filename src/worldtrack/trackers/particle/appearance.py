@@ -26,8 +26,8 @@ import cv2
 import numpy as np
 from numba import njit
 
-from ..geometry.camera import Camera
-from .particle_likelihood import (CameraLikelihood, _lens, add_camera, _pixels, _to_pixel, box_pixels, boxes_apart,
+from worldtrack.geometry.camera import Camera
+from .likelihood import (CameraLikelihood, _lens, add_camera, _pixels, _to_pixel, box_pixels, boxes_apart,
                                   column_counts, column_points, columns_beside, toward_camera)
 
 HUE_BINS = 12
@@ -208,10 +208,10 @@ def observe_column(cl: CameraLikelihood, xy: np.ndarray, offset: float, column_a
                    logpi: np.ndarray, likely: np.ndarray, n_seen: np.ndarray, col: np.ndarray,
                    hidden: np.ndarray) -> None:
     """One camera's share of the tracker's column likelihood (``weighting="ratio"``) in one compiled
-    call, added in place (as :func:`~worldtrack.trackers.particle_likelihood.add_camera` adds it):
+    call, added in place (as :func:`~worldtrack.trackers.particle.likelihood.add_camera` adds it):
     the columns ``offset`` m nearer to the camera than the particles ``xy`` (N, ≥ 2)
-    (:func:`~worldtrack.trackers.particle_likelihood.toward_camera`), their
-    :func:`~worldtrack.trackers.particle_likelihood.column_counts` (``column_args`` from
+    (:func:`~worldtrack.trackers.particle.likelihood.toward_camera`), their
+    :func:`~worldtrack.trackers.particle.likelihood.column_counts` (``column_args`` from
     :meth:`CameraLikelihood.column_args`; its best ratio and top), with ``image`` the colour term
     ``weight ·`` :func:`column_penalties` under ``models`` (per filter), and ``hidden`` (N,) out.
     The same values as those calls one by one (tested)."""
@@ -274,11 +274,11 @@ def learn_columns(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, cent
                   heights: np.ndarray, learners: np.ndarray, margin: float, offset: float,
                   models: Sequence["ColourModel | None"], rate: float) -> np.ndarray:
     """What the tracker's colour learning does in one camera, in one compiled call: the objects'
-    boxes (``margin`` m, :func:`~worldtrack.trackers.particle_likelihood.box_pixels`), which of the
+    boxes (``margin`` m, :func:`~worldtrack.trackers.particle.likelihood.box_pixels`), which of the
     ``learners`` (F,) bool have a box overlapping no other
-    (:func:`~worldtrack.trackers.particle_likelihood.boxes_apart`), and for those the
+    (:func:`~worldtrack.trackers.particle.likelihood.boxes_apart`), and for those the
     :func:`column_bins` of the column ``offset`` m nearer the camera than ``centres`` (F, 2) and the two
-    ``widths/4`` beside it (:func:`~worldtrack.trackers.particle_likelihood.columns_beside`), blended
+    ``widths/4`` beside it (:func:`~worldtrack.trackers.particle.likelihood.columns_beside`), blended
     into ``models`` (F, None where a filter has none yet) as :meth:`ColourModel.learn` blends them.
 
     Returns (F,) bool, the filters that were taught (whether or not they had enough object samples to
