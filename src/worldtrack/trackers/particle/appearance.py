@@ -18,17 +18,21 @@ Colours: hue × saturation bins for saturated pixels (hue means little on greys)
 the unsaturated ones, so black trousers and a white shirt are told apart too.
 """
 
+
 from __future__ import annotations
 
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import cv2
 import numpy as np
 from numba import njit
 
+from worldtrack.geometry._kernels import lens
 from worldtrack.geometry.camera import Camera
-from .likelihood import (CameraLikelihood, _lens, add_camera, _pixels, _to_pixel, box_pixels, boxes_apart,
-                                  column_counts, column_points, columns_beside, toward_camera)
+from worldtrack.trackers.particle.likelihood.boxes import box_pixels, boxes_apart
+from worldtrack.trackers.particle.likelihood.camera import CameraLikelihood, columns_beside
+from worldtrack.trackers.particle.likelihood.column import column_points, pixels
+from worldtrack.trackers.particle.likelihood.reading import pixel_of
 
 HUE_BINS = 12
 SAT_BINS = 3          # saturated pixels only: saturation ≥ GREY_SATURATION
@@ -119,6 +123,47 @@ def colour_bins_compiled(image: np.ndarray) -> np.ndarray:
     return out
 
 
+class ColourArgs(NamedTuple):
+    """What the colour kernels read of a frame: the labels ``hit`` (H, W) uint8 (1 = object), the BGR
+    ``image`` (H, W, 3) uint8, the colour samples' ``heights`` (S,) float64 metres, and per filter its
+    penalty ``tables`` (F, N_BINS) and whether it has ``learnt`` (F,) bool anything."""
+
+    hit: np.ndarray
+    image: np.ndarray
+    heights: np.ndarray
+    tables: np.ndarray
+    learnt: np.ndarray
+
+
+class Objects(NamedTuple):
+    """Tracked objects for colour learning: ``centres`` (F, 2), ``widths``, ``heights`` (F,) float64
+    metres, and which are ``learners`` (F,) bool."""
+
+    centres: np.ndarray
+    widths: np.ndarray
+    heights: np.ndarray
+    learners: np.ndarray
+
+
+class Learning(NamedTuple):
+    """The models being taught: ``hists`` (F, N_BINS), ``has_hist`` (F,) bool, the blend ``rate`` and
+    the least number of object samples ``min_samples`` a frame needs to teach anything."""
+
+    hists: np.ndarray
+    has_hist: np.ndarray
+    rate: float
+    min_samples: int
+
+
+class Taught(NamedTuple):
+    """:func:`learn_columns`' kernel outputs: ``chosen`` (F,) bool, ``status`` (F,) int64 (1 learnt,
+    0 too few samples, −1 a bin out of range) and the new ``hists`` (F, N_BINS)."""
+
+    chosen: np.ndarray
+    status: np.ndarray
+    hists: np.ndarray
+
+
 def column_bins(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
                 heights: np.ndarray = COLOUR_HEIGHTS) -> np.ndarray:
     """Colour bins along columns standing at ``xy``, where they read object.
@@ -143,19 +188,19 @@ def column_bins(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, xy: np
     """
     xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
     out = np.empty((len(xy), len(heights)), dtype=np.int16)
-    _column_bins(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.R, cl.t, cl.K, cl.dist, cl.has_dist,
-                 hit, np.ascontiguousarray(image, dtype=np.uint8), out)
+    _column_bins(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.args, hit,
+                 np.ascontiguousarray(image, dtype=np.uint8), out)
     return out
 
 
 @njit(cache=True)
-def _column_bins(xy, heights, R, t, K, dist, has_dist, hit, image, out):
+def _column_bins(xy, heights, camera, hit, image, out):
     """``out`` (N, S), in place: each column sample's :func:`pixel_bin` where it reads object, else −1."""
     H, W = hit.shape
-    lens = _lens(K, dist)
+    lens_ = lens(camera.K, camera.dist)
     for i in range(xy.shape[0]):
         for k in range(heights.shape[0]):
-            iu, iv = _to_pixel(xy[i, 0], xy[i, 1], heights[k], R, t, lens, has_dist, W, H)
+            iu, iv = pixel_of(xy[i, 0], xy[i, 1], heights[k], camera, lens_, W, H)
             if iu >= 0 and hit[iv, iu] == 1:
                 out[i, k] = pixel_bin(image[iv, iu, 0], image[iv, iu, 1], image[iv, iu, 2])
             else:
@@ -179,95 +224,29 @@ def column_penalties(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, x
     xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
     out = np.zeros(len(xy))
     if learnt.any():
-        _column_penalties(xy, np.ascontiguousarray(heights, dtype=np.float64), cl.R, cl.t, cl.K, cl.dist,
-                          cl.has_dist, hit, np.ascontiguousarray(image, dtype=np.uint8), tables, learnt,
-                          np.ascontiguousarray(which, dtype=np.int64), out)
+        colour = ColourArgs(hit, np.ascontiguousarray(image, dtype=np.uint8),
+                            np.ascontiguousarray(heights, dtype=np.float64), tables, learnt)
+        _column_penalties(xy, cl.args, colour, np.ascontiguousarray(which, dtype=np.int64), out)
     return out
 
 
 @njit(cache=True)
-def _column_penalties(xy, heights, R, t, K, dist, has_dist, hit, image, tables, learnt, which, out):
+def _column_penalties(xy, camera, colour, which, out):
     """``out[i]``, in place: ``Σ_k tables[which[i], bin]`` over the samples of column i that read
     object, in sample order (as :func:`_table_sums`), for the particles of learnt models."""
+    hit, image, heights, tables, learnt = colour.hit, colour.image, colour.heights, colour.tables, colour.learnt
     H, W = hit.shape
-    lens = _lens(K, dist)
+    lens_ = lens(camera.K, camera.dist)
     for i in range(xy.shape[0]):
         f = which[i]
         if not learnt[f]:
             continue
         s = 0.0
         for k in range(heights.shape[0]):
-            iu, iv = _to_pixel(xy[i, 0], xy[i, 1], heights[k], R, t, lens, has_dist, W, H)
+            iu, iv = pixel_of(xy[i, 0], xy[i, 1], heights[k], camera, lens_, W, H)
             if iu >= 0 and hit[iv, iu] == 1:
                 s += tables[f, pixel_bin(image[iv, iu, 0], image[iv, iu, 1], image[iv, iu, 2])]
         out[i] = s
-
-
-def observe_column(cl: CameraLikelihood, xy: np.ndarray, offset: float, column_args: tuple, hit: np.ndarray,
-                   image: np.ndarray | None, models: Sequence["ColourModel | None"], weight: float, likely_count: int,
-                   logpi: np.ndarray, likely: np.ndarray, n_seen: np.ndarray, col: np.ndarray,
-                   hidden: np.ndarray) -> None:
-    """One camera's share of the tracker's column likelihood (``weighting="ratio"``) in one compiled
-    call, added in place (as :func:`~worldtrack.trackers.particle.likelihood.add_camera` adds it):
-    the columns ``offset`` m nearer to the camera than the particles ``xy`` (N, ≥ 2)
-    (:func:`~worldtrack.trackers.particle.likelihood.toward_camera`), their
-    :func:`~worldtrack.trackers.particle.likelihood.column_counts` (``column_args`` from
-    :meth:`CameraLikelihood.column_args`; its best ratio and top), with ``image`` the colour term
-    ``weight ·`` :func:`column_penalties` under ``models`` (per filter), and ``hidden`` (N,) out.
-    The same values as those calls one by one (tested)."""
-    n = len(xy)
-    if image is None:
-        tables, learnt, image = _NO_TABLES, np.zeros(0, dtype=np.bool_), _NO_IMAGE
-    else:
-        tables, learnt = penalty_tables(models)
-    _observe_column(xy, float(offset), cl.centre, cl.floor_direction, *column_args, hit,
-                    np.ascontiguousarray(image, dtype=np.uint8), COLOUR_HEIGHTS, tables, learnt, float(weight),
-                    int(likely_count), logpi, likely, n_seen, col, hidden, *_work_arrays(cl, n))
-
-
-def _work_arrays(cl: CameraLikelihood, n: int) -> tuple[np.ndarray, ...]:
-    """Work arrays of :func:`_observe_column` for ``n`` particles (surface, counts, ratio, top, seen,
-    penalty), kept in the camera's ``cl.work`` between calls (the last few sizes): all are written
-    before they are read, the penalty set to 0 here."""
-    key = ("observe_column", n)
-    out = cl.work.get(key)
-    if out is None:
-        if len(cl.work) > 8:
-            cl.work.clear()
-        out = cl.work[key] = (np.empty((n, 2)), np.empty(n, dtype=np.int32), np.empty(n),
-                              np.empty(n, dtype=np.int32), np.empty(n, dtype=np.bool_), np.empty(n))
-    out[5][:] = 0.0
-    return out
-
-
-_NO_TABLES = np.zeros((0, N_BINS))
-_NO_IMAGE = np.zeros((0, 0, 3), dtype=np.uint8)
-
-
-@njit(cache=True)
-def _observe_column(xy, offset, centre, floor_direction, heights, R, t, K, dist, has_dist, radius, codes, boxes, which,
-                    pairs, depths, mes, cam_centre, margin, on, off, below, n_below, n_above, k_min, tops, top_sigma,
-                    px_scale, outside_unknown, k_lo, hit, image, colour_heights, tables, learnt, weight, likely_count,
-                    logpi, likely, n_seen, col, hidden, surface, counts, ratio, top, seen, penalty):
-    if offset > 0.0:
-        toward_camera(xy, offset, centre, floor_direction, surface)
-    else:
-        for i in range(xy.shape[0]):
-            surface[i, 0], surface[i, 1] = xy[i, 0], xy[i, 1]
-    column_counts(surface, heights, R, t, K, dist, has_dist, radius, codes, boxes, which, pairs, depths, mes,
-                  cam_centre, margin, on, off, below, n_below, n_above, k_min, tops, top_sigma, px_scale,
-                  outside_unknown, k_lo, counts, ratio, top, seen, hidden)
-    colour = image.shape[0] > 0
-    if colour:
-        any_learnt = False
-        for f in range(learnt.shape[0]):
-            any_learnt = any_learnt or learnt[f]
-        if any_learnt:
-            _column_penalties(surface, colour_heights, R, t, K, dist, has_dist, hit, image, tables, learnt, which,
-                              penalty)
-    # lv = the best ratio (+ weight · penalty), col_h = its top's height, ok = counts ≥ likely_count
-    add_camera(seen, ratio, penalty if colour else penalty[:0], weight, heights[top], counts >= likely_count,
-               logpi, likely, n_seen, col)
 
 
 def learn_columns(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, centres: np.ndarray, widths: np.ndarray,
@@ -290,41 +269,39 @@ def learn_columns(cl: CameraLikelihood, image: np.ndarray, hit: np.ndarray, cent
     for i, m in enumerate(models):
         if m is not None and m.hist is not None:
             hists[i], has_hist[i] = m.hist, True
-    chosen = np.empty(f, dtype=np.bool_)
-    status = np.zeros(f, dtype=np.int64)
-    out = np.empty((f, N_BINS))
-    _learn_columns(np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 2),
-                   np.ascontiguousarray(widths, dtype=np.float64), np.ascontiguousarray(heights, dtype=np.float64),
-                   np.ascontiguousarray(learners, dtype=np.bool_), float(margin), float(offset), cl.R, cl.t, cl.K,
-                   cl.dist, cl.has_dist, cl.centre, cl.floor_direction, cl.camera.width, cl.camera.height, hit,
-                   np.ascontiguousarray(image, dtype=np.uint8), COLOUR_HEIGHTS, hists, has_hist, float(rate),
-                   MIN_LEARN_SAMPLES, chosen, status, out)
-    for i in np.flatnonzero(status).tolist():
-        if status[i] < 0:
+    out = Taught(np.empty(f, dtype=np.bool_), np.zeros(f, dtype=np.int64), np.empty((f, N_BINS)))
+    objects = Objects(np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 2),
+                      np.ascontiguousarray(widths, dtype=np.float64), np.ascontiguousarray(heights, dtype=np.float64),
+                      np.ascontiguousarray(learners, dtype=np.bool_))
+    _learn_columns(objects, float(margin), float(offset), cl.args, hit, np.ascontiguousarray(image, dtype=np.uint8),
+                   COLOUR_HEIGHTS, Learning(hists, has_hist, float(rate), MIN_LEARN_SAMPLES), out)
+    for i in np.flatnonzero(out.status).tolist():
+        if out.status[i] < 0:
             raise ValueError(f"learn_columns: colour bins must be below {N_BINS}")
-        models[i]._learnt(out[i])
-    return chosen
+        models[i]._learnt(out.hists[i])
+    return out.chosen
 
 
 @njit(cache=True)
-def _learn_columns(centres, widths, heights, learners, margin, offset, R, t, K, dist, has_dist, centre, floor_direction,
-                   W, H, hit, image, colour_heights, hists, has_hist, rate, min_samples, chosen, status, out):
+def _learn_columns(objects, margin, offset, camera, hit, image, colour_heights, learning, out):
+    centres, widths, heights, learners = objects.centres, objects.widths, objects.heights, objects.learners
+    hists, has_hist = learning.hists, learning.has_hist
     f = centres.shape[0]
     boxes = np.empty((f, 4), dtype=np.int64)
-    box_pixels(centres, widths, heights, margin, 0.0, R, t, K, dist, has_dist, centre, floor_direction, W, H, boxes)
+    box_pixels(centres, widths, heights, margin, 0.0, camera, boxes)
     apart = boxes_apart(boxes)
     spread = np.empty(1)
     columns = np.empty((3, 2))
     bins = np.empty((3, colour_heights.shape[0]), dtype=np.int16)
     for i in range(f):
-        chosen[i] = learners[i] and apart[i]
-        if not chosen[i]:
+        out.chosen[i] = learners[i] and apart[i]
+        if not out.chosen[i]:
             continue
         spread[0] = 0.25 * widths[i]
-        columns_beside(centres[i:i + 1], offset, spread, centre, floor_direction, columns)
-        _column_bins(columns, colour_heights, R, t, K, dist, has_dist, hit, image, bins)
-        status[i] = _blend_histogram(bins.reshape(bins.size), hists[i] if has_hist[i] else hists[i, :0], rate,
-                                     min_samples, out[i])
+        columns_beside(centres[i:i + 1], offset, spread, camera, columns)
+        _column_bins(columns, colour_heights, camera, hit, image, bins)
+        out.status[i] = _blend_histogram(bins.reshape(bins.size), hists[i] if has_hist[i] else hists[i, :0],
+                                         learning.rate, learning.min_samples, out.hists[i])
 
 
 def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy: np.ndarray,
@@ -332,7 +309,7 @@ def column_bins_reference(camera: Camera, image: np.ndarray, hit: np.ndarray, xy
     """:func:`column_bins` written plainly: the whole frame's bins, every sample through
     :meth:`Camera.project`."""
     bins = colour_bins_reference(image)
-    iu, iv, inside = _pixels(camera, column_points(xy, heights))
+    iu, iv, inside = pixels(camera, column_points(xy, heights))
     on = inside & (hit[iv, iu] == 1)
     return np.where(on, bins[iv, iu].astype(np.int16), np.int16(-1))
 
@@ -448,3 +425,8 @@ def _table_sums(tables, bins, which, out):
             if bins[i, k] >= 0:
                 s += tables[which[i], bins[i, k]]
         out[i] = s
+
+
+__all__ = ["COLOUR_HEIGHTS", "N_BINS", "ColourArgs", "ColourModel", "colour_bins", "colour_bins_compiled",
+           "colour_bins_reference", "colour_log_ratio", "column_bins", "column_bins_reference", "column_penalties",
+           "learn_columns", "penalty_tables", "pixel_bin"]

@@ -14,8 +14,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.trackers.particle.likelihood import column_heights
-from worldtrack.trackers.particle.sampling import RESAMPLERS
+from worldtrack.trackers.particle.likelihood.column import column_heights
+from worldtrack.trackers.particle.resample import RESAMPLERS
 
 LIKELIHOODS = ("column", "point")
 WEIGHTINGS = ("ratio", "count")

@@ -78,7 +78,6 @@ Example
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
@@ -88,21 +87,22 @@ from scipy.spatial import cKDTree
 from scipy.spatial.distance import cdist
 
 from worldtrack.errors import InputError
-from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import PositionMap, Track, TrackerBase
+from worldtrack.foreground.shadows import floor_pixels, hit_image, hit_labels, thresholded_difference
+from worldtrack.trackers.particle.appearance import ColourModel, column_penalties, learn_columns
+from worldtrack.trackers.particle.likelihood.boxes import Box, boxes_on_one_object, image_box, image_boxes, overlap
 from worldtrack.trackers.particle.config import ParticleConfig
-from worldtrack.trackers.particle.appearance import ColourModel, column_penalties, learn_columns, observe_column
-from worldtrack.trackers.particle.likelihood import (F_MAX, CameraLikelihood, add_camera, boxes_on_one_object,
-                                                     floor_pixels, hit_image, hit_labels, occluder_layers, owner_image,
-                                                     thresholded_difference, top_edge_offsets)
-from worldtrack.trackers.particle.sampling import (FloorRegion, bimodal_split, close_sums, cloud_mean,
-                                                   gather_particles, inverse_lengths, jitter_reflect, order_statistic,
-                                                   polygon_distance, predict_walk, raster_blocks, raster_contains,
-                                                   particle_weights, region_sizes, resampler, splittable,
-                                                   take_rows)
-
-Box = tuple[int, int, int, int]
+from worldtrack.trackers.particle.floor import FloorRegion, polygon_distance, raster_blocks, raster_contains
+from worldtrack.trackers.particle.likelihood import (F_MAX, CameraLikelihood, ReadAs, Sums, add_camera, close_sums,
+                                                     column_spec, edge_spec, occluder_layers, owner_image,
+                                                     top_edge_offsets)
+from worldtrack.trackers.particle.likelihood.fused import observe_column
+from worldtrack.trackers.particle.likelihood.hidden import inverse_lengths, order_statistic, quantile_rank
+from worldtrack.trackers.particle.motion import HeightWalk, jitter_reflect, predict_walk
+from worldtrack.trackers.particle.region import cloud_mean, region_sizes
+from worldtrack.trackers.particle.resample import Particles, gather_particles, particle_weights, resampler, take_rows
+from worldtrack.trackers.particle.split import bimodal_split, splittable
 
 #: The per-particle arrays of a :class:`_Filter`, all indexed alike: the state (``xyz, v, h``) and
 #: this frame's observation (``logpi, likely, col_h``).
@@ -230,8 +230,10 @@ class ParticleTracker(TrackerBase):
                           for cid, cl in self._cams.items()}
         self._top_sigma = cfg.top_sigma if cfg.weighting == "ratio" and cfg.likelihood == "column" else 0.0
         # Top-edge samples about each particle's own height: below it on the object, above it over it.
-        self._edge_offsets = (top_edge_offsets(cfg.top_edge_step, cfg.top_edge_samples)
-                              if self._top_sigma > 0 and cfg.top_edge > 0 else None)
+        self._edge = (edge_spec(top_edge_offsets(cfg.top_edge_step, cfg.top_edge_samples), cfg.top_edge, self._on,
+                                self._off) if self._top_sigma > 0 and cfg.top_edge > 0 else None)
+        self._column_spec = column_spec(self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
+                                        self._n_below, self._n_above, self._top_sigma, cfg.out_of_view == "unknown")
         self._resample = resampler(cfg.resampling)
         self._walkable_raster = scene.walkable.raster(0.01)
         self._walkable_blocks = raster_blocks(self._walkable_raster)
@@ -524,45 +526,36 @@ class ParticleTracker(TrackerBase):
             me, colours = [me], [colours]
         if colours is None:
             colours = [None] * len(me)
-        logpi = np.zeros(n)
-        n_seen = np.zeros(n, dtype=np.int32)
-        likely = np.ones(n, dtype=bool)
-        col = np.zeros(n)
+        sums = Sums.start(n)
+        logpi, likely, n_seen, col = sums
         S = len(self.heights)
+        spec = self._column_spec if h is not None else self._column_spec._replace(top_sigma=0.0)
         with np.errstate(divide="ignore"):
             for cid, img in images.items():
                 cl = self._cams[cid]
                 owner = owners.get(cid) if owners is not None else None
                 box = boxes.get(cid) if boxes is not None else [None] * len(me)
+                read = ReadAs(owner, box, me, which, occluders.get(cid) if occluders is not None else None,
+                              cfg.occlusion_margin, self._px_scale[cid] if px_scale is None else px_scale[cid],
+                              k_lo[cid] if k_lo is not None else 0)
                 if cfg.likelihood == "column" and cfg.weighting == "ratio":
                     # The default: the whole camera's share in one compiled call (observe_column).
                     hid = np.empty(n, dtype=np.int32)
                     frame = self._frames.get(cid)
-                    args = cl.column_args(
-                        img, n, self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
-                        self._n_below, self._n_above, owner, box, h, self._top_sigma,
-                        self._px_scale[cid] if px_scale is None else px_scale[cid],
-                        occluders.get(cid) if occluders is not None else None, me, cfg.occlusion_margin, which,
-                        cfg.out_of_view == "unknown", k_lo[cid] if k_lo is not None else 0)
-                    observe_column(cl, xyz, cfg.surface_offset, args, img, frame,
+                    reading = cl.reading(img, n, read, h)
+                    observe_column(cl, xyz, cfg.surface_offset, spec, reading, img, frame,
                                    [c.get(cid) if c else None for c in colours] if frame is not None else (),
-                                   cfg.appearance_weight, cfg.likely_count, logpi, likely, n_seen, col, hid)
+                                   cfg.appearance_weight, cfg.likely_count, sums, hid)
                     if hidden is not None:
                         hidden[cid] = hid
-                    if top_edge and h is not None and self._edge_offsets is not None:
+                    if top_edge and h is not None and self._edge is not None:
                         # Raw labels unless top_edge_explain: no boxes, so codes are the labels themselves.
-                        edge_args = args if cfg.top_edge_explain else cl.column_args(img, n, self._column, self._on,
-                                                                                     self._off)
-                        cl.top_edge(edge_args, xyz, h, self._edge_offsets, cfg.top_edge, logpi)
+                        edge_reading = reading if cfg.top_edge_explain else cl.reading(img, n)
+                        cl.top_edge(edge_reading, xyz, h, self._edge, logpi)
                     continue
                 if cfg.likelihood == "column":
                     surface = self._near_surface(xyz, cl)
-                    counts, ratio, top, seen, hid = cl.column(
-                        img, surface, self._column, self._on, self._off, self._k_min, cfg.column_radius, -self._on,
-                        self._n_below, self._n_above, owner, box, h, self._top_sigma,
-                        self._px_scale[cid] if px_scale is None else px_scale[cid],
-                        occluders.get(cid) if occluders is not None else None, me, cfg.occlusion_margin, which,
-                        cfg.out_of_view == "unknown", k_lo[cid] if k_lo is not None else 0, return_hidden=True)
+                    counts, ratio, top, seen, hid = cl.column(img, surface, spec, read, h)
                     if hidden is not None:
                         hidden[cid] = hid
                     if cfg.weighting == "count":
@@ -645,9 +638,9 @@ class ParticleTracker(TrackerBase):
             h = np.ascontiguousarray(self._stacked(fs, "h"), dtype=np.float64)
             jitter = self._top_sigma > 0 and cfg.noise_h > 0 and h.size
             h_out = np.empty(h.shape) if jitter else h
-            predict_walk(old, a, noise, v, walk, scale, float(cfg.max_speed), float(dt), xyz, h,
-                         self.rng.standard_normal(h.shape) if jitter else _NO_DRAWS,
-                         cfg.noise_h * math.sqrt(dt), float(cfg.min_height), float(cfg.max_height), h_out)
+            heights = HeightWalk(h, self.rng.standard_normal(h.shape) if jitter else _NO_DRAWS,
+                                 cfg.noise_h * math.sqrt(dt), float(cfg.min_height), float(cfg.max_height), h_out)
+            predict_walk(old, a, noise, v, walk, scale, float(cfg.max_speed), float(dt), xyz, heights)
             self._set_rows(fs, "v", v)
         else:
             step = a * noise
@@ -761,7 +754,7 @@ class ParticleTracker(TrackerBase):
         column = self.config.likelihood == "column"
         if tuple(parts) == PARTICLE_FIELDS and parts["likely"].dtype == np.bool_:
             # All six fields (as tracking filters hold them): one kernel, heights drawn in it.
-            arrays = gather_particles(idx, *parts.values(), z=self.rng.random(idx.shape) if column else None)
+            arrays = gather_particles(idx, Particles(*parts.values()), z=self.rng.random(idx.shape) if column else None)
             return dict(zip(PARTICLE_FIELDS, arrays))
         out = {name: take_rows(a, idx) for name, a in parts.items()}
         if column:
@@ -817,7 +810,7 @@ class ParticleTracker(TrackerBase):
             # Next frame's k_lo: the share ``common_view`` of the filter's columns see every sample
             # from there up (tracking filters hold equal particle counts).
             # (np.quantile(..., method="higher") of each row, as the order statistic it picks.)
-            rank = _quantile_rank(n, cfg.common_view or 0.5)
+            rank = quantile_rank(n, cfg.common_view or 0.5)
             for cid, hid in hidden.items():
                 for f, v in zip(fs, order_statistic(hid.reshape(len(fs), n), rank).tolist()):
                     f.k_lo[cid] = v
@@ -1029,7 +1022,7 @@ class ParticleTracker(TrackerBase):
         lumps = np.array([xy[~side].mean(axis=0), xy[side].mean(axis=0)])
         for cl in self._cams.values():
             p, q = cl.boxes(lumps, w, h, 0.0)
-            if p is not None and q is not None and _overlap(p, q) < cfg.merge_overlap:
+            if p is not None and q is not None and overlap(p, q) < cfg.merge_overlap:
                 return side
         return None
 
@@ -1116,79 +1109,10 @@ class ParticleTracker(TrackerBase):
             self.position_map.remove(f.track.id)
 
 
-def image_boxes(camera: Camera, xy: np.ndarray, widths: np.ndarray, heights: np.ndarray, margin: float,
-                depth: float = 0.0) -> list[Box | None]:
-    """Pixel boxes ``(u0, u1, v0, v1)`` of objects standing at ``xy`` (K, 2), None where out of view.
-
-    Each box is the projection of an upright rectangle facing the camera: ``width/2 + margin`` to
-    each side of the object across the line of sight, from ``−margin`` to ``height + margin``
-    (metres); with ``depth > 0``, of the rectangles at the object and ``depth`` (m) nearer and
-    farther along the line of sight together.
-
-    Written plainly with :meth:`Camera.project`; the tracker uses the Numba kernel of the same,
-    :meth:`CameraLikelihood.boxes <worldtrack.trackers.particle.likelihood.CameraLikelihood.boxes>`
-    (~8× faster for a few objects; the tests check that they agree).
-    """
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    k = len(xy)
-    if k == 0:
-        return []
-    along, _ = camera.floor_rays(xy)
-    across = np.column_stack([-along[:, 1], along[:, 0]])
-    hw = 0.5 * np.broadcast_to(np.asarray(widths, float), (k,)) + margin
-    top = np.broadcast_to(np.asarray(heights, float), (k,)) + margin
-    shifts = np.array([0.0] if depth <= 0 else [-depth, 0.0, depth])
-    sides = np.array([-1.0, 1.0])
-    # corners (K, shifts, sides, 2 heights, 3)
-    floor = (xy[:, None, None, :] + shifts[None, :, None, None] * along[:, None, None, :]
-             + sides[None, None, :, None] * hw[:, None, None, None] * across[:, None, None, :])
-    corners = np.empty((k, len(shifts), 2, 2, 3))
-    corners[..., :2] = floor[:, :, :, None, :]
-    corners[..., 0, 2] = -margin
-    corners[..., 1, 2] = top[:, None, None]
-    uv = camera.project(corners.reshape(k, -1, 3))
-    ok = np.isfinite(uv).all(axis=2, keepdims=True)
-    # Clipped to the image: a box wholly outside it (or with no corner in front of the camera,
-    # lo = inf, hi = −inf) ends up empty.
-    size = (camera.width, camera.height)
-    lo = np.clip(np.floor(np.where(ok, uv, np.inf).min(axis=1) + 0.5), 0, size).astype(int).tolist()
-    hi = np.clip(np.floor(np.where(ok, uv, -np.inf).max(axis=1) + 0.5) + 1, 0, size).astype(int).tolist()
-    return [(u0, u1, v0, v1) if u0 < u1 and v0 < v1 else None for (u0, v0), (u1, v1) in zip(lo, hi)]
-
-
-def image_box(camera: Camera, x: float, y: float, width: float, height: float, margin: float,
-              depth: float = 0.0) -> Box | None:
-    """:func:`image_boxes` of one object."""
-    return image_boxes(camera, np.array([[x, y]]), np.array([width]), np.array([height]), margin, depth)[0]
-
-
 def _grown_bounds(polygon: np.ndarray, margin: float) -> tuple[float, float, float, float]:
     """(x0, x1, y0, y1) metres: the bounding box of ``polygon`` (N, 2) grown by ``margin`` on each side."""
     (x0, y0), (x1, y1) = polygon.min(axis=0), polygon.max(axis=0)
     return (x0 - margin, x1 + margin, y0 - margin, y1 + margin)
-
-
-def _overlaps(boxes: list[Box | None]) -> np.ndarray:
-    """(K, K) intersection of each pair of pixel boxes over the smaller one's area; NaN where either
-    is None."""
-    b = np.array([(np.nan,) * 4 if x is None else x for x in boxes], dtype=float).reshape(-1, 4)
-    w = np.minimum(b[:, None, 1], b[None, :, 1]) - np.maximum(b[:, None, 0], b[None, :, 0])
-    h = np.minimum(b[:, None, 3], b[None, :, 3]) - np.maximum(b[:, None, 2], b[None, :, 2])
-    area = (b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2])
-    with np.errstate(invalid="ignore"):
-        return np.where((w > 0) & (h > 0), w * h, 0.0) / np.minimum(area[:, None], area[None, :])
-
-
-def _overlap(p: Box, q: Box) -> float:
-    """Intersection of two pixel boxes over the smaller one's area."""
-    return float(_overlaps([p, q])[0, 1])
-
-
-@functools.lru_cache(maxsize=16)
-def _quantile_rank(n: int, q: float) -> int:
-    """The 0-based rank of the order statistic that ``np.quantile(x, q, method="higher")`` returns
-    for ``n`` values (so ``np.partition`` can pick it without the quantile machinery)."""
-    return int(np.quantile(np.arange(n), q, method="higher"))
 
 
 def _stack(fs: list[_Filter], name: str) -> np.ndarray:

@@ -1,6 +1,6 @@
 """The particle tracker's motion model (``velocity="state"``) and its depth along the line of sight.
 
-Small rendered scenes of :mod:`test_particle` (ellipsoid people over a textured floor, exact ground
+Small rendered scenes of :mod:`particle_scenes` (ellipsoid people over a textured floor, exact ground
 truth); every filter is started on the truth with ``init_track`` and no detection, so what is
 measured is the filter alone.
 """
@@ -10,7 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from test_particle import FPS, make_scene, run, tracker_for
+from worldtrack.trackers.particle.motion import (HeightWalk, jitter_reflect, predict_state, predict_state_reference,
+                                                 predict_walk, reflect_reference)
+
+from particle_scenes import FPS, make_scene, run, tracker_for
 
 
 def _errors(out, pid: int = 1) -> tuple[np.ndarray, np.ndarray]:
@@ -89,8 +92,6 @@ def test_prediction_kernel_equals_numpy_reference():
     """The compiled prediction (``velocity="state"``: the velocity walk, then ``x + a·noise + v·dt``)
     gives the NumPy code's values bit for bit, clipped speeds, stopped walks (scale 0) and the
     vertical component included."""
-    from worldtrack.trackers.particle.sampling import predict_state, predict_state_reference
-
     rng = np.random.default_rng(3)
     for f, n in ((1, 7), (6, 500)):
         old = rng.normal(0, 3, (f, n, 3))
@@ -111,8 +112,6 @@ def test_prediction_kernel_equals_numpy_reference():
 def test_height_walk_kernel_equals_numpy_reflection():
     """The heights' random walk folded into [lo, hi] (np.mod's sign rules, values far outside and
     on the ends included) is the NumPy expression's, bit for bit."""
-    from worldtrack.trackers.particle.sampling import jitter_reflect, reflect_reference
-
     rng = np.random.default_rng(4)
     h, a = rng.uniform(-5, 8, (7, 1000)), rng.normal(0, 3, (7, 1000))
     h[0, :30], a[0, :30] = np.repeat([0.8, 1.9, 3.0], 10), 0.0             # on the ends and on 2·span
@@ -124,15 +123,20 @@ def test_height_walk_kernel_equals_numpy_reflection():
         assert out.min() >= 0.8 and out.max() <= 1.9 and ((h + a * scale < 0.8) | (h + a * scale > 1.9)).sum() > 1000
 
 
-@pytest.mark.parametrize("q", [0.5, 0.3, 0.1, 0.9, 1.0, 0.0])
-def test_quantile_rank_picks_what_np_quantile_higher_picks(q):
-    """``k_lo`` is the per-filter order statistic at :func:`_quantile_rank` (np.partition), which is
-    the value ``np.quantile(..., method="higher")`` returns."""
-    from worldtrack.trackers.particle import _quantile_rank
-
-    rng = np.random.default_rng(5)
-    for f, n in ((1, 1), (4, 500), (3, 37)):
-        hid = rng.integers(0, 27, (f, n)).astype(np.int32)
-        r = _quantile_rank(n, q)
-        np.testing.assert_array_equal(np.partition(hid, r, axis=1)[:, r],
-                                      np.quantile(hid, q, axis=1, method="higher"))
+def test_predict_walk_is_prediction_then_height_walk():
+    rng = np.random.default_rng(20)
+    f, n = 3, 400
+    old, v = rng.normal(0, 3, (f, n, 3)), rng.normal(0, 1.5, (f, n, 3))
+    a, walk = rng.standard_normal((f, n, 3)), rng.standard_normal((f, n, 2))
+    h, ha = rng.uniform(0.8, 1.9, (f, n)), rng.standard_normal((f, n))
+    noise, scale = np.array([0.1, 0.1, 0.05]), np.array([0.3, 0.0, 0.2])
+    v1, v2, x1, x2, h1 = v.copy(), v.copy(), np.empty_like(old), np.empty_like(old), np.empty_like(h)
+    predict_walk(old, a, noise, v1, walk, scale, 2.5, 0.1, x1, HeightWalk(h, ha, 0.2, 0.8, 1.9, h1))
+    predict_state_reference(old, a, noise, v2, walk, scale, 2.5, 0.1, x2)
+    np.testing.assert_array_equal(x1, x2)
+    np.testing.assert_array_equal(v1, v2)
+    np.testing.assert_array_equal(h1, reflect_reference(h + ha * 0.2, 0.8, 1.9))
+    assert not np.array_equal(h1, h)
+    h2 = h.copy()
+    predict_walk(old, a, noise, v.copy(), walk, scale, 2.5, 0.1, x1, HeightWalk(h, np.zeros(0), 0.2, 0.8, 1.9, h2))
+    np.testing.assert_array_equal(h2, h)                  # no draws: the heights stay
