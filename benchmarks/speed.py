@@ -141,10 +141,10 @@ def foreground_stage(method: str, tracker, clip: Clip):
         cs = tracker.cams[clip.camera]
         return lambda img: ternary_real(cs.foreground.labels(img), cs.ring_px)
     if method == "particle":
-        gamma = tracker.config.gamma
-        if tracker.config.shadows != "object":
+        gamma = tracker.config.likelihood.gamma
+        if tracker.config.likelihood.shadows != "object":
             return lambda img: hit_labels(img, clip.background, gamma)
-        fg = tracker.foregrounds[clip.camera]
+        fg = tracker.labels.foregrounds[clip.camera]
         return lambda img: hit_image(fg.difference(img), gamma)
     model = AdaptiveBackground("mog2", background=clip.background)
     return model.labels

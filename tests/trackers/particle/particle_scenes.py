@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from worldtrack.config import with_overrides
 from worldtrack.foreground.background import StaticBackground
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid
 from worldtrack.scene import scene_from_dict
@@ -78,11 +79,23 @@ def foregrounds(scene, scene_seed=0):
     return {cid: StaticBackground(bg, 30.0, "colour") for cid, bg in bgs.items()}, bgs
 
 
-def tracker_for(scene, scene_seed=0, **options):
-    """A tracker with static backgrounds. An ellipsoid's lowest point is on its axis (a person's is
-    the near side of the feet), so the column stands on the particle: ``surface_offset=0``."""
+def config(**settings) -> ParticleConfig:
+    """The default configuration with ``settings`` by dotted path, ``__`` for the dots
+    (``detection__births="none"``)."""
+    return with_overrides(ParticleConfig(), {k.replace("__", "."): v for k, v in settings.items()}, root="particle")
+
+
+def tracker_for(scene, scene_seed=0, **settings):
+    """A tracker with static backgrounds and ``settings`` as in :func:`config`. An ellipsoid's lowest
+    point is on its axis (a person's is the near side of the feet), so the column stands on the
+    particle: ``column.surface_offset_m=0``."""
     fgs, bgs = foregrounds(scene, scene_seed)
-    return ParticleTracker(scene, fgs, ParticleConfig(**{"surface_offset": 0.0, **options})), bgs
+    return ParticleTracker(scene, fgs, config(**{"column__surface_offset_m": 0.0, **settings})), bgs
+
+
+def clouds(tracker) -> list:
+    """The tracker's tracking filters in id order."""
+    return [tracker.clouds[k] for k in sorted(tracker.clouds)]
 
 
 def walker(t):

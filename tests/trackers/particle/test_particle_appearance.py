@@ -9,14 +9,16 @@ import pytest
 
 from worldtrack.scene import scene_from_dict
 from worldtrack.trackers.base import Frame
-from worldtrack.trackers.particle.appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,
-                                                     SAT_BINS, ColourModel, colour_bins, colour_bins_compiled,
-                                                     colour_bins_reference, colour_log_ratio, column_bins,
-                                                     column_bins_reference, column_penalties, learn_columns)
+from worldtrack.trackers.particle.appearance import (column_bins, column_bins_reference, column_penalties,
+                                                     learn_columns)
+from worldtrack.trackers.particle.colour import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS, SAT_BINS,
+                                                 ColourModel, colour_bins, colour_bins_compiled, colour_bins_reference,
+                                                 colour_log_ratio)
 from worldtrack.trackers.particle.likelihood import CameraLikelihood
+from worldtrack.trackers.particle.likelihood.models import Readers
 from worldtrack.trackers.particle.likelihood.boxes import boxes_apart
 
-from particle_scenes import CAM, COLOURS, DISTORTION, FLOOR, H, W, make_scene, render, run, tracker_for
+from particle_scenes import CAM, COLOURS, DISTORTION, FLOOR, H, W, clouds, make_scene, render, run, tracker_for
 
 
 def bgr(*colours) -> np.ndarray:
@@ -159,16 +161,16 @@ def test_filters_learn_colours_only_while_their_boxes_are_apart():
 
     for paths, learns in ((apart, True), (behind, False)):
         scene = make_scene(entry=False)
-        tracker, bgs = tracker_for(scene, births="none")
+        tracker, bgs = tracker_for(scene, detection__births="none")
         people = paths(0.0)
         for i, (x, y) in enumerate(people, start=1):
             tracker.init_track(x, y, track_id=i)
         run(tracker, scene, bgs, paths, 5)
-        models = [f.colours.get("cam") for f in sorted(tracker.filters, key=lambda f: f.track.id)]
+        models = [c.colours.get("cam") for c in clouds(tracker)]
         if not learns:
             assert all(m is None or m.hist is None for m in models)
             continue
-        # Each learnt histogram peaks on its own person's colour bin (test_particle.COLOURS).
+        # Each learnt histogram peaks on its own person's colour bin (particle_scenes.COLOURS).
         own = [int(colour_bins(bgr(COLOURS[k]))[0, 0]) for k in range(2)]
         assert own[0] != own[1]
         for k, m in enumerate(models):
@@ -180,18 +182,18 @@ def test_likelihood_penalises_particles_on_another_persons_colours():
     """With person 1's learnt colours, particles on person 2 lose the colour penalty; particles on
     person 1 lose nothing; without colours both read the same column terms as before."""
     scene = make_scene(entry=False)
-    tracker, bgs = tracker_for(scene, births="none")
+    tracker, bgs = tracker_for(scene, detection__births="none")
     people = [(-1.0, 3.0), (1.0, 3.0)]
     for i, (x, y) in enumerate(people, start=1):
         tracker.init_track(x, y, track_id=i)
     run(tracker, scene, bgs, lambda t: people, 5)
-    first = min(tracker.filters, key=lambda f: f.track.id)
+    first = clouds(tracker)[0]
     assert first.colours["cam"].hist is not None
     frame = render(scene.camera("cam"), bgs["cam"], people, np.random.default_rng(9))
-    images = tracker._images({"cam": Frame(frame, 1.0, 10)})
+    view = tracker.labels.read({"cam": Frame(frame, 1.0, 10)})
     xyz = np.array([[-1.0, 3.0, 0.8], [1.0, 3.0, 0.8]])
-    plain, _, _ = tracker.likelihood(xyz, images)
-    coloured, _, _ = tracker.likelihood(xyz, images, colours=first.colours)
+    plain, _, _ = tracker.likelihood(xyz, None, view, Readers.one(2))
+    coloured, _, _ = tracker.likelihood(xyz, None, view, Readers.one(2, first.colours))
     assert coloured[0] == pytest.approx(plain[0])                        # own colours: no change
     absent = math.log(EPSILON / (1 + EPSILON))
     assert coloured[1] - plain[1] < 3 * absent                           # ≥ 3 samples of a foreign colour

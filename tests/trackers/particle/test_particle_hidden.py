@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from worldtrack.trackers.particle.likelihood import CameraLikelihood, occluder_layers, owner_image
-from worldtrack.trackers.particle.likelihood.hidden import (inverse_lengths, inverse_lengths_reference,
-                                                            order_statistic, quantile_rank)
+from worldtrack.trackers.particle.likelihood.hidden import order_statistic, quantile_rank
+from worldtrack.trackers.particle.likelihood.pixel_weights import inverse_lengths, inverse_lengths_reference
 
 from particle_scenes import CAM, DISTORTION, RING_HEIGHTS, H, W, column, column_reference, make_scene
 

@@ -1,4 +1,5 @@
-"""The particle tracker's motion model (``velocity="state"``) and its depth along the line of sight.
+"""The particle tracker's motion models (``motion.model``), chosen by name, and the depth along the
+line of sight.
 
 Small rendered scenes of :mod:`particle_scenes` (ellipsoid people over a textured floor, exact ground
 truth); every filter is started on the truth with ``init_track`` and no detection, so what is
@@ -13,7 +14,7 @@ import pytest
 from worldtrack.trackers.particle.motion import (HeightWalk, jitter_reflect, predict_state, predict_state_reference,
                                                  predict_walk, reflect_reference)
 
-from particle_scenes import FPS, make_scene, run, tracker_for
+from particle_scenes import FPS, clouds, make_scene, run, tracker_for
 
 
 def _errors(out, pid: int = 1) -> tuple[np.ndarray, np.ndarray]:
@@ -34,38 +35,40 @@ def _errors(out, pid: int = 1) -> tuple[np.ndarray, np.ndarray]:
 def test_state_velocity_moves_each_particle_by_its_own_velocity():
     """Without noise, x_t = x_{t−1} + v·dt exactly and v persists (constant velocity)."""
     scene = make_scene(entry=False)
-    tracker, _ = tracker_for(scene, velocity="state", noise_xy=0.0, noise_v=0.0, births="none")
+    tracker, _ = tracker_for(scene, motion__model="state", motion__noise_xy=0.0, motion__noise_v=0.0,
+                             detection__births="none")
     tracker.init_track(0.0, 3.0)
-    (f,) = tracker.filters
+    (f,) = clouds(tracker)
+    person = [tracker.position_map[1]]
     rng = np.random.default_rng(1)
     v = np.zeros_like(f.v)
     v[:, :2] = rng.uniform(-1, 1, (len(v), 2))
     f.v = v.copy()
     before = f.xyz.copy()
-    tracker._predict([f], 0.1)
+    tracker.motion.predict([f], person, 0.1)
     np.testing.assert_allclose(f.xyz[:, :2], before[:, :2] + 0.1 * v[:, :2], atol=1e-12)
     np.testing.assert_allclose(f.v, v, atol=1e-12)
-    tracker._predict([f], 0.2)
+    tracker.motion.predict([f], person, 0.2)
     np.testing.assert_allclose(f.xyz[:, :2], before[:, :2] + 0.3 * v[:, :2], atol=1e-12)
 
 
 def test_state_velocity_noise_and_initial_spread():
-    """The velocity walks by noise_v·√dt per step; new filters' velocities spread velocity_spread."""
+    """The velocity walks by noise_v·√dt per step; new filters' velocities spread velocity_spread_mps."""
     scene = make_scene(entry=False)
-    tracker, _ = tracker_for(scene, velocity="state", noise_xy=0.0, noise_v=1.0, velocity_spread=0.7,
-                             births="none", particles=4000)
+    tracker, _ = tracker_for(scene, motion__model="state", motion__noise_xy=0.0, motion__noise_v=1.0,
+                             motion__velocity_spread_mps=0.7, detection__births="none", tracking__particles=4000)
     tracker.init_track(0.0, 3.0)
-    (f,) = tracker.filters
+    (f,) = clouds(tracker)
     assert f.v[:, :2].std(axis=0) == pytest.approx([0.7, 0.7], rel=0.05)
     assert np.all(f.v[:, 2] == 0)
     v0 = f.v.copy()
-    tracker._predict([f], 0.25)
+    tracker.motion.predict([f], [tracker.position_map[1]], 0.25)
     dv = f.v[:, :2] - v0[:, :2]
     assert dv.std(axis=0) == pytest.approx([0.5, 0.5], rel=0.05)      # 1.0 m/s/√s · √0.25 s
     # Other velocity models start from rest and keep no velocity state.
-    t2, _ = tracker_for(scene, births="none", velocity="object")
+    t2, _ = tracker_for(scene, detection__births="none", motion__model="object")
     t2.init_track(0.0, 3.0)
-    assert np.all(t2.filters[0].v == 0)
+    assert np.all(clouds(t2)[0].v == 0)
 
 
 def towards_camera(t):
@@ -78,7 +81,7 @@ def test_walker_along_the_line_of_sight_is_followed(velocity):
     """The depth along the line of sight is the column's weak direction; the filter must keep up with
     a walker coming straight at the camera, started on the truth (no lag building up)."""
     scene = make_scene(entry=False)
-    tracker, bgs = tracker_for(scene, velocity=velocity, births="none", split=False, merge=False)
+    tracker, bgs = tracker_for(scene, motion__model=velocity, detection__births="none", split__enabled=False, merge__enabled=False)
     tracker.init_track(*towards_camera(0.0)[0], track_id=1)
     out = run(tracker, scene, bgs, towards_camera, int(3.0 * FPS))
     err, along = _errors(out)
@@ -89,7 +92,7 @@ def test_walker_along_the_line_of_sight_is_followed(velocity):
 
 
 def test_prediction_kernel_equals_numpy_reference():
-    """The compiled prediction (``velocity="state"``: the velocity walk, then ``x + a·noise + v·dt``)
+    """The compiled prediction (``motion.model="state"``: the velocity walk, then ``x + a·noise + v·dt``)
     gives the NumPy code's values bit for bit, clipped speeds, stopped walks (scale 0) and the
     vertical component included."""
     rng = np.random.default_rng(3)

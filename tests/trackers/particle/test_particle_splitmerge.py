@@ -28,7 +28,7 @@ def test_people_entering_together_then_parting_get_two_tracks():
 
 def test_one_filter_on_two_people_is_split_when_they_part():
     scene = make_scene(entry=False)
-    tracker, bgs = tracker_for(scene, births="none")
+    tracker, bgs = tracker_for(scene, detection__births="none")
 
     def parting(t):
         s = 0.15 + 0.5 * t
@@ -44,7 +44,7 @@ def test_one_filter_on_two_people_is_split_when_they_part():
 
 def test_duplicate_filters_on_one_person_are_merged():
     scene = make_scene(entry=False)
-    tracker, bgs = tracker_for(scene, births="none", explain="detection")
+    tracker, bgs = tracker_for(scene, detection__births="none", explain__filters="detection")
     tracker.init_track(0.0, 3.0)
     tracker.init_track(0.1, 3.05)
     out = run(tracker, scene, bgs, lambda t: [(0.0, 3.0)], 8)
@@ -53,29 +53,33 @@ def test_duplicate_filters_on_one_person_are_merged():
 
 def test_filters_one_behind_the_other_on_the_floor_are_merged_only_if_it_lasts():
     """Two filters whose image boxes overlap (0.86 of the smaller box here) are merged after
-    ``merge_frames`` frames if they stand within ``merge_distance`` on the floor, else after
-    ``merge_far_frames``: one camera's boxes also overlap while two people pass one behind the other.
-    The merge ends the younger track."""
+    ``merge.after_s`` if they stand within ``merge.distance_m`` on the floor, else after
+    ``merge.far_after_s``: one camera's boxes also overlap while two people pass one behind the other.
+    The merge ends the younger track. The waits are seconds: frames at the real frame interval."""
     scene = make_scene(entry=False)
 
-    def frames_to_merge(second, **options):
-        tracker, _ = tracker_for(scene, births="none", **options)
+    def frames_to_merge(second, dt=0.1, **options):
+        tracker, _ = tracker_for(scene, detection__births="none", **options)
         tracker.init_track(0.0, 3.0)
         tracker.init_track(*second)
-        for k in range(1, 12):
-            tracker._merge()                 # the filters stay where they were put
-            if len(tracker.filters) < 2:
-                assert [f.track.id for f in tracker.filters] == [1]
+        for k in range(1, 30):
+            # the filters stay where they were put
+            tracker.merger.merge(list(tracker.clouds.values()), tracker.position_map, dt, tracker._end)
+            if len(tracker.clouds) < 2:
+                assert list(tracker.clouds) == [1] and [p.id for p in tracker.position_map] == [1]
                 return k
         return None
 
     assert frames_to_merge((0.1, 3.3)) == 3                    # 0.32 m apart: one object
     assert frames_to_merge((0.1, 4.0)) == 6                    # 1.0 m apart: one behind the other
-    assert frames_to_merge((0.1, 4.0), merge_far_frames=9) == 9
-    assert frames_to_merge((0.1, 4.0), merge_distance=np.inf) == 3   # boxes alone (the former rule)
+    assert frames_to_merge((0.1, 4.0), merge__far_after_s=0.9) == 9
+    assert frames_to_merge((0.1, 4.0), merge__distance_m=np.inf) == 3   # boxes alone (the former rule)
     assert frames_to_merge((1.0, 3.0)) is None                 # side by side: boxes apart
-    # Beyond ``merge_depth`` from the camera the distance that counts as one object grows with it:
-    # the pair stands 4 and 5 m from the camera, 1 m apart: one object when merge_depth is 2 m
+    # Beyond ``merge.depth_m`` from the camera the distance that counts as one object grows with it:
+    # the pair stands 4 and 5 m from the camera, 1 m apart: one object when depth_m is 2 m
     # (0.6 m × 4.5 / 2 = 1.35 m), still one behind the other when it is 4 m (0.6 m × 4.5 / 4 = 0.68 m).
-    assert frames_to_merge((0.1, 4.0), merge_depth=2.0) == 3
-    assert frames_to_merge((0.1, 4.0), merge_depth=4.0) == 6
+    assert frames_to_merge((0.1, 4.0), merge__depth_m=2.0) == 3
+    assert frames_to_merge((0.1, 4.0), merge__depth_m=4.0) == 6
+    # The same 0.3 s and 0.6 s at 25 and 7 frames/s.
+    assert frames_to_merge((0.1, 3.3), dt=0.04) == 8 and frames_to_merge((0.1, 4.0), dt=0.04) == 15
+    assert frames_to_merge((0.1, 3.3), dt=1 / 7) == 2 and frames_to_merge((0.1, 4.0), dt=1 / 7) == 4

@@ -1,6 +1,18 @@
 """Prediction (seed 004, eqs. 1–2 in real time): ``x_t = x_{t−1} + v·dt + w``, ``w ~ N(0, σ²·dt)``.
 
-The compiled kernels of the prediction and their NumPy references:
+The velocity ``v`` is a component chosen by name (``particle.motion.model``, :data:`MOTIONS`):
+
+* ``state`` (:class:`StateVelocity`, worldtrack's default) — each particle carries its own velocity, a
+  constant-velocity model whose velocity walks by ``noise_v·√dt``: the particles that move like the
+  object survive resampling, so evidence adds up along its path; the walk stops (the particles coast)
+  while the filter's columns are mostly hidden;
+* ``particle`` (:class:`ParticleVelocity`, the paper's eq. 2) — each particle's own last step
+  ``(x_{t−1} − x_{t−2}) / dt``;
+* ``object`` (:class:`ObjectVelocity`) — the object centre's, from its last two positions, smoothed;
+* ``none`` (:class:`NoVelocity`).
+
+:class:`HeightState` walks the particles' object heights. The compiled kernels and their NumPy
+references:
 
 * :func:`predict_state` — each particle's own velocity walks by ``noise_v·√dt`` (clipped to the
   largest speed), then moves it: the constant-velocity model (``particle.motion.model="state"``);
@@ -15,10 +27,21 @@ The compiled kernels of the prediction and their NumPy references:
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, Protocol, Sequence
 
 import numpy as np
 from numba import njit
+
+from worldtrack.registry import Registry
+from worldtrack.trackers.base import Person
+from worldtrack.trackers.particle.cloud import Cloud, CloudStack
+from worldtrack.trackers.particle.region import cloud_mean
+
+if TYPE_CHECKING:
+    from worldtrack.trackers.particle.config import ParticleConfig
+
+#: No random draws (an empty array for a kernel's optional draws).
+_NO_DRAWS = np.zeros(0)
 
 
 class HeightWalk(NamedTuple):
@@ -128,5 +151,193 @@ def velocity_walk_reference(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max
     step += v * dt
 
 
-__all__ = ["HeightWalk", "jitter_reflect", "predict_state", "predict_state_reference", "predict_walk",
+
+def clip_speed(v: np.ndarray, max_speed: float) -> None:
+    """Scale the velocities in ``v`` (..., ≥ 2) whose floor speed exceeds ``max_speed`` (in place)."""
+    s = np.hypot(v[..., 0], v[..., 1])
+    over = s > max_speed
+    if over.any():
+        v[over, :2] *= (max_speed / s[over])[:, None]
+
+
+# ---------------------------------------------------------------------------- the models
+
+class HeightState:
+    """The particles' object heights (m): drawn about a person's height, walked by ``noise·√dt``,
+    folded into [min_height, max_height]. ``walks``: the heights are a state of the likelihood
+    (column-ratio with a height prior) and walk; otherwise they stay as drawn."""
+
+    def __init__(self, cfg: "ParticleConfig", person_height: float, walks: bool, rng: np.random.Generator):
+        self.spread, self.noise = cfg.height.spread_m, cfg.height.noise
+        self.lo, self.hi = float(cfg.column.min_height_m), float(cfg.column.max_height_m)
+        self.person_height = person_height
+        self.walks = walks and self.noise > 0
+        self.rng = rng
+
+    def draw(self, n: int, centre: float | None = None) -> np.ndarray:
+        """(n,) heights ~ N(centre, spread²) in [lo, hi] (default centre: the scene's person height)."""
+        c = self.person_height if centre is None else centre
+        return reflect_reference(c + self.spread * self.rng.standard_normal(n), self.lo, self.hi)
+
+    def walk(self, h: np.ndarray, dt: float) -> np.ndarray:
+        """``h`` (any shape) after the random walk (a new array; ``h`` itself when there is none)."""
+        if self.walks and dt > 0 and h.size:
+            out = np.empty(h.shape)
+            jitter_reflect(np.ascontiguousarray(h, dtype=np.float64), self.rng.standard_normal(h.shape),
+                           self.noise * math.sqrt(dt), self.lo, self.hi, out)
+            return out
+        return h
+
+
+class MotionModel(Protocol):
+    """The velocity of eqs. 1–2: draws a new filter's velocities, predicts filters, reports their
+    floor velocity."""
+
+    def velocities(self, n: int) -> np.ndarray:
+        """(n, 3) m/s: a new tracking filter's particle velocities."""
+        ...
+
+    def predict(self, clouds: Sequence[Cloud], persons: Sequence[Person], dt: float) -> None:
+        """Move the tracking filters ``clouds`` (of ``persons``) on by ``dt`` seconds, in place."""
+        ...
+
+    def velocity(self, clouds: Sequence[Cloud], persons: Sequence[Person], centres: np.ndarray,
+                 t: float) -> np.ndarray:
+        """(F, 2) m/s: each filter's floor velocity, its new resampled centre ``centres`` (F, ≥ 2) at ``t``."""
+        ...
+
+
+#: Motion models by the name ``particle.motion.model`` gives.
+MOTIONS: Registry[type] = Registry("particle.motion.model")
+
+
+class _Motion:
+    """The prediction every model shares: Gaussian noise ``σ·√dt`` per axis (the step of
+    :meth:`_step`), z folded into [0, max_height] for the point likelihood, the heights' walk."""
+
+    def __init__(self, cfg: "ParticleConfig", rng: np.random.Generator, stack: CloudStack, heights: HeightState,
+                 reflect_z: bool, column_samples: int):
+        m = cfg.motion
+        self.noise = np.array([m.noise_xy, m.noise_xy, m.noise_z])
+        self.max_speed, self.max_height = float(m.max_speed_mps), float(cfg.column.max_height_m)
+        self.cfg, self.rng, self.stack, self.heights = m, rng, stack, heights
+        self.reflect_z, self.column_samples = reflect_z, column_samples
+
+    def velocities(self, n: int) -> np.ndarray:
+        return np.zeros((n, 3))
+
+    def predict(self, clouds: Sequence[Cloud], persons: Sequence[Person], dt: float) -> None:
+        if dt <= 0:
+            return
+        old = self.stack.stacked(clouds, "xyz")
+        a = self.rng.standard_normal(old.shape)
+        xyz, h = self._step(clouds, persons, old, a, dt)
+        if self.reflect_z:
+            xyz[..., 2] = reflect_reference(xyz[..., 2], 0.0, self.max_height)
+        self.stack.set_rows(clouds, "h", self.heights.walk(self.stack.stacked(clouds, "h"), dt) if h is None else h)
+        self.stack.set_rows(clouds, "xyz", xyz)
+        self._after(clouds, xyz, old, dt)
+
+    def _step(self, clouds, persons, old, a, dt) -> tuple[np.ndarray, np.ndarray | None]:
+        """(new positions, new heights or None to walk them after) from the noise draws ``a``."""
+        return old + a * (self.noise * math.sqrt(dt)), None
+
+    def _after(self, clouds, xyz, old, dt) -> None:
+        return None
+
+    def velocity(self, clouds, persons, centres, t) -> np.ndarray:
+        return np.zeros((len(clouds), 2))
+
+
+@MOTIONS.register("none")
+class NoVelocity(_Motion):
+    """``x_t = x_{t−1} + w``: no velocity."""
+
+
+@MOTIONS.register("particle")
+class ParticleVelocity(_Motion):
+    """Eq. 2: each particle's own velocity ``v_t = (x_t − x_{t−1}) / dt`` from its last step."""
+
+    def _step(self, clouds, persons, old, a, dt):
+        step = a * (self.noise * math.sqrt(dt))
+        step += self.stack.stacked(clouds, "v") * dt
+        return old + step, None
+
+    def _after(self, clouds, xyz, old, dt) -> None:
+        # v_t = (x_t − x_{t−1}) / dt, each particle's velocity for the next frame (eq. 2).
+        v = (xyz - old) / dt
+        clip_speed(v, self.max_speed)
+        self.stack.set_rows(clouds, "v", v)
+
+    def velocity(self, clouds, persons, centres, t) -> np.ndarray:
+        return cloud_mean(self.stack.stacked(clouds, "v")[..., :2])
+
+
+@MOTIONS.register("object")
+class ObjectVelocity(_Motion):
+    """The object centre's velocity, from its last two resampled centres, smoothed
+    (``smoothing``: the newest measurement's weight); the person's ``vx, vy``."""
+
+    def _step(self, clouds, persons, old, a, dt):
+        step = a * (self.noise * math.sqrt(dt))
+        step[..., :2] += np.array([[p.vx, p.vy] for p in persons])[:, None, :] * dt
+        return old + step, None
+
+    def velocity(self, clouds, persons, centres, t) -> np.ndarray:
+        V = np.array([[p.vx, p.vy] for p in persons], dtype=float).reshape(-1, 2)
+        prev = np.array([(np.nan, np.nan) if c.centre is None else c.centre for c in clouds], dtype=float)
+        since = np.array([np.nan if c.t_update is None else t - c.t_update for c in clouds])
+        moved = np.isfinite(prev[:, 0]) & (since > 0)
+        if moved.any():
+            w = self.cfg.smoothing
+            V[moved] = (1 - w) * V[moved] + w * (centres[moved, :2] - prev[moved]) / since[moved, None]
+            clip_speed(V, self.max_speed)
+        return V
+
+
+@MOTIONS.register("state")
+class StateVelocity(_Motion):
+    """Constant velocity: each particle's own velocity walks by ``noise_v·√dt`` (less while the filter's
+    columns are hidden: it coasts), then moves it; the heights walk in the same compiled call."""
+
+    def velocities(self, n: int) -> np.ndarray:
+        v = np.zeros((n, 3))
+        if self.cfg.velocity_spread_mps > 0:
+            v[:, :2] = self.cfg.velocity_spread_mps * self.rng.standard_normal((n, 2))
+            clip_speed(v, self.max_speed)
+        return v
+
+    def _step(self, clouds, persons, old, a, dt):
+        # Constant velocity: each particle's own velocity walks by noise_v·√dt, then moves it; and
+        # the heights' walk (HeightState.walk), all in one call with the draws in their order.
+        v = self.stack.stacked(clouds, "v")                      # walked in place
+        scale = self.cfg.noise_v * math.sqrt(dt) * self._coasting(clouds)
+        xyz = np.empty_like(old)
+        walk = self.rng.standard_normal(v.shape[:2] + (2,))
+        hs = self.heights
+        h = np.ascontiguousarray(self.stack.stacked(clouds, "h"), dtype=np.float64)
+        walks = hs.walks and h.size
+        h_out = np.empty(h.shape) if walks else h
+        heights = HeightWalk(h, self.rng.standard_normal(h.shape) if walks else _NO_DRAWS, hs.noise * math.sqrt(dt),
+                             hs.lo, hs.hi, h_out)
+        predict_walk(old, a, self.noise * math.sqrt(dt), v, walk, scale, self.max_speed, float(dt), xyz, heights)
+        self.stack.set_rows(clouds, "v", v)
+        return xyz, h_out
+
+    def _coasting(self, clouds: Sequence[Cloud]) -> np.ndarray:
+        """(F,) factor of the velocity walk: ``1 − hidden / coast_hidden`` clipped to [0, 1], ``hidden``
+        the share of column samples hidden (``k_lo``) in the camera that sees most of the object;
+        1 with ``coast_hidden = 0``."""
+        coast = self.cfg.coast_hidden
+        if coast <= 0:
+            return np.ones(len(clouds))
+        n = self.column_samples
+        return np.array([min(max(1.0 - (min(c.k_lo.values(), default=0) / n) / coast, 0.0), 1.0) for c in clouds])
+
+    def velocity(self, clouds, persons, centres, t) -> np.ndarray:
+        return cloud_mean(self.stack.stacked(clouds, "v")[..., :2])
+
+
+__all__ = ["MOTIONS", "HeightState", "HeightWalk", "MotionModel", "NoVelocity", "ObjectVelocity", "ParticleVelocity",
+           "StateVelocity", "clip_speed", "jitter_reflect", "predict_state", "predict_state_reference", "predict_walk",
            "reflect_reference", "velocity_walk_reference"]

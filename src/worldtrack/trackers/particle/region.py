@@ -13,9 +13,18 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 from numba import njit
+
+if TYPE_CHECKING:
+    from worldtrack.trackers.base import Person
+    from worldtrack.trackers.particle.cloud import Cloud, CloudStack
+    from worldtrack.trackers.particle.motion import MotionModel
+
+#: No widths (region_sizes leaves the floor sizes as the particles' spread).
+_NO_WIDTHS = np.zeros(0)
 
 
 def cloud_mean(x: np.ndarray) -> np.ndarray:
@@ -52,4 +61,58 @@ def region_sizes_reference(sd: np.ndarray, widths: np.ndarray, sigma: np.ndarray
         sd[:, :2] = np.hypot(sd[:, :2], 0.25 * np.asarray(widths)[:, None])
 
 
-__all__ = ["cloud_mean", "region_sizes", "region_sizes_reference"]
+
+def mean_rows(a: np.ndarray) -> np.ndarray:
+    """(F,) the mean of each row of ``a`` (F, N): ``a.mean(axis=1)``, which is this sum over N."""
+    return np.add.reduce(a, axis=1) / a.shape[1]
+
+
+def mean_sd(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`cloud_mean` and the standard deviation over the particles of each cloud, two (F, C)."""
+    mean = cloud_mean(x)
+    d = x - mean[:, None, :]
+    return mean, np.sqrt(cloud_mean(d * d))
+
+
+class Regions:
+    """Writes each tracking filter's object region on its person: centre (eq. 9) and size (eq. 10),
+    velocity, height, and the box ``(x, y, z) ± (sx, sy, sz)`` as the output columns ``z, sx, sy, sz``.
+
+    Parameters
+    ----------
+    stack : CloudStack; motion : MotionModel — the filters' floor velocity
+    height_from : {"h", "col_h", None} — the person's height is the particles' mean object height,
+        their columns' mean top, or left as it is (the point likelihood)
+    widen : bool — the particles are the object's axis (the column ratio): the floor sizes add a disc
+        of the person's width, ``σ_x² = var(x) + (width/4)²``
+    """
+
+    def __init__(self, stack: "CloudStack", motion: "MotionModel", height_from: str | None, widen: bool):
+        self.stack, self.motion, self.height_from, self.widen = stack, motion, height_from, widen
+
+    def update(self, clouds: Sequence["Cloud"], persons: Sequence["Person"], t: float) -> None:
+        """The regions of ``clouds`` (of ``persons``, equal particle counts) at time ``t`` (s), from
+        their resampled particles."""
+        centre, sd = mean_sd(self.stack.stacked(clouds, "xyz"))
+        V = self.motion.velocity(clouds, persons, centre, t)
+        heights = None
+        if self.height_from == "h":
+            heights = mean_rows(self.stack.stacked(clouds, "h"))
+        elif self.height_from == "col_h" and all(c.col_h is not None for c in clouds):
+            heights = mean_rows(self.stack.stacked(clouds, "col_h"))
+        # sigma = sqrt((sx² + sy²) / 2); widened, sx, sy = hypot(sx, width/4).
+        widths = np.array([p.width for p in persons], dtype=float) if self.widen else _NO_WIDTHS
+        sigma = np.empty(len(clouds))
+        region_sizes(sd, widths, sigma)
+        floor_centre = centre[:, :2].copy()
+        rows = zip(clouds, persons, floor_centre, centre.tolist(), V.tolist(), sd.tolist(), sigma.tolist(),
+                   heights.tolist() if heights is not None else [None] * len(clouds))
+        for c, p, fc, (x, y, z), (vx, vy), (sx, sy, sz), s, height in rows:
+            c.centre, c.t_update = fc, t
+            p.x, p.y, p.vx, p.vy, p.sigma = x, y, vx, vy, s
+            if height is not None:
+                p.height = height
+            p.extra.update(z=z, sx=sx, sy=sy, sz=sz)
+
+
+__all__ = ["Regions", "cloud_mean", "mean_rows", "mean_sd", "region_sizes", "region_sizes_reference"]

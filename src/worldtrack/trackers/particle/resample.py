@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from worldtrack.registry import Registry
+from worldtrack.trackers.particle.cloud import PARTICLE_FIELDS, Cloud
 
 
 class Resampler(Protocol):
@@ -241,5 +242,48 @@ def resampler(name: str) -> Callable[[np.ndarray, int, np.random.Generator], np.
     return RESAMPLERS[name]
 
 
-__all__ = ["RESAMPLERS", "Particles", "Resampler", "gather_particles", "particle_weights", "resample_reference",
+
+class Resampling:
+    """Eq. 8 and the selection with replacement, for the clouds of one tracker.
+
+    Parameters
+    ----------
+    resample : Resampler — chosen by ``weights.resampler``
+    power : float — weights ∝ π^power
+    rng : numpy.random.Generator — the tracker's
+    draw_z : bool — the column likelihoods: after resampling, each particle's z is drawn uniformly
+        below the top its column sees (the column does not depend on z), so the particles fill the
+        object's height
+    """
+
+    def __init__(self, resample: Resampler, power: float, rng: np.random.Generator, draw_z: bool):
+        self.resample, self.power, self.rng, self.draw_z = resample, power, rng, draw_z
+
+    def weights(self, logpi: np.ndarray) -> np.ndarray:
+        """Eq. 8 up to its sum (the resampler normalises), along the last axis of ``logpi`` (one row
+        per filter): ``g ∝ π^κ``; uniform in a row whose every π is 0."""
+        return particle_weights(logpi, self.power)
+
+    def parts(self, parts: dict[str, np.ndarray], weights: np.ndarray, n: int) -> dict[str, np.ndarray]:
+        """The particles of F filters resampled to ``n`` each in proportion to ``weights`` (F, M):
+        ``parts`` maps each per-particle field to its (F, M, ...) array; returns them (F, n, ...)."""
+        idx = self.resample(weights, n, self.rng)
+        if tuple(parts) == PARTICLE_FIELDS and parts["likely"].dtype == np.bool_:
+            # All six fields (as tracking filters hold them): one kernel, heights drawn in it.
+            arrays = gather_particles(idx, Particles(*parts.values()),
+                                      z=self.rng.random(idx.shape) if self.draw_z else None)
+            return dict(zip(PARTICLE_FIELDS, arrays))
+        out = {name: take_rows(a, idx) for name, a in parts.items()}
+        if self.draw_z:
+            out["xyz"][..., 2] = self.rng.random(idx.shape) * out["col_h"]
+        return out
+
+    def cloud(self, c: Cloud, weights: np.ndarray, n: int) -> None:
+        """:meth:`parts` of one cloud, in place."""
+        parts = {name: getattr(c, name)[None] for name in PARTICLE_FIELDS if getattr(c, name) is not None}
+        for name, a in self.parts(parts, weights[None], n).items():
+            setattr(c, name, a[0])
+
+
+__all__ = ["RESAMPLERS", "Particles", "Resampler", "Resampling", "gather_particles", "particle_weights", "resample_reference",
            "resampler", "stratified_resample", "systematic_resample", "take_rows", "weights_reference"]

@@ -16,11 +16,83 @@ True
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 from numba import njit
 
+from worldtrack.trackers.base import Person
+from worldtrack.trackers.lifecycle import counts_for, frames_for
+from worldtrack.trackers.particle.cloud import Cloud, CloudStack
+from worldtrack.trackers.particle.likelihood.boxes import overlap
+from worldtrack.trackers.particle.likelihood.camera import CameraLikelihood
 from worldtrack.trackers.particle.region import cloud_mean
+
+if TYPE_CHECKING:
+    from worldtrack.trackers.particle.config import ParticleConfig
+
+
+class Splitter:
+    """Which clouds are two objects: split tracking filters, and the lumps a detection filter fires on.
+
+    Parameters
+    ----------
+    cfg : ParticleConfig — its ``split`` section, and ``merge.overlap`` (lumps whose boxes overlap
+        more are one object seen along a line of sight)
+    person_size : (height, width) metres — the scene's person
+    cameras : {camera_id: CameraLikelihood}
+    """
+
+    def __init__(self, cfg: "ParticleConfig", person_size: tuple[float, float],
+                 cameras: Mapping[str, CameraLikelihood]):
+        s = cfg.split
+        self.distance, self.dip, self.min_mass, self.after_s = s.distance_m, s.dip, s.min_mass, s.after_s
+        self.overlap = cfg.merge.overlap
+        self.height, self.width = person_size
+        self.cameras = cameras
+
+    def two_objects(self, xy: np.ndarray, principal: tuple | None = None) -> np.ndarray | None:
+        """Which side of a two-lump cloud ``xy`` (N, 2) each particle is on, or None for one object.
+
+        Two lumps (:func:`bimodal_split`) are two objects only if the cameras can tell them apart:
+        their image boxes must overlap less than ``merge.overlap`` in some camera that sees both
+        (lumps one behind the other on a single camera's line of sight are the depth ambiguity of one
+        object, not two objects). ``principal``: the cloud's row of :func:`splittable`'s, if at hand.
+        """
+        side = bimodal_split(xy, self.distance, self.dip, self.min_mass, principal=principal)
+        if side is None:
+            return None
+        lumps = np.array([xy[~side].mean(axis=0), xy[side].mean(axis=0)])
+        for cl in self.cameras.values():
+            p, q = cl.boxes(lumps, self.width, self.height, 0.0)
+            if p is not None and q is not None and overlap(p, q) < self.overlap:
+                return side
+        return None
+
+    def lumps(self, xyz: np.ndarray, idx: np.ndarray, depth: int = 2) -> list[np.ndarray]:
+        """Split particle indices ``idx`` into lumps on the floor, recursively (up to 2^depth)."""
+        side = self.two_objects(xyz[idx, :2])
+        if side is None or depth == 0:
+            return [idx]
+        return self.lumps(xyz, idx[~side], depth - 1) + self.lumps(xyz, idx[side], depth - 1)
+
+    def due(self, clouds: Sequence[Cloud], persons: Sequence[Person], stack: CloudStack, t: float,
+            dt: float) -> list[tuple[Cloud, np.ndarray]]:
+        """The tracking filters to split now, with their sides: those whose particles have been two
+        lumps for ``after_s`` seconds (counted on the person, frame interval ``dt``). The cheap first
+        test of the two-lump check (:func:`splittable`) runs for all of them at once."""
+        if not clouds:
+            return []
+        wide, principal = splittable(stack.stacked(clouds, "xyz")[:, :, :2], self.distance, self.min_mass,
+                                     principal=True)
+        need = frames_for(self.after_s, dt)
+        out = []
+        for c, p, w, pc in zip(clouds, persons, wide.tolist(), principal):
+            side = self.two_objects(c.xyz[:, :2], pc) if w else None
+            if counts_for(p, "split", t, side is not None) >= need:
+                p.reset("split", t)
+                out.append((c, side))
+        return out
 
 
 def bimodal_split(xy: np.ndarray, min_separation: float, max_dip: float, min_mass: float,
@@ -244,4 +316,4 @@ def _wide_enough(lam, min_separation: float, min_mass: float):
     return np.sqrt(np.maximum(lam, 0.0)) >= min_separation * np.sqrt(min_mass * (1 - min_mass))
 
 
-__all__ = ["bimodal_split", "splittable"]
+__all__ = ["Splitter", "bimodal_split", "splittable"]

@@ -15,8 +15,8 @@ from typing import Sequence
 import numpy as np
 from numba import njit
 
-from worldtrack.trackers.particle.appearance import (COLOUR_HEIGHTS, N_BINS, ColourArgs, ColourModel,
-                                                     _column_penalties, penalty_tables)
+from worldtrack.trackers.particle.appearance import COLOUR_HEIGHTS, ColourArgs, _column_penalties
+from worldtrack.trackers.particle.colour import N_BINS, ColourModel, penalty_tables
 from worldtrack.trackers.particle.likelihood.camera import CameraLikelihood, toward_camera
 from worldtrack.trackers.particle.likelihood.column import ColumnOut, ColumnSpec, column_counts
 from worldtrack.trackers.particle.likelihood.reading import Reading

@@ -1,13 +1,9 @@
-"""Columns whose lower part is hidden (behind a nearer object, below the image's edge), and the
-pixel weights of their samples.
+"""Columns whose lower part is hidden (behind a nearer object, below the image's edge).
 
-* :func:`order_statistic` — per filter, the number of lowest samples hidden that a share of its
-  columns reach (``k_lo``, read next frame by ``common_view``, ``pixel_weights="hidden"`` and the
-  coasting of the motion model);
-* :func:`inverse_lengths` — the pixel-weight scale of ``pixel_weights="filter"``: 1 / the image
-  length of a body sample of the column at each filter's centre.
-
-Each has a NumPy reference (tested equal).
+The column kernel reports how many of each column's lowest samples are hidden; per filter,
+:func:`order_statistic` picks the number that a share of its columns reach (``k_lo``, read next
+frame by ``common_view``, ``pixel_weights="hidden"`` and the coasting of the motion model) — the
+value ``np.quantile(..., method="higher")`` picks, by counting (tested equal to ``np.partition``).
 
 >>> order_statistic(np.array([[5, 1, 3, 3, 0]], dtype=np.int32), 2).tolist()
 [3]
@@ -16,7 +12,6 @@ Each has a NumPy reference (tested equal).
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
 from numba import njit
@@ -60,21 +55,4 @@ def quantile_rank(n: int, q: float) -> int:
     return int(np.quantile(np.arange(n), q, method="higher"))
 
 
-@njit(cache=True)
-def inverse_lengths(uv: np.ndarray, steps: int, out: np.ndarray) -> None:
-    """``out`` (F,), in place: 1 / (the image length from ``uv[0, f]`` to ``uv[1, f]`` (pixels) over
-    ``steps``), 0 where that is not finite and positive — :func:`inverse_lengths_reference`'s
-    arithmetic (the pixel scale of ``pixel_weights="filter"``)."""
-    for f in range(uv.shape[1]):
-        length = math.hypot(uv[1, f, 0] - uv[0, f, 0], uv[1, f, 1] - uv[0, f, 1]) / steps
-        out[f] = 1.0 / length if math.isfinite(length) and length > 0 else 0.0
-
-
-def inverse_lengths_reference(uv: np.ndarray, steps: int) -> np.ndarray:
-    """:func:`inverse_lengths` in NumPy (the tracker's former code)."""
-    length = np.hypot(*(uv[1] - uv[0]).T) / steps
-    ok = np.isfinite(length) & (length > 0)
-    return np.where(ok, 1.0 / np.where(ok, length, 1.0), 0.0)
-
-
-__all__ = ["inverse_lengths", "inverse_lengths_reference", "order_statistic", "quantile_rank"]
+__all__ = ["order_statistic", "quantile_rank"]
