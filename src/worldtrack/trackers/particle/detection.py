@@ -57,6 +57,7 @@ class Detection:
         self.heights, self.resample, self.power = heights, resample, cfg.weights.power
         self.min_height, self.max_height = cfg.column.min_height_m, cfg.column.max_height_m
         self.births = d.births if d.births != "auto" else ("entry+lost" if scene.entry_regions else "anywhere")
+        self.watches_lost = self.births == "entry+lost" and d.lost_radius_m > 0 and d.lost_hold_s > 0
         self.detectors = [Cloud(np.zeros((0, 3)), np.zeros((0, 3)), region=r, h=np.zeros(0))
                           for r in self._regions()]
 
@@ -164,7 +165,7 @@ class Detection:
         over the floor in view within ``lost_radius_m`` of it, kept for ``lost_hold_s`` or until it
         starts a track."""
         c = self.cfg
-        if self.births != "entry+lost" or not persons or c.lost_radius_m <= 0 or c.lost_hold_s <= 0:
+        if not self.watches_lost or not persons:
             return
         xy = np.array([[p.x, p.y] for p in persons], dtype=float)
         covered = np.zeros(len(xy), dtype=bool)

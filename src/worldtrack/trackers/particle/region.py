@@ -81,8 +81,8 @@ class Regions:
     Parameters
     ----------
     stack : CloudStack; motion : MotionModel — the filters' floor velocity
-    height_from : {"h", "col_h", None} — the person's height is the particles' mean object height,
-        their columns' mean top, or left as it is (the point likelihood)
+    height_from : {"h", "col_h", None} — the per-particle field whose mean is the person's height: the
+        particles' object heights, their columns' tops (once observed), or none (the point likelihood)
     widen : bool — the particles are the object's axis (the column ratio): the floor sizes add a disc
         of the person's width, ``σ_x² = var(x) + (width/4)²``
     """
@@ -95,11 +95,9 @@ class Regions:
         their resampled particles."""
         centre, sd = mean_sd(self.stack.stacked(clouds, "xyz"))
         V = self.motion.velocity(clouds, persons, centre, t)
-        heights = None
-        if self.height_from == "h":
-            heights = mean_rows(self.stack.stacked(clouds, "h"))
-        elif self.height_from == "col_h" and all(c.col_h is not None for c in clouds):
-            heights = mean_rows(self.stack.stacked(clouds, "col_h"))
+        heights, field = None, self.height_from
+        if field is not None and all(getattr(c, field) is not None for c in clouds):
+            heights = mean_rows(self.stack.stacked(clouds, field))
         # sigma = sqrt((sx² + sy²) / 2); widened, sx, sy = hypot(sx, width/4).
         widths = np.array([p.width for p in persons], dtype=float) if self.widen else _NO_WIDTHS
         sigma = np.empty(len(clouds))

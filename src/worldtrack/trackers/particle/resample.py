@@ -68,20 +68,16 @@ def systematic_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -
     (n,) or (F, n) int64, sorted — indices into each row
     """
     rows = _rows(weights)
-    return _draw_rows(rows, resample_draws("systematic", len(rows), n, rng), n).reshape(np.shape(weights)[:-1] + (n,))
+    r = rng.random((len(rows), 1))                              # one uniform number per row
+    return _draw_rows(rows, r, n).reshape(np.shape(weights)[:-1] + (n,))
 
 
 @RESAMPLERS.register("stratified")
 def stratified_resample(weights: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
     """As :func:`systematic_resample` with an independent uniform number in each stratum ``[j/n, (j+1)/n)``."""
     rows = _rows(weights)
-    return _draw_rows(rows, resample_draws("stratified", len(rows), n, rng), n).reshape(np.shape(weights)[:-1] + (n,))
-
-
-def resample_draws(name: str, f: int, n: int, rng: np.random.Generator) -> np.ndarray:
-    """The uniform numbers resampler ``name`` draws for F rows of ``n`` points: (F, 1) for
-    ``systematic`` (one per row), (F, n) for ``stratified`` (one per stratum)."""
-    return rng.random((f, 1) if name == "systematic" else (f, n))
+    r = rng.random((len(rows), n))                              # one uniform number per stratum
+    return _draw_rows(rows, r, n).reshape(np.shape(weights)[:-1] + (n,))
 
 
 def resample_reference(weights: np.ndarray, r: np.ndarray, n: int) -> np.ndarray:

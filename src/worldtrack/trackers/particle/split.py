@@ -9,7 +9,7 @@ particles. :func:`splittable` is its cheap first test, for many clouds at once. 
 >>> rng = np.random.default_rng(0)
 >>> two = np.vstack([rng.normal([0, 0], 0.06, (250, 2)), rng.normal([0.6, 0], 0.06, (250, 2))])
 >>> side = bimodal_split(two, 0.35, 0.5, 0.2)
->>> side is not None and 230 <= side.sum() <= 270
+>>> side is not None and 230 <= int(side.sum()) <= 270
 True
 """
 

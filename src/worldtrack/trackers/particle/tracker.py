@@ -214,10 +214,12 @@ class ParticleTracker(TrackerBase):
                 self._end(p)
 
     def _seeing(self, p: Person) -> list[str]:
-        """The cameras of this tracker in which person ``p`` stands in view."""
+        """The cameras of this tracker that show person ``p`` (whose evidence this frame was good): those
+        in which they stand in view, else all of them."""
         xy = np.array([[p.x, p.y]])
-        return [cid for cid, cl in self.cameras.items()
+        cams = [cid for cid, cl in self.cameras.items()
                 if cl.camera.sees_standing(xy, self.config.column.min_height_m)[0]]
+        return cams or list(self.cameras)
 
     def _split(self, t: float, dt: float) -> None:
         """Split each tracking filter whose particles have been two lumps long enough into two tracks."""
@@ -282,7 +284,7 @@ class ParticleTracker(TrackerBase):
     def _follow_map(self, t: float) -> None:
         """Clouds for the map's people: drop those whose person left the map; seed one (from the person's
         place, spread, height and velocity) for each confirmed person that has none, and afresh for
-        each that another tracker sees and this one did not at the last time stamp."""
+        each that another tracker sees while this one has not updated them since the last time stamp."""
         for pid in [pid for pid in self.clouds if pid not in self.position_map]:
             del self.clouds[pid]
         for p in self.position_map:
@@ -290,9 +292,9 @@ class ParticleTracker(TrackerBase):
             if not p.confirmed:
                 continue
             if c is None or (seen_elsewhere(p, self._mine) and (c.t_update is None or c.t_update < p.prev_t)):
-                self.clouds[p.id] = self._seeded(p, t)
+                self.clouds[p.id] = self._seeded(p)
 
-    def _seeded(self, p: Person, t: float) -> Cloud:
+    def _seeded(self, p: Person) -> Cloud:
         """A tracking filter about person ``p`` as the map has them."""
         n = self.config.tracking.particles
         spread = max(p.sigma, 0.05)
@@ -300,7 +302,8 @@ class ParticleTracker(TrackerBase):
                                self.rng.random(n) * self.config.column.max_height_m])
         v = self.motion.velocities(n)
         v[:, :2] += (p.vx, p.vy)
-        return Cloud(xyz, v, person=p.id, centre=np.array([p.x, p.y]), t_update=t, h=self.heights.draw(n, p.height))
+        # No region of its own yet (t_update None): seeded afresh each frame until this tracker sees them.
+        return Cloud(xyz, v, person=p.id, centre=np.array([p.x, p.y]), h=self.heights.draw(n, p.height))
 
 
 __all__ = ["ParticleConfig", "ParticleTracker"]
