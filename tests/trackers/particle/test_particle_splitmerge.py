@@ -83,3 +83,30 @@ def test_filters_one_behind_the_other_on_the_floor_are_merged_only_if_it_lasts()
     # The same 0.3 s and 0.6 s at 25 and 7 frames/s.
     assert frames_to_merge((0.1, 3.3), dt=0.04) == 8 and frames_to_merge((0.1, 4.0), dt=0.04) == 15
     assert frames_to_merge((0.1, 3.3), dt=1 / 7) == 2 and frames_to_merge((0.1, 4.0), dt=1 / 7) == 4
+
+
+def test_a_cloud_is_split_after_split_after_s_at_any_frame_rate():
+    """A cloud of two lumps side by side is due for splitting once it has been two lumps for
+    ``split.after_s`` (0.2 s): 2 frames at 10 frames/s, 1 at 7, 5 at 25; one lump never is."""
+    from worldtrack.trackers.base import PositionMap
+    from worldtrack.trackers.particle.cloud import Cloud, CloudStack
+
+    scene = make_scene(entry=False)
+    tracker, _ = tracker_for(scene, detection__births="none")
+    rng = np.random.default_rng(3)
+    two = np.column_stack([np.r_[rng.normal(-0.4, 0.05, 250), rng.normal(0.4, 0.05, 250)],
+                           rng.normal(3.0, 0.05, 500), np.zeros(500)])
+    one = two.copy()
+    one[:, 0] = rng.normal(0.0, 0.05, 500)
+
+    def frames_to_split(xyz, dt):
+        pm = PositionMap()
+        p = pm.add(0.0, 3.0, mode="tracking")
+        c = Cloud(xyz, np.zeros_like(xyz), person=p.id)
+        for k in range(1, 12):
+            if tracker.splitter.due([c], [p], CloudStack(), k * dt, dt):
+                return k
+        return None
+
+    assert [frames_to_split(two, dt) for dt in (0.1, 1 / 7, 0.04)] == [2, 1, 5]
+    assert frames_to_split(one, 0.1) is None

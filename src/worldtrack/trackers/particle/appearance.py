@@ -8,11 +8,8 @@ the object pixels on its own column — only in frames where its image box overl
 sample of its colour column that reads object in a colour its object rarely shows (another
 person's shirt), ``log((B·p(c) + ε) / (1 + ε)) < 0`` — p(c) below the uniform 1/B over the B bins.
 
-Penalty only: rewarding the object's own colours too (the same log-ratio, positive) acts as a
-second count of object samples and pulls the column to where it covers most of the body, which
-one camera places badly in depth. On the entry scenario (3 seeds, benchmarks/particle_entry.py)
-the reward version gave 1.47 tracks per person but a mean error of 0.165 m; penalty only 1.73
-tracks per person and 0.132 m (without appearance: 2.0 and 0.144 m).
+Penalty only: a reward for the object's own colours acts as a second count of object samples and
+pulls the column to where it covers most of the body (measured in ``benchmarks/results/tuning_particle.md``).
 
 This module reads colours along a filter's columns (:func:`column_bins`, :func:`column_penalties`)
 and teaches each filter its colours (:func:`learn_columns`, :class:`ColourLearning`); the bins and
