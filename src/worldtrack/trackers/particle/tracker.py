@@ -206,20 +206,22 @@ class ParticleTracker(TrackerBase):
         mine = [(c, p) for c, p, h in zip(clouds, persons, here) if h]
         if mine:
             self.regions.update([c for c, _ in mine], [p for _, p in mine], t)
-        for p in (p for p, s in zip(persons, seen) if s):
-            p.mark_seen(t, self._seeing(p))
+        self._mark_seen([p for p, s in zip(persons, seen) if s], t)
         for (_, p), leaving in zip(mine, self.life.leaving([p for _, p in mine])):
             if leaving:
                 self.life.exit(p, t)
                 self._end(p)
 
-    def _seeing(self, p: Person) -> list[str]:
-        """The cameras of this tracker that show person ``p`` (whose evidence this frame was good): those
-        in which they stand in view, else all of them."""
-        xy = np.array([[p.x, p.y]])
-        cams = [cid for cid, cl in self.cameras.items()
-                if cl.camera.sees_standing(xy, self.config.column.min_height_m)[0]]
-        return cams or list(self.cameras)
+    def _mark_seen(self, persons: list[Person], t: float) -> None:
+        """``persons`` (whose evidence this frame was good) are seen at ``t`` by this tracker's cameras
+        whose image holds their box (by all of them, if none does)."""
+        if not persons:
+            return
+        xy = np.array([[p.x, p.y] for p in persons])
+        widths, heights = [p.width for p in persons], [p.height for p in persons]
+        shown = {cid: cl.box_array(xy, widths, heights, 0.0)[:, 0] >= 0 for cid, cl in self.cameras.items()}
+        for k, p in enumerate(persons):
+            p.mark_seen(t, [cid for cid, s in shown.items() if s[k]] or list(self.cameras))
 
     def _split(self, t: float, dt: float) -> None:
         """Split each tracking filter whose particles have been two lumps long enough into two tracks."""
