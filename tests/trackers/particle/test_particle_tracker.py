@@ -284,6 +284,9 @@ def test_user_mistakes_are_input_errors():
     with pytest.raises(InputError, match="no difference"):
         ParticleTracker(scene, {"cam": object()})
     tracker = ParticleTracker(scene, fgs)
+    tracker.init_track(0.0, 3.0, track_id=4)
+    with pytest.raises(InputError, match="track id 4 is taken already"):
+        tracker.init_track(1.0, 3.0, track_id=4)
     tracker.step({"cam": texture(0)}, 1.0)
     with pytest.raises(InputError, match="time went backwards"):
         tracker.step({"cam": texture(0)}, 0.5)

@@ -33,6 +33,21 @@ def seen_elsewhere(p: Person, mine: frozenset[str]) -> bool:
     return p.prev_t is not None and p.seen_at >= p.prev_t and not set(p.seen_by) <= mine
 
 
+class Verdict(NamedTuple):
+    """What the β rule says of a tracking filter: whether its person goes on (``kept``), whether this
+    tracker updates them (``here``: it sees them, or nobody else does), whether it sees them
+    (``seen``: the share is above β)."""
+
+    kept: bool
+    here: bool
+    seen: bool
+
+
+#: Seen here; not seen but not for long enough to end; seen by another tracker only; ended.
+SEEN, FADING, FOLLOW, END = Verdict(True, True, True), Verdict(True, True, False), Verdict(True, False, False), \
+    Verdict(False, False, False)
+
+
 class Exited(NamedTuple):
     """An object that left through an exit: its person (off the map) and when, seconds."""
 
@@ -55,29 +70,28 @@ class Life:
         self.exited: list[Exited] = []
 
     def judge(self, persons: Sequence[Person], shares: Sequence[float], t: float,
-              mine: frozenset[str]) -> tuple[list[bool], list[bool], list[bool]]:
+              mine: frozenset[str]) -> list[Verdict]:
         """The β rule at time ``t`` (s) for ``persons`` whose filters' shares of likely particles are
-        ``shares``: (kept, here, seen) — which persons go on; which of those are this tracker's to
-        update (it sees them, or nobody else does); which it sees (share above β). A person this
-        tracker updates gets the share as their score."""
+        ``shares``, one :class:`Verdict` each. A person this tracker updates gets the share as their
+        score."""
         beta, wait = self.cfg.beta, self.cfg.end_after_s
-        kept, here, seen = [], [], []
+        out = []
         for p, share in zip(persons, shares):
             low = share <= beta
             if low and seen_elsewhere(p, mine):
-                kept.append(True), here.append(False), seen.append(False)
+                out.append(FOLLOW)
                 continue
             if low:
                 if p.low_since is None:
                     p.low_since = t
                 if t - p.low_since >= wait:
-                    kept.append(False), here.append(False), seen.append(False)
+                    out.append(END)
                     continue
             else:
                 p.low_since = None
             p.score = share
-            kept.append(True), here.append(True), seen.append(not low)
-        return kept, here, seen
+            out.append(FADING if low else SEEN)
+        return out
 
     def leaving(self, persons: Sequence[Person]) -> np.ndarray:
         """(F,) bool: whether each person is walking off the floor through an entry region: their centre
@@ -100,4 +114,4 @@ class Life:
         self.exited = [e for e in self.exited if t - e.t <= self.cfg.exit_hold_s]
 
 
-__all__ = ["Exited", "Life", "seen_elsewhere"]
+__all__ = ["END", "FADING", "FOLLOW", "SEEN", "Exited", "Life", "Verdict", "seen_elsewhere"]

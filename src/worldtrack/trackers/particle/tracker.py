@@ -107,7 +107,10 @@ class ParticleTracker(TrackerBase):
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0, *,
                    spread: float = 0.1) -> Track:
-        """Start a tracking filter at floor position ``(x, y)`` (m), particles spread ``spread`` (m, 1-σ)."""
+        """Start a tracking filter at floor position ``(x, y)`` (m), particles spread ``spread`` (m, 1-σ),
+        as person ``track_id`` (default: the next id) seen at time ``t`` (s)."""
+        if track_id is not None and track_id in self.position_map:
+            raise InputError(f"--init: track id {track_id} is taken already")
         n = self.config.tracking.particles
         xyz = np.column_stack([x + spread * self.rng.standard_normal(n), y + spread * self.rng.standard_normal(n),
                                self.rng.random(n) * self.config.column.max_height_m])
@@ -191,7 +194,8 @@ class ParticleTracker(TrackerBase):
         shares = (parts["likely"].sum(axis=1) / parts["likely"].shape[1]).tolist()
         resampled = self.resampling.parts(parts, self.resampling.weights(parts["logpi"]),
                                           self.config.tracking.particles)
-        kept, here, seen = self.life.judge(persons, shares, t, self._mine)
+        verdicts = self.life.judge(persons, shares, t, self._mine)
+        kept = [v.kept for v in verdicts]
         lost = [p for p, k in zip(persons, kept) if not k]
         for p in lost:
             self._end(p)
@@ -203,10 +207,10 @@ class ParticleTracker(TrackerBase):
                 for i in np.flatnonzero(kept).tolist():
                     setattr(clouds[i], name, a[i])
         self.detection.watch_lost(lost, t)
-        mine = [(c, p) for c, p, h in zip(clouds, persons, here) if h]
+        mine = [(c, p) for c, p, v in zip(clouds, persons, verdicts) if v.here]
         if mine:
             self.regions.update([c for c, _ in mine], [p for _, p in mine], t)
-        self._mark_seen([p for p, s in zip(persons, seen) if s], t)
+        self._mark_seen([p for p, v in zip(persons, verdicts) if v.seen], t)
         for (_, p), leaving in zip(mine, self.life.leaving([p for _, p in mine])):
             if leaving:
                 self.life.exit(p, t)

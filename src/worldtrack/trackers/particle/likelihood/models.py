@@ -97,6 +97,10 @@ class Likelihood(Protocol):
     column: bool
     #: the column ratio: ring samples, pixel weights, the height prior, a region as wide as the person
     ratio: bool
+    #: (S,) metres: the column's sample heights, ring samples included
+    samples: np.ndarray
+    #: metres: σ of the prior of a column's top about the particle's height (0: the heights are no state)
+    top_sigma: float
 
     def image(self, labels: np.ndarray, difference: np.ndarray | None) -> np.ndarray:
         """(H, W) what it reads of a camera's frame, from the labels and the difference F."""
