@@ -25,3 +25,15 @@ def test_cloud_mean_is_the_mean_over_particles():
     rng = np.random.default_rng(19)
     x = rng.normal(size=(5, 400, 3))
     np.testing.assert_allclose(cloud_mean(x), x.mean(axis=1), rtol=0, atol=1e-12)
+
+
+def test_row_means_and_sds_are_numpys():
+    from worldtrack.trackers.particle.region import mean_rows, mean_sd
+
+    rng = np.random.default_rng(20)
+    h = rng.normal(1.7, 0.1, (6, 500))
+    np.testing.assert_array_equal(mean_rows(h), h.mean(axis=1))
+    x = rng.normal(0, 0.3, (4, 500, 3))
+    mean, sd = mean_sd(x)
+    np.testing.assert_allclose(mean, x.mean(axis=1), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(sd, x.std(axis=1), rtol=0, atol=1e-12)

@@ -151,7 +151,6 @@ def velocity_walk_reference(v: np.ndarray, a: np.ndarray, scale: np.ndarray, max
     step += v * dt
 
 
-
 def clip_speed(v: np.ndarray, max_speed: float) -> None:
     """Scale the velocities in ``v`` (..., ≥ 2) whose floor speed exceeds ``max_speed`` (in place)."""
     s = np.hypot(v[..., 0], v[..., 1])

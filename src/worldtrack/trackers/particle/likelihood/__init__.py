@@ -6,6 +6,7 @@ Which module holds which part:
   likelihood ratio of the best object top (worldtrack's);
 * :mod:`.top_edge` — the top edge at each particle's own height (worldtrack's);
 * :mod:`.point` — the point likelihood, eq. 7 (the paper's baseline);
+* :mod:`.labels` — what each camera's frame reads as: ``F > γ``, cast shadows set apart;
 * :mod:`.images` — the per-frame layers: who owns a pixel (explaining away), who hides it
   (occluders);
 * :mod:`.reading` — how particles read a camera's frame: the kernels' argument containers and
@@ -13,7 +14,9 @@ Which module holds which part:
 * :mod:`.camera` — :class:`~.camera.CameraLikelihood`, one camera's constants and the floor
   geometry of its columns;
 * :mod:`.sums` — the likelihood multiplied over the cameras that see a particle;
-* :mod:`.hidden` — columns whose lower part is hidden, and pixel weights;
+* :mod:`.boxes` — the objects' image boxes and their overlaps;
+* :mod:`.hidden` — columns whose lower part is hidden; :mod:`.pixel_weights` — samples weighted by
+  the image length they stand for;
 * :mod:`.fused` — one camera's share of the column ratio in one compiled call (the hot path);
 * :mod:`.models` — the likelihoods a configuration names (``column-ratio``, ``column-count``,
   ``point``).
