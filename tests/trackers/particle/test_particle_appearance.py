@@ -3,22 +3,22 @@
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_particle import CAM, COLOURS, FLOOR, make_scene, render, run, tracker_for  # noqa: E402
+from worldtrack.scene import scene_from_dict
+from worldtrack.trackers.base import Frame
+from worldtrack.trackers.particle.appearance import (column_bins, column_bins_reference, column_penalties,
+                                                     learn_columns)
+from worldtrack.trackers.particle.colour import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS, SAT_BINS,
+                                                 ColourModel, colour_bins, colour_bins_compiled, colour_bins_reference,
+                                                 colour_log_ratio)
+from worldtrack.trackers.particle.likelihood import CameraLikelihood
+from worldtrack.trackers.particle.likelihood.models import Readers
+from worldtrack.trackers.particle.likelihood.boxes import boxes_apart
 
-from worldtrack.trackers.particle_appearance import (EPSILON, GREY_BINS, HUE_BINS, MIN_LEARN_SAMPLES, N_BINS,  # noqa: E402
-                                                     SAT_BINS, ColourModel, colour_bins, colour_bins_compiled,
-                                                     colour_bins_reference, colour_log_ratio, column_bins,
-                                                     column_bins_reference, column_penalties)
-from worldtrack.trackers.base import Frame  # noqa: E402
-from worldtrack.scene import scene_from_dict  # noqa: E402
-from worldtrack.trackers.particle_likelihood import CameraLikelihood  # noqa: E402
+from particle_scenes import CAM, COLOURS, DISTORTION, FLOOR, H, W, clouds, make_scene, render, run, tracker_for
 
 
 def bgr(*colours) -> np.ndarray:
@@ -81,9 +81,8 @@ def test_colour_log_ratio_of_several_models_is_each_models():
 def test_column_bins_read_the_colour_of_object_pixels_on_the_column():
     scene = make_scene(entry=False)
     cam = scene.camera("cam")
-    H, W = cam.height, cam.width
-    hit = np.zeros((H, W), dtype=np.uint8)
-    image = np.full((H, W, 3), 128, dtype=np.uint8)
+    hit = np.zeros((cam.height, cam.width), dtype=np.uint8)
+    image = np.full((cam.height, cam.width, 3), 128, dtype=np.uint8)
     xy = np.array([[0.0, 3.0], [1.5, 3.0]])
     heights = np.array([0.5, 1.0, 2.5])
     uv = cam.project(np.array([[0.0, 3.0, 0.5], [0.0, 3.0, 1.0]]))
@@ -102,7 +101,7 @@ def test_colour_bins_lookup_agrees_with_arithmetic():
     np.testing.assert_array_equal(colour_bins(img), colour_bins_reference(img))
 
 
-@pytest.mark.parametrize("dist", [None, [-0.2, 0.05, 0.001, -0.002, 0.0]])
+@pytest.mark.parametrize("dist", [None, DISTORTION])
 def test_column_bins_kernel_agrees_with_reference(dist):
     scene = scene_from_dict({"name": "t", "cameras": [{**CAM, **({"distortion": dist} if dist else {})}], "floor": FLOOR})
     cam = scene.camera("cam")
@@ -125,7 +124,7 @@ def test_compiled_colour_bins_agree_with_opencv_on_every_colour():
     assert len(np.unique(fast)) == N_BINS                               # every bin occurs
 
 
-@pytest.mark.parametrize("dist", [None, [-0.2, 0.05, 0.001, -0.002, 0.0]])
+@pytest.mark.parametrize("dist", [None, DISTORTION])
 def test_column_penalties_agree_with_bins_and_log_ratio(dist):
     """The fused penalty kernel: each particle's colour log-ratio of its column under its own
     filter's model, 0 where the model is None or has learnt nothing — as column_bins_reference then
@@ -162,16 +161,16 @@ def test_filters_learn_colours_only_while_their_boxes_are_apart():
 
     for paths, learns in ((apart, True), (behind, False)):
         scene = make_scene(entry=False)
-        tracker, bgs = tracker_for(scene, births="none")
+        tracker, bgs = tracker_for(scene, detection__births="none")
         people = paths(0.0)
         for i, (x, y) in enumerate(people, start=1):
             tracker.init_track(x, y, track_id=i)
         run(tracker, scene, bgs, paths, 5)
-        models = [f.colours.get("cam") for f in sorted(tracker.filters, key=lambda f: f.track.id)]
+        models = [c.colours.get("cam") for c in clouds(tracker)]
         if not learns:
             assert all(m is None or m.hist is None for m in models)
             continue
-        # Each learnt histogram peaks on its own person's colour bin (test_particle.COLOURS).
+        # Each learnt histogram peaks on its own person's colour bin (particle_scenes.COLOURS).
         own = [int(colour_bins(bgr(COLOURS[k]))[0, 0]) for k in range(2)]
         assert own[0] != own[1]
         for k, m in enumerate(models):
@@ -183,18 +182,73 @@ def test_likelihood_penalises_particles_on_another_persons_colours():
     """With person 1's learnt colours, particles on person 2 lose the colour penalty; particles on
     person 1 lose nothing; without colours both read the same column terms as before."""
     scene = make_scene(entry=False)
-    tracker, bgs = tracker_for(scene, births="none")
+    tracker, bgs = tracker_for(scene, detection__births="none")
     people = [(-1.0, 3.0), (1.0, 3.0)]
     for i, (x, y) in enumerate(people, start=1):
         tracker.init_track(x, y, track_id=i)
     run(tracker, scene, bgs, lambda t: people, 5)
-    first = min(tracker.filters, key=lambda f: f.track.id)
+    first = clouds(tracker)[0]
     assert first.colours["cam"].hist is not None
     frame = render(scene.camera("cam"), bgs["cam"], people, np.random.default_rng(9))
-    images = tracker._images({"cam": Frame(frame, 1.0, 10)})
+    view = tracker.labels.read({"cam": Frame(frame, 1.0, 10)})
     xyz = np.array([[-1.0, 3.0, 0.8], [1.0, 3.0, 0.8]])
-    plain, _, _ = tracker.likelihood(xyz, images)
-    coloured, _, _ = tracker.likelihood(xyz, images, colours=first.colours)
+    plain, _, _ = tracker.likelihood(xyz, None, view, Readers.one(2))
+    coloured, _, _ = tracker.likelihood(xyz, None, view, Readers.one(2, first.colours))
     assert coloured[0] == pytest.approx(plain[0])                        # own colours: no change
     absent = math.log(EPSILON / (1 + EPSILON))
     assert coloured[1] - plain[1] < 3 * absent                           # ≥ 3 samples of a foreign colour
+
+
+def test_colour_learning_kernel_agrees_with_numpy():
+    rng = np.random.default_rng(10)
+    fast, slow = ColourModel(), ColourModel()
+    for frame in range(30):
+        bins = rng.integers(-1, N_BINS, (3, 6)).astype(np.int16)
+        if frame % 7 == 3:
+            bins[:] = -1
+            bins[0, :MIN_LEARN_SAMPLES - 1] = 2                  # too few to learn from
+        assert fast.learn(bins, 0.1) == slow.learn_reference(bins, 0.1)
+        np.testing.assert_array_equal(fast.hist, slow.hist)
+        assert fast.frames == slow.frames
+    assert fast.frames > 20 and abs(fast.hist.sum() - 1) < 1e-12
+    with pytest.raises(ValueError, match="below"):
+        fast.learn(np.full(10, N_BINS), 0.1)
+
+
+def test_learn_columns_equals_the_calls_one_by_one():
+    """Colour learning in one compiled call: the same models (histograms, frames) as box_array,
+    boxes_apart, beside, column_bins and ColourModel.learn one after the other; filters whose boxes
+    overlap another's, or that are not learners, are not taught."""
+    cam = make_scene().cameras["cam"]
+    cl = CameraLikelihood(cam)
+    rng = np.random.default_rng(23)
+    hit = (rng.random((H, W)) < 0.7).astype(np.uint8)
+    image = rng.integers(0, 256, (H, W, 3)).astype(np.uint8)
+    centres = np.array([[-2.0, 3.0], [0.0, 2.5], [0.2, 2.6], [2.0, 4.0], [1.0, 5.5], [-1.0, 5.0]])
+    widths, heights = np.full(6, 0.45), np.array([1.7, 1.6, 1.8, 1.7, 1.75, 1.7])
+    learners = np.array([True, True, True, True, False, True])
+    old = ColourModel()
+    old.learn(rng.integers(0, N_BINS, 30), 1.0)
+    for trial in range(2):
+        models = [ColourModel() if i % 2 else None for i in range(6)]
+        models[3] = old if trial else models[3]
+        ref = [None if m is None else ColourModel() for m in models]
+        for a, b in zip(models, ref):                     # the same models, for the calls one by one
+            if a is not None and a.hist is not None:
+                b.hist, b.frames = a.hist.copy(), a.frames
+        given = [m if m is not None else ColourModel() for m in models]
+        taught = learn_columns(cl, image, hit, centres, widths, heights, learners, 0.05, 0.14, given, 0.1)
+        boxes = cl.box_array(centres, widths, heights, 0.05)
+        idx = np.flatnonzero(learners & boxes_apart(boxes))
+        np.testing.assert_array_equal(np.flatnonzero(taught), idx)
+        bins = column_bins(cl, image, hit, cl.beside(centres[idx], 0.14, 0.25 * widths[idx])).reshape(len(idx), -1)
+        want = [r if r is not None else ColourModel() for r in ref]
+        for i, b in zip(idx, bins):
+            want[i].learn(b, 0.1)
+        for a, b in zip(given, want):
+            assert a.frames == b.frames
+            assert (a.hist is None) == (b.hist is None)
+            if a.hist is not None:
+                np.testing.assert_array_equal(a.hist, b.hist)
+        assert 1 not in idx and 2 not in idx and 4 not in idx and 3 in idx   # overlapping, not a learner
+    assert old.frames == 2                                # learnt once more, blending into its histogram
