@@ -6,13 +6,16 @@ functions give, for a synthetic scenario, the exact head point of every person a
 it — the observations a head detector would make — with optional pixel noise.
 
 >>> from worldtrack.synth import make_scenario
->>> sc = make_scenario("non-overlapping", frames=50, seed=0, people=1)
+>>> sc = make_scenario("non-overlapping", frames=200, seed=13, people=1)
 >>> heads = head_tracks(sc)
 >>> heads[1].points.shape
-(50, 3)
->>> obs = head_pixels(sc, noise_px=0.0)
->>> sorted(set(obs.camera))[:1]
-['cam1']
+(200, 3)
+>>> obs = head_pixels(sc, noise_px=0.0, tracks=heads)
+>>> sorted(str(c) for c in set(obs.camera))
+['cam2', 'cam4']
+>>> seen = obs.camera == "cam2"
+>>> bool(np.allclose(sc.scene.cameras["cam2"].project(obs.truth[seen]), obs.uv[seen]))
+True
 """
 
 from __future__ import annotations

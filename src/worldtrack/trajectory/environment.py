@@ -43,7 +43,7 @@ def sample_field(grid: FloorGrid, xy: np.ndarray) -> tuple[np.ndarray, np.ndarra
     """Bilinear value and gradient of a floor field at points (N, 2), extrapolated outside the grid.
 
     Beyond the grid the value continues as ``d(nearest grid point) − distance to it`` (walls lie
-    inside the grid, so there it only grows more negative), with the gradient pointing back.
+    inside the grid, so there it only grows more negative), with its gradient.
 
     Returns
     -------
@@ -70,8 +70,9 @@ def sample_field(grid: FloorGrid, xy: np.ndarray) -> tuple[np.ndarray, np.ndarra
     gap = np.hypot(out[:, 0], out[:, 1])
     far = gap > 0
     if far.any():
+        # d(p) = d(c(p)) − |c(p) − p|: the clamped coordinates of c do not follow p
         d[far] -= gap[far]
-        grad[far] = out[far] / gap[far, None]
+        grad[far] = np.where(out[far] != 0, 0.0, grad[far]) + out[far] / gap[far, None]
     return d, grad
 
 

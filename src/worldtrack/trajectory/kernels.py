@@ -143,9 +143,10 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
         gy = ((1 - u) * (v10 - v00) + u * (v11 - v01)) / res
         ox, oy = cx - px, cy - py
         gap = np.sqrt(ox * ox + oy * oy)
-        if gap > 0:
+        if gap > 0:                    # d(p) = d(c(p)) − |c(p) − p|, c the clamped point
             d -= gap
-            gx, gy = ox / gap, oy / gap
+            gx = (0.0 if ox != 0 else gx) + ox / gap
+            gy = (0.0 if oy != 0 else gy) + oy / gap
         z = max((clearance - d) / softness, -30.0)
         soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
         sig = 1.0 / (1.0 + np.exp(-z))

@@ -50,7 +50,7 @@ class TimeGrid:
     """The uniform time grid ``t_k = t0 + k·dt``, k = 0 … n − 1 (seconds).
 
     >>> grid = TimeGrid.covering([0.0, 0.1, 0.25, 1.0], dt=0.1)
-    >>> grid.n, grid.times[-1]
+    >>> grid.n, float(grid.times[-1])
     (11, 1.0)
     >>> grid.locate([0.25])   # step 2 or 3: 0.25 s is 0.05 s after step 2
     (array([2]), array([0.05]))

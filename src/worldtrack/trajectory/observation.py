@@ -40,7 +40,7 @@ class Observations:
     >>> obs = Observations.from_points([0.0, 0.1], ["c1", "c1"], [[0, 0, 1.7], [0.1, 0, 1.7]], {"c1": cam})
     >>> obs.uv.round(1)
     array([[319.5, 239.5],
-           [333.5, 239.5]])
+           [333.1, 239.5]])
     """
 
     time: np.ndarray

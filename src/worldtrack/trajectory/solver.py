@@ -230,14 +230,14 @@ def jacobian_dense(problem: Problem, X: np.ndarray) -> np.ndarray:
     return np.vstack(rows)
 
 
-def solve_dense(problem: Problem, X0: np.ndarray, xtol: float = 1e-12) -> np.ndarray:
+def solve_dense(problem: Problem, X0: np.ndarray, xtol: float = 1e-8) -> np.ndarray:
     """Reference optimum: ``scipy.optimize.least_squares`` (MINPACK's Levenberg–Marquardt, dense
     Jacobian) on :func:`residual_vector` from X0. Small problems only (T of a few hundred)."""
     shape = np.shape(X0)
     fun = lambda x: residual_vector(problem, x.reshape(shape))  # noqa: E731
     jac = "2-point" if problem.robust else (lambda x: jacobian_dense(problem, x.reshape(shape)))
     sol = scipy.optimize.least_squares(fun, np.asarray(X0, float).ravel(), jac=jac, method="lm",
-                                       xtol=xtol, ftol=1e-15, gtol=1e-15, x_scale="jac")
+                                       xtol=xtol, ftol=1e-12, gtol=1e-12)
     return sol.x.reshape(shape)
 
 
