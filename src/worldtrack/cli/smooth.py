@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     field = scene.distance_field(0.05) if options.environment else None
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    estimates, columns = {}, {}
+    estimates, columns, observations = {}, {}, {}
     for pid in people:
         rows = table.of(pid)
         if len(rows) < 2:
@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
         obs = Observations.from_rows(rows.time, rows.camera, rows.uv, scene.cameras, rows.sigma)
         t0 = time.perf_counter()
         est = estimate_trajectory(obs, field, replace(options, height=height))
-        estimates[pid], columns[pid] = est, est.columns()
+        estimates[pid], columns[pid], observations[pid] = est, est.columns(), obs
         write_trajectories(out / "trajectory.csv", columns)      # after every person: an interrupt keeps them
         if not args.quiet:
             seen = int(np.count_nonzero(est.observed))
@@ -126,23 +126,14 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("no person has 2 or more observations")
     print(f"trajectories: {out / 'trajectory.csv'}", file=sys.stderr)
     if not args.no_plots:
-        _plots(scene, table, estimates, out)
+        _plots(scene, observations, estimates, out)
     return 0
 
 
-def _plots(scene, table: ObservationTable, estimates: dict, out: Path) -> None:
-    from worldtrack.viz.trajectory import save_height_plot, save_trajectory_plan
+def _plots(scene, observations: dict, estimates: dict, out: Path) -> None:
+    from worldtrack.viz.trajectory import observation_points, save_height_plot, save_trajectory_plan
     ids = list(scene.cameras)
-    points = {}
-    for pid, est in estimates.items():
-        rows = table.of(pid)
-        xy = np.full((len(rows), 2), np.nan)
-        for k, cid in enumerate(ids):
-            sel = np.flatnonzero(rows.camera == cid)
-            if len(sel):
-                z = np.interp(rows.time[sel], est.times, est.positions[:, 2])   # at the estimated height
-                xy[sel] = scene.cameras[cid].backproject(rows.uv[sel], z)[:, :2]
-        points[pid] = (xy, np.array([ids.index(c) for c in rows.camera]))
+    points = {pid: observation_points(observations[pid], est, ids) for pid, est in estimates.items()}
     head = float(np.median([np.median(e.positions[:, 2]) for e in estimates.values()]))
     plan = save_trajectory_plan(scene, out / "floorplan.png", estimates, points, coverage_height=head)
     height = save_height_plot(out / "height.png", estimates)

@@ -22,6 +22,18 @@ from worldtrack.scene.model import Scene  # noqa: E402
 from worldtrack.viz.floorplan import CAMERA_COLOURS, draw_scene  # noqa: E402
 
 
+def observation_points(obs, estimate, camera_ids: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Where the observations put the head on the floor: each pixel back-projected to the estimated
+    head height at its time. Returns points (N, 2) metres and each one's index in ``camera_ids``
+    (for its colour)."""
+    xy = np.full((len(obs), 2), np.nan)
+    for k, cam in enumerate(obs.cameras):
+        sel = obs.camera == k
+        z = np.interp(obs.time[sel], estimate.times, estimate.positions[:, 2])
+        xy[sel] = cam.backproject(obs.uv[sel], z)[:, :2]
+    return xy, np.array([camera_ids.index(obs.cameras[k].id) for k in obs.camera], dtype=int)
+
+
 def sigma_ellipses(xy: np.ndarray, cov: np.ndarray, k: float = 2.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Full axes (n,), (n,) in metres and angles (n,) in degrees of the k-σ ellipses of 2 × 2
     covariances ``cov`` (n, 2, 2) — what the band is drawn from."""
