@@ -18,6 +18,7 @@ Needs ``pip install 'worldtrack[gtsam]'``; :func:`available` says whether it is 
 
 from __future__ import annotations
 
+import threading
 import time
 from dataclasses import dataclass
 
@@ -131,13 +132,36 @@ def solve(problem: Problem, X0: np.ndarray, with_barrier: bool = False, relative
     params.setAbsoluteErrorTol(0.0)
     params.setMaxIterations(max_iterations)
     optimizer = gtsam.LevenbergMarquardtOptimizer(graph, values, params)
-    result = optimizer.optimize()
+    result = _with_large_stack(optimizer.optimize)
     t2 = time.perf_counter()
     X = np.zeros_like(X0)
     for t in range(problem.grid.n):
         X[t, POS] = result.atPoint3(P(t))
         X[t, VEL] = result.atVector(V(t))
     return PeerResult(X, 2.0 * graph.error(result), t1 - t0, t2 - t1, optimizer.iterations())
+
+
+def _with_large_stack(fn, size: int = 1 << 30):
+    """``fn()`` on a thread with a ``size``-byte stack: GTSAM eliminates a chain recursively, and at
+    T = 100 000 that overflows the main thread's default 8 MB stack (a segmentation fault)."""
+    out: dict = {}
+
+    def target():
+        try:
+            out["value"] = fn()
+        except BaseException as e:  # noqa: BLE001 (re-raised below, on the caller's thread)
+            out["error"] = e
+
+    old = threading.stack_size(size)
+    try:
+        worker = threading.Thread(target=target)
+        worker.start()
+        worker.join()
+    finally:
+        threading.stack_size(old)
+    if "error" in out:
+        raise out["error"]
+    return out["value"]
 
 
 def check_same_objective(problem: Problem, X: np.ndarray, with_barrier: bool = False) -> tuple[float, float]:

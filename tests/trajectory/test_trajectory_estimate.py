@@ -35,6 +35,20 @@ def test_free_space_route_goes_round_a_wall_and_keeps_its_clearance(office):
     assert 2.0 + 0.8 < length < 4.0
 
 
+def test_free_space_route_finds_a_far_door_and_never_enters_a_wall():
+    from worldtrack.trajectory.environment import field_from_walkable
+    walk = np.ones((120, 60), dtype=bool)                               # x −3…2.9 m, y −6…5.9 m at 0.1 m
+    walk[:90, 35] = False                                               # a thin wall at x = 0.5 m up to y = 3 m
+    field = field_from_walkable(walk, (-3.0, -6.0), 0.1)
+    a, b = np.array([0.0, 0.0]), np.array([1.0, 0.0])
+    route = free_space_route(field, a, b, clearance=0.2)
+    d, _ = sample_field(field, route)
+    assert route[:, 1].max() > 3.0 and d.min() > 0                      # round the end, 3 m away, not through it
+    closed = walk.copy()
+    closed[:, 35] = False
+    assert free_space_route(field_from_walkable(closed, (-3.0, -6.0), 0.1), a, b, 0.2) is None
+
+
 def _office_estimate(office, **options):
     sc, tracks, pixels = office
     person = pixels.of(1)
@@ -60,6 +74,7 @@ def test_office_with_detours_map_beats_the_kalman_smoother_and_keeps_out_of_obst
     between = ~seen
     assert np.sqrt(np.mean(err[between] ** 2)) < 0.7 * np.sqrt(np.mean(base_err[between] ** 2))
     assert est.start == "shortest"                                      # only it knows the passages
+    assert est.results["shortest"].converged                            # the race's leader went on
     assert est.start_objectives["shortest"] < est.start_objectives["straight"]
     # without the barrier the MAP cuts through a screen, as the paper's figure shows
     assert inside_obstacles(field, est.without_barrier[:, [0, 2]]).any()

@@ -32,6 +32,40 @@ def test_band_storage_products_and_solves_equal_the_dense_matrix():
     np.testing.assert_allclose(solve_blocks(D, B, x), np.linalg.solve(H, x.ravel()).reshape(9, 6), atol=1e-10)
 
 
+def test_the_block_cholesky_kernel_equals_lapacks_band_cholesky():
+    D, B = _random_blocks(40, seed=8)
+    rng = np.random.default_rng(9)
+    rhs, damping = rng.normal(size=(40, 6)), rng.uniform(0, 2, (40, 6))
+    work = np.empty((40, 6, 6)), np.empty((40, 6, 6)), np.empty((40, 6)), np.empty((40, 6))
+    assert kernels.block_cholesky_solve(D, B, damping, rhs, *work)
+    Dd = D.copy()
+    Dd[:, np.arange(6), np.arange(6)] += damping
+    np.testing.assert_allclose(work[3], solve_blocks(Dd, B, rhs), rtol=1e-10, atol=1e-12)
+    D[17] = -np.eye(6)                                              # not positive definite
+    assert not kernels.block_cholesky_solve(D, B, damping * 0, rhs, *work)
+
+
+def test_lm_with_either_linear_solver_reaches_the_same_optimum():
+    case = observed_walk(T=81, seed=5)
+    X0 = straight_start(case.problem.observations, case.problem.grid, 1.7)
+    a = levenberg_marquardt(case.problem, X0, SolverOptions(linear_solver="block"))
+    b = levenberg_marquardt(case.problem, X0, SolverOptions(linear_solver="lapack"))
+    assert a.costs.total == pytest.approx(b.costs.total, rel=1e-12)
+    assert np.abs(a.X - b.X).max() < 1e-8
+
+
+def test_the_motion_kernel_equals_its_numpy_reference():
+    from worldtrack.trajectory.model import MotionPrior
+    X = np.random.default_rng(3).normal(size=(30, 6))
+    prior = MotionPrior(0.8, 0.05)
+    A, W = prior.transition(0.2), prior.whitener(0.2)
+    g1, g2 = np.zeros((30, 6)), np.zeros((30, 6))
+    c1 = kernels.add_motion_terms(X, A, W, g1)
+    c2 = kernels.add_motion_terms_reference(X, A, W, g2)
+    assert c1 == pytest.approx(c2, rel=1e-12)
+    np.testing.assert_allclose(g1, g2, atol=1e-9)
+
+
 def test_the_compiled_scatter_equals_np_add_at():
     rng = np.random.default_rng(4)
     n, m = 12, 40

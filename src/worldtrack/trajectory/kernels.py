@@ -1,9 +1,9 @@
 """Compiled kernels of the normal equations, each beside the NumPy reference it is tested against.
 
-Two scatter operations dominate an iteration at T = 100 000 if done with NumPy: adding the
-barrier samples' outer products into the blocks (``np.add.at`` over ~10⁵ samples × 144 entries)
-and copying the blocks into LAPACK's band storage (fancy indexing over 7·10⁶ entries). Both are
-plain loops in Numba.
+At T = 100 000 an iteration touches arrays of tens of megabytes; done with NumPy, the scatters
+(adding the barrier samples' outer products into the blocks with ``np.add.at``, copying the blocks
+into LAPACK's band storage by fancy indexing) and the temporaries of the motion term dominate
+it. These are plain loops in Numba over buffers that are allocated once.
 """
 
 from __future__ import annotations
@@ -13,6 +13,45 @@ from numba import njit
 
 STATE = 6
 BANDWIDTH = 2 * STATE - 1
+
+
+@njit(cache=True)
+def add_motion_terms(X: np.ndarray, A: np.ndarray, W: np.ndarray, g: np.ndarray) -> float:  # pragma: no cover
+    """In place: the motion residuals r_t = W·(x_{t+1} − A·x_t) added into the half-gradient g (n, 6)
+    (∂r_t/∂x_t = −W·A, ∂r_t/∂x_{t+1} = W); returns Σ‖r_t‖². One pass, no temporaries."""
+    n = X.shape[0]
+    WA = W @ A
+    e = np.empty(STATE)
+    r = np.empty(STATE)
+    cost = 0.0
+    for t in range(n - 1):
+        for i in range(STATE):
+            acc = X[t + 1, i]
+            for j in range(STATE):
+                acc -= A[i, j] * X[t, j]
+            e[i] = acc
+        for i in range(STATE):
+            acc = 0.0
+            for j in range(STATE):
+                acc += W[i, j] * e[j]
+            r[i] = acc
+            cost += acc * acc
+        for j in range(STATE):
+            down, up = 0.0, 0.0
+            for i in range(STATE):
+                down += WA[i, j] * r[i]
+                up += W[i, j] * r[i]
+            g[t, j] -= down
+            g[t + 1, j] += up
+    return cost
+
+
+def add_motion_terms_reference(X: np.ndarray, A: np.ndarray, W: np.ndarray, g: np.ndarray) -> float:
+    """NumPy reference of :func:`add_motion_terms`."""
+    r = (X[1:] - X[:-1] @ A.T) @ W.T
+    g[:-1] -= r @ (W @ A)
+    g[1:] += r @ W
+    return float(np.sum(r * r))
 
 
 @njit(cache=True)
@@ -77,6 +116,70 @@ def block_matvec_reference(D: np.ndarray, B: np.ndarray, x: np.ndarray) -> np.nd
     y[:-1] += np.einsum("nij,nj->ni", B, x[1:])
     y[1:] += np.einsum("nji,nj->ni", B, x[:-1])
     return y
+
+
+@njit(cache=True)
+def block_cholesky_solve(D: np.ndarray, B: np.ndarray, damping: np.ndarray, rhs: np.ndarray, L: np.ndarray,
+                         C: np.ndarray, y: np.ndarray, x: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """Solve (H + diag(damping))·x = rhs for the SPD block-tridiagonal H of D (n, 6, 6), B (n − 1, 6, 6):
+    the banded Cholesky factorisation done block by block (S_t = D_t − C_{t−1}ᵀC_{t−1} = L_t·L_tᵀ,
+    C_t = L_t⁻¹·B_t, then forward and back substitution). L, C (n, 6, 6), y, x (n, 6) are work and
+    output buffers; returns False if H is not positive definite."""
+    n = D.shape[0]
+    S = np.empty((STATE, STATE))
+    for t in range(n):
+        # S = D_t + diag(damping_t) - C_{t-1}^T C_{t-1}
+        for i in range(STATE):
+            for j in range(i + 1):
+                acc = D[t, i, j]
+                if t > 0:
+                    for k in range(STATE):
+                        acc -= C[t - 1, k, i] * C[t - 1, k, j]
+                S[i, j] = acc
+            S[i, i] += damping[t, i]
+        # Cholesky S = L L^T (lower)
+        for j in range(STATE):
+            acc = S[j, j]
+            for k in range(j):
+                acc -= L[t, j, k] * L[t, j, k]
+            if not acc > 0.0:
+                return False
+            d = np.sqrt(acc)
+            L[t, j, j] = d
+            for i in range(j + 1, STATE):
+                acc = S[i, j]
+                for k in range(j):
+                    acc -= L[t, i, k] * L[t, j, k]
+                L[t, i, j] = acc / d
+            for i in range(j):
+                L[t, i, j] = 0.0
+        # forward: y_t = L^-1 (rhs_t - C_{t-1}^T y_{t-1})
+        for i in range(STATE):
+            acc = rhs[t, i]
+            if t > 0:
+                for k in range(STATE):
+                    acc -= C[t - 1, k, i] * y[t - 1, k]
+            for k in range(i):
+                acc -= L[t, i, k] * y[t, k]
+            y[t, i] = acc / L[t, i, i]
+        # C_t = L^-1 B_t
+        if t < n - 1:
+            for col in range(STATE):
+                for i in range(STATE):
+                    acc = B[t, i, col]
+                    for k in range(i):
+                        acc -= L[t, i, k] * C[t, k, col]
+                    C[t, i, col] = acc / L[t, i, i]
+    for t in range(n - 1, -1, -1):
+        for i in range(STATE - 1, -1, -1):
+            acc = y[t, i]
+            if t < n - 1:
+                for k in range(STATE):
+                    acc -= C[t, i, k] * x[t + 1, k]
+            for k in range(i + 1, STATE):
+                acc -= L[t, k, i] * x[t, k]
+            x[t, i] = acc / L[t, i, i]
+    return True
 
 
 @njit(cache=True)

