@@ -11,7 +11,7 @@ from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.smoother import constant_velocity, kalman_rts
 from worldtrack.trajectory.starts import free_space_route, shortest_path_start, straight_start
 
-from conftest import observed_walk
+from _trajectory_cases import observed_walk
 
 
 def test_straight_start_passes_through_the_back_projected_observations():
@@ -86,7 +86,7 @@ def test_unsynchronised_cameras_cost_no_accuracy():
     case = observed_walk(T=81, noise_px=0.5, seed=4)
     obs = case.obs
     shifted = np.where(obs.camera == 1, obs.time + 0.037, obs.time)     # camera b 37 ms late
-    from conftest import walk
+    from _trajectory_cases import walk
     t, pts = walk(81)
     truth_at = np.column_stack([np.interp(shifted, t, pts[:, k]) for k in range(3)])
     uv = np.empty_like(obs.uv)

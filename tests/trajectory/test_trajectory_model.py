@@ -8,7 +8,7 @@ from worldtrack.trajectory.model import (MotionPrior, TimeGrid, dense_from_block
                                          motion_residuals)
 from worldtrack.trajectory.observation import Observations, ObservationTerm, project_with_jacobian
 
-from conftest import ceiling_cameras
+from _trajectory_cases import ceiling_cameras
 
 
 def test_time_grid_covers_the_observations_and_locates_off_grid_times():

@@ -11,7 +11,7 @@ from worldtrack.trajectory.solver import (LevenbergMarquardt, SolverOptions, den
 from worldtrack.trajectory.starts import straight_start
 from worldtrack.trajectory.uncertainty import marginal_covariances, marginal_covariances_dense
 
-from conftest import observed_walk
+from _trajectory_cases import observed_walk
 
 
 def _random_blocks(n, seed=0):
