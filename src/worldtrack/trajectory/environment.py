@@ -169,7 +169,7 @@ class BarrierResiduals:
     curvature: np.ndarray
 
 
-#: Beyond z = (c − d)/w < −30 a sample's residual is below 1e-13·w/s_h: it is left out.
+#: Beyond z = (c − d)/w ≤ −30 a sample's residual is below 1e-13·w/s_h: it is left out (r = 0).
 Z_CUTOFF = -30.0
 
 
@@ -183,11 +183,12 @@ def barrier_samples_reference(X: np.ndarray, step: np.ndarray, alpha: np.ndarray
     u = H[:, 0] * x0[:, _U] + H[:, 1] * x0[:, _UD] + H[:, 2] * x1[:, _U] + H[:, 3] * x1[:, _UD]
     v = H[:, 0] * x0[:, _V] + H[:, 1] * x0[:, _VD] + H[:, 2] * x1[:, _V] + H[:, 3] * x1[:, _VD]
     d, grad = sample_field(field, np.column_stack([u, v]))
-    z = np.maximum((clearance - d) / softness, Z_CUTOFF)
-    r = gain * softness * np.logaddexp(0.0, z)                 # w·log(1 + e^z)
-    sigmoid = expit(z)
+    z = (clearance - d) / softness
+    reach = z > Z_CUTOFF                                       # beyond: r and J exactly 0
+    r = np.where(reach, gain * softness * np.logaddexp(0.0, z), 0.0)      # w·log(1 + e^z)
+    sigmoid = np.where(reach, expit(z), 0.0)
     # r′ = ∂r/∂(c − d) = gain·σ(z), r″ = gain·σ(1 − σ)/w, so r·r″/r′² = r·(1 − σ)/(gain·w·σ)
-    curvature = 1.0 + r * (1.0 - sigmoid) / (gain * softness * sigmoid)
+    curvature = np.where(reach, 1.0 + r * (1.0 - sigmoid) / (gain * softness * np.where(reach, sigmoid, 1.0)), 1.0)
     g = -(gain * sigmoid)[:, None] * grad                      # ∂r/∂(u, v) of the sample point
     J = np.zeros((len(d), 2 * STATE))
     for k, (iu, iud) in enumerate(((_U, _UD), (_V, _VD))):
@@ -202,9 +203,9 @@ def barrier_residuals(X: np.ndarray, barrier: Barrier, weight: float, dt: float,
                       only_active: bool = True, reference: bool = False) -> BarrierResiduals:
     """√(λ/m)·w·log(1 + e^((c − d_h(p(α)))/w))/s_h at every sample of :meth:`Barrier.samples`.
 
-    With ``only_active`` (the solver's use) only the samples with (c − d)/w > −30 are returned;
-    otherwise all, in sample order (the dense reference's use). ``reference``: the NumPy version
-    instead of the compiled kernel.
+    With ``only_active`` only the samples with (c − d)/w > −30 are returned; otherwise all, in sample
+    order, those beyond the barrier's reach with r = 0 and J = 0 (the solver's and the dense
+    reference's use). ``reference``: the NumPy version instead of the compiled kernel.
     """
     from worldtrack.trajectory.kernels import barrier_samples
     t, alpha = barrier.samples(len(X))

@@ -60,6 +60,8 @@ def add_pair_terms(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray
     """In place: residuals r (M,) with Jacobians J (M, 12) on (x_t, x_{t+1}), t = step, added into
     the diagonal blocks D and upper blocks B (as weight·JᵀJ) and the half-gradient g (as Jᵀr)."""
     for m in range(step.shape[0]):
+        if r[m] == 0.0:                # a sample left out (beyond the barrier's reach): nothing to add
+            continue
         t = step[m]
         w = weight[m]
         for i in range(2 * STATE):
@@ -250,11 +252,15 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
             d -= gap
             gx = (0.0 if ox != 0 else gx) + ox / gap
             gy = (0.0 if oy != 0 else gy) + oy / gap
-        z = max((clearance - d) / softness, -30.0)
+        z = (clearance - d) / softness
+        d_out[m] = d
+        if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
+            r[m] = 0.0
+            curvature[m] = 1.0
+            continue
         soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
         sig = 1.0 / (1.0 + np.exp(-z))
         r[m] = gain * softness * soft
-        d_out[m] = d
         curvature[m] = 1.0 + r[m] * (1.0 - sig) / (gain * softness * sig)
         sx, sy = -gain * sig * gx, -gain * sig * gy
         J[m, 0], J[m, 1], J[m, 6], J[m, 7] = sx * h0, sx * h1, sx * h2, sx * h3

@@ -156,9 +156,9 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None)
     env = problem.environment
     barrier_cost = height_cost = 0.0
     if env.barrier is not None:
-        br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt)
+        br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
         if len(br.r):
-            add_pair_terms(D, B, g, br.step, br.J, br.r, br.curvature)
+            add_pair_terms(D, B, g, br.step, br.J, br.r, br.curvature)      # skips the r = 0 samples
             barrier_cost = float(br.r @ br.r)
             barrier_steps[br.step[br.inside]] = True
     if env.height is not None:

@@ -25,6 +25,8 @@ from worldtrack.trajectory.model import STATE, TimeGrid
 from worldtrack.trajectory.observation import ObservationTerm
 
 START_NAMES = ("straight", "map", "shortest")
+#: Gaps whose ends fall in the same cells of this size (m) share one shortest-path search.
+ROUTE_CACHE_CELL = 0.25
 
 
 def anchor_points(term: ObservationTerm, head_height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -66,13 +68,18 @@ def shortest_path_start(term: ObservationTerm, grid: TimeGrid, head_height: floa
     steps, xy = anchor_points(term, head_height)
     k = np.arange(grid.n)
     path = np.column_stack([np.interp(k, steps, xy[:, 0]), np.interp(k, steps, xy[:, 1])])
+    routes: dict[tuple, np.ndarray | None] = {}     # long tracks cross the same gaps again and again
     for i in np.flatnonzero(np.diff(steps) > 1):
         k0, k1 = steps[i], steps[i + 1]
         a, b = xy[i], xy[i + 1]
         if not _blocked(field, a, b, clearance):
             continue
-        route = free_space_route(field, a, b, clearance, resolution)
+        key = tuple(np.rint(np.r_[a, b] / ROUTE_CACHE_CELL).astype(int))
+        if key not in routes:
+            routes[key] = free_space_route(field, a, b, clearance, resolution)
+        route = routes[key]
         if route is not None:
+            route = np.vstack([a, route[1:-1], b])          # a cached route, joined to these ends
             path[k0:k1 + 1] = resample_by_length(route, k1 - k0 + 1)
     return states_from_positions(path, grid, head_height)
 
