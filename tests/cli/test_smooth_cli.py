@@ -95,3 +95,21 @@ def test_tracks_csv_of_a_camera_run_are_read_as_head_pixels(office_files, tmp_pa
     assert len(table) == 5
     np.testing.assert_allclose(table.uv, cam.project(head.points[k]), atol=1e-6)
     assert read_observations(d / "obs.csv", sc.scene.cameras).people() == [1]
+
+
+def test_a_person_that_cannot_be_estimated_is_skipped_with_a_line(office_files, capsys, tmp_path):
+    d, _, _ = office_files
+    rows = list(csv.reader(open(d / "obs.csv")))
+    header = rows[0]
+    lone = [dict(zip(header, r)) for r in rows[1:3]]
+    for r in lone:                                   # person 7: two cameras' rows at one time stamp
+        r["id"], r["t"] = "7", "1.0"
+    lone[1]["camera"] = "cam1" if lone[0]["camera"] != "cam1" else "cam2"
+    path = tmp_path / "two_people.csv"
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, header)
+        w.writeheader()
+        w.writerows([dict(zip(header, r)) for r in rows[1:]] + lone)
+    assert main(["smooth", str(d / "scene.yaml"), str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert "person 7: skipped: cannot tell the time step" in err and "person 1:" in err

@@ -111,7 +111,11 @@ def run(args: argparse.Namespace) -> int:
         height = height_arg or (float(np.median(given)) if len(given) else scene.people.size_of(pid)[0])
         obs = Observations.from_rows(rows.time, rows.camera, rows.uv, scene.cameras, rows.sigma)
         t0 = time.perf_counter()
-        est = estimate_trajectory(obs, field, replace(options, height=height))
+        try:
+            est = estimate_trajectory(obs, field, replace(options, height=height))
+        except InputError as e:                       # this person only (e.g. one time stamp): go on
+            print(f"person {pid}: skipped: {e}", file=sys.stderr)
+            continue
         estimates[pid], columns[pid], observations[pid] = est, est.columns(), obs
         write_trajectories(out / "trajectory.csv", columns)      # after every person: an interrupt keeps them
         if not args.quiet:
