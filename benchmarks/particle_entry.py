@@ -110,11 +110,13 @@ def render(seed: int, size: tuple[int, int], **overrides) -> Sequence:
 #: The foreground's colour threshold (the particle tracker's γ): the synthetic world's, as every
 #: synthetic benchmark uses (``--threshold``).
 THRESHOLD = [SYNTHETIC_COLOUR_THRESHOLD]
+#: The foreground model's kind (``--foreground``).
+KIND = ["colour"]
 
 
 def foreground(seq: Sequence) -> dict:
     """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart)."""
-    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, "colour", THRESHOLD[0])
+    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], THRESHOLD[0])
 
 
 def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
@@ -406,10 +408,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", default=None, metavar="PATH", help="also write every run's figures as JSON")
     p.add_argument("--name", default="particle_entry", help="result file benchmarks/results/NAME.md")
     p.add_argument("--no-write", action="store_true")
+    p.add_argument("--foreground", default="colour", choices=("grey", "colour"),
+                   help="the foreground model (default colour, as worldtrack track)")
     p.add_argument("--threshold", type=float, default=SYNTHETIC_COLOUR_THRESHOLD,
                    help=f"the foreground's colour threshold, the particle tracker's γ (default {SYNTHETIC_COLOUR_THRESHOLD:g})")
     args = p.parse_args(argv)
     THRESHOLD[0] = args.threshold
+    KIND[0] = args.foreground
     w, h = (int(v) for v in args.size.lower().split("x"))
     options = dict(parse_assignment(s) for s in args.set)
     for name in args.configs:
