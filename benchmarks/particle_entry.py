@@ -107,16 +107,17 @@ def render(seed: int, size: tuple[int, int], **overrides) -> Sequence:
     return Sequence(seed, sc, render_images(sc), sc.background("cam"))
 
 
-#: The foreground's colour threshold (the particle tracker's γ): the synthetic world's, as every
-#: synthetic benchmark uses (``--threshold``).
-THRESHOLD = [SYNTHETIC_COLOUR_THRESHOLD]
-#: The foreground model's kind (``--foreground``).
-KIND = ["colour"]
+#: The foreground's threshold (the particle tracker's γ; ``--threshold``): None, the kind's default (grey 25;
+#: colour: the synthetic world's 20, as every synthetic benchmark uses).
+THRESHOLD: list[float | None] = [None]
+#: The foreground model's kind (``--foreground``): the particle tracker's own, grey.
+KIND = ["grey"]
 
 
 def foreground(seq: Sequence) -> dict:
     """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart)."""
-    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], THRESHOLD[0])
+    threshold = SYNTHETIC_COLOUR_THRESHOLD if THRESHOLD[0] is None and KIND[0] == "colour" else THRESHOLD[0]
+    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], threshold)
 
 
 def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
@@ -408,10 +409,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", default=None, metavar="PATH", help="also write every run's figures as JSON")
     p.add_argument("--name", default="particle_entry", help="result file benchmarks/results/NAME.md")
     p.add_argument("--no-write", action="store_true")
-    p.add_argument("--foreground", default="colour", choices=("grey", "colour"),
-                   help="the foreground model (default colour, as worldtrack track)")
-    p.add_argument("--threshold", type=float, default=SYNTHETIC_COLOUR_THRESHOLD,
-                   help=f"the foreground's colour threshold, the particle tracker's γ (default {SYNTHETIC_COLOUR_THRESHOLD:g})")
+    p.add_argument("--foreground", default="grey", choices=("grey", "colour"),
+                   help="the foreground model (default grey, the particle tracker's own in worldtrack track)")
+    p.add_argument("--threshold", type=float, default=None,
+                   help=f"the foreground's threshold, the particle tracker's γ (default: grey 25, colour "
+                        f"{SYNTHETIC_COLOUR_THRESHOLD:g})")
     args = p.parse_args(argv)
     THRESHOLD[0] = args.threshold
     KIND[0] = args.foreground

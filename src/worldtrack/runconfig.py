@@ -63,6 +63,11 @@ def _method_config_class(method: str) -> type[Section]:
     return CONFIGS[method]
 
 
+def default_foreground(method: str) -> str:
+    from worldtrack.trackers import default_foreground as method_default
+    return method_default(method)
+
+
 def _base(method: str, preset: str) -> Section:
     cls = _method_config_class(method)
     if preset == "paper":
@@ -89,7 +94,8 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
         method), or None
     method, preset : the command line's ``--method`` / ``--preset`` (None: the file's, else
         ellipsoid / default)
-    flags : the command line's named settings: ``foreground`` (kind), ``threshold``, ``births``
+    flags : the command line's named settings: ``foreground`` (kind; default the method's, e.g. grey for
+        the particle tracker, colour for the ellipsoid tracker), ``threshold``, ``births``
         (where new people may appear; set on the method that runs)
     sets : ``--set`` pairs (dotted path from the top, value), applied last in order
 
@@ -114,7 +120,13 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
                 raise InputError(f"{m}: expected a mapping of settings, got {given!r}"[:120])
             base = from_mapping(type(base), _deep_merge(to_mapping(base), given), root=m)
         methods[m] = base
-    foreground = from_mapping(ForegroundConfig, data.get("foreground"), root="foreground")
+    given_fg = data.get("foreground")
+    kind_given = ((isinstance(given_fg, Mapping) and "kind" in given_fg) or flags is not None
+                  and flags.get("foreground") is not None or any(path == "foreground.kind" for path, _ in sets))
+    if not kind_given and (given_fg is None or isinstance(given_fg, Mapping)):
+        # the method's own foreground model (a file, a flag or --set chooses another)
+        given_fg = {**(given_fg or {}), "kind": default_foreground(method)}
+    foreground = from_mapping(ForegroundConfig, given_fg, root="foreground")
     flags = dict(flags or {})
     fg_changes = {k: v for k, v in (("kind", flags.get("foreground")), ("threshold", flags.get("threshold")))
                   if v is not None}
