@@ -276,9 +276,10 @@ def main(argv: list[str] | None = None) -> int:
             for seed in seeds:
                 rs = crowd_case(cameras, seed, frames, binary, workdir, core)
                 runs.setdefault(name, []).extend(rs)
-                print(f"{name}, seed {seed}: " + ", ".join(
-                    f"{r['method']} recall {r['counts'][0.5]['tp'] / max(r['counts'][0.5]['tp'] + r['counts'][0.5]['fn'], 1):.3f}"
-                    for r in rs), file=sys.stderr, flush=True)
+                recall = {r["method"]: r["counts"][0.5]["tp"] / max(r["counts"][0.5]["tp"] + r["counts"][0.5]["fn"], 1)
+                          for r in rs}
+                print(f"{name}, seed {seed}: " + ", ".join(f"{m} recall {v:.3f}" for m, v in recall.items()),
+                      file=sys.stderr, flush=True)
         pets = pets_case(pets_frames, binary, workdir, core)
         notes = []
         if isinstance(pets, str):
@@ -293,14 +294,17 @@ def main(argv: list[str] | None = None) -> int:
         tables.append((gate, rows))
     text = (f"crowd: {SIZE[0]}×{SIZE[1]}, {frames} frames, seeds {', '.join(map(str, seeds))}; PETS: View_001, the "
             f"first {pets_frames} frames, inside the tracking area. POM: grid {CELL_M} m, prior {POM_PRIOR}, "
-            f"SIGMA_IMAGE_DENSITY {POM_SIGMA} by camera count, detections where p > {POM_THRESHOLD}. Precision, recall, MODA and "
+            f"SIGMA_IMAGE_DENSITY {POM_SIGMA} by camera count, detections where p > {POM_THRESHOLD}. "
+            f"Precision, recall, MODA and "
             f"mean error are per-frame detection (a tracker's tracks in a frame are its detections) summed over the "
             f"runs (POM's error includes its grid: a uniform point is 0.096 m from the centre of its {CELL_M} m "
-            f"cell on average); MOTA, IDF1, HOTA (trackers only, gate 0.5 m) are means over the runs. Speed on one core "
+            f"cell on average); MOTA, IDF1, HOTA (trackers only, gate 0.5 m) are means over the runs. "
+            f"Speed on one core "
             f"(core {core}); in-run reference: one MOG2 apply on a {SIZE[0]}×{SIZE[1]} frame takes {mog2_ms:.2f} ms "
             f"({1000 / mog2_ms:.0f} frames/s).\n\n")
     for gate, rows in tables:
-        text += f"### Gate {gate} m\n\n{markdown_table(HEADERS, rows)}\n\n**{verdict(rows)}**\n\nAgainst POM (ours − POM):\n\n"
+        text += (f"### Gate {gate} m\n\n{markdown_table(HEADERS, rows)}\n\n**{verdict(rows)}**\n\n"
+                 "Against POM (ours − POM):\n\n")
         text += "\n".join(ahead_lines(rows)) + "\n\n"
     text += "".join(f"- {n}\n" for n in notes)
     print(text)
