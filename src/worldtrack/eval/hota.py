@@ -12,13 +12,13 @@ person and a track in a frame is
 with ``d`` their distance on the floor in metres, so a pair counts at threshold ``α`` when it is
 within ``(1 − α) · gate`` metres: the 19 thresholds run from 0.05 · gate to 0.95 · gate. The frames
 and rows compared are those of :func:`worldtrack.eval.evaluate_detailed` (its area and frame
-range), which calls :func:`hota` and reports ``hota``, ``hota_deta``, ``hota_assa`` and
+range), which calls :func:`evaluate_hota` and reports ``hota``, ``hota_deta``, ``hota_assa`` and
 ``hota_loca`` beside MOTA and IDF1.
 
 TrackEval comes from PyPI ``trackeval==1.3.0``, installed **without its dependencies**
 (``pip install --no-deps trackeval==1.3.0``, as the Makefile does): it declares ``opencv-python``
 (a second OpenCV owning ``cv2`` beside our ``opencv-python-headless``) and ``pycocotools``, which
-its HOTA class does not use. Without TrackEval, :func:`hota` returns None and the metrics say n/a.
+its HOTA class does not use. Without TrackEval, :func:`evaluate_hota` returns None and the metrics say n/a.
 """
 
 from __future__ import annotations
@@ -117,7 +117,7 @@ def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: fl
             "gt_ids": gt_ids, "tracker_ids": tracker_ids, "similarity_scores": similarity}
 
 
-def hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray | None = None) -> HotaResult | None:
+def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray | None = None) -> HotaResult | None:
     """HOTA of ``pred`` against ``gt`` on the floor, with TrackEval's ``HOTA`` metric.
 
     Parameters
@@ -136,7 +136,7 @@ def hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray | Non
     Examples
     --------
     >>> t = TrackTable.from_arrays([0, 1, 1], [1, 1, 2], [0.0, 1.0, 5.0], [0.0, 0.0, 5.0])
-    >>> round(hota(t, t, gate=1.0).hota, 6)
+    >>> round(evaluate_hota(t, t, gate=1.0).hota, 6)
     1.0
     """
     metric = _hota_metric()

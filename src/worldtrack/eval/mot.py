@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
-from worldtrack.eval.hota import hota
+from worldtrack.eval.hota import evaluate_hota
 from worldtrack.io.tracks import TrackTable
 from worldtrack.scene.floor import points_in_polygon
 
@@ -305,7 +305,7 @@ def evaluate(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GATE_M,
 
 def hota_metrics(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray) -> dict[str, float | None]:
     """``hota, hota_deta, hota_assa, hota_loca`` of the compared rows (None without TrackEval)."""
-    h = hota(gt, pred, gate, frames)
+    h = evaluate_hota(gt, pred, gate, frames)
     if h is None:
         return dict.fromkeys(("hota", "hota_deta", "hota_assa", "hota_loca"))
     return {"hota": h.hota, "hota_deta": h.deta, "hota_assa": h.assa, "hota_loca": h.loca}
