@@ -104,7 +104,7 @@ def compare(label: str, name: str, params: dict, occlusion: bool, frames: int | 
         r = run_scenario(sc, method, foreground=FOREGROUND, gate=GATE_M, bundles=bundles)
         mem = peak_memory_mb(sc, bundles, method)
         m = r.metrics
-        rows.append([label, "yes" if occlusion else "no", method, m["mota"], m["idf1"], m["num_switches"],
+        rows.append([label, "yes" if occlusion else "no", method, m["mota"], m["idf1"], m["hota"], m["num_switches"],
                      r.errors.mean_m, r.fps, mem])
         print(f"  {method:9s} MOTA {m['mota']:6.3f} IDF1 {m['idf1']:.3f} switches {m['num_switches']:3d} "
               f"error {r.errors.mean_m:.3f} m  {r.fps:6.1f} frames/s  {mem:.1f} MB", file=sys.stderr)
@@ -132,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         rows += compare(label, name, params, occlusion, 60 if args.quick else None)
     elapsed = time.perf_counter() - t_start
-    table = markdown_table(["scenario", "occlusion", "method", "MOTA", "IDF1", "ID switches", "mean error m",
+    table = markdown_table(["scenario", "occlusion", "method", "MOTA", "IDF1", "HOTA", "ID switches", "mean error m",
                             "frames/s", "peak memory MB (tracemalloc)"], rows)
     summary = verdict(rows)
     text = (f"{SIZE[0]}×{SIZE[1]}, seed {SEED}, default presets, foreground `{FOREGROUND or OWN_FOREGROUND}` (blobs: its own MOG2), "

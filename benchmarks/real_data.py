@@ -152,10 +152,12 @@ def run_folder(folder: Path, limit: int | None, particle_seeds: int, start_frame
             pred, fps = track(method, scene, recipe.camera, background, frames, recipe.fps, first, **options)
             ev = evaluate_detailed(gt.select(gt.frame >= first), pred, gate=GATE_M, area=area)
             m = ev.metrics
-            runs.append([m["mota"], m["idf1"], m["num_switches"], position_errors(ev.gt, ev.pred, gate=GATE_M).mean_m,
-                         m["recall"], m["precision"], fps])
+            hota = np.nan if m["hota"] is None else m["hota"]
+            runs.append([m["mota"], m["idf1"], hota, m["num_switches"],
+                         position_errors(ev.gt, ev.pred, gate=GATE_M).mean_m, m["recall"], m["precision"], fps])
             print(f"  {method:9s}{f' from frame {first}' if seed is None else f' seed {seed}'} MOTA {m['mota']:.3f} IDF1 {m['idf1']:.3f} "
-                  f"switches {m['num_switches']} error {runs[-1][3]:.3f} m {fps:.1f} frames/s", file=sys.stderr)
+                  f"HOTA {hota:.3f} switches {m['num_switches']} error {runs[-1][4]:.3f} m {fps:.1f} frames/s",
+                  file=sys.stderr)
         a = np.array(runs, dtype=float)
         mean = a.mean(axis=0)
         cells = list(mean)
@@ -189,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
     elapsed = time.perf_counter() - t_start
     if not rows:
         return 0
-    table = markdown_table(["data", "frames", "method", "runs", "MOTA", "IDF1", "ID switches", "mean error m",
+    table = markdown_table(["data", "frames", "method", "runs", "MOTA", "IDF1", "HOTA", "ID switches", "mean error m",
                             "recall", "precision", "frames/s"], rows)
     text = (f"Inside the tracking area, gate {GATE_M} m; default presets, foreground `{FOREGROUND or OWN_FOREGROUND}` (blobs: MOG2); "
             f"frames/s of the tracker alone (its steps, and the ellipsoid tracker's warm start). Each row is the mean over `runs` runs (MOTA and IDF1 ± their "
