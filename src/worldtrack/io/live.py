@@ -1,0 +1,365 @@
+"""Live cameras: a grab thread per camera, capture time stamps, reconnection, bundles by time.
+
+``--video CAM=0`` (a device index), ``CAM=rtsp://…``, ``CAM=http://…``, ``CAM=udp://…`` (any URL
+OpenCV's FFmpeg backend opens) and video files all come through :class:`LiveSource`:
+
+* one :class:`Grabber` thread per camera reads frames as they come and stamps each with its capture
+  time (the wall clock when it was grabbed, seconds); a live stream keeps only the newest frame (a
+  frame the tracker had no time for is counted as dropped), a file keeps every frame;
+* a live stream that stops (the sender restarts, the network drops) is reopened with back-off
+  (0.5 s, doubling, at most 8 s); the time without signal and the reconnections are counted;
+* frames of several cameras are put together by capture time, not by frame number: a bundle holds
+  each camera's frame nearest in time, and a camera with nothing recent is left out of it.
+
+A video file played as a camera (``pace=True``, what a worker of the shared map does) has capture
+times ``epoch + i / fps`` and is released frame by frame at those wall-clock times, starting at
+the frame due now; otherwise it is read as fast as the tracker goes, with ``t = epoch + i / fps``.
+
+>>> parse_source("0"), parse_source("rtsp://cam.local/stream"), parse_source("clip.mp4")
+(0, 'rtsp://cam.local/stream', 'clip.mp4')
+>>> is_live(0), is_live("udp://127.0.0.1:5000"), is_live("clip.mp4")
+(True, True, False)
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import queue
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterator, Mapping
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Frame
+
+#: URL schemes opened through OpenCV's FFmpeg backend.
+STREAM_SCHEMES = ("rtsp", "rtsps", "rtmp", "http", "https", "udp", "rtp", "tcp", "srt")
+_END = object()
+
+
+def parse_source(text: str) -> int | str:
+    """A camera's source: an integer device index, a stream URL or a file path (as given)."""
+    text = str(text).strip()
+    return int(text) if text.isdigit() else text
+
+
+def is_live(source: int | str) -> bool:
+    """True for a device index or a stream URL (frames come in real time and may be dropped)."""
+    return isinstance(source, int) or str(source).split("://", 1)[0].lower() in STREAM_SCHEMES
+
+
+@dataclass
+class GrabStats:
+    """One camera's counters: frames grabbed, frames dropped (a newer one replaced them before the
+    tracker took them), reconnections, seconds without signal, and the last problem met."""
+
+    frames: int = 0
+    dropped: int = 0
+    reconnects: int = 0
+    outage_s: float = 0.0
+    last_error: str = ""
+
+
+def _open_capture(source: int | str, open_timeout_s: float, read_timeout_s: float):
+    import cv2
+    os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
+    if isinstance(source, int):
+        return cv2.VideoCapture(source)
+    if is_live(source):
+        params = [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(open_timeout_s * 1000),
+                  cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(read_timeout_s * 1000)]
+        return cv2.VideoCapture(source, cv2.CAP_FFMPEG, params)
+    return cv2.VideoCapture(str(source))
+
+
+class Grabber(threading.Thread):
+    """Reads one camera in the background.
+
+    Parameters
+    ----------
+    camera_id : str
+    source : device index, stream URL or file path (:func:`parse_source`)
+    fps : frame rate of a file's time stamps (default: its header, else 10)
+    epoch : wall-clock time (s) of a file's frame 0
+    pace : release a file's frames at their wall-clock times, starting with the frame due now
+    clock : wall clock, seconds
+    backoff_s : (first, largest) wait before reopening a dropped live stream
+    """
+
+    def __init__(self, camera_id: str, source: int | str, fps: float | None = None, epoch: float = 0.0,
+                 pace: bool = False, clock: Callable[[], float] = time.time,
+                 backoff_s: tuple[float, float] = (0.5, 8.0), open_timeout_s: float = 5.0,
+                 read_timeout_s: float = 2.0, buffer_frames: int = 8):
+        super().__init__(name=f"grab-{camera_id}", daemon=True)
+        self.camera_id, self.source, self.clock = camera_id, source, clock
+        self.live = is_live(source)
+        self.epoch, self.pace = float(epoch), bool(pace)
+        self.backoff_s, self.open_timeout_s, self.read_timeout_s = backoff_s, open_timeout_s, read_timeout_s
+        self.stats = GrabStats()
+        self.fps = fps
+        self._stop = threading.Event()
+        self._cond = threading.Condition()
+        self._newest: tuple[float, int, np.ndarray] | None = None   # live: the one slot
+        self._taken = -1
+        self._queue: queue.Queue = queue.Queue(maxsize=buffer_frames)   # files: every frame
+        self.ended = False
+        if not self.live:
+            if not Path(str(source)).is_file():
+                raise InputError(f"{camera_id}: {source}: no such video file (or give a device index or a "
+                                 f"stream URL: {', '.join(s + '://' for s in STREAM_SCHEMES[:6])}…)")
+            cap = _open_capture(source, open_timeout_s, read_timeout_s)
+            if not cap.isOpened():
+                raise InputError(f"{camera_id}: {source}: cannot open as a video")
+            import cv2
+            header = cap.get(cv2.CAP_PROP_FPS)
+            self.fps = fps or (float(header) if header and math.isfinite(header) and header > 0 else 10.0)
+            self._cap = cap
+
+    # ------------------------------------------------------------------ the thread
+    def run(self) -> None:
+        try:
+            self._run_live() if self.live else self._run_file()
+        except Exception as e:     # reported to the reader, not lost in a thread
+            self.stats.last_error = f"{type(e).__name__}: {e}"
+            self._finish()
+
+    def _run_file(self) -> None:
+        import cv2
+        cap = self._cap
+        index = 0
+        if self.pace:
+            due = max(0, math.ceil((self.clock() - self.epoch) * self.fps - 1e-6))
+            while index < due and cap.grab():     # not CAP_PROP_POS_FRAMES: it may land on a key frame
+                index += 1
+        while not self._stop.is_set():
+            ok, img = cap.read()
+            if not ok or img is None:
+                break
+            t = self.epoch + index / self.fps
+            if self.pace:
+                delay = t - self.clock()
+                if delay > 0 and self._stop.wait(delay):
+                    break
+            self.stats.frames += 1
+            while not self._stop.is_set():
+                try:
+                    self._queue.put((t, index, img), timeout=0.2)
+                    break
+                except queue.Full:
+                    continue
+            index += 1
+        cap.release()
+        self._finish()
+
+    def _run_live(self) -> None:
+        wait = self.backoff_s[0]
+        lost_at: float | None = None
+        first = True
+        while not self._stop.is_set():
+            cap = _open_capture(self.source, self.open_timeout_s, self.read_timeout_s)
+            if not cap.isOpened():
+                cap.release()
+                self.stats.last_error = f"cannot open {self.source}"
+                lost_at = self.clock() if lost_at is None else lost_at
+                if self._stop.wait(wait):
+                    break
+                wait = min(wait * 2, self.backoff_s[1])
+                continue
+            if not first:
+                self.stats.reconnects += 1
+            first = False
+            if lost_at is not None:
+                self.stats.outage_s += self.clock() - lost_at
+                lost_at = None
+            wait = self.backoff_s[0]
+            while not self._stop.is_set():
+                if not cap.grab():
+                    break
+                t = self.clock()
+                ok, img = cap.retrieve()
+                if not ok or img is None:
+                    break
+                self._offer(t, img)
+            cap.release()
+            if not self._stop.is_set():
+                self.stats.last_error = f"stream {self.source} stopped; reconnecting"
+                lost_at = self.clock()
+        self._finish()
+
+    def _offer(self, t: float, img: np.ndarray) -> None:
+        with self._cond:
+            if self._newest is not None and self._newest[1] > self._taken:
+                self.stats.dropped += 1
+            index = self.stats.frames
+            self.stats.frames += 1
+            self._newest = (t, index, img)
+            self._cond.notify_all()
+
+    def _finish(self) -> None:
+        with self._cond:
+            self.ended = True
+            self._cond.notify_all()
+        try:
+            self._queue.put_nowait(_END)
+        except queue.Full:
+            pass
+
+    # ------------------------------------------------------------------ the reader's side
+    def newest(self, after: int, timeout: float) -> tuple[float, int, np.ndarray] | None:
+        """A live camera's newest frame if it is newer than frame ``after`` (waits up to ``timeout``)."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while (self._newest is None or self._newest[1] <= after) and not self.ended:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return None
+                self._cond.wait(left)
+            if self._newest is None or self._newest[1] <= after:
+                return None
+            self._taken = self._newest[1]
+            return self._newest
+
+    def next_frame(self, timeout: float | None = None):
+        """A file's next frame ``(t, index, image)``, or None at its end."""
+        item = self._queue.get(timeout=timeout)
+        if item is _END:
+            self._queue.put(_END)
+            return None
+        return item
+
+    def stop(self) -> None:
+        self._stop.set()
+
+
+class LiveSource:
+    """Frame bundles ``(index, t, {camera_id: Frame})`` from live cameras and files, by capture time.
+
+    Parameters
+    ----------
+    sources : {camera_id: device index, stream URL or file path}
+    cameras : the scene's cameras (image sizes are checked)
+    fps : frame rate of files' time stamps (default: their headers)
+    epoch, pace : see :class:`Grabber` (files only)
+    sync_s : how long a bundle waits for the other live cameras after the first new frame (s)
+    stop : stop after this many bundles
+    """
+
+    def __init__(self, sources: Mapping[str, int | str], cameras: Mapping[str, Camera], fps: float | None = None,
+                 epoch: float = 0.0, pace: bool = False, sync_s: float = 0.05, stop: int | None = None,
+                 clock: Callable[[], float] = time.time, **grab_options):
+        unknown = [c for c in sources if c not in cameras]
+        if unknown:
+            raise InputError(f"--video {unknown[0]}=…: no camera {unknown[0]!r} in the scene "
+                             f"(cameras: {', '.join(cameras)})")
+        if not sources:
+            raise InputError("no video given (use --video CAMERA=PATH, =DEVICE or =URL)")
+        self.cameras = {c: cameras[c] for c in sources}
+        self.grabbers = {c: Grabber(c, s, fps=fps, epoch=epoch, pace=pace, clock=clock, **grab_options)
+                         for c, s in sources.items()}
+        self.live = any(g.live for g in self.grabbers.values())
+        rates = [g.fps for g in self.grabbers.values() if g.fps]
+        self.fps = float(fps) if fps else (rates[0] if rates else 10.0)
+        self.sync_s, self.stop_after = sync_s, stop
+        self.length = None
+
+    def stats(self) -> dict[str, GrabStats]:
+        """Each camera's counters (frames, dropped, reconnects, seconds without signal)."""
+        return {c: g.stats for c, g in self.grabbers.items()}
+
+    def start(self) -> None:
+        """Start the grab threads (iterating starts them too): a live camera's frames, and a paced
+        file's clock, run from now."""
+        for g in self.grabbers.values():
+            if not g.is_alive() and not g.ended:
+                g.start()
+
+    def __iter__(self) -> Iterator[tuple[int, float, dict[str, Frame]]]:
+        self.start()
+        try:
+            bundles = self._live_bundles() if self.live else self._file_bundles()
+            for i, (t, bundle) in enumerate(bundles):
+                if self.stop_after is not None and i >= self.stop_after:
+                    return
+                for cid, frame in bundle.items():
+                    self._check_size(cid, frame.image, frame.index)
+                yield i, t, bundle
+        finally:
+            for g in self.grabbers.values():
+                g.stop()
+
+    def _check_size(self, cid: str, img: np.ndarray, index: int) -> None:
+        cam = self.cameras[cid]
+        if img.shape[1] != cam.width or img.shape[0] != cam.height:
+            raise InputError(f"{cid}: {self.grabbers[cid].source}: frame {index} is {img.shape[1]}x{img.shape[0]} "
+                             f"but the scene's camera is {cam.width}x{cam.height}")
+
+    def _file_bundles(self) -> Iterator[tuple[float, dict[str, Frame]]]:
+        heads: dict[str, tuple] = {}
+        while True:
+            for cid, g in self.grabbers.items():
+                if cid not in heads:
+                    item = g.next_frame()
+                    if item is None:
+                        if g.stats.last_error:
+                            raise InputError(f"{cid}: {g.source}: {g.stats.last_error}")
+                        return        # the shortest input ends the bundles
+                    heads[cid] = item
+            t0 = min(h[0] for h in heads.values())
+            tolerance = 0.5 / self.fps
+            bundle = {cid: Frame(img, t, idx) for cid, (t, idx, img) in heads.items() if t - t0 < tolerance}
+            for cid in bundle:
+                del heads[cid]
+            yield max(f.t for f in bundle.values()), bundle
+
+    def _live_bundles(self) -> Iterator[tuple[float, dict[str, Frame]]]:
+        taken = {c: -1 for c in self.grabbers}
+        while True:
+            bundle: dict[str, Frame] = {}
+            first_at = None
+            while True:
+                for cid, g in self.grabbers.items():
+                    item = None if cid in bundle else g.newest(taken[cid], timeout=0.0)
+                    if item is not None:
+                        t, idx, img = item
+                        bundle[cid] = Frame(img, t, idx)
+                        taken[cid] = idx
+                if bundle and first_at is None:
+                    first_at = time.monotonic()
+                if len(bundle) == len(self.grabbers):
+                    break
+                if first_at is not None and time.monotonic() - first_at >= self.sync_s:
+                    break
+                if not bundle and all(g.ended for g in self.grabbers.values()):
+                    return
+                time.sleep(0.003)
+            yield max(f.t for f in bundle.values()), bundle
+
+
+def background_from_live(source: LiveSource, frames: int = 25, timeout_s: float = 20.0) -> dict[str, np.ndarray]:
+    """Temporal median of the first ``frames`` frames of each live camera (people must keep moving)."""
+    from worldtrack.foreground.estimate import estimate_background
+    got: dict[str, list[np.ndarray]] = {c: [] for c in source.grabbers}
+    taken = {c: -1 for c in source.grabbers}
+    source.start()
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline and any(len(v) < frames for v in got.values()):
+        for cid, g in source.grabbers.items():
+            item = g.newest(taken[cid], timeout=0.05)
+            if item is not None and len(got[cid]) < frames:
+                taken[cid] = item[1]
+                got[cid].append(item[2])
+    missing = [c for c, v in got.items() if len(v) < 3]
+    if missing:
+        raise InputError(f"{missing[0]}: no frames from {source.grabbers[missing[0]].source} in {timeout_s:.0f} s "
+                         f"to estimate a background (give --background {missing[0]}=PNG)")
+    return {c: estimate_background(v) for c, v in got.items()}
+
+
+__all__ = ["GrabStats", "Grabber", "LiveSource", "STREAM_SCHEMES", "background_from_live", "is_live",
+           "parse_source"]
