@@ -120,11 +120,14 @@ def estimate_weight(e: Estimate) -> float:
 
 
 def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
-                      step_m: float = 0.05) -> tuple[float, float, float]:
+                      step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None
+                      ) -> tuple[float, float, float]:
     """How finely ``cameras`` resolve a person standing at floor point ``xy`` (metres): the
-    information matrix ``Σ Jᵀ J / σ²`` (1/m², as ``ixx, ixy, iyy``) of their feet and head image
-    points, ``J`` the pixels moved per metre on the floor, ``σ = sigma_px``. Cameras whose image
-    holds neither point add nothing; none gives ``(nan, nan, nan)``.
+    information matrix ``Σ Jᵀ J / σ²`` (1/m², as ``ixx, ixy, iyy``) of five points on the person's
+    axis (feet to head), ``J`` the pixels a point moves per metre on the floor, ``σ = sigma_px``.
+    Points outside a camera's image, or hidden there by a structure (``occlusion``: per camera the
+    scene's floor-distance map of obstacles, (H, W) metres), add nothing; so a person seen only
+    through a door counts for less. No visible point gives ``(nan, nan, nan)``.
 
     >>> from worldtrack.geometry.camera import Camera
     >>> cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
@@ -133,17 +136,19 @@ def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, 
     True
     """
     info = np.zeros((2, 2))
-    offsets = np.array([[step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
-    for cam in cameras:
-        for z in (0.0, height):
-            pts = np.column_stack([xy[None, :] + offsets, np.full(4, z)])
-            centre = np.append(xy, z)[None, :]
-            if not cam.in_image(cam.project(centre)).all():
-                continue
-            uv = cam.project(pts)
-            if not np.isfinite(uv).all():
-                continue
-            J = np.column_stack([(uv[0] - uv[1]) / (2 * step_m), (uv[2] - uv[3]) / (2 * step_m)])
+    offsets = np.array([[0.0, 0.0], [step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
+    heights = np.linspace(0.0, height, 5)
+    for k, cam in enumerate(cameras):
+        pts = np.concatenate([np.column_stack([xy[None, :] + offsets, np.full(5, z)]) for z in heights])
+        uv = cam.project(pts).reshape(len(heights), 5, 2)
+        seen = cam.in_image(uv[:, 0]) & np.isfinite(uv).all(axis=(1, 2))
+        occ = occlusion[k] if occlusion is not None else None
+        if occ is not None and seen.any():
+            px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
+            mine = float(cam.floor_distance(np.append(xy, 0.0)[None, :])[0])
+            seen &= occ[px[:, 1], px[:, 0]] > mine - 0.3
+        for i in np.flatnonzero(seen):
+            J = np.column_stack([(uv[i, 1] - uv[i, 2]) / (2 * step_m), (uv[i, 3] - uv[i, 4]) / (2 * step_m)])
             info += J.T @ J / sigma_px ** 2
     if not info.any():
         return float("nan"), float("nan"), float("nan")

@@ -98,12 +98,16 @@ class MapLink:
     cameras : {camera_id: Camera} — the cameras this worker owns
     fps : the cameras' frame rate (for the fusion's wait)
     clock : wall clock, seconds
+    occlusion : {camera_id: (H, W) floor distance of the obstacles} — the scene's occlusion maps
+        (:func:`~worldtrack.map.fusion.floor_information` leaves hidden body points out)
     """
 
     def __init__(self, client: Any, keys: MapKeys, cfg: MapConfig, name: str, cameras: Mapping[str, Camera],
-                 fps: float = 10.0, clock: Callable[[], float] = time.time):
+                 fps: float = 10.0, clock: Callable[[], float] = time.time,
+                 occlusion: Mapping[str, np.ndarray] | None = None):
         self.client, self.keys, self.cfg, self.name, self.clock = client, keys, cfg, name, clock
         self.cameras = dict(cameras)
+        self.occlusion = dict(occlusion or {})
         self.fps = fps
         self.leases = {c: Lease(client, keys.camera_lease(c), name, cfg.lease_s) for c in self.cameras}
         self._xadd = client.register_script(FENCED_XADD)
@@ -229,8 +233,9 @@ class MapLink:
                 self.placed.discard(tr.id)
             now_ids.add(tr.id)
             support = _support(person, tr)
-            info = floor_information([self.cameras[c] for c, ok in zip(cams, views) if ok], np.array([tr.x, tr.y]),
-                                     tr.height)
+            mine = [c for c, ok in zip(cams, views) if ok]
+            info = floor_information([self.cameras[c] for c in mine], np.array([tr.x, tr.y]), tr.height,
+                                     occlusion=[self.occlusion.get(c) for c in mine])
             e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info)
             for c, ok in zip(cams, views):
                 if ok:
