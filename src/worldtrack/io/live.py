@@ -11,6 +11,11 @@ OpenCV's FFmpeg backend opens) and video files all come through :class:`LiveSour
 * frames of several cameras are put together by capture time, not by frame number: a bundle holds
   each camera's frame nearest in time, and a camera with nothing recent is left out of it.
 
+Streams are probed for half a second before the first frame (FFmpeg's ``analyzeduration``; set
+``OPENCV_FFMPEG_CAPTURE_OPTIONS`` to change it, e.g. ``rtsp_transport;tcp`` for RTSP over TCP).
+The capture time is this machine's clock when the frame was grabbed (it includes the network and
+decoding delay); a sender's own wall clock would need PyAV and is not read.
+
 A video file played as a camera (``pace=True``, what a worker of the shared map does) has capture
 times ``epoch + i / fps`` and is released frame by frame at those wall-clock times, starting at
 the frame due now; otherwise it is read as fast as the tracker goes, with ``t = epoch + i / fps``.
@@ -38,6 +43,8 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
 
+#: FFmpeg's options for live streams unless ``OPENCV_FFMPEG_CAPTURE_OPTIONS`` says otherwise.
+FFMPEG_PROBE = "analyzeduration;500000|probesize;131072"
 #: URL schemes opened through OpenCV's FFmpeg backend.
 STREAM_SCHEMES = ("rtsp", "rtsps", "rtmp", "http", "https", "udp", "rtp", "tcp", "srt")
 _END = object()
@@ -67,8 +74,13 @@ class GrabStats:
 
 
 def _open_capture(source: int | str, open_timeout_s: float, read_timeout_s: float):
+    """An OpenCV capture of ``source``: streams through the FFmpeg backend with open and read
+    timeouts (so a dead stream returns instead of blocking), devices and files as OpenCV opens them."""
     import cv2
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
+    # FFmpeg probes 5 s of a stream by default before the first frame; half a second finds a
+    # camera's video stream and starts tracking (and a reconnection) seconds sooner.
+    os.environ.setdefault("OPENCV_FFMPEG_CAPTURE_OPTIONS", FFMPEG_PROBE)
     if isinstance(source, int):
         return cv2.VideoCapture(source)
     if is_live(source):
@@ -94,7 +106,7 @@ class Grabber(threading.Thread):
 
     def __init__(self, camera_id: str, source: int | str, fps: float | None = None, epoch: float = 0.0,
                  pace: bool = False, clock: Callable[[], float] = time.time,
-                 backoff_s: tuple[float, float] = (0.5, 8.0), open_timeout_s: float = 5.0,
+                 backoff_s: tuple[float, float] = (0.5, 8.0), open_timeout_s: float = 3.0,
                  read_timeout_s: float = 2.0, buffer_frames: int = 8):
         super().__init__(name=f"grab-{camera_id}", daemon=True)
         self.camera_id, self.source, self.clock = camera_id, source, clock
@@ -103,7 +115,7 @@ class Grabber(threading.Thread):
         self.backoff_s, self.open_timeout_s, self.read_timeout_s = backoff_s, open_timeout_s, read_timeout_s
         self.stats = GrabStats()
         self.fps = fps
-        self._stop = threading.Event()
+        self._halt = threading.Event()
         self._cond = threading.Condition()
         self._newest: tuple[float, int, np.ndarray] | None = None   # live: the one slot
         self._taken = -1
@@ -137,17 +149,17 @@ class Grabber(threading.Thread):
             due = max(0, math.ceil((self.clock() - self.epoch) * self.fps - 1e-6))
             while index < due and cap.grab():     # not CAP_PROP_POS_FRAMES: it may land on a key frame
                 index += 1
-        while not self._stop.is_set():
+        while not self._halt.is_set():
             ok, img = cap.read()
             if not ok or img is None:
                 break
             t = self.epoch + index / self.fps
             if self.pace:
                 delay = t - self.clock()
-                if delay > 0 and self._stop.wait(delay):
+                if delay > 0 and self._halt.wait(delay):
                     break
             self.stats.frames += 1
-            while not self._stop.is_set():
+            while not self._halt.is_set():
                 try:
                     self._queue.put((t, index, img), timeout=0.2)
                     break
@@ -161,13 +173,13 @@ class Grabber(threading.Thread):
         wait = self.backoff_s[0]
         lost_at: float | None = None
         first = True
-        while not self._stop.is_set():
+        while not self._halt.is_set():
             cap = _open_capture(self.source, self.open_timeout_s, self.read_timeout_s)
             if not cap.isOpened():
                 cap.release()
                 self.stats.last_error = f"cannot open {self.source}"
                 lost_at = self.clock() if lost_at is None else lost_at
-                if self._stop.wait(wait):
+                if self._halt.wait(wait):
                     break
                 wait = min(wait * 2, self.backoff_s[1])
                 continue
@@ -178,7 +190,7 @@ class Grabber(threading.Thread):
                 self.stats.outage_s += self.clock() - lost_at
                 lost_at = None
             wait = self.backoff_s[0]
-            while not self._stop.is_set():
+            while not self._halt.is_set():
                 if not cap.grab():
                     break
                 t = self.clock()
@@ -187,7 +199,7 @@ class Grabber(threading.Thread):
                     break
                 self._offer(t, img)
             cap.release()
-            if not self._stop.is_set():
+            if not self._halt.is_set():
                 self.stats.last_error = f"stream {self.source} stopped; reconnecting"
                 lost_at = self.clock()
         self._finish()
@@ -234,7 +246,7 @@ class Grabber(threading.Thread):
         return item
 
     def stop(self) -> None:
-        self._stop.set()
+        self._halt.set()
 
 
 class LiveSource:
@@ -290,8 +302,16 @@ class LiveSource:
                     self._check_size(cid, frame.image, frame.index)
                 yield i, t, bundle
         finally:
-            for g in self.grabbers.values():
-                g.stop()
+            self.close()
+
+    def close(self) -> None:
+        """Stop the grab threads and wait for them (a thread inside a capture call finishes it:
+        at most the open or read timeout)."""
+        for g in self.grabbers.values():
+            g.stop()
+        for g in self.grabbers.values():
+            if g.is_alive():
+                g.join(g.open_timeout_s + g.read_timeout_s + 1.0)
 
     def _check_size(self, cid: str, img: np.ndarray, index: int) -> None:
         cam = self.cameras[cid]

@@ -111,10 +111,10 @@ class LeaseKeeper(threading.Thread):
         self.every_s = every_s
         self.on_lost = on_lost
         self.beat = beat
-        self._stop = threading.Event()
+        self._halt = threading.Event()
 
     def run(self) -> None:
-        while not self._stop.wait(self.every_s):
+        while not self._halt.wait(self.every_s):
             for lease in list(self.leases):
                 try:
                     ok = lease.renew()
@@ -130,7 +130,7 @@ class LeaseKeeper(threading.Thread):
                     pass
 
     def stop(self, release: bool = True) -> None:
-        self._stop.set()
+        self._halt.set()
         if release:
             for lease in self.leases:
                 try:
