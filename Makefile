@@ -4,19 +4,25 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench clean services
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,baseline]'
+	$(PY) -m pip install --quiet -e '.[test,baseline,redis]'
 	touch $(STAMP)
 
 demo: $(STAMP)
 	$(VENV)/bin/worldtrack demo
 
-test: $(STAMP)
+test: $(STAMP) services
 	$(PY) -m pytest
+
+# The shared-map and live-stream tests start their own redis-server and ffmpeg (Debian packages).
+services:
+	@command -v redis-server >/dev/null && command -v ffmpeg >/dev/null || \
+	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq redis-server ffmpeg >/dev/null; } || \
+	  echo "redis-server/ffmpeg could not be installed: the shared-map and live-stream tests will be skipped"
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

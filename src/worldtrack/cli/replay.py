@@ -16,7 +16,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "DIR/floorplan.png and DIR/plan.mp4.")
     p.add_argument("url", help="the map: redis://[USER:PASSWORD@]HOST[:PORT][/DB] or rediss://…")
     p.add_argument("--from", dest="t_from", default=None, metavar="T",
-                   help="first capture time: Unix seconds, ISO 8601 or -15m (default: the stream's start)")
+                   help="first capture time: Unix seconds, ISO 8601, or relative to now as --from=-15m "
+                        "(default: the stream's start)")
     p.add_argument("--to", dest="t_to", default=None, metavar="T", help="last capture time (default: the end)")
     p.add_argument("--out", default="replay", metavar="DIR", help="output folder (default: replay)")
     p.add_argument("--scene", default=None, help="the map's scene file: draws the floor plan and plan video "

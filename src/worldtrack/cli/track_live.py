@@ -147,7 +147,7 @@ def run_live(args: argparse.Namespace, cfg) -> int:
     """``worldtrack track`` on live cameras and/or a shared map; returns the exit status."""
     from worldtrack.cli.track import _init, _pair
     from worldtrack.foreground import foregrounds_from_config
-    from worldtrack.io.live import LiveSource, background_from_live, is_live, parse_source
+    from worldtrack.io.live import LiveSource, background_from_live, check_source, is_live, parse_source
     from worldtrack.io.runinfo import write_run_info
     from worldtrack.pipeline import run_tracking
     from worldtrack.scene import load_scene
@@ -165,6 +165,8 @@ def run_live(args: argparse.Namespace, cfg) -> int:
         if c not in videos:
             raise InputError(f"--cameras {c}: give its video or stream with --video {c}=…")
     sources = {c: parse_source(videos[c]) for c in own}
+    for c, s in sources.items():
+        check_source(c, s)
     backgrounds = _backgrounds(args, scene, sources)
     worker = _Worker(args, cfg, scene, own, args.fps or 10.0) if args.map else None
     try:

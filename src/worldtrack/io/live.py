@@ -90,6 +90,51 @@ def _open_capture(source: int | str, open_timeout_s: float, read_timeout_s: floa
     return cv2.VideoCapture(str(source))
 
 
+def check_source(camera_id: str, source: int | str) -> None:
+    """:class:`InputError` if a file source is neither a video file nor a folder of images."""
+    from worldtrack.io.sources import _IMAGE_SUFFIXES
+    if is_live(source):
+        return
+    p = Path(str(source))
+    if p.is_dir() and not any(q.suffix.lower() in _IMAGE_SUFFIXES for q in p.iterdir()):
+        raise InputError(f"{camera_id}: {source}: folder holds no images ({', '.join(_IMAGE_SUFFIXES)})")
+    if not p.exists():
+        raise InputError(f"{camera_id}: {source}: no such video file or folder (or give a device index or a "
+                         f"stream URL: {', '.join(s + '://' for s in STREAM_SCHEMES[:6])}…)")
+
+
+class _FolderReader:
+    """A folder of images (sorted by name) read like an OpenCV capture."""
+
+    def __init__(self, folder: Path):
+        from worldtrack.io.sources import _IMAGE_SUFFIXES
+        self.files = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES)
+        self.i = 0
+
+    def isOpened(self) -> bool:
+        return bool(self.files)
+
+    def get(self, prop: int) -> float:
+        return 0.0
+
+    def grab(self) -> bool:
+        self.i += 1
+        return self.i <= len(self.files)
+
+    def read(self):
+        import cv2
+        if self.i >= len(self.files):
+            return False, None
+        img = cv2.imread(str(self.files[self.i]), cv2.IMREAD_COLOR)
+        if img is None:
+            raise InputError(f"{self.files[self.i]}: frame {self.i} cannot be decoded")
+        self.i += 1
+        return True, img
+
+    def release(self) -> None:
+        pass
+
+
 class Grabber(threading.Thread):
     """Reads one camera in the background.
 
@@ -122,10 +167,9 @@ class Grabber(threading.Thread):
         self._queue: queue.Queue = queue.Queue(maxsize=buffer_frames)   # files: every frame
         self.ended = False
         if not self.live:
-            if not Path(str(source)).is_file():
-                raise InputError(f"{camera_id}: {source}: no such video file (or give a device index or a "
-                                 f"stream URL: {', '.join(s + '://' for s in STREAM_SCHEMES[:6])}…)")
-            cap = _open_capture(source, open_timeout_s, read_timeout_s)
+            check_source(camera_id, source)
+            cap = _FolderReader(Path(source)) if Path(source).is_dir() else \
+                _open_capture(source, open_timeout_s, read_timeout_s)
             if not cap.isOpened():
                 raise InputError(f"{camera_id}: {source}: cannot open as a video")
             import cv2
@@ -381,5 +425,5 @@ def background_from_live(source: LiveSource, frames: int = 25, timeout_s: float 
     return {c: estimate_background(v) for c, v in got.items()}
 
 
-__all__ = ["GrabStats", "Grabber", "LiveSource", "STREAM_SCHEMES", "background_from_live", "is_live",
-           "parse_source"]
+__all__ = ["GrabStats", "Grabber", "LiveSource", "STREAM_SCHEMES", "background_from_live", "check_source",
+           "is_live", "parse_source"]

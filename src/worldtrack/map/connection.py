@@ -97,6 +97,9 @@ def connect(url: str, timeout_s: float = 5.0) -> Any:
     try:
         client.ping()
     except redis.AuthenticationError:
+        if urlsplit(full).password is None:
+            raise InputError(f"{where}: the server wants a password (give it in the URL or in "
+                             f"{PASSWORD_ENV}, and the user in {USER_ENV})") from None
         user = unquote(urlsplit(full).username or "") or "default"
         raise InputError(f"{where}: the server refused user {user!r} and its password "
                          f"(give them in the URL or in {USER_ENV}/{PASSWORD_ENV})") from None

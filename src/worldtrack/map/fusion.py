@@ -3,9 +3,12 @@
 This is the answer worldtrack gives to the question paper 000 leaves open (§5–6: several systems,
 each with its own cameras, share one person map — who updates a person two of them see?):
 
-* **Every worker that sees a person updates them, on its own map, from its own cameras only**, and
+* **Every worker that sees a person updates them, on its own map, from its own cameras**, and
   publishes its estimate. A worker never moves a person its cameras do not show: those it takes
-  from the shared map as they are (:mod:`worldtrack.map.worker`).
+  from the shared map as they are (:mod:`worldtrack.map.worker`). Of the workers that see a person,
+  the one whose estimate weighs most (``lead``) continues from its own estimate; the others start
+  each frame from the map's and move the person by their own cameras' evidence, so a worker that
+  sees somebody poorly (far, through a door) contributes without drifting away on its own.
 * **The shared map keeps each worker's estimate and weighs them by support and by geometry** —
   the support is the share of the person's own pixels that are foreground in that worker's views
   (the evidence the estimate rests on; else the match score; at least 0.05), and the geometry is
@@ -53,6 +56,9 @@ from worldtrack.map.messages import Estimate, MapPerson, MapState, Observation
 
 #: The least weight an estimate has (support 0 still says "a worker sees somebody here").
 MIN_WEIGHT = 0.05
+#: The lead of a person is a worker whose cameras show at least this share of their body, if any
+#: does (a tracker fitting a head at the image's edge is no lead, however near the camera).
+LEAD_SHARE = 0.6
 
 
 @dataclass
@@ -72,10 +78,11 @@ class FusedPerson:
     born: float = 0.0
     mode: str = "tracking"
     workers: int = 0
+    lead: str = ""
 
     def public(self) -> MapPerson:
         return MapPerson(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
-                         self.support, self.mode, self.last_seen, self.born, self.workers)
+                         self.support, self.mode, self.last_seen, self.born, self.workers, self.lead)
 
 
 @dataclass
@@ -119,6 +126,32 @@ def estimate_weight(e: Estimate) -> float:
     return MIN_WEIGHT
 
 
+def _body_points(cam: Camera, xy: np.ndarray, height: float, occlusion: np.ndarray | None,
+                 step_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Five points on a person's axis (feet to head) and four neighbours of each a step away on
+    the floor, in ``cam``'s image: (5, 5, 2) pixels, and which of the five show (inside the image,
+    not behind an obstacle), (5,) bool."""
+    offsets = np.array([[0.0, 0.0], [step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
+    heights = np.linspace(0.0, height, 5)
+    pts = np.concatenate([np.column_stack([xy[None, :] + offsets, np.full(5, z)]) for z in heights])
+    uv = cam.project(pts).reshape(len(heights), 5, 2)
+    seen = cam.in_image(uv[:, 0]) & np.isfinite(uv).all(axis=(1, 2))
+    if occlusion is not None and seen.any():
+        px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
+        mine = float(cam.floor_distance(np.append(xy, 0.0)[None, :])[0])
+        seen &= occlusion[px[:, 1], px[:, 0]] > mine - 0.3
+    return uv, seen
+
+
+def visible_share(cameras: Sequence[Camera], xy: np.ndarray, height: float,
+                  occlusion: Sequence[np.ndarray | None] | None = None) -> float:
+    """The largest share, over ``cameras``, of a person's five axis points (feet to head) that the
+    camera shows: 1 in full view, 0.2 when one camera sees only their head through a door."""
+    shares = [_body_points(cam, xy, height, occlusion[k] if occlusion else None, 0.05)[1].mean()
+              for k, cam in enumerate(cameras)]
+    return float(max(shares, default=0.0))
+
+
 def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
                       step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None
                       ) -> tuple[float, float, float]:
@@ -136,17 +169,8 @@ def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, 
     True
     """
     info = np.zeros((2, 2))
-    offsets = np.array([[0.0, 0.0], [step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
-    heights = np.linspace(0.0, height, 5)
     for k, cam in enumerate(cameras):
-        pts = np.concatenate([np.column_stack([xy[None, :] + offsets, np.full(5, z)]) for z in heights])
-        uv = cam.project(pts).reshape(len(heights), 5, 2)
-        seen = cam.in_image(uv[:, 0]) & np.isfinite(uv).all(axis=(1, 2))
-        occ = occlusion[k] if occlusion is not None else None
-        if occ is not None and seen.any():
-            px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
-            mine = float(cam.floor_distance(np.append(xy, 0.0)[None, :])[0])
-            seen &= occ[px[:, 1], px[:, 0]] > mine - 0.3
+        uv, seen = _body_points(cam, xy, height, occlusion[k] if occlusion is not None else None, step_m)
         for i in np.flatnonzero(seen):
             J = np.column_stack([(uv[i, 1] - uv[i, 2]) / (2 * step_m), (uv[i, 3] - uv[i, 4]) / (2 * step_m)])
             info += J.T @ J / sigma_px ** 2
@@ -222,6 +246,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
+        p.lead = max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
+                      for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
         workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
@@ -274,4 +300,5 @@ def _finite(v: float) -> float:
     return v if v is not None and math.isfinite(v) else 0.0
 
 
-__all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket"]
+__all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket",
+           "visible_share"]

@@ -44,7 +44,7 @@ end
 redis.call('HSET', KEYS[3], 'state', ARGV[4], 'last_bucket', ARGV[5], 'written', ARGV[6], 't', ARGV[7],
            'people', ARGV[8], 'holder', ARGV[1])
 for i = 9, #ARGV, 2 do
-  if ARGV[i] == 'people' or ARGV[i] == 'aliases' then
+  if ARGV[i] == 'people' or ARGV[i] == 'aliases' or ARGV[i] == 'reports' then
     redis.call('HSET', KEYS[3], 'map_' .. ARGV[i], ARGV[i + 1])
   end
 end

@@ -37,7 +37,9 @@ class Estimate(NamedTuple):
     does not say); ``seen`` is False for a person the worker holds in its view without evidence in
     this frame (hidden behind something), True when its cameras show them. ``ixx, ixy, iyy``
     (1/m²): how finely the worker's cameras resolve the floor there, the information matrix of a
-    one-pixel error of the person's feet and head (:func:`worldtrack.map.fusion.floor_information`).
+    one-pixel error of the person's feet and head (:func:`worldtrack.map.fusion.floor_information`);
+    ``visible``: the share of the person's body the worker's best camera shows
+    (:func:`worldtrack.map.fusion.visible_share`).
     """
 
     id: int
@@ -53,6 +55,7 @@ class Estimate(NamedTuple):
     ixx: float = 1.0
     ixy: float = 0.0
     iyy: float = 1.0
+    visible: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -72,7 +75,8 @@ class MapPerson(NamedTuple):
     """A person on the fused map (metres, m/s, seconds).
 
     ``mode``: ``"tracking"`` (some worker reported them in this bucket) or ``"lost"`` (none did;
-    kept until ``forget_after_s``). ``workers``: how many workers' estimates were merged.
+    kept until ``forget_after_s``). ``workers``: how many workers' estimates were merged;
+    ``lead``: the worker whose estimate weighed most (support × floor information), "" if none.
     """
 
     id: int
@@ -88,6 +92,7 @@ class MapPerson(NamedTuple):
     last_seen: float
     born: float
     workers: int
+    lead: str = ""
 
 
 @dataclass(frozen=True)
@@ -105,6 +110,11 @@ class MapState:
     aliases: Mapping[int, int] = field(default_factory=dict)
     written: float = 0.0
     late: int = 0
+
+    @property
+    def captured(self) -> float:
+        """The latest capture time merged into this state (s); the bucket's middle if none."""
+        return max((t for _, t, _ in self.reports), default=self.t)
 
     def present(self) -> list[MapPerson]:
         """The people some worker reported in this bucket (what ``tracks.csv`` lists)."""
@@ -128,7 +138,7 @@ def encode_observation(o: Observation) -> dict[str, str]:
     """The stream fields of an observation."""
     people = [[int(e.id), _num(e.x), _num(e.y), _num(e.height, 3), _num(e.width, 3), _num(e.vx, 3),
                _num(e.vy, 3), _num(e.score, 3), _num(e.support, 3), int(bool(e.seen)), _sig(e.ixx), _sig(e.ixy),
-               _sig(e.iyy)] for e in o.people]
+               _sig(e.iyy), _num(e.visible, 2)] for e in o.people]
     return {"v": FORMAT_VERSION, "camera": o.camera, "t": repr(float(o.t)), "worker": o.worker,
             "frame": str(int(o.frame)), "sent": repr(float(o.sent)),
             "people": json.dumps(people, separators=(",", ":")),
@@ -140,7 +150,7 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
     try:
         if fields.get("v") != FORMAT_VERSION:
             raise ValueError(f"format version {fields.get('v')!r}, expected {FORMAT_VERSION}")
-        people = tuple(Estimate(int(p[0]), *(_float(v) for v in p[1:9]), bool(p[9]), *(_float(v) for v in p[10:13]))
+        people = tuple(Estimate(int(p[0]), *(_float(v) for v in p[1:9]), bool(p[9]), *(_float(v) for v in p[10:14]))
                        for p in json.loads(fields["people"]))
         return Observation(fields["camera"], float(fields["t"]), fields["worker"], int(fields["frame"]),
                            float(fields["sent"]), people, tuple(int(i) for i in json.loads(fields.get("ended", "[]"))))
@@ -151,7 +161,7 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
 def encode_map_state(s: MapState) -> dict[str, str]:
     """The stream fields of a map state."""
     people = [[p.id, _num(p.x), _num(p.y), _num(p.height, 3), _num(p.width, 3), _num(p.vx, 3), _num(p.vy, 3),
-               _num(p.score, 3), _num(p.support, 3), p.mode, _num(p.last_seen, 3), _num(p.born, 3), p.workers]
+               _num(p.score, 3), _num(p.support, 3), p.mode, _num(p.last_seen, 3), _num(p.born, 3), p.workers, p.lead]
               for p in s.people]
     reports = [[c, _num(t, 4), _num(sent, 4)] for c, t, sent in s.reports]
     return {"v": FORMAT_VERSION, "t": repr(float(s.t)), "written": repr(float(s.written)), "late": str(int(s.late)),
@@ -166,7 +176,7 @@ def decode_map_state(fields: Mapping[str, str]) -> MapState:
         if fields.get("v") != FORMAT_VERSION:
             raise ValueError(f"format version {fields.get('v')!r}, expected {FORMAT_VERSION}")
         people = tuple(MapPerson(int(p[0]), *(_float(v) for v in p[1:9]), str(p[9]), _float(p[10]), _float(p[11]),
-                                 int(p[12])) for p in json.loads(fields["people"]))
+                                 int(p[12]), str(p[13]) if len(p) > 13 else "") for p in json.loads(fields["people"]))
         reports = tuple((str(c), _float(t), _float(s)) for c, t, s in json.loads(fields.get("reports", "[]")))
         aliases = {int(k): int(v) for k, v in json.loads(fields.get("aliases", "{}")).items()}
         return MapState(float(fields["t"]), people, reports, aliases, float(fields.get("written", 0.0)),

@@ -31,7 +31,7 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.fusion import floor_information
+from worldtrack.map.fusion import LEAD_SHARE, floor_information, visible_share
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (Estimate, MapState, Observation, decode_map_state, encode_observation,
                                      stream_id_ms)
@@ -163,11 +163,12 @@ class MapLink:
     # ------------------------------------------------------------------ each frame
     def read_map(self) -> MapState | None:
         """The latest map state (None before the first)."""
-        raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written"])
+        raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports"])
         if raw[0] is None:
             return None
         if self.state is None or float(raw[2]) != self.state.t:
-            fields = {"v": "1", "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}", "written": raw[3] or "0"}
+            fields = {"v": "1", "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}", "written": raw[3] or "0",
+                      "reports": raw[4] or "[]"}
             self.state = decode_map_state(fields)
         return self.state
 
@@ -184,14 +185,16 @@ class MapLink:
                 self.mine_seen.discard(young)
         present = {p.id: p for p in state.present()}
         cams = list(self.cameras.values())
+        dt = min(max(t - state.captured, 0.0), 0.5)
         for p in present.values():
-            dt = min(max(t - state.t, 0.0), 0.5)
             x, y = p.x + p.vx * dt, p.y + p.vy * dt
             q = local.get(p.id)
             if q is None:
                 if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)):
                     self._place(tracker, p, x, y, t)
-            elif p.id not in self.mine_seen:
+            elif p.id not in self.mine_seen or p.lead not in ("", self.name):
+                # Not shown by this worker's cameras, or shown better by another worker's: from
+                # where the map has them (this worker's cameras then move them by their evidence).
                 q.x, q.y, q.vx, q.vy = x, y, p.vx, p.vy
                 if math.isfinite(p.height):
                     q.height = p.height
@@ -227,16 +230,20 @@ class MapLink:
             views = in_views([self.cameras[c] for c in cams], np.array([tr.x, tr.y]), tr.height)
             if not any(views) or not (seen or tr.id in self.ever_seen):
                 continue
-            if seen:
+            mine = [c for c, ok in zip(cams, views) if ok]
+            where, occ = np.array([tr.x, tr.y]), [self.occlusion.get(c) for c in mine]
+            # This worker's own estimate only where its cameras show most of the body; a person
+            # it glimpses (through a door, at the image's edge) it keeps taking from the map.
+            share = visible_share([self.cameras[c] for c in mine], where, tr.height, occ)
+            if seen and share >= LEAD_SHARE:
                 self.mine_seen.add(tr.id)
                 self.ever_seen.add(tr.id)
                 self.placed.discard(tr.id)
             now_ids.add(tr.id)
             support = _support(person, tr)
-            mine = [c for c, ok in zip(cams, views) if ok]
-            info = floor_information([self.cameras[c] for c in mine], np.array([tr.x, tr.y]), tr.height,
-                                     occlusion=[self.occlusion.get(c) for c in mine])
-            e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info)
+            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ)
+            e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info,
+                         share)
             for c, ok in zip(cams, views):
                 if ok:
                     per_cam[c].append(e)
