@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Iterable, Sequence
 
 import numpy as np
@@ -85,6 +85,9 @@ class FusedPerson:
                          self.support, self.mode, self.last_seen, self.born, self.workers, self.lead)
 
 
+_PERSON_FIELDS = [f.name for f in fields(FusedPerson)]
+
+
 @dataclass
 class FusionState:
     """What the fusion role carries from bucket to bucket (and hands over on failover as JSON)."""
@@ -97,7 +100,7 @@ class FusionState:
     last_bucket: int | None = None
 
     def to_json(self) -> str:
-        return json.dumps({"people": [asdict(p) for p in self.people.values()],
+        return json.dumps({"fields": _PERSON_FIELDS, "people": [list(vars(p).values()) for p in self.people.values()],
                            "close_since": [[a, b, t] for (a, b), t in self.close_since.items()],
                            "aliases": [[y, e, t] for y, (e, t) in self.aliases.items()],
                            "last_bucket": self.last_bucket}, allow_nan=True)
@@ -105,7 +108,8 @@ class FusionState:
     @classmethod
     def from_json(cls, text: str) -> "FusionState":
         d = json.loads(text)
-        return cls({p["id"]: FusedPerson(**p) for p in d["people"]},
+        people = [FusedPerson(**dict(zip(d["fields"], p))) for p in d["people"]]
+        return cls({p.id: p for p in people},
                    {(int(a), int(b)): float(t) for a, b, t in d["close_since"]},
                    {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"])
 
@@ -185,6 +189,9 @@ def _information(e: Estimate) -> np.ndarray:
 
 
 def _weighted(estimates: list[Estimate]) -> tuple[float, ...]:
+    if len(estimates) == 1:           # most people, most of the time: one worker sees them
+        e = estimates[0]
+        return e.x, e.y, e.height, e.width, e.vx, e.vy, e.score, e.support
     w = [estimate_weight(e) for e in estimates]
     total = sum(w)
     infos = [wi * _information(e) for wi, e in zip(w, estimates)]
@@ -246,8 +253,9 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
-        p.lead = max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
-                      for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
+        p.lead = next(iter(by_worker)) if len(by_worker) == 1 else \
+            max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
+                 for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
         workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
@@ -269,15 +277,16 @@ def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: fl
                       cfg: MapConfig) -> dict[int, int]:
     """Fold the younger of two ids that workers report apart but that stay within
     ``merge_distance_m`` for ``merge_after_s`` into the elder. Returns ``{younger: elder}``."""
+    from scipy.spatial import cKDTree
     ids = sorted(workers_of)
     close_now = set()
-    for i, a in enumerate(ids):
-        for b in ids[i + 1:]:
-            pa, pb = state.people[a], state.people[b]
+    if len(ids) >= 2:
+        xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
+        for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
+            a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
             if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
                 continue      # one worker's tracker holds both: two people, its business
-            if math.hypot(pa.x - pb.x, pa.y - pb.y) < cfg.merge_distance_m:
-                close_now.add((a, b))
+            close_now.add((a, b))
     state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
     merged: dict[int, int] = {}
     for (a, b), since in sorted(state.close_since.items()):
