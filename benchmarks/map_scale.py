@@ -49,8 +49,8 @@ def run(server: Server, cameras: int, people: int, seconds: float) -> dict:
     client = connect(server.url)
     keys, cfg = MapKeys(), MapConfig()
     pin = ["taskset", "-c", "1"] if shutil.which("taskset") and os.cpu_count() and os.cpu_count() > 1 else []
-    fuser = subprocess.Popen([*pin, *WORLDTRACK, "map", "fuse", server.url], stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
+    log = open(Path(tempfile.gettempdir()) / f"map_scale_fuse_{cameras}.log", "w")
+    fuser = subprocess.Popen([*pin, *WORLDTRACK, "map", "fuse", server.url], stdout=subprocess.DEVNULL, stderr=log)
     while not client.get(keys.fusion_lease):
         time.sleep(0.05)
     pubs = Publishers(client, keys, cfg, SimulatedFloor(cameras, people, np.random.default_rng(cameras))).start()
@@ -69,7 +69,7 @@ def run(server: Server, cameras: int, people: int, seconds: float) -> dict:
     late = sum(s.late for s in states)
     p50, p99 = percentiles(lag)
     return {"cameras": cameras, "obs_s": cameras * 10.0, "merged_s": merged / (t1 - t0), "lag50": p50, "lag99": p99,
-            "late": late, "overruns": pubs.overruns, "people": int(np.median([len(s.present()) for s in states]))}
+            "late": late, "overruns": pubs.overruns, "people": int(np.median([len(s.present()) for s in states])) if states else 0}
 
 
 def main() -> None:

@@ -32,9 +32,10 @@ def test_observation_and_map_state_round_trip_with_nan():
     assert decode_map_state(encode_map_state(s)) == s
 
 
-@pytest.mark.parametrize("fields, problem", [({"v": "0"}, "format version"), ({"v": "1", "camera": "c"}, "KeyError"),
-                                             ({"v": "1", "camera": "c", "t": "1", "worker": "w", "frame": "1",
-                                               "sent": "1", "people": "[[1, 2]"}, "JSONDecodeError")])
+@pytest.mark.parametrize("fields, problem", [({"v": "0"}, "format version"), ({"v": "2", "t": "1"}, "KeyError"),
+                                             ({"v": "2", "t": "1", "o": '["c", "w", 1, 1.0, [[1, 2]'}, "JSONDecodeError"),
+                                             ({"v": "2", "t": "1", "o": '["c", "w", 1, 1.0, [[1, 2]], []]'},
+                                              "IndexError")])
 def test_malformed_observations_are_named(fields, problem):
     with pytest.raises(ValueError, match=problem):
         decode_observation(fields)

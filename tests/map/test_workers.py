@@ -47,8 +47,12 @@ def test_two_workers_hand_a_person_over_and_score_as_well_as_one_process(two_roo
         for p in procs:
             p.kill()
     assert [p.returncode for p in procs] == [0, 0], [(tmp_path / f"{c}.log").read_text()[-600:] for c in ("west", "east")]
-    result = replay(client, MapKeys(), tmp_path / "replay")
+    from worldtrack.scene import load_scene
+    result = replay(client, MapKeys(), tmp_path / "replay", scene=load_scene(two_rooms / "scene.yaml"))
     fused = read_tracks(result.tracks_csv)
+    import cv2
+    plan = cv2.VideoCapture(str(result.video))
+    assert int(plan.get(cv2.CAP_PROP_FRAME_COUNT)) == result.states and result.floorplan.stat().st_size > 10_000
     gt = read_tracks(two_rooms / "gt.csv")
     assert main(["track", str(two_rooms / "scene.yaml"), "--video", f"west={two_rooms / 'west.mp4'}",
                  "--video", f"east={two_rooms / 'east.mp4'}", "--out", str(tmp_path / "one"), "--quiet",

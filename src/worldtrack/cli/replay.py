@@ -19,7 +19,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="first capture time: Unix seconds, ISO 8601, or relative to now as --from=-15m "
                         "(default: the stream's start)")
     p.add_argument("--to", dest="t_to", default=None, metavar="T", help="last capture time (default: the end)")
-    p.add_argument("--out", default="replay", metavar="DIR", help="output folder (default: replay)")
+    p.add_argument("--out", default="replay", metavar="DIR",
+                   help="output folder (default: replay); frame 0 is --from's bucket, else the map's epoch or first state")
     p.add_argument("--scene", default=None, help="the map's scene file: draws the floor plan and plan video "
                                                  "(must be the scene the map belongs to)")
     p.add_argument("--no-video", action="store_true", help="do not write plan.mp4")
@@ -50,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         if theirs and theirs.get("sha256") != scene_digest(args.scene):
             raise InputError(f"--scene {args.scene}: the map belongs to scene {theirs.get('name')!r} "
                              f"(sha256 {str(theirs.get('sha256'))[:12]}…), not this one")
-    result = replay(client, keys, args.out, t_from, t_to, scene=scene, bucket_s=cfg.bucket_s,
+    result = replay(client, keys, args.out, t_from, t_to, scene=scene, bucket_s=cfg.bucket_s, origin=t_from,
                     video=not args.no_video)
     if result.states == 0:
         raise InputError(f"{redacted(args.url)}: no map states between {args.t_from or 'the start'} and "

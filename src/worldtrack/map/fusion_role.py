@@ -105,17 +105,23 @@ class FusionRole:
 
     # ------------------------------------------------------------------ the loop
     def run(self, stop: threading.Event) -> None:
-        """Contend and fuse until ``stop`` is set (then give the lease back)."""
+        """Contend and fuse until ``stop`` is set (then give the lease back). The lease is renewed by
+        a thread of its own, so a long step (a backlog after a take-over) does not let it lapse."""
+        from worldtrack.map.lease import LeaseKeeper
+        keeper = LeaseKeeper([], self.cfg.renew_s, self._lost)
+        keeper.start()
         try:
             while not stop.is_set():
                 if not self.holding:
                     if self.lease.acquire():
                         self._take_over()
+                        keeper.leases[:] = [self.lease]
                     else:
                         stop.wait(self.cfg.renew_s)
                     continue
-                self.step(block_ms=20)
+                self.step(block_ms=20, renew=False)
         finally:
+            keeper.stop(release=False)
             if self.holding:
                 self.drain()
                 self.lease.release()
@@ -132,6 +138,10 @@ class FusionRole:
             b = min(self._buckets)
             if not self._write_bucket(b, self._buckets.pop(b)):
                 break
+
+    def _lost(self, lease) -> None:
+        self.holding = False
+        self.log("fusion: lease taken by another process; contending again")
 
     def _take_over(self) -> None:
         self.holding = True
@@ -163,10 +173,11 @@ class FusionRole:
         for c in self._cameras:
             self._cursors.setdefault(self.keys.observations(c), f"{self._start_ms}-0")
 
-    def step(self, block_ms: int = 20) -> int:
-        """Read what has come, write the buckets that are due; returns buckets written."""
+    def step(self, block_ms: int = 20, renew: bool = True) -> int:
+        """Read what has come, write the buckets that are due; returns buckets written. ``renew``:
+        renew the lease here (when no :class:`LeaseKeeper` does)."""
         now = self.clock()
-        if now - self._renewed >= self.cfg.renew_s:
+        if renew and now - self._renewed >= self.cfg.renew_s:
             if not self.lease.renew():
                 if self.lease.acquire():      # expired while this process stalled, but nobody took it
                     self._take_over()         # somebody may have held it meanwhile: reload the state
@@ -177,7 +188,9 @@ class FusionRole:
             self._renewed = now
         self._refresh_cameras()
         if self._cursors:
-            replies = self.client.xread(self._cursors, count=2000, block=block_ms)
+            # A bounded batch per step (a backlog after a take-over is read in several).
+            count = max(20, 4000 // len(self._cursors))
+            replies = self.client.xread(self._cursors, count=count, block=block_ms)
             self._take(replies)
         else:
             time.sleep(block_ms / 1000.0)

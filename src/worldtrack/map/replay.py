@@ -142,7 +142,11 @@ class PlanVideo:
         import matplotlib.pyplot as plt
 
         from worldtrack.viz.floorplan import draw_scene
-        fig, ax = plt.subplots(figsize=(8, 6), dpi=100)
+        x0, x1, y0, y1 = scene.walkable.bounds
+        w, h = x1 - x0 + 2, y1 - y0 + 2
+        scale = 8.0 / max(w, h)
+        # Even pixel sizes (video codecs want them).
+        fig, ax = plt.subplots(figsize=(max(4.0, round(w * scale, 1)), max(3.0, round(h * scale, 1) + 0.4)), dpi=100)
         draw_scene(ax, scene, show_coverage=True)
         fig.tight_layout()
         fig.canvas.draw()

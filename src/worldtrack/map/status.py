@@ -7,7 +7,7 @@ import time
 from typing import Any
 
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.messages import decode_map_state, time_of_id
+from worldtrack.map.messages import FORMAT_VERSION, decode_map_state, time_of_id
 
 
 def map_status(client: Any, keys: MapKeys, now: float | None = None) -> dict[str, Any]:
@@ -48,7 +48,7 @@ def map_status(client: Any, keys: MapKeys, now: float | None = None) -> dict[str
     holder, ttl, n_map, (people_json, t, written, last_holder) = pipe.execute()
     people = []
     if people_json:
-        state = decode_map_state({"v": "1", "t": t, "people": people_json})
+        state = decode_map_state({"v": FORMAT_VERSION, "t": t, "people": people_json})
         people = [{"id": p.id, "x": p.x, "y": p.y, "mode": p.mode, "workers": p.workers} for p in state.people]
     fusion = {"holder": holder, "lease_s": max(0, ttl) / 1000 if holder else 0.0, "entries": n_map,
               "last_bucket": float(t) if t else None, "lag_s": now - float(t) if t else None,

@@ -33,8 +33,8 @@ from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
 from worldtrack.map.fusion import LEAD_SHARE, floor_information, visible_share
 from worldtrack.map.lease import FENCED_XADD, Lease
-from worldtrack.map.messages import (Estimate, MapState, Observation, decode_map_state, encode_observation,
-                                     stream_id_ms)
+from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
+                                     encode_observation, stream_id_ms)
 from worldtrack.trackers.base import Frame, Person, PositionMap, Track, Tracker
 
 
@@ -167,7 +167,8 @@ class MapLink:
         if raw[0] is None:
             return None
         if self.state is None or float(raw[2]) != self.state.t:
-            fields = {"v": "1", "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}", "written": raw[3] or "0",
+            fields = {"v": FORMAT_VERSION, "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}",
+                      "written": raw[3] or "0",
                       "reports": raw[4] or "[]"}
             self.state = decode_map_state(fields)
         return self.state
