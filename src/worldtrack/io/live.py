@@ -261,10 +261,13 @@ class Grabber(threading.Thread):
         with self._cond:
             self.ended = True
             self._cond.notify_all()
-        try:
-            self._queue.put_nowait(_END)
-        except queue.Full:
-            pass
+        while True:          # after the frames still queued (a reader slower than the file)
+            try:
+                self._queue.put(_END, timeout=0.2)
+                return
+            except queue.Full:
+                if self._halt.is_set():
+                    return
 
     # ------------------------------------------------------------------ the reader's side
     def newest(self, after: int, timeout: float) -> tuple[float, int, np.ndarray] | None:
