@@ -94,7 +94,8 @@ class _Worker:
         self.state = "standby"
         self.source = None
         self.frames = 0
-        threading.Thread(target=self.fusion.run, args=(self.stop,), name="fusion", daemon=True).start()
+        if self.cfg.fusion_in_worker:
+            threading.Thread(target=self.fusion.run, args=(self.stop,), name="fusion", daemon=True).start()
         self.keeper = None
 
     def beat(self) -> None:

@@ -43,6 +43,9 @@ class MapConfig(Section):
                                                             "when they come this close to its cameras' views")
     pace_files: bool = Field(True, description="play video files as live cameras (in real time from the map's "
                                                "epoch); false: as fast as the worker can (batch runs)")
+    fusion_in_worker: bool = Field(True, description="each worker contends for the fusion role in a thread; false: "
+                                                     "leave it to `worldtrack map fuse` processes (a fusion thread "
+                                                     "shares the worker's interpreter lock with its tracker)")
     wait_for_start: bool = Field(False, description="video files wait for `worldtrack map start` (which sets "
                                                     "the epoch for all at once) instead of the first worker's start")
 
