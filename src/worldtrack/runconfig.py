@@ -188,11 +188,14 @@ def _deep_merge(base: dict[str, Any], given: Mapping[str, Any]) -> dict[str, Any
 
 
 def _find_field(section: Section, name: str, prefix: str = "") -> str | None:
-    """The dotted path of the first field called ``name`` in ``section`` (depth first), or None."""
+    """The dotted path of the first field called ``name`` in ``section`` (depth first), or of its
+    ``where`` if ``name`` is a section with one (``births.where``), or None."""
     for field, value in ((f, getattr(section, f)) for f in type(section).model_fields):
         path = f"{prefix}{field}"
         if field == name and not isinstance(value, Section):
             return path
+        if field == name and "where" in type(value).model_fields:
+            return f"{path}.where"
         if isinstance(value, Section):
             found = _find_field(value, name, path + ".")
             if found is not None:

@@ -32,6 +32,8 @@ _MOG[127] = UNSURE
 
 
 class Foreground(Protocol):
+    """What trackers read of a frame, one model per camera (:data:`worldtrack.foreground.FOREGROUNDS`)."""
+
     #: True when ``labels``/``mask`` update a model (the answer depends on the frames seen before).
     learns: bool
 
@@ -41,6 +43,14 @@ class Foreground(Protocol):
 
     def labels(self, image: np.ndarray) -> np.ndarray:
         """(H, W) uint8: 0 background, 1 foreground, 2 unsure (shadow-like)."""
+        ...
+
+    def difference(self, image: np.ndarray) -> np.ndarray:
+        """(H, W) float32: colour distance to the background (paper 004's F)."""
+        ...
+
+    def background_image(self) -> np.ndarray | None:
+        """(H, W, 3) uint8: the empty scene the model compares with now, if it has one."""
         ...
 
 
@@ -150,6 +160,10 @@ class StaticBackground:
         self._check(image)
         return colour_distance(image, self.background)
 
+    def background_image(self) -> np.ndarray:
+        """The fixed empty-scene image."""
+        return self.background
+
 
 class AdaptiveBackground:
     """OpenCV's adaptive background subtractors with shadow detection.
@@ -202,3 +216,7 @@ class AdaptiveBackground:
     def difference(self, image: np.ndarray) -> np.ndarray:
         """Colour distance to the model's current background image."""
         return colour_distance(image, self.model.getBackgroundImage())
+
+    def background_image(self) -> np.ndarray | None:
+        """The model's current background image (OpenCV's estimate), or None before any frame."""
+        return self.model.getBackgroundImage()

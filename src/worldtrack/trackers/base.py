@@ -242,6 +242,12 @@ class PositionMap:
         self._next_tentative = -1
         #: Pairs of ids and how many frames in a row they have been close (duplicate rules).
         self.close_pairs: dict[tuple[int, int], int] = {}
+        #: ``close_pairs`` before the time stamp ``close_time`` (several trackers count it once).
+        self.close_before: dict[tuple[int, int], int] = {}
+        self.close_time: float | None = None
+        #: The cameras of the trackers stepping on this map (each tracker adds its own): a tracker
+        #: leaves the people another tracker's cameras show to that tracker.
+        self.cameras: set[str] = set()
 
     def add(self, x: float, y: float, height: float = 1.65, width: float = 0.40, mode: str = "capture",
             time: float = 0.0, track_id: int | None = None, tentative: bool = False,

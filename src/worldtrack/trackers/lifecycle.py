@@ -44,7 +44,7 @@ def younger(a: Person, b: Person) -> Person:
 
 
 def merge_duplicates(position_map: PositionMap, close: Mapping[tuple[int, int], int],
-                     end: Callable[[Person], None]) -> None:
+                     end: Callable[[Person], None], t: float | None = None) -> None:
     """End the younger of each pair of people that has been close for its number of frames.
 
     Parameters
@@ -54,10 +54,16 @@ def merge_duplicates(position_map: PositionMap, close: Mapping[tuple[int, int], 
     close : {(id_a, id_b): frames} — the pairs close this frame (``id_a < id_b``), each with the
         frames in a row it must last (e.g. longer for a pair one behind the other)
     end : callable — ends a person (the tracker's own clean-up)
+    t : float, optional — the time stamp (s). Given, a pair advances once per time stamp however
+        many trackers sharing the map call this at ``t`` (the last call's pairs count); without it,
+        once per call.
 
     A pair whose elder has just been ended (a chain of three) is left alone: it duplicates nobody.
     """
-    counts = {pair: position_map.close_pairs.get(pair, 0) + 1 for pair in close}
+    if t is None or position_map.close_time != t:
+        position_map.close_before, position_map.close_time = dict(position_map.close_pairs), t
+    before = position_map.close_pairs if t is None else position_map.close_before
+    counts = {pair: before.get(pair, 0) + 1 for pair in close}
     position_map.close_pairs = counts
     for (ia, ib), need in close.items():
         if counts.get((ia, ib), 0) >= need and ia in position_map and ib in position_map:
