@@ -194,6 +194,7 @@ def run_live(args: argparse.Namespace, cfg) -> int:
         if worker is not None:
             worker.source = source
             worker.link.fps = source.fps
+            worker.link.lockstep = not pace and not source.live
             worker.link.register()
         missing = [c for c in sources if c not in backgrounds]
         if missing:

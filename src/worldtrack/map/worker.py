@@ -119,6 +119,12 @@ class MapLink:
         self._reported: dict[int, tuple[str, ...]] = {}
         self.published = 0
         self.last_capture: float | None = None
+        #: Batch runs (files not played in real time): before each step wait (at most
+        #: ``lockstep_wait_s``) until the map holds the previous frame, so that workers going at
+        #: different speeds stay in step and none reads a map from its own future.
+        self.lockstep = False
+        self.lockstep_wait_s = 2.0
+        self._first_t: float | None = None
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
@@ -173,8 +179,21 @@ class MapLink:
             self.state = decode_map_state(fields)
         return self.state
 
+    def _wait_for_map(self, t: float) -> None:
+        if self._first_t is None:
+            self._first_t = t
+        if not self.lockstep or t - self._first_t < 1.5 / self.fps:
+            return
+        deadline = time.monotonic() + self.lockstep_wait_s
+        while time.monotonic() < deadline:
+            state = self.read_map()
+            if state is not None and state.captured >= t - 1.5 / self.fps:
+                return
+            time.sleep(0.002)
+
     def sync(self, tracker: Tracker, t: float) -> None:
         """Before the tracker steps at ``t``: take from the shared map what this worker does not see."""
+        self._wait_for_map(t)
         state = self.read_map()
         self._state_t = t
         if state is None:
