@@ -33,7 +33,7 @@ class MapConfig(Section):
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")
-    merge_after_s: float = Field(0.5, ge=0, description="see merge_distance_m")
+    merge_after_s: float = Field(0.2, ge=0, description="see merge_distance_m")
     forget_after_s: float = Field(3.0, gt=0, description="a person no worker reports for this long leaves the "
                                                          "map (their id may be reclaimed until then)")
     claim_radius_m: float = Field(1.0, gt=0, description="a worker's new person within this distance of a "

@@ -22,8 +22,8 @@ each with its own cameras, share one person map — who updates a person two of 
 * **Ids are the map's.** A worker's tracker takes new ids from the map (one counter in Redis) and,
   for a person walking in from a neighbour's view, finds them already on its map under their id.
   If two workers still start the same person at once (both saw them first in the same frame), the
-  two ids are close for ``merge_after_s`` with estimates from different workers: the younger id is
-  folded into the elder (``aliases``), and the workers rename their copy.
+  two ids are close for ``merge_after_s`` with estimates from different sets of workers: the
+  younger id is folded into the elder (``aliases``), and the workers rename their copy.
 * A person no worker reports is ``lost`` (kept, not moved) and leaves the map after
   ``forget_after_s``, or at once when the workers that saw them last say their tracker ended them
   (walked out of the door).
@@ -275,8 +275,9 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 
 def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
                       cfg: MapConfig) -> dict[int, int]:
-    """Fold the younger of two ids that workers report apart but that stay within
-    ``merge_distance_m`` for ``merge_after_s`` into the elder. Returns ``{younger: elder}``."""
+    """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
+    the elder, unless the very same workers see both (then they are two people those workers tell
+    apart). Returns ``{younger: elder}``."""
     from scipy.spatial import cKDTree
     ids = sorted(workers_of)
     close_now = set()
@@ -284,8 +285,8 @@ def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: fl
         xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
         for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
             a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
-            if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
-                continue      # one worker's tracker holds both: two people, its business
+            if workers_of[a] == workers_of[b] or not workers_of[a] or not workers_of[b]:
+                continue      # the same workers hold both apart: two people
             close_now.add((a, b))
     state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
     merged: dict[int, int] = {}

@@ -210,7 +210,10 @@ class MapLink:
             x, y = p.x + p.vx * dt, p.y + p.vy * dt
             q = local.get(p.id)
             if q is None:
-                if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)):
+                # Not where this worker already holds somebody under another id: the map merges
+                # those two ids (a copy here would make one worker hold the same person twice).
+                if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)) and \
+                        not self._holds_near(local, x, y):
                     self._place(tracker, p, x, y, t)
             elif p.id not in self.mine_seen or p.lead not in ("", self.name):
                 # Not shown by this worker's cameras, or shown better by another worker's: from
@@ -222,6 +225,9 @@ class MapLink:
             if q.id > 0 and q.id in self.placed and q.id not in present and q.id not in self.mine_seen:
                 local.remove(q.id)
                 self.placed.discard(q.id)
+
+    def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
+        return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m for q in local)
 
     def _place(self, tracker: Tracker, p, x: float, y: float, t: float) -> None:
         local = tracker.position_map
