@@ -82,12 +82,12 @@ def test_filters_one_behind_the_other_on_the_floor_are_merged_only_if_it_lasts()
     assert frames_to_merge((0.1, 4.0), merge__depth_m=4.0) == 6
     # The same 0.3 s and 0.6 s at 25 and 7 frames/s.
     assert frames_to_merge((0.1, 3.3), dt=0.04) == 8 and frames_to_merge((0.1, 4.0), dt=0.04) == 15
-    assert frames_to_merge((0.1, 3.3), dt=1 / 7) == 2 and frames_to_merge((0.1, 4.0), dt=1 / 7) == 4
+    assert frames_to_merge((0.1, 3.3), dt=1 / 7) == 3 and frames_to_merge((0.1, 4.0), dt=1 / 7) == 5
 
 
 def test_a_cloud_is_split_after_split_after_s_at_any_frame_rate():
     """A cloud of two lumps side by side is due for splitting once it has been two lumps for
-    ``split.after_s`` (0.24 s): 2 frames at 10 frames/s, 2 at 7, 6 at 25; one lump never is."""
+    ``split.after_s`` (0.2 s): at least that long, 2 frames at 10 frames/s, 2 at 7, 5 at 25; one lump never is."""
     from worldtrack.trackers.base import PositionMap
     from worldtrack.trackers.particle.cloud import Cloud, CloudStack
 
@@ -108,5 +108,5 @@ def test_a_cloud_is_split_after_split_after_s_at_any_frame_rate():
                 return k
         return None
 
-    assert [frames_to_split(two, dt) for dt in (0.1, 1 / 7, 0.04)] == [2, 2, 6]
+    assert [frames_to_split(two, dt) for dt in (0.1, 1 / 7, 0.04)] == [2, 2, 5]
     assert frames_to_split(one, 0.1) is None

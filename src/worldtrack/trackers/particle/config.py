@@ -223,7 +223,7 @@ class SplitConfig(Section):
     distance_m: float = _finite(0.35, "least distance between the two lumps' peaks, metres", gt=0)
     dip: float = _finite(0.5, "deepest valley between them, as a share of the lower peak", gt=0, lt=1)
     min_mass: float = _finite(0.2, "least share of the particles on each side", gt=0, lt=0.5)
-    after_s: float = _finite(0.24, "how long the cloud must stay two lumps, seconds (two frames at 7–10 frames/s: "
+    after_s: float = _finite(0.2, "how long the cloud must stay two lumps, seconds (two frames at 7–10 frames/s: "
                              "one frame of two lumps is the resampling's noise)", gt=0)
 
 
