@@ -117,7 +117,7 @@ class FusionRole:
                         self._take_over()
                         keeper.leases[:] = [self.lease]
                     else:
-                        stop.wait(self.cfg.renew_s)
+                        stop.wait(self.cfg.renew_s / 2)     # as a camera standby: take it soon after expiry
                     continue
                 self.step(block_ms=20, renew=False)
         finally:
