@@ -110,6 +110,10 @@ def connect(url: str, timeout_s: float = 5.0) -> Any:
         raise
     except (redis.ConnectionError, redis.TimeoutError, OSError) as e:
         raise InputError(f"{where}: cannot reach the map ({_first_line(e)})") from None
+    except TypeError as e:           # an option in the URL's query the client does not take
+        name = str(e).rsplit(" ", 1)[-1]
+        raise InputError(f"{where}: the redis client takes no option {name} (TLS options such as "
+                         f"ssl_ca_certs need rediss://)") from None
     return client
 
 
