@@ -31,6 +31,10 @@ def test_killed_fusion_holder_is_replaced_within_2_s_and_nothing_is_lost(redis_u
     first = _fuser(redis_url, log)
     holder = wait_until(lambda: client.get(keys.fusion_lease), 60, what="the first fusion holder")
     second = _fuser(redis_url, log)
+    # The standby is up (imports done, connected) before the holder dies: on a loaded machine its
+    # start-up alone can outlast the test's 2 s of publishing.
+    wait_until(lambda: (tmp_path / "fusers.log").read_text().count("contending for the fusion role") == 2, 120,
+               what="the standby fusion process")
     pubs = Publishers(client, keys, cfg, SimulatedFloor(4, 3, np.random.default_rng(0))).start()
     try:
         time.sleep(2.0)
