@@ -5,6 +5,7 @@ the fusion holder killed with SIGKILL is taken over within 2 s with ids kept and
 from __future__ import annotations
 
 import json
+import re
 import signal
 import subprocess
 import time
@@ -20,8 +21,8 @@ from worldtrack.map.connection import MapKeys, connect
 from worldtrack.map.replay import read_states, replay
 
 pytestmark = pytest.mark.slow
-#: How far below one process with both cameras the map may score (MOTA, IDF1) in one real-time run.
-TOLERANCE = 0.05
+#: How far below one process with both cameras the map may score (MOTA, IDF1) in a batch run.
+TOLERANCE = 0.03
 
 
 def _start_when_ready(client, cameras, timeout=120):
@@ -38,7 +39,8 @@ def _finish(procs, timeout=120):
 
 def test_two_workers_hand_a_person_over_and_score_as_well_as_one_process(two_rooms, redis_url, tmp_path):
     from worldtrack.cli import main
-    procs = [worker(two_rooms, redis_url, cam, tmp_path / cam) for cam in ("west", "east")]
+    procs = [worker(two_rooms, redis_url, cam, tmp_path / cam, "--set", "map.pace_files=false")
+             for cam in ("west", "east")]
     client = connect(redis_url)
     try:
         _start_when_ready(client, ("west", "east"))
@@ -61,11 +63,17 @@ def test_two_workers_hand_a_person_over_and_score_as_well_as_one_process(two_roo
     m = evaluate(gt, fused)
     print(f"fused MOTA {m['mota']:.3f} IDF1 {m['idf1']:.3f} err {m['motp_m']:.3f} m; "
           f"one process MOTA {one['mota']:.3f} IDF1 {one['idf1']:.3f} err {one['motp_m']:.3f} m")
-    # The map's result depends on which map state each worker reads before a step (real time):
-    # over repeated runs it ranged MOTA 0.96-1.00, IDF1 0.95-1.00 (one process 0.994 / 0.964);
+    # Batch run (map.pace_files=false): each worker waits for the map to hold its previous frame, so
+    # the result hardly depends on how loaded the machine is (in real time it does: at load 25 on 2
+    # cores MOTA 0.94-0.97). Here MOTA 0.972-0.994, IDF1 0.986-0.997 (one process 0.994 / 0.964);
     # the misses are a person standing a metre from the west camera, mostly below its image.
     assert m["mota"] >= one["mota"] - TOLERANCE and m["idf1"] >= one["idf1"] - TOLERANCE
-    # Each walker crossed the door from one camera's view into the other's under one map id.
+    # Each walker crossed the door from one camera's view into the other's under one map id, put on
+    # the receiving worker's map from the shared one before they entered its view (not born again
+    # and given the id afterwards, which scores as well here: the logs tell the two apart).
+    logs = " ".join((tmp_path / f"{c}.log").read_text() for c in ("west", "east"))
+    handed = [int(n) for n in re.findall(r"(\d+) people taken from the map before they entered its views", logs)]
+    assert len(handed) == 2 and sum(handed) >= 2, handed
     for person in (1, 2):
         g = gt.id == person
         crossing = [f for f, x in zip(gt.frame[g], gt.x[g]) if 4.5 < x < 7.5]

@@ -116,6 +116,8 @@ class MapLink:
         self.mine_seen: set[int] = set()      # people this worker's cameras have shown (its own)
         self.ever_seen: set[int] = set()
         self.placed: set[int] = set()         # people put on the local map from the shared one
+        self.handed_over = 0                  # how many times (hand-overs from a neighbour's view)
+        self.claimed = 0                      # new people that took the id of a person the map had
         self._reported: dict[int, tuple[str, ...]] = {}
         self.published = 0
         self.last_capture: float | None = None
@@ -147,7 +149,10 @@ class MapLink:
         """An id for a person the tracker confirms at (x, y): a lost person's of the map nearby, else
         the next of the map's counter."""
         claimed = self._claim(x, y)
-        return claimed if claimed is not None else int(self.client.incr(self.keys.ids))
+        if claimed is not None:
+            self.claimed += 1
+            return claimed
+        return int(self.client.incr(self.keys.ids))
 
     def _claim(self, x: float, y: float) -> int | None:
         if self.state is None:
@@ -240,6 +245,7 @@ class MapLink:
         q.height = p.height if math.isfinite(p.height) else q.height
         q.width = p.width if math.isfinite(p.width) else q.width
         self.placed.add(p.id)
+        self.handed_over += 1
 
     def observations(self, tracker: Tracker, tracks: Sequence[Track], t: float,
                      frames: Mapping[str, Frame]) -> list[Observation]:
