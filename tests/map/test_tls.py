@@ -34,21 +34,22 @@ def tls_server(tmp_path_factory):
                              "--requirepass", PASSWORD, "--save", "", "--appendonly", "no", "--dir", str(d)],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     url = f"rediss://:{PASSWORD}@127.0.0.1:{port}/0?ssl_ca_certs={d / 'cert.pem'}"
-    deadline = time.monotonic() + 10
-    while True:
-        if proc.poll() is not None:
-            pytest.skip("this redis-server was built without TLS")
-        try:
-            connect(url, timeout_s=1.0)
-            break
-        except InputError:
-            if time.monotonic() > deadline:
-                proc.kill()
-                raise
-            time.sleep(0.05)
-    yield url, port
-    proc.terminate()
-    proc.wait(5)
+    try:                                  # stopped however the set-up or the test ends
+        deadline = time.monotonic() + 10
+        while True:
+            if proc.poll() is not None:
+                pytest.skip("this redis-server was built without TLS")
+            try:
+                connect(url, timeout_s=1.0)
+                break
+            except InputError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.05)
+        yield url, port
+    finally:
+        proc.kill()
+        proc.wait(5)
 
 
 def test_rediss_reaches_a_tls_server_and_plain_or_unverified_connections_fail_in_one_line(tls_server, capsys):
