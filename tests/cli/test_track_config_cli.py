@@ -13,7 +13,7 @@ def test_print_config_prints_every_setting_and_round_trips(tmp_path, capsys):
     text = capsys.readouterr().out
     data = yaml.safe_load(text)
     assert data["method"] == "ellipsoid" and data["preset"] == "default"
-    assert set(data) == {"method", "preset", "foreground", "ellipsoid", "particle", "blobs"}
+    assert set(data) == {"method", "preset", "foreground", "ellipsoid", "particle", "blobs", "map"}
     assert "# " in text                                        # each field carries its description
     (tmp_path / "all.yaml").write_text(text)
     assert main(["track", "--config", str(tmp_path / "all.yaml"), "--print-config"]) == 0

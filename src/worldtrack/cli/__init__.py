@@ -15,7 +15,8 @@ from worldtrack import __version__
 from worldtrack.errors import InputError
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
-_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt")
+_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt", "replay",
+             "map")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -41,7 +41,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "DIR/<camera>_annotated.mp4 and DIR/floorplan.png.")
     p.add_argument("scene", nargs="?", help="scene YAML file (required unless --print-config)")
     p.add_argument("--video", action="append", default=[], metavar="CAM=PATH",
-                   help="video file or folder of images for camera CAM (repeat for several cameras)")
+                   help="video file or folder of images for camera CAM (repeat for several cameras); or a live "
+                        "camera: a device index (CAM=0) or a stream URL (rtsp://, http://, udp://)")
+    p.add_argument("--map", metavar="URL", default=None,
+                   help="work on a shared map on Redis (redis://[USER:PASSWORD@]HOST:PORT/DB or rediss://): own "
+                        "the --cameras, publish what they see, take over the fusion if free")
+    p.add_argument("--cameras", metavar="CAM,CAM", default=None,
+                   help="with --map: the cameras this worker owns (default: every --video camera)")
     p.add_argument("--background", action="append", default=[], metavar="CAM=PNG",
                    help="empty-scene image for CAM; default: <video folder>/<CAM>_background.png if "
                         "present, else the temporal median of frames sampled over the video")
@@ -102,6 +108,10 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if not args.scene:
         raise InputError("track: give a scene file (worldtrack track SCENE --video CAM=PATH …)")
+    from worldtrack.io.live import is_live, parse_source
+    if args.map or any(is_live(parse_source(_pair(v, "--video")[1])) for v in args.video):
+        from worldtrack.cli.track_live import run_live
+        return run_live(args, cfg)
     from worldtrack.foreground import foregrounds_from_config
     from worldtrack.io.runinfo import write_run_info
     from worldtrack.io.sources import VideoSource, background_from_video, read_image

@@ -486,6 +486,41 @@ def crowd(seed: int, common: Common, *, size=None, frames=None, people: int = 10
                     _rigs(scene, common), seed, description=f"{people} random walkers")
 
 
+# ------------------------------------------------------------------------------------ two rooms
+
+@_register("two-rooms", "two rooms joined by a door, one camera each: people walk from one view into the other")
+def two_rooms(seed: int, common: Common, *, size=None, frames=None, people: int = 2, stagger: float = 3.0,
+              speed: tuple = (0.9, 1.3)) -> Scenario:
+    """Two 6 × 5 m rooms joined by a 1.2 m door at x = 6 m, a camera on each end wall looking at the
+    door. Person k starts in one room (alternating west, east), waits ``stagger`` · k seconds, walks
+    through the door into the other room to a random point and stops there; the door is seen by
+    both cameras. 320×240 by default."""
+    if not 1 <= int(people) <= 6:
+        raise InputError(f"people: expected 1 to 6, got {people}")
+    rng = np.random.default_rng(seed)
+    scene = _scene(scenes.scene_dict("two_rooms"), size or (320, 240))
+    env = Environment(wall_height=3.2, floor_style="tiles", floor_colour=(140, 150, 160), wall_colour=(195, 200, 190),
+                      obstacle_colours={"wall_south": (195, 200, 190), "wall_north": (195, 200, 190),
+                                        "table_west": (70, 100, 140), "cabinet_east": (120, 120, 125)},
+                      posters=4, seed=23)
+    shapes, routes = [], []
+    for k in range(int(people)):
+        side = 1.0 if k % 2 == 0 else -1.0           # +1: starts west
+        lane = float(rng.uniform(2.1, 2.9))
+        start = (6.0 - side * rng.uniform(3.5, 4.8), float(rng.uniform(1.2, 3.6)))
+        goal = (6.0 + side * rng.uniform(2.5, 4.5), float(rng.uniform(1.5, 3.5)))
+        v = float(rng.uniform(*speed))
+        routes.append([Waypoint(*start, dwell=stagger * k + 0.5), Waypoint(6.0 - side * 1.2, lane, speed=v),
+                       Waypoint(6.0 + side * 1.2, lane, speed=v), Waypoint(*goal, speed=v, dwell=1.0)])
+        shapes.append(_shape(rng, env))
+    tracks = [scripted_track(r, common.fps, _route_frames(r, common.fps), s.height) for r, s in zip(routes, shapes)]
+    n = frames or _route_length(tracks, 1.0, common.fps, _MAX_FRAMES)
+    persons = [Person(k + 1, shapes[k], _trim(_pad(tracks[k], n), n)) for k in range(int(people))]
+    light = Light(ambient=0.6, direct=0.45, direction=light_direction(200.0, 60.0))
+    return Scenario("two-rooms", scene, common.fps, n, persons, env, _lighting(common, rng, light), _options(common),
+                    _rigs(scene, common), seed, description=f"{people} people walking between two rooms")
+
+
 # ------------------------------------------------------------------------------------ seed 004
 
 @_register("entry", "seed 004: people enter side by side through a door region, then split up and leave")
