@@ -44,6 +44,12 @@ def test_scrubbing_puts_every_person_where_tracks_csv_says(page, run_server, fin
         assert page.evaluate("window.worldtrack.frameIndex") == k
         assert f"frame {frames[k]}" in page.locator("#clock").inner_text()
         seen.append(check_frame(page, finished_run, frames[k]))
+    t_now = table.time[table.frame == frames[-1]][0]
+    assert page.locator("#layer-trails polyline").count() >= 2
+    for line in page.locator("#layer-trails polyline").all():       # trails: the last 2 s (--trail 2)
+        pid = int(line.get_attribute("data-id"))
+        rows = (table.id == pid) & (table.time <= t_now + 1e-6) & (table.time >= t_now - 2.0 - 1e-6)
+        assert len(line.get_attribute("points").split()) == int(rows.sum())
     moved = [pid for pid in set(seen[1]) & set(seen[2]) if np.hypot(*np.subtract(seen[1][pid], seen[2][pid])) > 5]
     assert moved, "nobody moved between the middle and the last frame"
     page.keyboard.press("ArrowLeft")                          # keys step one frame (focus on the page)
