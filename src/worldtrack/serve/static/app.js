@@ -1,14 +1,15 @@
 // worldtrack serve: the floor plan and the people on it. Plain JavaScript, no build step, no CDN.
 // Floor metres -> SVG pixels: u = (x - x_min) * scale, v = (y_max - y) * scale (see serve/plan.py).
 // window.worldtrack is the page's small public handle (tests and users' scripts): ready, mode,
-// frameIndex, state, seek(k), play(), pause(), select(id).
+// frameIndex, state, updates, lags (live: s from the map state's writing to its drawing), seek(k),
+// play(), pause(), select(id).
 "use strict";
 (() => {
   const SVGNS = "http://www.w3.org/2000/svg";
   const COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
                    "#bcbd22", "#17becf"];
   const $ = (id) => document.getElementById(id);
-  const WT = (window.worldtrack = { ready: false, frameIndex: 0, state: null, updates: 0 });
+  const WT = (window.worldtrack = { ready: false, frameIndex: 0, state: null, updates: 0, lags: [] });
   let plan, T, run = null, selected = null, current = [];
   const nodes = new Map();            // id -> {g, sigma, heading, label, speed}
   const cameraRows = new Map();       // camera id -> {state, lag, sees, ring}
@@ -322,6 +323,10 @@
       $("clock").textContent = `${clockText(msg.t)} · lag ${Math.round(msg.lag_ms)} ms`;
       WT.state = msg;
       WT.updates++;
+      if (msg.written) {                                  // map written -> drawn here (same machine's clock)
+        WT.lags.push(Date.now() / 1000 - msg.written);
+        if (WT.lags.length > 5000) WT.lags.shift();
+      }
     }
     function onCameras(msg) {
       for (const c of msg.cameras) setCameraState(c.id, c.state, c.lag_ms);
