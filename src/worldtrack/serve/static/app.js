@@ -245,8 +245,9 @@
       k = Math.max(0, Math.min(last, Math.round(k)));
       WT.frameIndex = k;
       scrub.value = k;
-      render(byFrame[k] ? byFrame[k].map(row) : []);
-      const t = run.times[k] ?? 0;
+      const people = byFrame[k] ? byFrame[k].map(row) : [], t = run.times[k] ?? 0;
+      render(people);
+      WT.state = { frame: run.frames[k], t, people };
       $("clock").textContent = `t ${fmt(t, 2)} s · frame ${run.frames[k] ?? 0}`;
       $("t-label").textContent = `${fmt(t, 1)} / ${fmt(tEnd, 1)} s`;
       WT.updates++;
@@ -275,8 +276,9 @@
     scrub.addEventListener("input", () => { pause(); seek(parseInt(scrub.value, 10)); });
     $("play").addEventListener("click", () => (playing ? pause() : play()));
     document.addEventListener("keydown", (ev) => {
-      if (ev.key === " " && ev.target.tagName !== "SELECT") { ev.preventDefault(); playing ? pause() : play(); }
-      else if (ev.target === scrub) return;
+      if (["BUTTON", "SELECT"].includes(ev.target.tagName)) return;     // their own keys
+      if (ev.key === " ") { ev.preventDefault(); playing ? pause() : play(); }
+      else if (ev.target === scrub) return;                                // the slider steps by itself
       else if (ev.key === "ArrowRight") { pause(); seek(WT.frameIndex + 1); }
       else if (ev.key === "ArrowLeft") { pause(); seek(WT.frameIndex - 1); }
     });
