@@ -75,11 +75,6 @@ DOTS_JS = """() => {
 }"""
 
 
-def open_page(page, url: str):
-    page.goto(url)
-    page.wait_for_function("window.worldtrack && window.worldtrack.ready", timeout=20000)
-
-
 def open_page(page, url: str) -> None:
     """Load the page and wait until it has drawn the plan and the people."""
     page.goto(url)

@@ -6,6 +6,8 @@ skipped with one line saying so; the live-map test uses the real ``redis-server`
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from _servekit import RedisServer, Server, chromium_path

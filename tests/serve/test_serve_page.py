@@ -4,7 +4,6 @@ positions of tracks.csv (within a pixel of the scene-to-SVG transform), scrubbin
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from worldtrack.io.tracks import read_tracks
 from worldtrack.scene import load_scene
@@ -109,10 +108,28 @@ def test_unmeasurable_people_are_drawn_differently(page, run_server, finished_ru
     assert "unmeasurable" not in page.locator(f'#people .person[data-id="{marked}"]').get_attribute("class")
 
 
-@pytest.mark.parametrize("width", [700])
-def test_screenshot_of_a_narrow_window_keeps_the_transform(page, run_server, finished_run, width, tmp_path):
-    """The SVG scales with the window: positions in SVG units stay those of the transform."""
-    page.set_viewport_size({"width": width, "height": 700})
+def test_zoom_and_a_narrow_window_keep_the_transform(page, run_server, finished_run, tmp_path):
+    """The SVG scales with the window and zooms with the wheel: positions in SVG units stay those of
+    the transform, the dots keep their size on screen and the σ circles their size in metres."""
+    page.set_viewport_size({"width": 700, "height": 700})
     open_page(page, run_server.url)
-    check_frame(page, finished_run, 0)
-    page.screenshot(path=str(tmp_path / "narrow.png"))
+    frames = page.evaluate("window.worldtrack.frames")
+    k = len(frames) // 2
+    page.evaluate(f"window.worldtrack.seek({k})")
+    check_frame(page, finished_run, frames[k])
+    width = "document.querySelector('#people .person .dot').getBoundingClientRect().width"
+    sigma = "document.querySelector('#people .person .sigma').getBoundingClientRect().width"
+    dot_px, sigma_px = page.evaluate(width), page.evaluate(sigma)
+    box = page.locator("#plan").bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.wheel(0, -400)                                  # zoom in about 1.8x
+    page.wait_for_timeout(100)
+    zoom = page.evaluate("window.worldtrack.transform.width / document.getElementById('plan').viewBox.baseVal.width")
+    assert zoom > 1.5
+    inside = page.evaluate(DOTS_JS)
+    check_frame(page, finished_run, frames[k])
+    assert abs(page.evaluate(width) - dot_px) < 0.5
+    if sigma_px > 2:
+        assert abs(page.evaluate(sigma) / sigma_px - zoom) < 0.05
+    assert inside
+    page.screenshot(path=str(tmp_path / "zoomed.png"))

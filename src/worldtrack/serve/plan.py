@@ -40,16 +40,18 @@ class PlanTransform:
     height: int
 
     @classmethod
-    def fit(cls, scene: Scene, margin_m: float = 0.6, box_px: tuple[int, int] = PLAN_PX) -> "PlanTransform":
-        """The transform that fits the walkable area and the cameras into ``box_px``."""
+    def fit(cls, scene: Scene, margin_px: float = 40.0, box_px: tuple[int, int] = PLAN_PX) -> "PlanTransform":
+        """The transform that fits the walkable area and the cameras into ``box_px``, with
+        ``margin_px`` around them (room for the cameras' icons and labels)."""
         x0, x1, y0, y1 = scene.walkable.bounds
         xs = [x0, x1] + [float(c.centre[0]) for c in scene.cameras.values()]
         ys = [y0, y1] + [float(c.centre[1]) for c in scene.cameras.values()]
-        lo = np.array([min(xs), min(ys)]) - margin_m
-        hi = np.array([max(xs), max(ys)]) + margin_m
+        lo, hi = np.array([min(xs), min(ys)]), np.array([max(xs), max(ys)])
         span = np.maximum(hi - lo, 1e-3)
-        scale = float(min(box_px[0] / span[0], box_px[1] / span[1]))
-        return cls(float(lo[0]), float(hi[1]), scale, int(np.ceil(span[0] * scale)), int(np.ceil(span[1] * scale)))
+        scale = float(min((box_px[0] - 2 * margin_px) / span[0], (box_px[1] - 2 * margin_px) / span[1]))
+        m = margin_px / scale
+        return cls(float(lo[0] - m), float(hi[1] + m), scale, int(np.ceil(span[0] * scale + 2 * margin_px)),
+                   int(np.ceil(span[1] * scale + 2 * margin_px)))
 
     def to_svg(self, xy: ArrayLike) -> np.ndarray:
         """(N, 2) floor points (m) → (N, 2) SVG pixels."""

@@ -2,7 +2,7 @@
 // Floor metres -> SVG pixels: u = (x - x_min) * scale, v = (y_max - y) * scale (see serve/plan.py).
 // window.worldtrack is the page's small public handle (tests and users' scripts): ready, mode,
 // frameIndex, state, updates, lags (live: s from the map state's writing to its drawing), seek(k),
-// play(), pause(), select(id).
+// play(), pause(), select(id), setView({x, y, w, h}) (SVG pixels; double-click: the whole plan).
 "use strict";
 (() => {
   const SVGNS = "http://www.w3.org/2000/svg";
@@ -64,24 +64,87 @@
     plan.cameras.forEach((c, k) => {
       const g = el("g", { class: "camera", "data-camera": c.id,
                           transform: `translate(${c.at[0]},${c.at[1]})` }, $("layer-cameras"));
+      g.dataset.at = `translate(${c.at[0]},${c.at[1]})`;
       const ring = el("circle", { r: 13, class: "camera-ring " + (plan.mode === "live" ? "down" : "recorded") }, g);
       el("polygon", { points: "13,0 -7,-8 -7,8", class: "camera-icon", fill: COLOURS[k % COLOURS.length],
                       transform: `rotate(${(c.heading * 180 / Math.PI).toFixed(1)})` }, g);
       const lu = -Math.cos(c.heading) * 26, lv = -Math.sin(c.heading) * 26 + 4;   // behind the camera
-      text(g, lu, lv, "plan-label", `${c.id} (${c.height_m} m)`).setAttribute("text-anchor", "middle");
+      const anchor = c.at[0] < 0.15 * T.width ? "start" : c.at[0] > 0.85 * T.width ? "end" : "middle";
+      text(g, anchor === "start" ? Math.max(lu, -12) : anchor === "end" ? Math.min(lu, 12) : lu, lv, "plan-label",
+           `${c.id} (${c.height_m} m)`).setAttribute("text-anchor", anchor);
       addCameraRow(c.id, ring);
     });
-    drawScaleBar();
   }
 
-  function drawScaleBar() {
-    const target = 120 / T.scale;                  // about 120 px
-    const nice = [0.5, 1, 2, 5, 10, 20, 50, 100].find((m) => m >= target * 0.6) || 100;
-    const len = nice * T.scale, x = 14, y = T.height - 14, g = $("layer-scale");
+  function drawScaleBar() {                       // in the view's corner farthest from every camera
+    const g = $("layer-scale"), k = 1 / zoom;
+    g.replaceChildren();
+    const target = 120 / T.scale * k;             // about 120 screen px
+    const nice = [0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100].find((m) => m >= target * 0.6) || 100;
+    const len = nice * T.scale, pad = 16 * k;
+    const corners = [[view.x + pad, view.y + view.h - pad], [view.x + view.w - pad - len, view.y + view.h - pad],
+                     [view.x + pad, view.y + pad + 12 * k], [view.x + view.w - pad - len, view.y + pad + 12 * k]];
+    const far = (c) => Math.min(...plan.cameras.map((q) => Math.hypot(q.at[0] - c[0] - len / 2, q.at[1] - c[1])), 1e9);
+    const [x, y] = corners.reduce((a, b) => (far(b) > far(a) ? b : a));
     el("line", { x1: x, y1: y, x2: x + len, y2: y, class: "scale-bar" }, g);
-    el("line", { x1: x, y1: y - 4, x2: x, y2: y + 4, class: "scale-bar" }, g);
-    el("line", { x1: x + len, y1: y - 4, x2: x + len, y2: y + 4, class: "scale-bar" }, g);
-    text(g, x + len / 2, y - 6, "scale-text", `${nice} m`).setAttribute("text-anchor", "middle");
+    el("line", { x1: x, y1: y - 4 * k, x2: x, y2: y + 4 * k, class: "scale-bar" }, g);
+    el("line", { x1: x + len, y1: y - 4 * k, x2: x + len, y2: y + 4 * k, class: "scale-bar" }, g);
+    const t = text(g, x + len / 2, y - 6 * k, "scale-text", `${nice} m`);
+    t.setAttribute("text-anchor", "middle");
+    t.style.fontSize = `${11 * k}px`;
+  }
+
+  // ---------------------------------------------------------------- zoom (wheel), pan (drag), fit
+  let view = null, zoom = 1, dragged = false;
+  function setView(v) {
+    const w = Math.min(T.width, Math.max(T.width / 60, v.w)), h = w * T.height / T.width;
+    const cx = Math.min(T.width, Math.max(0, v.x + v.w / 2)), cy = Math.min(T.height, Math.max(0, v.y + v.h / 2));
+    view = { x: cx - w / 2, y: cy - h / 2, w, h };
+    zoom = T.width / w;
+    $("plan").setAttribute("viewBox", `${view.x.toFixed(2)} ${view.y.toFixed(2)} ${w.toFixed(2)} ${h.toFixed(2)}`);
+    const k = 1 / zoom;                             // symbols keep their size on screen
+    for (const g of document.querySelectorAll("#layer-cameras .camera"))
+      g.setAttribute("transform", g.dataset.at + ` scale(${k})`);
+    for (const t of document.querySelectorAll("#layer-entries text, #layer-obstacles text"))
+      t.style.fontSize = `${11 * k}px`;
+    drawScaleBar();
+    render(current);
+  }
+  function fitTo(points) {                         // [[u, v], …] in SVG pixels
+    if (!points.length) return setView({ x: 0, y: 0, w: T.width, h: T.height });
+    const [u0, u1, v0, v1] = extent(points);
+    const w = Math.max(u1 - u0, (v1 - v0) * T.width / T.height) * 1.15 + 4 * T.scale;
+    setView({ x: (u0 + u1) / 2 - w / 2, y: (v0 + v1) / 2 - w * T.height / T.width / 2, w, h: w * T.height / T.width });
+  }
+  function extent(points) {                      // [u0, u1, v0, v1] (no spread: runs have 100k rows)
+    let u0 = Infinity, u1 = -Infinity, v0 = Infinity, v1 = -Infinity;
+    for (const [u, v] of points) { u0 = Math.min(u0, u); u1 = Math.max(u1, u); v0 = Math.min(v0, v); v1 = Math.max(v1, v); }
+    return [u0, u1, v0, v1];
+  }
+  let peoplePoints = () => current.map((p) => toSvg(p.x, p.y));
+  function initZoom() {
+    const svg = $("plan");
+    view = { x: 0, y: 0, w: T.width, h: T.height };
+    svg.addEventListener("wheel", (ev) => {
+      ev.preventDefault();
+      const p = new DOMPoint(ev.clientX, ev.clientY).matrixTransform(svg.getScreenCTM().inverse());
+      const r = Math.exp(Math.max(-1, Math.min(1, ev.deltaY * 0.0015)));
+      setView({ x: p.x - (p.x - view.x) * r, y: p.y - (p.y - view.y) * r, w: view.w * r, h: view.h * r });
+    }, { passive: false });
+    let drag = null;
+    svg.addEventListener("pointerdown", (ev) => {
+      drag = { x: ev.clientX, y: ev.clientY, view: { ...view }, s: svg.getScreenCTM().a, moved: false };
+    });
+    window.addEventListener("pointermove", (ev) => {
+      if (!drag || !(ev.buttons & 1)) return;
+      if (Math.hypot(ev.clientX - drag.x, ev.clientY - drag.y) > 4) drag.moved = true;
+      if (drag.moved) setView({ ...drag.view, x: drag.view.x - (ev.clientX - drag.x) / drag.s,
+                                y: drag.view.y - (ev.clientY - drag.y) / drag.s });
+    });
+    window.addEventListener("pointerup", () => { dragged = !!(drag && drag.moved); drag = null; });
+    svg.addEventListener("dblclick", () => setView({ x: 0, y: 0, w: T.width, h: T.height }));
+    $("fit-all").addEventListener("click", () => setView({ x: 0, y: 0, w: T.width, h: T.height }));
+    $("fit-people").addEventListener("click", () => fitTo(peoplePoints()));
   }
 
   function addCameraRow(id, ring) {
@@ -123,11 +186,12 @@
     for (const p of people) {
       present.add(p.id);
       const n = personNode(p.id), [u, v] = toSvg(p.x, p.y);
-      n.g.setAttribute("transform", `translate(${u.toFixed(2)},${v.toFixed(2)})`);
-      n.sigma.setAttribute("r", p.sigma > 0 ? (p.sigma * T.scale).toFixed(1) : 0);
+      const m = T.scale * zoom;                      // metres -> the symbol's own units (scaled by 1/zoom)
+      n.g.setAttribute("transform", `translate(${u.toFixed(2)},${v.toFixed(2)}) scale(${(1 / zoom).toFixed(4)})`);
+      n.sigma.setAttribute("r", p.sigma > 0 ? (p.sigma * m).toFixed(1) : 0);
       const vx = p.vx || 0, vy = p.vy || 0, speed = Math.hypot(vx, vy);
-      n.heading.setAttribute("x2", speed > 0.05 ? (vx * T.scale).toFixed(1) : 0);
-      n.heading.setAttribute("y2", speed > 0.05 ? (-vy * T.scale).toFixed(1) : 0);
+      n.heading.setAttribute("x2", speed > 0.05 ? (vx * m).toFixed(1) : 0);
+      n.heading.setAttribute("y2", speed > 0.05 ? (-vy * m).toFixed(1) : 0);
       n.speed.textContent = `${speed.toFixed(1)} m/s`;
       n.g.classList.toggle("unmeasurable", !!p.unmeasurable);
       n.g.classList.toggle("selected", p.id === selected);
@@ -288,6 +352,13 @@
       $("frame-cam").addEventListener("change", () => seek(WT.frameIndex));
     }
     Object.assign(WT, { seek, play, pause, frames: run.frames, times: run.times });
+    const everyone = R.x.map((x, i) => toSvg(x, R.y[i]));
+    peoplePoints = () => everyone;
+    if (everyone.length) {
+      const [u0, u1, v0, v1] = extent(everyone);
+      if ((u1 - u0) * (v1 - v0) < 0.3 * T.width * T.height)
+        fitTo(everyone);                            // people use a small part of the plan: start there
+    }
     $("map-line").textContent = `${run.frames.length} frames, ${byId.size} people, ${fmt(tEnd, 1)} s`;
     seek(0);
   }
@@ -366,7 +437,9 @@
     $("title").textContent = plan.title;
     $("mode").textContent = plan.mode === "live" ? "live map" : "finished run";
     drawPlan();
-    $("plan").addEventListener("click", () => select(null));
+    initZoom();
+    setView(view);
+    $("plan").addEventListener("click", () => { if (!dragged) select(null); dragged = false; });
     $("p-close").addEventListener("click", () => select(null));
     if (plan.mode === "run") await initRun(); else initLive();
     WT.ready = true;
