@@ -10,8 +10,9 @@ Set-up: our own redis-server; ``worldtrack serve --map`` as its own process pinn
 ``examples/scenes/office_4cams.yaml``) as the fusion role writes them (``XADD`` to the map
 stream, ``written`` = wall clock just before). Reference measured in the same run: a plain Redis
 reader (``XREAD BLOCK`` on the same stream, in this process) — the floor no server can beat; the
-ratio is serve / reference. Throughput: states published as fast as possible for 4 s; the rate
-the websocket client receives them.
+ratio is serve / reference. Burst: states published as fast as possible for 4 s; how many a second
+reach the websocket client (a server behind the map skips to the newest states, so fewer than
+were published) and how late.
 
 Run: ``.venv/bin/python benchmarks/serve_latency.py [--people 10,100,300] [--seconds 8] [--quick]``.
 Writes ``benchmarks/results/serve_latency.md``.
@@ -113,11 +114,26 @@ def ws_reader(url: str, stop: threading.Event, lags: list[float], ready: threadi
     asyncio.run(go())
 
 
+def drain(received: list, quiet_s: float = 1.0, limit_s: float = 60.0) -> None:
+    """Wait until nothing has arrived for ``quiet_s`` (the server has caught up)."""
+    start, n, last_change = time.time(), len(received), time.time()
+    while time.time() - last_change < quiet_s and time.time() - start < limit_s:
+        time.sleep(0.1)
+        if len(received) != n:
+            n, last_change = len(received), time.time()
+
+
 def pct(v: list[float], q: float) -> float:
     return float(np.percentile(v, q) * 1000) if v else float("nan")
 
 
-def measure(redis_url: str, client, serve_url: str, scene, people: int, seconds: float, browser) -> dict:
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU time of a process so far (s; Linux /proc)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def measure(redis_url: str, client, serve_url: str, scene, people: int, seconds: float, browser, pid: int) -> dict:
     client.delete(KEYS.map_stream)
     stop, ready = threading.Event(), threading.Event()
     ref, ws = [], []
@@ -132,8 +148,10 @@ def measure(redis_url: str, client, serve_url: str, scene, people: int, seconds:
     page.wait_for_function("window.worldtrack && window.worldtrack.ready", timeout=30000)
     time.sleep(0.5)
     walkers = Walkers(scene, people)
+    cpu0 = cpu_seconds(pid)
     sent = publish(client, walkers, seconds, 0.1)
     time.sleep(1.0)
+    cpu_ms = (cpu_seconds(pid) - cpu0) / sent * 1000
     drawn = page.evaluate("window.worldtrack.lags")
     on_page = page.locator("#people .person").count()
     page.close()
@@ -141,18 +159,20 @@ def measure(redis_url: str, client, serve_url: str, scene, people: int, seconds:
     before = len(ws)
     t0 = time.time()
     burst = publish(client, walkers, 4.0, None)
-    time.sleep(1.0)
+    rate_in = burst / (time.time() - t0)
+    drain(ws)
     received = len(ws) - before
-    rate_in, rate_out = burst / (time.time() - t0 - 1.0), received / (time.time() - t0 - 1.0)
+    rate_out = received / 4.0
+    behind = float(np.median(ws[before:])) * 1000 if received else float("nan")
     stop.set()
     for th in threads:
         th.join(5)
     skip = 5                                           # the first half second: connections warming up
     ref, ws_lat, drawn = ref[skip:sent], ws[skip:sent], drawn[skip:]
-    return {"people": people, "states": sent, "on page": on_page,
+    return {"people": people, "states": sent, "on page": on_page, "server CPU ms/state": cpu_ms,
             "ref p50": pct(ref, 50), "ref p99": pct(ref, 99), "ws p50": pct(ws_lat, 50), "ws p99": pct(ws_lat, 99),
             "drawn p50": pct(drawn, 50), "drawn p99": pct(drawn, 99), "drawn max": pct(drawn, 100),
-            "published/s": rate_in, "pushed/s": rate_out,
+            "burst published/s": rate_in, "burst pushed/s": rate_out, "burst lag p50": behind,
             "ratio ws/ref p50": pct(ws_lat, 50) / max(pct(ref, 50), 1e-3)}
 
 
@@ -194,7 +214,7 @@ def main() -> int:
             with sync_playwright() as p:
                 browser = p.chromium.launch(executable_path=exe, args=["--no-sandbox"])
                 for n in sizes:
-                    r = measure(redis.url, client, url, scene, n, seconds, browser)
+                    r = measure(redis.url, client, url, scene, n, seconds, browser, serve.pid)
                     print(json.dumps(r), flush=True)
                     rows.append(r)
                 browser.close()
@@ -206,7 +226,9 @@ def main() -> int:
     table = markdown_table(headers, [[r[h] for h in headers] for r in rows])
     text = (f"Map states at 10 Hz for {seconds:g} s per size, then 4 s as fast as possible; latencies in ms from "
             f"the state's writing (`written`) to: `ref` a plain Redis XREAD reader (the floor), `ws` a websocket "
-            f"client of the server, `drawn` the page in chromium after drawing it. Load average "
+            f"client of the server, `drawn` the page in chromium after drawing it; `burst`: 4 s of states as fast "
+            f"as this process writes them (the server skips to the newest when behind); `server CPU`: the serve "
+            f"process's CPU time during the 10 Hz phase per state (its camera-status thread included). Load average "
             f"{load_average()}.\n\n{table}\n")
     print(text)
     save_result("serve_latency", "worldtrack serve: map update to page", text, args.quick, time.time() - started)

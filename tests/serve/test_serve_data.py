@@ -77,13 +77,32 @@ def test_run_folder_without_scene_is_one_clear_error(tmp_path, finished_run):
 
 
 def test_live_state_sigma_and_cameras(room):
-    from worldtrack.serve.live import LOST_GROWTH_M_S, SigmaCache, state_message
+    from worldtrack.serve.live import LOST_GROWTH_M_S, state_message
     people = (MapPerson(1, 5.0, 2.0, 1.7, 0.45, 1.0, 0.0, 1.0, 0.9, "tracking", 100.0, 90.0, 1),
               MapPerson(2, 5.0, 2.0, 1.7, 0.45, 0.0, 0.0, 1.0, 0.9, "lost", 98.5, 90.0, 0),
               MapPerson(3, 9.5, -1.9, 1.7, 0.45, 0.0, 0.0, 1.0, 0.9, "tracking", 100.0, 90.0, 1))
-    msg = state_message(MapState(100.0, people, reports=(("c1", 100.0, 100.01),)), room, SigmaCache(room), now=100.25)
+    msg = state_message(MapState(100.0, people, reports=(("c1", 100.0, 100.01),)), room, now=100.25)
     seen, lost, outside = msg["people"]
     assert seen["cams"] == ["c1"] and 0.005 < seen["sigma"] < 0.2            # ~5.4 m away, 2 px
     assert lost["unmeasurable"] == 1 and np.isclose(lost["sigma"], seen["sigma"] + 1.5 * LOST_GROWTH_M_S, atol=2e-3)
     assert outside["cams"] == [] and outside["sigma"] == 1.0
     assert msg["lag_ms"] == 250.0
+
+
+def test_floor_sigma_is_floor_information_vectorised(room):
+    """The page's σ is the map's own floor information (fusion.floor_information), person by person."""
+    from worldtrack.map.fusion import floor_information
+    from worldtrack.scene.model import Box
+    from worldtrack.serve.plan import floor_sigma
+    cam2 = Camera.look_at("c2", 320, 240, [10.0, 6.0, 2.5], [5.0, 1.0, 0.0], hfov_deg=70)
+    scene = Scene("room2", {**room.cameras, "c2": cam2}, room.walkable,
+                  obstacles=[Box("cabinet", np.array([6.0, 3.0, 0.8]), np.array([1.0, 1.0, 1.6]))])
+    xy = np.random.default_rng(2).uniform([0.5, -1.5], [9.5, 5.5], (60, 2))
+    got = floor_sigma(scene, xy, 1.7)
+    occlusion = [scene.occlusion(c).floor_distance for c in scene.cameras]
+    for (x, y), s in zip(xy, got):
+        ixx, ixy, iyy = floor_information(list(scene.cameras.values()), np.array([x, y]), 1.7, sigma_px=2.0,
+                                          occlusion=occlusion)
+        info = np.array([[ixx, ixy], [ixy, iyy]])
+        want = np.sqrt(np.linalg.eigvalsh(np.linalg.inv(info))[-1]) if np.isfinite(info).all() else 1.0
+        assert np.isclose(s, want, rtol=1e-6), (x, y, s, want)

@@ -98,3 +98,33 @@ def test_camera_status_live_stale_down(page, live):
         === 'stale'""", timeout=5000)                                  # nobody holds c1 any more
     page.wait_for_function("""() => document.querySelectorAll('#camera-table tbody tr')[1].cells[1].textContent
         === 'down'""", timeout=6000)                                   # c2: nothing for 5 s
+
+
+def test_a_reader_behind_the_map_skips_to_the_newest(redis_server, finished_run):
+    """Twenty states written at once (2 s of map): the page gets the last 0.5 s of them, not the past."""
+    import redis
+
+    from worldtrack.serve.live import CATCH_UP_S, LiveMap
+    client = redis.Redis(port=redis_server.port, decode_responses=True)
+    client.flushall()
+    got: list[dict] = []
+    live = LiveMap(client, KEYS, load_scene(finished_run.parent / "syn" / "scene.yaml"),
+                   lambda text: got.append(json.loads(text)), status_every_s=60)
+    live.start()
+    try:
+        time.sleep(0.3)                                       # the reader waits on the stream
+        t0 = time.time()
+        pipe = client.pipeline(transaction=True)
+        for k in range(20):
+            t = t0 + 0.1 * k
+            pipe.xadd(KEYS.map_stream, encode_map_state(MapState(t, (person(1, 1.0 + 0.1 * k, 2.0, t),))),
+                      id=f"{int(t * 1000)}-0")
+        pipe.execute()
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline and not any(m["type"] == "state" and m["t"] >= t0 + 1.85 for m in got):
+            time.sleep(0.05)
+    finally:
+        live.stop()
+    states = [m["t"] - t0 for m in got if m["type"] == "state"]
+    assert states and abs(states[-1] - 1.9) < 1e-3
+    assert min(states) >= 1.9 - CATCH_UP_S - 1e-3 and len(states) == 6 and live.skipped == 14

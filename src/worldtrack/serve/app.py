@@ -37,8 +37,8 @@ from worldtrack.scene.model import Scene
 
 STATIC = Path(__file__).resolve().parent / "static"
 COOKIE = "worldtrack_token"
-#: Messages a slow browser may fall behind by before the oldest are dropped.
-QUEUE_MESSAGES = 512
+#: Messages a slow browser may fall behind by before the oldest are dropped (about 3 s of map states).
+QUEUE_MESSAGES = 32
 
 
 @dataclass

@@ -9,12 +9,14 @@ is less than ``stale_s`` old), ``stale`` (older, or nobody holds it any more) or
 (nothing for ``down_s``, or never), with the lag in ms.
 
 σ: map states carry no covariance, so the page's circle is the cameras' floor resolution at the
-person's place (:func:`worldtrack.map.fusion.floor_information` of a
-:data:`SIGMA_PX`-pixel error, the cameras that show them), growing by :data:`LOST_GROWTH_M_S`
-for every second a ``lost`` person has not been seen.
+person's place (:func:`worldtrack.serve.plan.floor_sigma`: the information matrix of
+:func:`worldtrack.map.fusion.floor_information` for a :data:`SIGMA_PX`-pixel error, vectorised
+over people), growing by :data:`LOST_GROWTH_M_S` for every second a ``lost`` person has not been
+seen.
 
 The last ``trail_s`` seconds of messages are kept, so a page that connects late draws the
-trails at once.
+trails at once. A reader that falls behind the map (a slow machine, a burst) skips to the newest
+states it reads (:data:`CATCH_UP_S`): a live view shows now, not the past.
 """
 
 from __future__ import annotations
@@ -29,9 +31,9 @@ from typing import Any, Callable
 import numpy as np
 
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.messages import MapState, decode_map_state
+from worldtrack.map.messages import MapState, decode_map_state, stream_id_ms, time_of_id
 from worldtrack.scene.model import Scene
-from worldtrack.serve.plan import cameras_seeing
+from worldtrack.serve.plan import cameras_seeing, floor_sigma
 
 #: Pixel error behind the σ circle of a person a camera shows.
 SIGMA_PX = 2.0
@@ -39,46 +41,29 @@ SIGMA_PX = 2.0
 LOST_GROWTH_M_S = 1.0
 #: σ of a person no camera shows (m).
 UNSEEN_SIGMA_M = 1.0
+#: Behind the map, the reader skips the states more than this much older than the newest it read (s):
+#: the page stays current and its trails get coarser.
+CATCH_UP_S = 0.5
+#: Map states read at most at once; a full read means the reader is far behind.
+READ_COUNT = 50
 
 
-class SigmaCache:
-    """σ (m) of the floor resolution at a place, cached on a 0.25 m grid per set of cameras."""
-
-    def __init__(self, scene: Scene, cell_m: float = 0.25):
-        self.scene, self.cell_m = scene, cell_m
-        self._cache: dict[tuple, float] = {}
-
-    def __call__(self, x: float, y: float, height: float, cams: tuple[str, ...]) -> float:
-        from worldtrack.map.fusion import floor_information
-        if not cams:
-            return UNSEEN_SIGMA_M
-        key = (round(x / self.cell_m), round(y / self.cell_m), cams)
-        if key not in self._cache:
-            if len(self._cache) > 100_000:
-                self._cache.clear()
-            ixx, ixy, iyy = floor_information([self.scene.cameras[c] for c in cams], np.array([x, y]), height,
-                                              sigma_px=SIGMA_PX)
-            info = np.array([[ixx, ixy], [ixy, iyy]])
-            ok = np.isfinite(info).all() and np.linalg.det(info) > 0
-            self._cache[key] = float(math.sqrt(np.linalg.eigvalsh(np.linalg.inv(info))[-1])) if ok else UNSEEN_SIGMA_M
-        return self._cache[key]
-
-
-def state_message(state: MapState, scene: Scene, sigma: SigmaCache, now: float | None = None) -> dict[str, Any]:
+def state_message(state: MapState, scene: Scene, now: float | None = None) -> dict[str, Any]:
     """One map state as the page's ``state`` message (positions in metres, times in seconds)."""
     now = time.time() if now is None else now
     people = state.people
+    xy = np.array([(p.x, p.y) for p in people], dtype=float).reshape(-1, 2)
     height = np.array([p.height if math.isfinite(p.height) else scene.people.height for p in people])
-    seen = cameras_seeing(scene, [(p.x, p.y) for p in people], height) if people else []
+    seen = cameras_seeing(scene, xy, height)
+    sigma = floor_sigma(scene, xy, height, sigma_px=SIGMA_PX, unseen_m=UNSEEN_SIGMA_M) if people else []
     out = []
-    for p, h, cams in zip(people, height, seen):
+    for p, h, cams, s in zip(people, height, seen, sigma):
         lost = p.mode != "tracking"
-        s = sigma(p.x, p.y, float(h), tuple(cams))
         if lost and math.isfinite(p.last_seen):
             s += LOST_GROWTH_M_S * max(0.0, state.t - p.last_seen)
         out.append({"id": p.id, "x": round(p.x, 3), "y": round(p.y, 3), "vx": _r(p.vx), "vy": _r(p.vy),
-                    "sigma": round(s, 3), "height": round(float(h), 2), "mode": p.mode, "unmeasurable": int(lost),
-                    "cams": cams, "workers": p.workers, "lead": p.lead})
+                    "sigma": round(float(s), 3), "height": round(float(h), 2), "mode": p.mode,
+                    "unmeasurable": int(lost), "cams": cams, "workers": p.workers, "lead": p.lead})
     return {"type": "state", "t": state.t, "captured": state.captured, "written": state.written,
             "lag_ms": round((now - state.captured) * 1000.0, 1), "people": out,
             "aliases": {str(k): v for k, v in state.aliases.items()}}
@@ -131,15 +116,20 @@ class LiveMap:
                  trail_s: float = 10.0, stale_s: float = 1.0, down_s: float = 5.0, status_every_s: float = 0.5):
         self.client, self.keys, self.scene, self.publish = client, keys, scene, publish
         self.trail_s, self.stale_s, self.down_s, self.status_every_s = trail_s, stale_s, down_s, status_every_s
-        self.sigma = SigmaCache(scene)
         self.recent: collections.deque[tuple[float, str]] = collections.deque()
         self.last_cameras: str | None = None
         self.stop_event = threading.Event()
         self.error: str | None = None
+        self.skipped = 0
         self._lock = threading.Lock()
         self._threads: list[threading.Thread] = []
 
     def start(self) -> None:
+        """Build what the first state needs (the cameras' obstacle maps: seconds in a large scene) and
+        start the reader threads."""
+        if self.scene.obstacles:
+            for cid in self.scene.cameras:
+                self.scene.occlusion(cid)
         for target in (self._read_states, self._read_status):
             th = threading.Thread(target=target, name=f"serve-{target.__name__}", daemon=True)
             th.start()
@@ -164,7 +154,7 @@ class LiveMap:
             state = decode_map_state(fields)
         except ValueError:
             return
-        text = json.dumps(state_message(state, self.scene, self.sigma), separators=(",", ":"))
+        text = json.dumps(state_message(state, self.scene), separators=(",", ":"))
         with self._lock:
             self.recent.append((state.t, text))
             while self.recent and self.recent[0][0] < state.t - self.trail_s:
@@ -183,16 +173,28 @@ class LiveMap:
                         since = f"{int(float(head[0][1].get('t', 0)) * 1000 - self.trail_s * 1000)}-0"
                         for _, fields in self.client.xrange(self.keys.map_stream, min=since, max=last):
                             self._emit_state(fields)
-                reply = self.client.xread({self.keys.map_stream: last}, block=500, count=100)
+                reply = self.client.xread({self.keys.map_stream: last}, block=500, count=READ_COUNT)
+                if reply and len(reply[0][1]) == READ_COUNT:      # far behind: jump to the newest
+                    head = self.client.xrevrange(self.keys.map_stream, count=1)
+                    since = f"{stream_id_ms(time_of_id(head[0][0]) - CATCH_UP_S)}-0"
+                    self.skipped += READ_COUNT
+                    reply = [(self.keys.map_stream, self.client.xrange(self.keys.map_stream, min=since,
+                                                                       max=head[0][0]))]
                 self._set_error(None)
             except (redis.RedisError, OSError) as e:
                 self._set_error(f"map unreachable ({type(e).__name__})")
                 self.stop_event.wait(1.0)
                 continue
             for _, entries in reply or ():
+                if not entries:
+                    continue
+                last = entries[-1][0]
+                newest = time_of_id(last)
                 for entry_id, fields in entries:
-                    last = entry_id
-                    self._emit_state(fields)
+                    if time_of_id(entry_id) >= newest - CATCH_UP_S:
+                        self._emit_state(fields)
+                    else:
+                        self.skipped += 1
 
     def _read_status(self) -> None:
         import redis
@@ -217,4 +219,4 @@ class LiveMap:
         self.error = error
 
 
-__all__ = ["LOST_GROWTH_M_S", "LiveMap", "SIGMA_PX", "SigmaCache", "camera_status", "state_message"]
+__all__ = ["CATCH_UP_S", "LOST_GROWTH_M_S", "LiveMap", "SIGMA_PX", "camera_status", "state_message"]

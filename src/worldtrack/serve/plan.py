@@ -129,24 +129,76 @@ def cameras_seeing(scene: Scene, xy: ArrayLike, height: ArrayLike, min_share: fl
     >>> cameras_seeing(Scene("s", {"c1": cam}, room), [[4.0, 0.0], [4.0, 2.9]], 1.7)
     [['c1'], []]
     """
-    p = np.asarray(xy, dtype=float).reshape(-1, 2)
-    n = len(p)
-    h = np.broadcast_to(np.asarray(height, dtype=float), (n,))
-    h = np.where(np.isfinite(h), h, scene.people.height)
-    pts = np.concatenate([np.column_stack([p, h * z]) for z in _AXIS])          # (5N, 3): axis point k of person i
-    seen_by: list[list[str]] = [[] for _ in range(n)]
-    if n == 0:
+    p, h = _people(scene, xy, height)
+    seen_by: list[list[str]] = [[] for _ in range(len(p))]
+    if len(p) == 0:
         return seen_by
-    for cid, cam in scene.cameras.items():
-        uv = cam.project(pts)
-        shows = cam.in_image(uv) & np.isfinite(uv).all(axis=1)
-        if scene.obstacles and shows.any():
-            feet_m = cam.floor_distance(np.column_stack([p, np.zeros(n)]))
-            shows &= ~scene.occlusion(cid).hidden(uv, np.tile(feet_m - 0.3, len(_AXIS)))
-        share = shows.reshape(len(_AXIS), n).mean(axis=0)
+    for cid in scene.cameras:
+        share = axis_points_shown(scene, cid, p, h)[1].mean(axis=0)
         for i in np.flatnonzero(share >= min_share):
             seen_by[i].append(cid)
     return seen_by
 
 
-__all__ = ["PLAN_PX", "PlanTransform", "cameras_seeing", "coverage_rings", "plan_json"]
+def _people(scene: Scene, xy: ArrayLike, height: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    p = np.asarray(xy, dtype=float).reshape(-1, 2)
+    h = np.broadcast_to(np.asarray(height, dtype=float), (len(p),))
+    return p, np.where(np.isfinite(h), h, scene.people.height)
+
+
+def axis_points_shown(scene: Scene, camera_id: str, xy: np.ndarray, height: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Five points on each person's axis (feet to head) in one camera: pixels (5, N, 2) and whether
+    each shows (5, N) bool: in the image, in front of the camera, not hidden by an obstacle."""
+    cam, n = scene.cameras[camera_id], len(xy)
+    pts = np.concatenate([np.column_stack([xy, height * z]) for z in _AXIS])    # (5N, 3): point k of person i
+    uv = cam.project(pts)
+    shows = cam.in_image(uv) & np.isfinite(uv).all(axis=1)
+    if scene.obstacles and shows.any():
+        feet_m = cam.floor_distance(np.column_stack([xy, np.zeros(n)]))
+        shows &= ~scene.occlusion(camera_id).hidden(uv, np.tile(feet_m - 0.3, len(_AXIS)))
+    return uv.reshape(len(_AXIS), n, 2), shows.reshape(len(_AXIS), n)
+
+
+def floor_sigma(scene: Scene, xy: ArrayLike, height: ArrayLike, sigma_px: float = 2.0, step_m: float = 0.05,
+                unseen_m: float = 1.0) -> np.ndarray:
+    """(N,) metres: how sure the cameras can be of where each person stands — the square root of
+    the largest eigenvalue of the inverse of :func:`worldtrack.map.fusion.floor_information`
+    (the information of a ``sigma_px`` error of the five axis points the cameras show), vectorised
+    over people; ``unseen_m`` where no camera shows any of their points.
+
+    >>> from worldtrack.geometry.camera import Camera
+    >>> from worldtrack.scene.floor import FloorPolygon, WalkableArea
+    >>> cam = Camera.look_at("c1", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
+    >>> room = WalkableArea((FloorPolygon(np.array([[0, -3], [9, -3], [9, 3], [0, 3.0]])),))
+    >>> near, far, outside = floor_sigma(Scene("s", {"c1": cam}, room), [[3, 0], [8, 0], [4, 2.9]], 1.7)
+    >>> bool(far > 2 * near), float(outside)
+    (True, 1.0)
+    """
+    p, h = _people(scene, xy, height)
+    n = len(p)
+    offsets = np.array([[step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
+    info = np.zeros((n, 3))                                          # ixx, ixy, iyy
+    for cid, cam in scene.cameras.items():
+        shows = axis_points_shown(scene, cid, p, h)[1]               # (5, N)
+        if not shows.any():
+            continue
+        pts = np.stack([np.column_stack([p + o, h * z]) for z in _AXIS for o in offsets])   # (5·4, N, 3)
+        uv = cam.project(pts.reshape(-1, 3)).reshape(len(_AXIS), 4, n, 2)
+        jx = (uv[:, 0] - uv[:, 1]) / (2 * step_m)                       # (5, N, 2): pixels per metre of x
+        jy = (uv[:, 2] - uv[:, 3]) / (2 * step_m)
+        w = shows & np.isfinite(jx).all(axis=2) & np.isfinite(jy).all(axis=2)
+        jx, jy = np.where(w[..., None], jx, 0.0), np.where(w[..., None], jy, 0.0)
+        info += np.stack([(jx * jx).sum(axis=(0, 2)), (jx * jy).sum(axis=(0, 2)), (jy * jy).sum(axis=(0, 2))], 1)
+    info /= sigma_px ** 2
+    det = info[:, 0] * info[:, 2] - info[:, 1] ** 2
+    ok = det > 1e-12
+    # Largest eigenvalue of the inverse = 1 / smallest eigenvalue of the information matrix.
+    tr = info[:, 0] + info[:, 2]
+    smallest = tr / 2 - np.sqrt(np.maximum((tr / 2) ** 2 - det, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(ok & (smallest > 0), 1.0 / np.sqrt(np.maximum(smallest, 1e-300)), unseen_m)
+
+
+__all__ = ["PLAN_PX", "PlanTransform", "axis_points_shown", "cameras_seeing", "coverage_rings", "floor_sigma",
+           "plan_json"]
