@@ -180,6 +180,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--people", default="10,100,300", help="people on the map, comma-separated")
     ap.add_argument("--seconds", type=float, default=8.0, help="seconds of 10 Hz states per size")
+    ap.add_argument("--no-pin", action="store_true", help="do not pin the server to core 1")
     ap.add_argument("--quick", action="store_true", help="10 and 100 people, 3 s, results not written")
     args = ap.parse_args()
     sizes = [10, 100] if args.quick else [int(v) for v in args.people.split(",")]
@@ -199,7 +200,7 @@ def main() -> int:
         import redis as redis_py
         client = redis_py.Redis(port=redis.port, decode_responses=True)
         port = redis.port + 1 if redis.port < 65000 else 18080
-        pin = ["taskset", "-c", "1"] if os.cpu_count() and os.cpu_count() > 1 else []
+        pin = ["taskset", "-c", "1"] if (os.cpu_count() or 1) > 1 and not args.no_pin else []
         serve = subprocess.Popen([*pin, *WORLDTRACK, "serve", "--map", redis.url, "--scene", str(SCENE),
                                   "--port", str(port)], stderr=subprocess.DEVNULL)
         url = f"http://127.0.0.1:{port}/"

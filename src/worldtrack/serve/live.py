@@ -16,7 +16,8 @@ seen.
 
 The last ``trail_s`` seconds of messages are kept, so a page that connects late draws the
 trails at once. A reader that falls behind the map (a slow machine, a burst) skips to the newest
-states it reads (:data:`CATCH_UP_S`): a live view shows now, not the past.
+states it reads (:data:`CATCH_UP_S`), and states less than :data:`MIN_STEP_S` apart are thinned:
+a live view shows now, not the past.
 """
 
 from __future__ import annotations
@@ -44,6 +45,8 @@ UNSEEN_SIGMA_M = 1.0
 #: Behind the map, the reader skips the states more than this much older than the newest it read (s):
 #: the page stays current and its trails get coarser.
 CATCH_UP_S = 0.5
+#: States closer together than this (map time, s) are thinned to one: a page draws at most 25 a second.
+MIN_STEP_S = 0.04
 #: Map states read at most at once; a full read means the reader is far behind.
 READ_COUNT = 50
 
@@ -121,6 +124,7 @@ class LiveMap:
         self.stop_event = threading.Event()
         self.error: str | None = None
         self.skipped = 0
+        self._emitted = -math.inf
         self._lock = threading.Lock()
         self._threads: list[threading.Thread] = []
 
@@ -191,7 +195,9 @@ class LiveMap:
                 last = entries[-1][0]
                 newest = time_of_id(last)
                 for entry_id, fields in entries:
-                    if time_of_id(entry_id) >= newest - CATCH_UP_S:
+                    t = time_of_id(entry_id)
+                    if t >= newest - CATCH_UP_S and (t >= self._emitted + MIN_STEP_S or entry_id == last):
+                        self._emitted = t
                         self._emit_state(fields)
                     else:
                         self.skipped += 1
@@ -219,4 +225,4 @@ class LiveMap:
         self.error = error
 
 
-__all__ = ["CATCH_UP_S", "LOST_GROWTH_M_S", "LiveMap", "SIGMA_PX", "camera_status", "state_message"]
+__all__ = ["CATCH_UP_S", "LOST_GROWTH_M_S", "LiveMap", "MIN_STEP_S", "SIGMA_PX", "camera_status", "state_message"]
