@@ -9,7 +9,9 @@
 * :mod:`~worldtrack.serve.frames` — annotated camera frames as JPEG (``--frames``, off by default);
 * :mod:`~worldtrack.serve.app` — the Starlette app: routes, websocket fan-out, the token gate;
 * :mod:`~worldtrack.serve.server` — binding the port, the token rule, uvicorn;
-* ``static/`` — the page itself: ``index.html``, ``app.js``, ``style.css`` (no build step, no CDN).
+* ``static/`` — the page itself: ``index.html``, ``style.css`` and JavaScript modules (``app.js`` starts,
+  ``page.js`` plan and people, ``zoom.js``, ``timeline.js`` a finished run, ``live.js`` the live map); no
+  build step, no CDN.
 
 Needs the ``serve`` extra: ``pip install 'worldtrack[serve]'`` (Starlette, uvicorn, websockets).
 """
