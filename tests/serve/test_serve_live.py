@@ -69,6 +69,7 @@ def test_a_map_update_moves_the_person_within_a_second(page, live):
         t = time.time()
         publish(client, t, [person(5, x, y, t), person(9, 8.0, 2.0, t, mode="lost")])
         delays.append(wait_position(page, 5, transform.to_svg([x, y])[0], timeout_s=3.0))
+    print(f"map update -> element moved: {', '.join(f'{d:.3f}' for d in delays)} s")
     assert max(delays) < 1.0, f"page updated {delays} s after the map"
     classes = {d["id"]: d["cls"].split() for d in page.evaluate(DOTS_JS)}
     assert "unmeasurable" in classes[9] and "unmeasurable" not in classes[5]   # lost: drawn differently
