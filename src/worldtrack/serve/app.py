@@ -169,7 +169,7 @@ def make_app(source: PageSource, token: str | None = None) -> Any:
             return JSONResponse({"error": "history comes from the live map"}, status_code=404)
         try:
             pid = int(request.path_params["pid"])
-            seconds = float(request.query_params.get("s", 120))
+            seconds = min(float(request.query_params.get("s", 120)), 3600.0)
         except ValueError:
             return JSONResponse({"error": "expected /api/history/<id>?s=<seconds>"}, status_code=400)
         return JSONResponse(await asyncio.to_thread(source.history, pid, seconds))
