@@ -16,7 +16,7 @@ from worldtrack.errors import InputError
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
 _COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt", "replay",
-             "map")
+             "map", "serve")
 
 
 def build_parser() -> argparse.ArgumentParser:
