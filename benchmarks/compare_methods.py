@@ -42,17 +42,16 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, render_images, save_result  # noqa: E402
 
-from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, synthetic_tracker  # noqa: E402
+from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, synthetic_threshold, synthetic_tracker  # noqa: E402
 from worldtrack.trackers.base import Frame  # noqa: E402
-from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
-from worldtrack.trackers import METHODS, default_foreground, make_tracker  # noqa: E402
+from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 
 SIZE = (320, 240)
 SEED = 0
 GATE_M = 0.5
-FOREGROUND = None            # each method's own (worldtrack track's default): colour, particle grey
-OWN_FOREGROUND = "each method's own: colour, particle grey"
+FOREGROUND = "colour"
 
 #: (label, scenario, parameters, occlusion scenario?)
 SCENARIOS = [
@@ -75,9 +74,8 @@ def peak_memory_mb(scenario, bundles, method: str) -> float:
     # Not experiment.synthetic_tracker: here ``fgs`` stays referenced while stepping, as it was for the
     # published figures (the blobs baseline does not keep the foreground models; dropping them lowers its peak).
     cams = scenario.camera_ids
-    kind = FOREGROUND or default_foreground(method)
-    fgs = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, kind,
-                           SYNTHETIC_COLOUR_THRESHOLD if kind == "colour" else None)
+    fgs = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, FOREGROUND,
+                           synthetic_threshold(method, FOREGROUND))
     tracker = make_tracker(method, scenario.scene, fgs)
     for b in bundles:
         tracker.step({c: Frame(b.views[c].image, b.time, b.frame) for c in cams}, b.time)
@@ -135,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     table = markdown_table(["scenario", "occlusion", "method", "MOTA", "IDF1", "HOTA", "ID switches", "mean error m",
                             "frames/s", "peak memory MB (tracemalloc)"], rows)
     summary = verdict(rows)
-    text = (f"{SIZE[0]}×{SIZE[1]}, seed {SEED}, default presets, foreground `{FOREGROUND or OWN_FOREGROUND}` (blobs: its own MOG2), "
+    text = (f"{SIZE[0]}×{SIZE[1]}, seed {SEED}, default presets, foreground `{FOREGROUND}` (blobs: its own MOG2), "
             f"gate {GATE_M} m. frames/s: `tracker.step` only. Peak memory: tracemalloc peak while building "
             "the tracker and stepping it over all frames (frames excluded; OpenCV's and Numba's own buffers "
             f"not seen).\n\n{table}\n\n{summary}\n")

@@ -78,9 +78,9 @@ def _method_config_class(method: str) -> type[Section]:
     return CONFIGS[method]
 
 
-def default_foreground(method: str) -> str:
-    from worldtrack.trackers import default_foreground as method_default
-    return method_default(method)
+def _method_threshold(method: str) -> float | None:
+    from worldtrack.trackers import method_threshold
+    return method_threshold(method)
 
 
 def _base(method: str, preset: str) -> Section:
@@ -109,8 +109,8 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
         method), or None
     method, preset : the command line's ``--method`` / ``--preset`` (None: the file's, else
         ellipsoid / default)
-    flags : the command line's named settings: ``foreground`` (kind; default the method's, e.g. grey for
-        the particle tracker, colour for the ellipsoid tracker), ``threshold``, ``births``
+    flags : the command line's named settings: ``foreground`` (kind), ``threshold`` (default the
+        method's own, e.g. 25 for the particle tracker, else the kind's), ``births``
         (where new people may appear; set on the method that runs)
     sets : ``--set`` pairs (dotted path from the top, value), applied last in order
 
@@ -135,13 +135,7 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
                 raise InputError(f"{m}: expected a mapping of settings, got {given!r}"[:120])
             base = from_mapping(type(base), _deep_merge(to_mapping(base), given), root=m)
         methods[m] = base
-    given_fg = data.get("foreground")
-    kind_given = ((isinstance(given_fg, Mapping) and "kind" in given_fg) or flags is not None
-                  and flags.get("foreground") is not None or any(path == "foreground.kind" for path, _ in sets))
-    if not kind_given and (given_fg is None or isinstance(given_fg, Mapping)):
-        # the method's own foreground model (a file, a flag or --set chooses another)
-        given_fg = {**(given_fg or {}), "kind": default_foreground(method)}
-    foreground = from_mapping(ForegroundConfig, given_fg, root="foreground")
+    foreground = from_mapping(ForegroundConfig, data.get("foreground"), root="foreground")
     stages = {n: from_mapping(_stage_class(n), data.get(n), root=n) for n in STAGES}
     flags = dict(flags or {})
     fg_changes = {k: v for k, v in (("kind", flags.get("foreground")), ("threshold", flags.get("threshold")))
@@ -174,6 +168,9 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
         else:
             raise InputError(f"{head}: unknown setting (expected one of: method, preset, foreground, "
                              f"{', '.join(METHODS + tuple(STAGES))})")
+    if foreground.threshold is None and foreground.kind in ("grey", "colour") and \
+            _method_threshold(method) is not None:        # the method's own threshold (the particle's γ)
+        foreground = with_overrides(foreground, {"threshold": _method_threshold(method)}, root="foreground")
     return RunConfig(method, preset, foreground, methods, stages)
 
 

@@ -32,14 +32,13 @@ def test_config_file_flags_and_set_in_that_order(tmp_path, capsys):
     assert cfg.preset == "paper" and cfg.section("ellipsoid") == resolve_run_config(preset="paper").section("ellipsoid")
 
 
-def test_each_method_runs_on_its_own_foreground_unless_one_is_chosen(tmp_path):
-    assert resolve_run_config(method="ellipsoid").foreground.kind == "colour"
-    assert resolve_run_config(method="particle").foreground.kind == "grey"
-    assert resolve_run_config(method="particle", flags={"threshold": 12}).foreground.kind == "grey"
-    assert resolve_run_config(method="particle", flags={"foreground": "colour"}).foreground.kind == "colour"
-    assert resolve_run_config({"foreground": {"kind": "mog2"}}, method="particle").foreground.kind == "mog2"
-    assert resolve_run_config(method="particle", sets=[("foreground.kind", "knn")]).foreground.kind == "knn"
+def test_the_particle_tracker_keeps_its_own_threshold_unless_one_is_given():
+    assert resolve_run_config(method="ellipsoid").foreground.threshold is None          # the kind's: 30 colour
+    assert resolve_run_config(method="particle").foreground.threshold == 25.0            # its γ
+    assert resolve_run_config(method="particle", flags={"threshold": 12}).foreground.threshold == 12
     assert resolve_run_config({"method": "particle", "foreground": {"threshold": 9}}).foreground.threshold == 9
+    assert resolve_run_config(method="particle", sets=[("foreground.threshold", 40)]).foreground.threshold == 40
+    assert resolve_run_config(method="particle", flags={"foreground": "mog2"}).foreground.threshold is None
 
 
 @pytest.mark.parametrize("args, message", [

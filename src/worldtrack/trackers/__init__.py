@@ -58,13 +58,14 @@ def _override(config: Section, overrides: Mapping[str, Any], method: str) -> Sec
     return with_overrides(config, overrides, root=method)
 
 
-def default_foreground(method: str) -> str:
-    """The foreground model ``method`` runs on when none is chosen (``foreground.kind``).
+def method_threshold(method: str) -> float | None:
+    """The foreground threshold ``method`` runs with when none is given (None: the foreground kind's
+    default, :data:`worldtrack.foreground.DEFAULT_THRESHOLDS`).
 
-    >>> default_foreground("ellipsoid"), default_foreground("particle")
-    ('colour', 'grey')
+    >>> method_threshold("ellipsoid"), method_threshold("particle")
+    (None, 25.0)
     """
-    return CONFIGS[method].foreground_kind
+    return CONFIGS[method].foreground_threshold
 
 
 def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *, preset: str = "default",
@@ -95,4 +96,4 @@ def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *
 
 
 __all__ = ["CONFIGS", "METHODS", "PRESETS", "TRACKERS", "Frame", "Person", "PositionMap", "Track", "Tracker",
-           "TrackerBase", "default_foreground", "make_tracker", "method_config", "warm_started"]
+           "TrackerBase", "method_threshold", "make_tracker", "method_config", "warm_started"]
