@@ -15,7 +15,7 @@ from worldtrack import __version__
 from worldtrack.errors import InputError
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
-_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "eval", "background", "gt", "pose")
+_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt")
 
 
 def build_parser() -> argparse.ArgumentParser:
