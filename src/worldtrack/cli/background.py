@@ -11,11 +11,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from worldtrack.cli._args import parse_size
 from worldtrack.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 DESCRIPTION = """\
 Estimate the background (the scene without people) from a video in which people walk, when
@@ -80,6 +82,9 @@ def sample_frames(path: str | Path, samples: int, progress: bool = True) -> tupl
     InputError
         No such file, not a video, or no frame can be decoded.
     """
+
+
+    import numpy as np
     import cv2
 
     path = Path(path)

@@ -14,11 +14,12 @@ import math
 import re
 import sys
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from worldtrack.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -58,6 +59,9 @@ def parse_gate(text: str) -> float:
 
 def read_area(text: str) -> np.ndarray:
     """``--area``: a polygon file (numbers x1,y1,x2,y2,…, '#' comments) or the numbers, → (M, 2) m."""
+
+
+    import numpy as np
     path = Path(text)
     if path.is_file():
         try:
@@ -77,6 +81,9 @@ def read_area(text: str) -> np.ndarray:
 
 def parse_area(text: str) -> np.ndarray:
     """``--area x1,y1,x2,y2,…`` → (M, 2) polygon in metres, M ≥ 3."""
+
+
+    import numpy as np
     parts = [s.strip() for s in text.split(",")]
     try:
         values = [float(s) for s in parts]
@@ -166,6 +173,9 @@ def format_table(m: dict[str, Any]) -> str:
 
 
 def _within(frames: np.ndarray, gt_frames: np.ndarray) -> np.ndarray:
+
+
+    import numpy as np
     return (frames >= gt_frames.min()) & (frames <= gt_frames.max())
 
 
@@ -188,6 +198,9 @@ def _write_per_frame(path: str, per_frame: dict[str, np.ndarray]) -> None:
 
 
 def _json_value(v: Any) -> Any:
+
+
+    import numpy as np
     if v is None or isinstance(v, (bool, str)):
         return v
     if isinstance(v, (int, np.integer)):

@@ -4,11 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
-from worldtrack.scene import load_scene
-from worldtrack.scene.model import Box
-
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("scene", help="check a scene file and draw its floor plan",
@@ -24,6 +19,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run_check(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from worldtrack.scene import load_scene
+    from worldtrack.scene.model import Box
+
     scene = load_scene(args.scene)
     print(f"scene {scene.name!r} ({args.scene}): valid")
     print(f"cameras: {len(scene.cameras)}")
@@ -57,6 +57,8 @@ def run_check(args: argparse.Namespace) -> int:
 
 def _seen_floor_area(scene, cam, resolution: float = 0.05) -> float:
     """Area (m²) of walkable floor whose Z = 0 point falls inside the camera's image."""
+    import numpy as np
+
     x0, x1, y0, y1 = scene.walkable.bounds
     xs = np.arange(x0, x1, resolution) + resolution / 2
     ys = np.arange(y0, y1, resolution) + resolution / 2
