@@ -163,10 +163,10 @@ def test_writer_writes_header_at_once_and_flushes_every_frame(tmp_path):
                             flags=(), sx=0.4, sy=0.3)])
     # Still open: the row is already on disk.
     lines = p.read_text().splitlines()
-    assert lines[1] == "0,0.0,1,1.0,2.0,1.7,0.4,0.9,capture,,0.4,0.3"
+    assert lines[1] == "0,0.0,1,1.0,2.0,1.7,0.4,0.9,capture,,,,,0.4,0.3"   # no vx, vy, speed given: empty
     w.write(1, 0.1, [{"id": 2, "xy": (3.0, 4.0), "mode": "tracking",
                       "flags": ["unmeasurable", "occluded"]}])
-    assert p.read_text().splitlines()[2] == "1,0.1,2,3.0,4.0,,,,tracking,unmeasurable;occluded,,"
+    assert p.read_text().splitlines()[2] == "1,0.1,2,3.0,4.0,,,,tracking,unmeasurable;occluded,,,,,"
     w.close()
     with pytest.raises(ValueError, match="after close"):
         w.write(2, 0.2, [])

@@ -1,18 +1,25 @@
 """The ``worldtrack`` command: one entry point, one sub-command per verb.
 
 Each verb lives in its own module of this package with a ``register(subparsers)`` function that
-adds its parser and sets ``func`` to the function that runs it. A user's mistake (an
+adds its parser and sets ``func`` to the function that runs it; verb modules import NumPy, OpenCV
+and the rest inside the functions that run, so ``--help`` answers at once. A user's mistake (an
 :class:`~worldtrack.errors.InputError`) prints one line, ``error: …``, and exits with status 2.
+Ctrl-C prints ``interrupted`` and exits with 130 (SIGTERM: ``terminated``, 143), wherever it lands
+(:mod:`worldtrack.interrupts`); a closed pipe on standard output (``worldtrack … | head``) ends the
+command quietly. FFmpeg's own messages about damaged video stay off the terminal unless
+``--verbose`` is given.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from worldtrack import __version__
 from worldtrack.errors import InputError
+from worldtrack.interrupts import exit_status, install_terminate_handler, interrupt_in, signal_of
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
 _COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "eval", "background", "gt")
@@ -36,21 +43,42 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit status (0 ok, 2 bad input, 130 interrupted)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    args.command_line = ["worldtrack", *(sys.argv[1:] if argv is None else argv)]
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 2
+    """Run the command line; returns the exit status (0 ok, 2 bad input, 130 interrupted, 143
+    terminated, 141 when standard output is a closed pipe)."""
+    args_in = sys.argv[1:] if argv is None else list(argv)
+    if "--verbose" not in args_in:
+        # FFmpeg (inside OpenCV) prints every damaged packet; read before cv2 opens a video.
+        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
+    install_terminate_handler()
     try:
+        parser = build_parser()
+        args = parser.parse_args(args_in)
+        args.command_line = ["worldtrack", *args_in]
+        if not getattr(args, "func", None):
+            parser.print_help()
+            return 2
         return int(args.func(args) or 0)
     except InputError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+    except BrokenPipeError:
+        _silence_stdout()
+        return 141
+    except BaseException as e:
+        interrupt = interrupt_in(e)
+        if interrupt is None:
+            raise
+        print("terminated" if signal_of(interrupt) == 15 else "interrupted", file=sys.stderr)
+        return exit_status(interrupt)
+
+
+def _silence_stdout() -> None:
+    """Point standard output at /dev/null so the interpreter's last flush does not fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

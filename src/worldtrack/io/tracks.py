@@ -4,12 +4,13 @@ Two headered CSV formats that open in a spreadsheet, plus MOTChallenge text for 
 
 ``tracks.csv`` (tracker output), one row per person per frame::
 
-    frame,time,id,x,y,height,width,score,mode,flags[,extra…]
+    frame,time,id,x,y,height,width,score,mode,flags,vx,vy,speed[,extra…]
 
-``frame`` counts from 0, ``time`` is seconds, ``id`` is an integer from 1, ``x, y, height,
-width`` are metres, ``mode`` is a word (``capture``, ``tracking``…) and ``flags`` is a
-``;``-separated list of words (``unmeasurable``), possibly empty. Trackers may append columns
-(``sx,sy,sz`` box sizes…); readers keep them.
+``frame`` counts from 0, ``time`` is seconds (to the microsecond), ``id`` is an integer from 1,
+``x, y, height, width`` are metres, ``vx, vy, speed`` metres per second, ``mode`` is a word
+(``capture``, ``tracking``…) and ``flags`` is a ``;``-separated list of words
+(``unmeasurable``), possibly empty. Trackers may append columns (``sigma``, the 1-σ position
+uncertainty in metres; ``sx,sy,sz`` box sizes…); readers keep them.
 
 ``gt.csv`` (ground truth from the synthetic-world renderer)::
 
@@ -47,7 +48,7 @@ from worldtrack.io.text import is_number
 
 #: Columns of ``tracks.csv``, in order; trackers may append more.
 TRACK_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "height", "width", "score",
-                                  "mode", "flags")
+                                  "mode", "flags", "vx", "vy", "speed")
 #: Columns of a MOTChallenge text file (1-based frames and ids, ``-1`` = unknown).
 MOT_COLUMNS: tuple[str, ...] = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height",
                                 "conf", "x", "y", "z")
@@ -55,8 +56,8 @@ MOT_COLUMNS: tuple[str, ...] = ("frame", "id", "bb_left", "bb_top", "bb_width", 
 _CORE = ("frame", "time", "id", "x", "y")
 _REQUIRED = ("frame", "id", "x", "y")
 # Extra columns that must be numbers (empty cells read as NaN) and ones that are always text.
-_FLOAT_COLUMNS = frozenset({"height", "width", "score", "z_head", "speed", "sx", "sy", "sz",
-                            "bb_left", "bb_top", "bb_width", "bb_height", "conf", "z"})
+_FLOAT_COLUMNS = frozenset({"height", "width", "score", "z_head", "speed", "vx", "vy", "sigma", "sx", "sy",
+                            "sz", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "z"})
 _FLOAT_PREFIXES = ("vis_", "head_", "feet_")
 _TEXT_COLUMNS = frozenset({"mode", "flags"})
 _SPLIT_MOT = re.compile(r"[,\s]+")
@@ -455,11 +456,11 @@ class TracksWriter:
         ----------
         frame : int
             Frame index from 0.
-        time : float, seconds
+        time : float, seconds (written rounded to the microsecond)
         tracks : iterable of objects or mappings
             Each has ``id`` (int ≥ 1) and ``x, y`` (metres) — or ``xy``/``position`` (2+,) —
             and optionally ``height, width`` (metres), ``score``, ``mode`` (str or Enum),
-            ``flags`` (str or iterable of str) and the extra columns.
+            ``flags`` (str or iterable of str), ``vx, vy, speed`` (m/s) and the extra columns.
         """
         if self._file is None:
             raise ValueError(f"TracksWriter({self.path}): write after close")
@@ -478,10 +479,11 @@ class TracksWriter:
                     xy = _get(t, "position")
                 x, y = xy[0], xy[1]
             flags = _get(t, "flags", "")
-            row = [str(frame), _fmt_float(time), str(tid), _fmt_float(x), _fmt_float(y),
+            row = [str(frame), _fmt_float(round(float(time), 6)), str(tid), _fmt_float(x), _fmt_float(y),
                    _fmt_float(_get(t, "height")), _fmt_float(_get(t, "width")),
                    _fmt_float(_get(t, "score")), _fmt_cell(_get(t, "mode", "")),
-                   flags if isinstance(flags, str) else ";".join(map(str, flags))]
+                   flags if isinstance(flags, str) else ";".join(map(str, flags)),
+                   _fmt_float(_get(t, "vx")), _fmt_float(_get(t, "vy")), _fmt_float(_get(t, "speed"))]
             row += [_fmt_cell(_get(t, c)) for c in self.extra_columns]
             rows.append(row)
         self._csv.writerows(rows)
@@ -538,3 +540,46 @@ def write_mot(path: str | Path, table: TrackTable) -> None:
         for k in range(n):
             f.write(",".join([str(int(t.frame[k]) + 1), str(int(t.id[k]))]
                              + [_fmt_float(c[k]) for c in cols]) + "\n")
+
+
+class MotWriter:
+    """Stream MOTChallenge rows as a tracker runs: ``frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z``.
+
+    Frames are written 1-based, the box in pixels with the MOTChallenge convention of 1-based
+    pixel coordinates (``bb_left = u_min + 1``), ``-1`` when the person is not in front of the
+    camera; ``x, y, z`` are world metres. Every :meth:`write` is flushed.
+
+    Examples
+    --------
+    >>> with MotWriter("tracks_mot.txt") as out:                     # doctest: +SKIP
+    ...     out.write(0, [(1, (100.0, 50.0, 40.0, 120.0), 0.9, 1.2, 0.4, 0.0)])
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self._file: TextIO | None = _open_for_writing(self.path)
+
+    def write(self, frame: int, rows: Iterable[tuple[int, Sequence[float] | None, float, float, float, float]]) -> None:
+        """Append this frame's rows: ``(id, box, conf, x, y, z)`` with ``box = (u_min, v_min, width,
+        height)`` in 0-based pixels or None."""
+        if self._file is None:
+            raise ValueError(f"MotWriter({self.path}): write after close")
+        lines = []
+        for tid, box, conf, x, y, z in rows:
+            b = ["-1"] * 4 if box is None else [_fmt_float(round(box[0] + 1, 2)), _fmt_float(round(box[1] + 1, 2)),
+                                                _fmt_float(round(box[2], 2)), _fmt_float(round(box[3], 2))]
+            lines.append(",".join([str(int(frame) + 1), str(int(tid)), *b, _fmt_float(round(float(conf), 4)),
+                                   _fmt_float(round(x, 4)), _fmt_float(round(y, 4)), _fmt_float(round(z, 4))]))
+        self._file.write("".join(line + "\n" for line in lines))
+        self._file.flush()
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> "MotWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

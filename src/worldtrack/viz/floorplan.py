@@ -98,19 +98,24 @@ def draw_trajectories(ax: plt.Axes, paths: Mapping[int, np.ndarray], style: str 
 
 def save_floorplan(scene: Scene, path: str | Path, title: str | None = None,
                    paths: Mapping[int, np.ndarray] | None = None,
-                   reference_paths: Mapping[int, np.ndarray] | None = None) -> Path:
+                   reference_paths: Mapping[int, np.ndarray] | None = None,
+                   area: np.ndarray | None = None) -> Path:
     """Write a floor-plan PNG of ``scene``, optionally with trajectories.
 
     Parameters
     ----------
     paths : {id: (T, 2)} — e.g. tracker output, drawn solid
     reference_paths : {id: (T, 2)} — e.g. ground truth, drawn dashed and thin
+    area : (M, 2) metres — the tracking area (e.g. the one evaluation uses), outlined
     """
     x0, x1, y0, y1 = scene.walkable.bounds
     w, h = x1 - x0 + 2, y1 - y0 + 2
     scale = 9.0 / max(w, h)
     fig, ax = plt.subplots(figsize=(max(4.0, w * scale), max(4.0, h * scale) + 0.6), dpi=110)
     draw_scene(ax, scene)
+    if area is not None:
+        ring = np.vstack([area, area[:1]])
+        ax.plot(ring[:, 0], ring[:, 1], color="#1f4e9c", lw=1.5, ls="-.", zorder=4, label="tracking area")
     if reference_paths:
         draw_trajectories(ax, reference_paths, style="--", label_prefix="gt", lw=1.0)
     if paths:
