@@ -134,13 +134,17 @@ def _cache_misses() -> int:
 
 
 def say_warm_up(method: str, config: Any = None, foreground: Any = None, stream: Any = None) -> float:
-    """:func:`warm_up` with one line on ``stream`` (default standard error) saying what it did."""
+    """:func:`warm_up` with one line on ``stream`` (default standard error) saying what it did and how
+    long it took; on a terminal the line first says what is being waited for."""
     stream = sys.stderr if stream is None else stream
-    print("preparing compiled kernels (the first run after installing compiles them, about a minute)…",
-          end="", file=stream, flush=True)
+    live = hasattr(stream, "isatty") and stream.isatty()
+    if live:
+        print("kernels: compiling or loading (compiling takes about a minute after an install)…",
+              end="", file=stream, flush=True)
     seconds, compiled = warm_up(method, config, foreground)
-    what = f"compiled {compiled} kernels (first run only; cached for later runs)" if compiled else "loaded from the cache"
-    print(f"\rkernels: {what} in {seconds:.1f} s" + " " * 40, file=stream, flush=True)
+    what = (f"compiled {compiled} in {seconds:.1f} s (first run only; cached for later runs)" if compiled
+            else f"loaded from the cache in {seconds:.1f} s")
+    print(("\r\033[K" if live else "") + f"kernels: {what}", file=stream, flush=True)
     return seconds
 
 

@@ -34,6 +34,8 @@ if TYPE_CHECKING:   # NumPy, and the fitting and import modules load SciPy: impo
 #: worldtrack.geometry.calibrate.ADVISED_POINTS, repeated here so ``--help`` need not load SciPy
 #: (tests/cli check that the two agree).
 ADVISED_POINTS = 20
+#: Largest points file read (bytes; 100 000 points take about 4 MB).
+MAX_POINTS_FILE_BYTES = 20_000_000
 
 _HEADER = ("X", "Y", "Z", "x", "y")
 _SIZE_COMMENT = re.compile(r"^#\s*image[_ ]?size\s*[:=]\s*(.*)$", re.IGNORECASE)
@@ -117,10 +119,15 @@ def read_points(path: str | Path) -> PointsFile:
     InputError
         Naming the file, the line and what was expected.
     """
-
-
     import numpy as np
+
     label = str(path)
+    try:
+        size = Path(path).stat().st_size
+    except OSError:
+        size = 0                                # read_text names the problem
+    if size > MAX_POINTS_FILE_BYTES:
+        raise InputError(f"{label}: {size:,} bytes; a points file may have at most {MAX_POINTS_FILE_BYTES:,}")
     text = read_text(path, "CSV with header X,Y,Z,x,y", directory="a CSV file")
 
     header_seen = False
@@ -136,7 +143,10 @@ def read_points(path: str | Path) -> PointsFile:
             if m:
                 image_size = parse_size(m.group(1).strip(), f"{label}: line {n}: image_size", "640x480")
             continue
-        cells = _cells(line)
+        try:
+            cells = _cells(line)
+        except csv.Error as e:
+            raise InputError(f"{label}: line {n}: not valid CSV ({e})") from None
         if not header_seen:
             names = [c.lower() for c in cells]
             expected = [h.lower() for h in _HEADER]
@@ -245,6 +255,8 @@ def format_report(result: CalibrationResult, points: PointsFile, label: str) -> 
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     if args.import_file is not None:
         if args.points is not None:
             raise InputError(f"give either POINTS.csv ({args.points}) or --import FILE, not both")
@@ -281,6 +293,9 @@ def run(args: argparse.Namespace) -> int:
                            point_names=[f"line {n}" for n in points.lines])
     except InputError as e:
         raise InputError(f"{label}: {e}") from None
+    except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:   # degenerate beyond the checks
+        raise InputError(f"{label}: these points do not determine a camera (the fit failed numerically: "
+                         f"{e}); check for repeated or mistyped points") from None
     result.warnings.extend(extra_warnings)
     print(format_report(result, points, label), end="")
     if not result.success:

@@ -22,6 +22,10 @@ if TYPE_CHECKING:
     import numpy as np
 
 
+#: Most vertices of an --area polygon.
+MAX_AREA_POINTS = 1000
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "eval", help="score tracks against ground truth (MOTA, MOTP in metres, IDF1, errors)",
@@ -89,8 +93,8 @@ def parse_area(text: str) -> np.ndarray:
         values = [float(s) for s in parts]
     except ValueError:
         raise InputError(f"--area: expected numbers x1,y1,x2,y2,... in metres, got {text!r}") from None
-    if len(values) % 2 or len(values) < 6 or not all(math.isfinite(v) for v in values):
-        raise InputError(f"--area: expected x1,y1,x2,y2,... with at least 3 (x, y) points, "
+    if len(values) % 2 or not 6 <= len(values) <= 2 * MAX_AREA_POINTS or not all(math.isfinite(v) for v in values):
+        raise InputError(f"--area: expected x1,y1,x2,y2,... with 3 to {MAX_AREA_POINTS} finite (x, y) points, "
                          f"got {len(values)} numbers")
     return np.asarray(values, dtype=float).reshape(-1, 2)
 

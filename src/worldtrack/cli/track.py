@@ -133,6 +133,8 @@ def run(args: argparse.Namespace) -> int:
     max_bad = positive_int(args.max_bad_frames, "--max-bad-frames", "25")
     area = read_area(args.area) if args.area else None
     scene = load_scene(args.scene)
+    for line in scene.warnings:
+        print(f"warning: {line}", file=sys.stderr)
     videos = dict(_pair(v, "--video") for v in args.video)
     if not videos:
         raise InputError("no video given: use --video CAMERA=PATH (cameras: " + ", ".join(scene.cameras) + ")")

@@ -32,9 +32,7 @@ from __future__ import annotations
 
 import csv
 import enum
-import io
 import math
-import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,7 +42,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
-from worldtrack.io.text import is_number
 
 #: Columns of ``tracks.csv``, in order; trackers may append more.
 TRACK_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "height", "width", "score",
@@ -54,13 +51,6 @@ MOT_COLUMNS: tuple[str, ...] = ("frame", "id", "bb_left", "bb_top", "bb_width", 
                                 "conf", "x", "y", "z")
 
 _CORE = ("frame", "time", "id", "x", "y")
-_REQUIRED = ("frame", "id", "x", "y")
-# Extra columns that must be numbers (empty cells read as NaN) and ones that are always text.
-_FLOAT_COLUMNS = frozenset({"height", "width", "score", "z_head", "speed", "vx", "vy", "sigma", "sx", "sy",
-                            "sz", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "z"})
-_FLOAT_PREFIXES = ("vis_", "head_", "feet_")
-_TEXT_COLUMNS = frozenset({"mode", "flags"})
-_SPLIT_MOT = re.compile(r"[,\s]+")
 
 
 # --------------------------------------------------------------------------------------------
@@ -162,213 +152,6 @@ class TrackTable:
         """Rows ordered by frame, then id (stable)."""
         order = np.lexsort((self.id, self.frame))
         return self.select(order)
-
-
-# --------------------------------------------------------------------------------------------
-# Reading
-# --------------------------------------------------------------------------------------------
-
-def read_tracks(path: str | Path) -> TrackTable:
-    """Read ``tracks.csv``, ``gt.csv`` or MOTChallenge text into a :class:`TrackTable`.
-
-    A headered CSV needs at least ``frame, id, x, y``; ``time`` is optional (NaN if absent) and
-    every other column is kept in ``extra``. A file without a header whose first line has at
-    least ten numbers is read as MOTChallenge (frames made 0-based; world ``x, y`` from columns
-    8–9, ``z`` and the box kept as extras).
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    TrackTable
-        Sorted by frame, then id.
-
-    Raises
-    ------
-    InputError
-        One line naming the file and, where it applies, the line and column: a missing file,
-        an empty file, missing columns, a cell that is not a number, a row with the wrong number
-        of fields, a negative frame, an id below 1, or two rows for the same (frame, id).
-    """
-    name = str(path)
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as f:
-            text = f.read()
-    except FileNotFoundError:
-        raise InputError(f"{name}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{name}: is a directory, expected a track file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{name}: not a text file (expected UTF-8 CSV)") from None
-    except OSError as e:
-        raise InputError(f"{name}: cannot read: {e.strerror or e}") from None
-
-    first = next((line for line in text.splitlines() if line.strip()), None)
-    if first is None:
-        raise InputError(f"{name}: empty file")
-    tokens = [t for t in _SPLIT_MOT.split(first.strip()) if t]
-    if all(is_number(t) for t in tokens):
-        if len(tokens) < len(MOT_COLUMNS):
-            raise InputError(f"{name}: line 1: no header and only {len(tokens)} numeric columns; "
-                             f"expected a CSV header (frame,id,x,y,…) or MOTChallenge text with "
-                             f"{len(MOT_COLUMNS)} columns")
-        return _read_mot(text, name)
-    return _read_csv(text, name)
-
-
-def _read_csv(text: str, name: str) -> TrackTable:
-    reader = csv.reader(io.StringIO(text))
-    header: list[str] | None = None
-    cells: list[list[str]] = []
-    lines: list[int] = []
-    for record in reader:
-        if not any(c.strip() for c in record):
-            continue
-        if header is None:
-            header = [c.strip() for c in record]
-            if "" in header:
-                raise InputError(f"{name}: line {reader.line_num}: empty column name in header")
-            dup = sorted({c for c in header if header.count(c) > 1})
-            if dup:
-                raise InputError(f"{name}: line {reader.line_num}: repeated columns: {', '.join(dup)}")
-            missing = [c for c in _REQUIRED if c not in header]
-            if missing:
-                hint = ""
-                if len(header) == 1 and any(sep in header[0] for sep in ";\t"):
-                    hint = " (the header is one column: columns must be separated by commas)"
-                raise InputError(f"{name}: missing columns: {', '.join(missing)}{hint}")
-            continue
-        if len(record) != len(header):
-            raise InputError(f"{name}: line {reader.line_num}: expected {len(header)} fields "
-                             f"({','.join(header)}), got {len(record)}")
-        cells.append([c.strip() for c in record])
-        lines.append(reader.line_num)
-    assert header is not None  # the caller saw a non-blank first line
-    line_no = np.asarray(lines, dtype=np.int64)
-    cols = list(zip(*cells)) if cells else [() for _ in header]
-    raw = {h: np.asarray(c, dtype=str) for h, c in zip(header, cols)}
-
-    frame = _integers(raw["frame"], "frame", line_no, name, minimum=0)
-    ids = _integers(raw["id"], "id", line_no, name, minimum=1)
-    x = _floats(raw["x"], "x", line_no, name, allow_empty=False)
-    y = _floats(raw["y"], "y", line_no, name, allow_empty=False)
-    if "time" in raw:
-        time = _floats(raw["time"], "time", line_no, name, allow_empty=True, finite=False)
-    else:
-        time = np.full(len(cells), np.nan)
-    extra: dict[str, np.ndarray] = {}
-    for h in header:
-        if h in _CORE:
-            continue
-        if h in _TEXT_COLUMNS:
-            extra[h] = raw[h]
-        elif h in _FLOAT_COLUMNS or h.startswith(_FLOAT_PREFIXES):
-            extra[h] = _floats(raw[h], h, line_no, name, allow_empty=True, finite=False)
-        else:
-            extra[h] = _guess(raw[h])
-    return _finish(TrackTable(frame=frame, time=time, id=ids, x=x, y=y, extra=extra, source=name),
-                   line_no)
-
-
-def _read_mot(text: str, name: str) -> TrackTable:
-    rows: list[list[str]] = []
-    lines: list[int] = []
-    width = None
-    for i, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        tokens = [t for t in _SPLIT_MOT.split(line.strip()) if t]
-        if width is None:
-            width = len(tokens)
-        elif len(tokens) != width:
-            raise InputError(f"{name}: line {i}: expected {width} fields (MOTChallenge), "
-                             f"got {len(tokens)}")
-        rows.append(tokens)
-        lines.append(i)
-    assert width is not None
-    line_no = np.asarray(lines, dtype=np.int64)
-    names = list(MOT_COLUMNS) + [f"col_{k + 1}" for k in range(len(MOT_COLUMNS), width)]
-    raw = np.asarray(rows, dtype=str)
-    col = {n: raw[:, k] for k, n in enumerate(names)}
-
-    frame = _integers(col["frame"], "frame", line_no, name, minimum=1) - 1
-    ids = _integers(col["id"], "id", line_no, name, minimum=1)
-    x = _floats(col["x"], "x", line_no, name, allow_empty=False)
-    y = _floats(col["y"], "y", line_no, name, allow_empty=False)
-    extra = {n: _floats(col[n], n, line_no, name, allow_empty=False, finite=False)
-             for n in names if n not in ("frame", "id", "x", "y")}
-    if np.all(x == -1) and np.all(y == -1) and np.all(extra["z"] == -1):
-        raise InputError(f"{name}: MOTChallenge file without world coordinates (columns 8-10, "
-                         f"x,y,z, are all -1); worldtrack evaluates positions in metres")
-    return _finish(TrackTable(frame=frame, time=np.full(len(rows), np.nan), id=ids, x=x, y=y,
-                              extra=extra, source=name), line_no)
-
-
-def _finish(table: TrackTable, line_no: np.ndarray) -> TrackTable:
-    """Sort by (frame, id) and reject duplicate rows, naming both lines."""
-    order = np.lexsort((table.id, table.frame))
-    table = table.select(order)
-    line_no = line_no[order]
-    same = (np.diff(table.frame) == 0) & (np.diff(table.id) == 0)
-    if np.any(same):
-        k = int(np.flatnonzero(same)[0])
-        a, b = sorted((int(line_no[k]), int(line_no[k + 1])))
-        raise InputError(f"{table.source}: line {b}: duplicate row for frame {table.frame[k]}, "
-                         f"id {table.id[k]} (first at line {a})")
-    return table
-
-
-def _floats(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
-            allow_empty: bool, finite: bool = True) -> np.ndarray:
-    """Parse a column of strings to float64; the first bad cell raises with its line number."""
-    vals = np.where(values == "", "nan", values) if allow_empty else values
-    try:
-        out = vals.astype(float) if vals.size else np.zeros(0)
-    except ValueError:
-        out = None
-    bad = np.zeros(values.shape, bool)
-    if out is None:
-        bad = np.array([not is_number(v) for v in vals], dtype=bool)
-        if not np.any(bad):  # text NumPy refuses but Python's float() accepts ("1_000")
-            out = np.array([float(v) for v in vals])
-    if finite and out is not None:
-        bad = ~np.isfinite(out)
-    if np.any(bad):
-        k = int(np.flatnonzero(bad)[0])
-        what = "a number" if out is None else "a finite number"
-        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected {what}, "
-                         f"got {str(values[k])!r}")
-    assert out is not None
-    return out
-
-
-def _integers(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
-              minimum: int) -> np.ndarray:
-    out = _floats(values, column, line_no, name, allow_empty=False)
-    bad = out != np.round(out)
-    if np.any(bad):
-        k = int(np.flatnonzero(bad)[0])
-        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected an integer, "
-                         f"got {str(values[k])!r}")
-    low = out < minimum
-    if np.any(low):
-        k = int(np.flatnonzero(low)[0])
-        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected an integer "
-                         f">= {minimum}, got {str(values[k])!r}")
-    return out.astype(np.int64)
-
-
-def _guess(values: np.ndarray) -> np.ndarray:
-    """An unknown extra column: float64 if every non-empty cell is a number, else text."""
-    filled = values != ""
-    if not np.any(filled):
-        return values
-    try:
-        return np.where(filled, values, "nan").astype(float)
-    except ValueError:
-        return values
 
 
 # --------------------------------------------------------------------------------------------
@@ -583,3 +366,7 @@ class MotWriter:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+# Reading lives in worldtrack.io.track_reader (imported here, after TrackTable, for the old name).
+from worldtrack.io.track_reader import read_tracks  # noqa: E402

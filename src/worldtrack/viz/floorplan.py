@@ -29,6 +29,9 @@ def camera_floor_coverage(camera: Camera, bounds: tuple[float, float, float, flo
     -------
     xs : (nx,) ndarray, ys : (ny,) ndarray, seen : (ny, nx) bool ndarray
     """
+    from worldtrack.scene.floor import grid_resolution
+
+    resolution = grid_resolution(bounds, resolution, max_cells=1_000_000)
     x0, x1, y0, y1 = bounds
     xs = np.arange(x0, x1 + resolution / 2, resolution)
     ys = np.arange(y0, y1 + resolution / 2, resolution)
