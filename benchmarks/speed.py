@@ -60,7 +60,7 @@ from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 from worldtrack.trackers.ellipsoid.real import ternary_real  # noqa: E402
-from worldtrack.trackers.particle_likelihood import hit_image, hit_labels  # noqa: E402
+from worldtrack.foreground.shadows import hit_image, hit_labels  # noqa: E402
 
 SEED = 0
 SIZES = ((160, 120), (640, 480))
@@ -144,10 +144,10 @@ def foreground_stage(method: str, tracker, clip: Clip):
         cs = tracker.views[clip.camera]
         return lambda img: ternary_real(cs.foreground.labels(img), cs.ring_px)
     if method == "particle":
-        gamma = tracker.config.gamma
-        if tracker.config.shadows != "object":
+        gamma = tracker.config.likelihood.gamma
+        if tracker.config.likelihood.shadows != "object":
             return lambda img: hit_labels(img, clip.background, gamma)
-        fg = tracker.foregrounds[clip.camera]
+        fg = tracker.labels.foregrounds[clip.camera]
         return lambda img: hit_image(fg.difference(img), gamma)
     model = AdaptiveBackground("mog2", background=clip.background)
     return model.labels

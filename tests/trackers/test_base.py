@@ -60,8 +60,10 @@ def test_mark_seen_collects_the_cameras_of_one_time_stamp():
 
 
 def test_frames_for_converts_seconds_at_the_real_frame_interval():
-    assert frames_for(0.3, 0.1) == 3 and frames_for(0.3, 1 / 7) == 2 and frames_for(0.3, 1 / 25) == 8
-    assert frames_for(0.01, 0.1) == 1 and frames_for(1.0, 0.0) == NEVER
+    # At least the duration: ⌈s / dt⌉, with slack for time stamps that do not divide exactly.
+    assert frames_for(0.3, 0.1) == 3 and frames_for(0.3, 1 / 7) == 3 and frames_for(0.3, 1 / 25) == 8
+    assert frames_for(0.2, 1 / 7) == 2 and frames_for(0.3, 0.1 * (1 + 1e-15)) == 3
+    assert frames_for(0.3, 0.1 * (1 - 1e-15)) == 3 and frames_for(0.01, 0.1) == 1 and frames_for(1.0, 0.0) == NEVER
 
 
 def test_merge_duplicates_ends_the_younger_after_the_frames_needed():

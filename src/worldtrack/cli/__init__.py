@@ -22,7 +22,7 @@ from worldtrack.errors import InputError
 from worldtrack.interrupts import exit_status, install_terminate_handler, interrupt_in, signal_of
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
-_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "eval", "background", "gt")
+_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt")
 
 
 def build_parser() -> argparse.ArgumentParser:

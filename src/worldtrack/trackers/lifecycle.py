@@ -8,6 +8,7 @@ so trackers that share a map advance them once per time stamp.
 
 from __future__ import annotations
 
+import math
 from typing import Callable, Mapping
 
 from worldtrack.trackers.base import Person, PositionMap
@@ -17,16 +18,21 @@ NEVER = 2 ** 31 - 1
 
 
 def frames_for(seconds: float, dt: float) -> int:
-    """Frames (at least 1) that a duration of ``seconds`` spans at frame interval ``dt`` (s).
+    """Frames (at least 1) a rule must hold for to last ``seconds`` at frame interval ``dt`` (s).
 
-    ``dt ≤ 0`` (the first frame: no interval known yet) gives :data:`NEVER`.
+    At least the duration: ``⌈seconds / dt⌉`` (with a millionth of a frame of slack for time stamps
+    that do not divide exactly), so 0.2 s is two frames at 10 frames/s and also at 7 frames/s,
+    where one frame would last only 0.14 s. ``dt ≤ 0`` (the first frame: no interval known yet)
+    gives :data:`NEVER`.
 
-    >>> frames_for(0.3, 0.1), frames_for(1.0, 1 / 7), frames_for(0.05, 0.1), frames_for(1.0, 0.0) == NEVER
-    (3, 7, 1, True)
+    >>> frames_for(0.3, 0.1), frames_for(0.2, 1 / 7), frames_for(1.0, 1 / 7), frames_for(0.05, 0.1)
+    (3, 2, 7, 1)
+    >>> frames_for(0.3, 0.3 / 2.9999999999999996), frames_for(1.0, 0.0) == NEVER
+    (3, True)
     """
     if not dt > 0:
         return NEVER
-    return max(1, int(round(seconds / dt)))
+    return max(1, int(math.ceil(seconds / dt - 1e-6)))
 
 
 def counts_for(p: Person, name: str, t: float, condition: bool, by: int = 1) -> int:
