@@ -24,7 +24,7 @@ import numpy as np
 # Image sizes of the two cameras: some steps take other paths on images over 320 px wide.
 _SIZES = {"cam1": (640, 480), "cam2": (320, 240)}
 _FPS = 10.0
-_FRAMES = 24
+_FRAMES = 16
 # People of the tiny scene: (x, y) at frame 0 and velocity (m/frame); the first two cross, the
 # third walks in over the image border, so births, merges and partial views are all exercised.
 _PEOPLE = (((-1.6, -0.4), (0.13, 0.03)), ((1.4, 0.5), (-0.12, -0.03)), ((2.6, 1.9), (-0.15, 0.0)))
@@ -32,7 +32,7 @@ _PEOPLE = (((-1.6, -0.4), (0.13, 0.03)), ((1.4, 0.5), (-0.12, -0.03)), ((2.6, 1.
 _DESK = {"name": "desk", "type": "box", "centre": [-0.2, 1.4, 0.4], "size": [1.4, 0.5, 0.8]}
 # From this frame on, a wide dark band crosses every image (a passing trolley, a light change):
 # foreground from border to border, as close-up people give.
-_BAND_FROM = 18
+_BAND_FROM = 12
 
 
 def _tiny_scene() -> Any:

@@ -8,14 +8,6 @@ import numpy as np
 import pytest
 
 from worldtrack.cli import main
-from worldtrack.synth import make_scenario, write_sequence
-
-
-@pytest.fixture(scope="module")
-def sequence(tmp_path_factory):
-    out = tmp_path_factory.mktemp("seq")
-    write_sequence(make_scenario("two-crossing", size=(160, 120), frames=30, seed=1), out, png=True, progress=False)
-    return out
 
 
 def rows(path):

@@ -21,17 +21,35 @@ from worldtrack import __version__
 from worldtrack.errors import InputError
 from worldtrack.interrupts import exit_status, install_terminate_handler, interrupt_in, signal_of
 
-# Verb modules, in the order ``worldtrack --help`` lists them.
-_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt")
+# Verb modules, in the order ``worldtrack --help`` lists them, with the one line it shows for each
+# (each module's own ``register`` repeats it; tests/cli/test_cli_startup.py checks they agree).
+COMMANDS = {
+    "demo": "synthesise a scene, track it, evaluate against ground truth (the README's first command)",
+    "scene": "check a scene file and draw its floor plan",
+    "calibrate": "fit a camera to point pairs (CSV) or import a calibration file",
+    "synth": "render a synthetic multi-camera sequence with exact ground truth",
+    "track": "track people in videos of a calibrated scene",
+    "smooth": "estimate head trajectories across cameras that do not share views (paper 002)",
+    "pose": "track the pose of a face, an upper body or a rigid object (paper 003)",
+    "eval": "score tracks against ground truth (MOTA, MOTP in metres, IDF1, errors)",
+    "background": "estimate an empty-scene background image from a video",
+    "gt": "ground-truth tools: import image-box GT (CVML, MOTChallenge) as world GT",
+}
+_COMMANDS = tuple(COMMANDS)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(verb: str | None = None) -> argparse.ArgumentParser:
+    """The command line's parser; with ``verb``, only that verb's module is imported and registered
+    (the others are listed by name and help line), so ``--help`` needs no heavy import."""
     parser = argparse.ArgumentParser(
         prog="worldtrack",
         description="Track people in world coordinates (metres on the floor) from calibrated cameras.")
     parser.add_argument("--version", action="version", version=f"worldtrack {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="<command>")
-    for name in _COMMANDS:
+    for name, line in COMMANDS.items():
+        if verb is not None and name != verb:
+            sub.add_parser(name, help=line, add_help=False)
+            continue
         try:
             module = importlib.import_module(f"worldtrack.cli.{name}")
         except ModuleNotFoundError as e:
@@ -40,6 +58,12 @@ def build_parser() -> argparse.ArgumentParser:
             raise
         module.register(sub)
     return parser
+
+
+def _verb(argv: list[str]) -> str:
+    """The verb named on the command line ('' when none: only the listing is built)."""
+    first = next((a for a in argv if not a.startswith("-")), "")
+    return first if first in COMMANDS else ""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -51,13 +75,15 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
     install_terminate_handler()
     try:
-        parser = build_parser()
+        parser = build_parser(_verb(args_in))
         args = parser.parse_args(args_in)
         args.command_line = ["worldtrack", *args_in]
         if not getattr(args, "func", None):
             parser.print_help()
             return 2
-        return int(args.func(args) or 0)
+        status = int(args.func(args) or 0)
+        sys.stdout.flush()          # a reader that went away (| head) is met here, not at exit
+        return status
     except InputError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

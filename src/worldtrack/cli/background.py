@@ -39,8 +39,8 @@ methods:
 """
 
 EPILOG = """\
-example (PETS 2009 S2.L1):
-  worldtrack background /work/shared/data/pets2009_s2l1/video/View_001_480x360.avi --out bg.png
+example (PETS 2009 S2.L1, with PETS=path/to/pets2009_s2l1 as in examples/pets2009/README.md):
+  worldtrack background $PETS/video/View_001_480x360.avi --out bg.png
 """
 
 
