@@ -122,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from worldtrack.viz.eval_plots import plot_evaluation
         plot_evaluation(args.plot, gt_in, pred_in, result.pairs, gate=gate, area=area,
-                        title=f"{args.pred} vs {args.gt}")
+                        title=plot_title(args.pred, args.gt, metrics))
 
     if args.json:
         print(json.dumps({k: _json_value(v) for k, v in metrics.items()}, sort_keys=False))
@@ -141,6 +141,22 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         print(f"plot: {args.plot}")
     return 0
+
+
+def plot_title(pred: str, gt: str, m: dict[str, Any]) -> str:
+    """A short title: the predictions by folder and name, the ground truth by name, and the scores.
+
+    >>> plot_title("/data/run3/tracks.csv", "/data/gt.csv", {"mota": 0.91, "idf1": 0.85, "gate_m": 0.5})
+    'run3/tracks.csv vs gt.csv: MOTA 0.910, IDF1 0.850 (0.5 m gate)'
+    """
+    def name(path: str) -> str:
+        p = Path(path)
+        return f"{p.parent.name}/{p.name}" if p.parent.name else p.name
+
+    def f3(v: Any) -> str:
+        return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3f}"
+
+    return f"{name(pred)} vs {Path(gt).name}: MOTA {f3(m['mota'])}, IDF1 {f3(m['idf1'])} ({m['gate_m']:g} m gate)"
 
 
 def format_table(m: dict[str, Any]) -> str:
