@@ -479,10 +479,12 @@ def run_import(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("calibrate", help="fit a camera to point pairs (CSV) or import a calibration file",
+                              usage="worldtrack calibrate POINTS.csv [options]\n"
+                                    "       worldtrack calibrate --import FILE [options]",
                               description=DESCRIPTION, epilog=EPILOG,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("points", metavar="POINTS.csv", nargs="?",
-                   help="CSV with header X,Y,Z,x,y (metres, pixels)")
+                   help="CSV with header X,Y,Z,x,y (metres, pixels); required unless --import")
     p.add_argument("--image-size", metavar="WxH",
                    help="image size in pixels, e.g. 640x480 (default: the file's '# image_size:' comment); "
                         "with --import: the size of the images you track on (the camera is rescaled)")

@@ -151,7 +151,7 @@ def parse_size(size) -> tuple[int, int]:
         try:
             w, h = (int(x) for x in size.lower().split("x"))
         except ValueError:
-            raise InputError(f"size: expected WIDTHxHEIGHT in pixels (e.g. 320x240), got {size!r}") from None
+            raise InputError(f"size: expected WxH in pixels (e.g. 320x240), got {size!r}") from None
     else:
         try:
             w, h = (int(x) for x in size)
