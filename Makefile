@@ -10,6 +10,8 @@ $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test,baseline]'
+	@echo "compiling the trackers' kernels once (cached in src/**/__pycache__; a few minutes on a small machine)"
+	$(PY) -m worldtrack.warmup
 	touch $(STAMP)
 
 demo: $(STAMP)
