@@ -1,4 +1,4 @@
-"""``worldtrack pose track``: track the 6-DoF pose of a face or a rigid object (seed 003).
+"""``worldtrack pose track``: track the 6-DoF pose of a face or a rigid object (paper 003).
 
     worldtrack pose track --model face|upper-body|MODEL.obj --rgb DIR [--depth DIR] \\
         --camera K.yaml --init POSE --out DIR

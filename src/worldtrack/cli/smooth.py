@@ -1,5 +1,5 @@
 """``worldtrack smooth SCENE OBSERVATIONS… --out DIR``: head trajectories across cameras that do not
-share views, by MAP estimation with the scene as environment model (seed 002)."""
+share views, by MAP estimation with the scene as environment model (paper 002)."""
 
 from __future__ import annotations
 
