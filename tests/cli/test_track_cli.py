@@ -126,3 +126,7 @@ def test_demo_synthesises_tracks_and_scores(tmp_path, capsys):
     assert (tmp_path / "d" / "track" / "cam1_annotated.mp4").exists()
     assert (tmp_path / "d" / "track" / "floorplan.png").exists()
     assert (tmp_path / "d" / "synth" / "gt.csv").exists()
+    import yaml
+    info = yaml.safe_load((tmp_path / "d" / "track" / "run.yaml").read_text())
+    assert info["config"]["method"] == "ellipsoid" and info["config"]["foreground"]["kind"] == "colour"
+    assert info["inputs"]["synthetic"] == {"scenario": "two-crossing", "size": "160x120", "frames": 40, "seed": 0}

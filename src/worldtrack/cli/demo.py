@@ -58,8 +58,9 @@ def run(args: argparse.Namespace) -> int:
     from worldtrack.experiment import visibility
     from worldtrack.io.sources import VideoSource, read_image
     from worldtrack.io.tracks import read_tracks
-    from worldtrack.config import from_mapping
-    from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, ForegroundConfig, foregrounds_from_config
+    from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, foregrounds_from_config
+    from worldtrack.io.runinfo import write_run_info
+    from worldtrack.runconfig import resolve_run_config
     from worldtrack.pipeline import run_tracking
     from worldtrack.scene import load_scene
     from worldtrack.synth import make_scenario, write_sequence
@@ -81,13 +82,18 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(synth_dir / "scene.yaml")
     videos = {c: synth_dir / f"{c}.mp4" for c in scenario.camera_ids}
     backgrounds = {c: read_image(synth_dir / f"{c}_background.png", scene.camera(c), "background") for c in videos}
-    fg_config = from_mapping(ForegroundConfig, {"kind": "colour", "threshold": SYNTHETIC_COLOUR_THRESHOLD},
-                             root="foreground")
-    tracker = make_tracker(args.method, scene, foregrounds_from_config(scene, backgrounds, fg_config))
+    cfg = resolve_run_config({"foreground": {"kind": "colour", "threshold": SYNTHETIC_COLOUR_THRESHOLD}},
+                             method=args.method)
+    tracker = make_tracker(cfg.method, scene, foregrounds_from_config(scene, backgrounds, cfg.foreground),
+                           cfg.section())
     source = VideoSource(videos, scene.cameras, fps=scenario.fps)
     gt_all = read_tracks(synth_dir / "gt.csv")
     gt_paths = {int(i): gt_all.xy[gt_all.id == i] for i in set(gt_all.id.tolist())}
-    say_warm_up(args.method, foreground=fg_config)
+    say_warm_up(cfg.method, cfg.section(), cfg.foreground)
+    write_run_info(out / "track", cfg.to_mapping(), inputs={
+        "scene": synth_dir / "scene.yaml", "videos": videos, "backgrounds": {c: synth_dir / f"{c}_background.png"
+                                                                             for c in videos},
+        "synthetic": {"scenario": args.scenario, "size": args.size, "frames": scenario.n_frames, "seed": args.seed}})
     result = run_tracking(scene, source, tracker, out / "track", gt_paths=gt_paths, show_ring=True,
                           progress=not args.quiet)
     if result.error:
