@@ -25,3 +25,20 @@ def test_the_tiny_scene_shows_people_to_both_cameras():
 def test_warm_up_runs_the_ellipsoid_tracker_to_tracks():
     seconds, compiled = warm_up("ellipsoid")
     assert seconds > 0 and compiled >= 0
+
+
+def test_the_people_put_on_the_map_stand_on_the_floor_one_with_hidden_feet():
+    import cv2
+    import numpy as np
+
+    from worldtrack.warmup import _ON_FLOOR_AT_START, _PEOPLE
+
+    scene = _tiny_scene()
+    starts = np.array([_PEOPLE[n][0] for n in _ON_FLOOR_AT_START])
+    assert scene.walkable.contains(starts).all()
+    desk = scene.obstacles[0]
+    for cam in scene.cameras.values():
+        hull = cv2.convexHull(cam.project(desk.corners).astype(np.float32))
+        feet = cam.project(np.column_stack([starts, np.zeros(len(starts))]))
+        hidden = [cv2.pointPolygonTest(hull, (float(u), float(v)), False) > 0 for u, v in feet]
+        assert hidden == [False, False, True], cam.id     # the crossing pair in view, the third behind the desk
