@@ -106,12 +106,15 @@ def draw_scene(ax: plt.Axes, scene: Scene, show_coverage: bool = True, margin: f
 
 
 def draw_trajectories(ax: plt.Axes, paths: Mapping[int, np.ndarray], style: str = "-",
-                      label_prefix: str = "", lw: float = 1.5, legend: str | None = None) -> None:
+                      label_prefix: str = "", lw: float = 1.5, legend: str | None = None,
+                      side: str = "right") -> None:
     """Draw one polyline per id: ``paths[id]`` is (T, 2) floor positions in metres.
 
     Each track is named once, at its start (a hollow circle; a dot marks its end); a name that
     would sit on an earlier one moves up until it is clear, so 35 ids stay readable.
-    ``legend`` is the legend entry for the whole set (e.g. "tracks").
+    ``legend`` is the legend entry for the whole set (e.g. "tracks"). ``side`` ("right" or "left")
+    is where the names sit beside the starts: ground truth on one side and tracks on the other keep
+    a track's name clear of the true path it starts on.
     """
     cmap = plt.get_cmap("tab20")
     placed: list[tuple[float, float]] = []
@@ -129,8 +132,16 @@ def draw_trajectories(ax: plt.Axes, paths: Mapping[int, np.ndarray], style: str 
         while any(abs(x - px) < 2 * step and abs(y - py) < step for px, py in placed):
             y += step
         placed.append((x, y))
-        ax.text(x, y, f"{label_prefix}{tid}", fontsize=7, color=colour, zorder=9, ha="left", va="bottom",
-                bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.6))
+        ax.annotate(f"{label_prefix}{tid}", (x, y), xytext=(4 if side == "right" else -4, 1),
+                    textcoords="offset points", fontsize=7, color=_darker(colour), zorder=9, va="bottom",
+                    ha="left" if side == "right" else "right",
+                    bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.6))
+
+
+def _darker(colour: tuple, scale: float = 0.6) -> tuple:
+    """An RGBA colour with its RGB scaled down: names in tab20's pale shades stay readable on white."""
+    r, g, b, *a = colour
+    return (r * scale, g * scale, b * scale, *a)
 
 
 def save_floorplan(scene: Scene, path: str | Path, title: str | None = None,
@@ -154,7 +165,8 @@ def save_floorplan(scene: Scene, path: str | Path, title: str | None = None,
         ring = np.vstack([area, area[:1]])
         ax.plot(ring[:, 0], ring[:, 1], color="#1f4e9c", lw=1.5, ls="-.", zorder=4, label="tracking area")
     if reference_paths:
-        draw_trajectories(ax, reference_paths, style="--", label_prefix="gt", lw=1.0, legend="ground truth (gtN)")
+        draw_trajectories(ax, reference_paths, style="--", label_prefix="gt", lw=1.0, legend="ground truth (gtN)",
+                          side="left")
     if paths:
         draw_trajectories(ax, paths, legend="tracks (id at ○ start, ● end)")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
