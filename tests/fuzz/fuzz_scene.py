@@ -220,6 +220,7 @@ INVALID: dict[str, Callable] = {
     "sexagesimal-fov": _text(lambda t, r: t.replace("hfov_deg: ", "hfov_deg: 1:", 1) if "hfov_deg: " in t else t + "x: 1"),
     "duplicate-key": _duplicate_key, "deep-nesting": _deep, "alias-bomb": _bomb,
     "missing-floor": lambda s, r: dump({k: v for k, v in s.items() if k != "floor"}),
+    "control-character": _text(lambda t, r: t.replace("\n", "\n\x1b[31m", 1)),   # a terminal colour code
     "unknown-key": _set("colour", "red"), "string-for-list": _set("cameras.*.position", "1, 2, 3"),
     "100-cameras": lambda s, r: dump({**s, "cameras": [dict(s["cameras"][0], id=f"c{k}") for k in range(100)]}),
 }

@@ -158,8 +158,9 @@ def _count_nodes(node: Any, budget: int, label: str) -> int:
 
 def load_yaml_text(text: str, label: str) -> Any:
     """Parse one YAML document (see the module docstring for what is refused)."""
-    loader = _Loader(text, label)
+    loader = None
     try:
+        loader = _Loader(text, label)       # its reader refuses control characters here already
         node = loader.get_single_node()
         if node is None:
             return None
@@ -168,13 +169,16 @@ def load_yaml_text(text: str, label: str) -> Any:
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f"line {mark.line + 1}: " if mark is not None else ""
+        if isinstance(e, yaml.reader.ReaderError):          # a control character: no mark, a position
+            where = f"line {text.count(chr(10), 0, e.position) + 1}: "
         problem = str(getattr(e, "problem", None) or str(e).splitlines()[0])
         problem = clip(problem, 80)
         raise InputError(f"{label}: {where}not valid YAML ({problem})") from None
     except RecursionError:
         raise InputError(f"{label}: nested too deeply") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def read_yaml(path: str | Path, what: str = "YAML", label: str | None = None, max_bytes: int = MAX_BYTES) -> Any:
