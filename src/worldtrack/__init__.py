@@ -12,7 +12,10 @@ The names below are imported on first use (PEP 562), so ``import worldtrack`` an
 from __future__ import annotations
 
 import importlib
-from typing import Any
+
+TYPE_CHECKING = False       # typing itself is not imported: at start-up every import is a moment
+if TYPE_CHECKING:           # Ctrl-C can land in (see worldtrack.entry)
+    from typing import Any
 
 __version__ = "0.1.0"
 

@@ -20,7 +20,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-COMMAND = [sys.executable, "-c", "import sys; from worldtrack.cli import main; sys.exit(main())"]
+COMMAND = [sys.executable, "-c", "from worldtrack.entry import run; run()"]     # as the installed `worldtrack`
 
 
 def long_sequence(sequence: Path, folder: Path, frames: int = 200) -> Path:

@@ -69,3 +69,20 @@ def test_a_closed_pipe_ends_the_command_quietly():
     err = proc.stderr.read().decode()
     code = proc.wait(timeout=120)
     assert err == "" and code == 141
+
+
+def test_ctrl_c_while_the_command_line_is_imported_is_one_line_and_130():
+    # The interrupt lands in the import of worldtrack.cli (the entry point's first moments).
+    code = ("import builtins\nreal = builtins.__import__\n"
+            "def importing(name, *args, **kwargs):\n"
+            "    if name == 'worldtrack.cli':\n        raise KeyboardInterrupt\n"
+            "    return real(name, *args, **kwargs)\n"
+            "builtins.__import__ = importing\nfrom worldtrack.entry import run\nrun()\n")
+    out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
+    assert (out.returncode, out.stderr) == (130, "interrupted\n")
+
+
+def test_the_entry_point_imports_almost_nothing_before_it_can_catch_ctrl_c():
+    code = "import sys\nimport worldtrack.entry\nprint(sorted(m for m in ('typing', 'argparse', 're', 'enum') if m in sys.modules))"
+    out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.strip() == "[]"
