@@ -6,10 +6,14 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test bench clean
 
-$(STAMP): pyproject.toml
+# TrackEval (HOTA) without its declared dependencies: see the comment in pyproject.toml.
+TRACKEVAL := trackeval==1.3.0
+
+$(STAMP): pyproject.toml Makefile
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test,baseline]'
+	$(PY) -m pip install --quiet --no-deps '$(TRACKEVAL)'
 	@echo "compiling the trackers' kernels once (cached in src/**/__pycache__; a few minutes on a small machine)"
 	$(PY) -m worldtrack.warmup
 	touch $(STAMP)

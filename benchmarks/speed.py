@@ -58,15 +58,15 @@ from worldtrack.errors import InputError  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
-from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
+from worldtrack.trackers import METHODS, default_foreground, make_tracker  # noqa: E402
 from worldtrack.trackers.ellipsoid.real import ternary_real  # noqa: E402
-from worldtrack.foreground.shadows import hit_image, hit_labels  # noqa: E402
 
 SEED = 0
 SIZES = ((160, 120), (640, 480))
 COUNTS = (1, 2, 5, 10, 20, 50)
 FRAMES, WARMUP = 40, 10
-FOREGROUND = "colour"
+FOREGROUND = None     # each method's own (worldtrack track's default): colour, particle grey
+OWN_FOREGROUND = "each method's own: colour, particle grey"
 
 
 @dataclass
@@ -120,8 +120,9 @@ def empty_clip(clip: Clip, frames: int) -> Clip:
 
 def step_times(method: str, clip: Clip) -> tuple[float, float, object]:
     """Median seconds per ``tracker.step`` after the warm-up, the mean number of tracks, the tracker."""
-    fgs = make_foregrounds(clip.scene, {clip.camera: clip.background}, FOREGROUND,
-                           SYNTHETIC_COLOUR_THRESHOLD if FOREGROUND == "colour" else None)
+    kind = FOREGROUND or default_foreground(method)
+    fgs = make_foregrounds(clip.scene, {clip.camera: clip.background}, kind,
+                           SYNTHETIC_COLOUR_THRESHOLD if kind == "colour" else None)
     tracker = make_tracker(method, clip.scene, fgs)
     try:
         for tid, x, y in clip.start:
@@ -144,11 +145,8 @@ def foreground_stage(method: str, tracker, clip: Clip):
         cs = tracker.views[clip.camera]
         return lambda img: ternary_real(cs.foreground.labels(img), cs.ring_px)
     if method == "particle":
-        gamma = tracker.config.likelihood.gamma
-        if tracker.config.likelihood.shadows != "object":
-            return lambda img: hit_labels(img, clip.background, gamma)
-        fg = tracker.labels.foregrounds[clip.camera]
-        return lambda img: hit_image(fg.difference(img), gamma)
+        # The foreground's labels and the shadows judged, as the particle tracker reads a frame.
+        return lambda img: tracker.labels.read({clip.camera: img})
     model = AdaptiveBackground("mog2", background=clip.background)
     return model.labels
 
@@ -231,7 +229,7 @@ def main(argv: list[str] | None = None) -> int:
     elapsed = time.perf_counter() - t_start
     table = markdown_table(HEADERS, rows)
     text = (f"`crowd`, one camera, seed {SEED}, {frames} frames written as MP4 and decoded; medians over frames "
-            f"{WARMUP}–{frames - 1}; default presets, foreground `{FOREGROUND}` (blobs: MOG2). Limit = decode + one "
+            f"{WARMUP}–{frames - 1}; default presets, foreground `{FOREGROUND or OWN_FOREGROUND}` (blobs: MOG2). Limit = decode + one "
             f"MOG2 apply per frame, measured in this run.\n\n{table}\n\n{summary(results, rows)}\n")
     print(text)
     save_result("speed", "Per-frame cost and scaling with people", text, args.quick, elapsed)

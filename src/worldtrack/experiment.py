@@ -23,7 +23,7 @@ from worldtrack.eval.tables import PositionErrors, position_errors
 from worldtrack.trackers.base import Frame
 from worldtrack.io.tracks import TrackTable
 from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
-from worldtrack.trackers import make_tracker
+from worldtrack.trackers import default_foreground, make_tracker
 from worldtrack.trackers.base import warm_started
 
 
@@ -75,7 +75,7 @@ def visibility(gt: TrackTable) -> np.ndarray:
     return np.max(np.vstack(vis), axis=0) if vis else np.ones(len(gt))
 
 
-def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
+def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str | None = None,
                       threshold: float | None = None, cameras: list[str] | None = None,
                       shadow_texture_ncc: float | None = None, **options):
     """A tracker for a synthetic scenario, its foregrounds made from the scenario's background plates.
@@ -84,12 +84,15 @@ def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "defaul
     ----------
     scenario : worldtrack.synth.Scenario
     method, preset, options : passed to :func:`worldtrack.trackers.make_tracker`
-    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
-        the colour threshold defaults to the synthetic world's 20
+    foreground, threshold : the foreground model (see :func:`worldtrack.foreground.make_foregrounds`;
+        default the method's own, :func:`worldtrack.trackers.default_foreground`); the colour
+        threshold defaults to the synthetic world's 20
     cameras : the cameras to track with (default: all)
     shadow_texture_ncc : the foreground's texture test of shadow-like pixels (default off; see
-        :func:`worldtrack.pipeline.make_foregrounds`)
+        :func:`worldtrack.foreground.make_foregrounds`)
     """
+    if foreground is None:
+        foreground = default_foreground(method)
     if threshold is None and foreground == "colour":
         threshold = SYNTHETIC_COLOUR_THRESHOLD
     cams = list(cameras or scenario.camera_ids)
@@ -140,7 +143,7 @@ def predictions_table(rows) -> TrackTable:
     return TrackTable.from_arrays(a[:, 0].astype(int), a[:, 2].astype(int), a[:, 3], a[:, 4], time=a[:, 1])
 
 
-def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
+def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str | None = None,
                  threshold: float | None = None, min_visibility: float = 0.2, gate: float = 0.5,
                  score_rows: Callable[[TrackTable], np.ndarray] | None = None, init_from_gt: bool = False,
                  cameras: list[str] | None = None, bundles=None, shadow_texture_ncc: float | None = None,
@@ -151,8 +154,9 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
     ----------
     scenario : worldtrack.synth.Scenario
     method, preset, options : passed to :func:`worldtrack.trackers.make_tracker`
-    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
-        the colour threshold defaults to the synthetic world's 20
+    foreground, threshold : the foreground model (see :func:`worldtrack.foreground.make_foregrounds`;
+        default the method's own, :func:`worldtrack.trackers.default_foreground`); the colour
+        threshold defaults to the synthetic world's 20
     min_visibility : ground truth less visible than this in every camera is not scored
     gate : metres
     score_rows : optional ``gt -> (N,) bool`` choosing the ground-truth rows to score (e.g. only

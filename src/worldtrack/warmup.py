@@ -106,7 +106,8 @@ def warm_up(method: str, config: Any = None, foreground: Any = None) -> tuple[fl
     method : "ellipsoid", "particle" or "blobs"
     config : the method's configuration (default: its defaults) — the run's own, so that numbers
         given as integers or floats compile the same specialisations the run will call
-    foreground : :class:`~worldtrack.foreground.config.ForegroundConfig` (default: the defaults)
+    foreground : :class:`~worldtrack.foreground.config.ForegroundConfig` (default: the method's own, as
+        :func:`~worldtrack.runconfig.resolve_run_config` gives it)
 
     Returns
     -------
@@ -114,7 +115,7 @@ def warm_up(method: str, config: Any = None, foreground: Any = None) -> tuple[fl
     compiled : int — kernels that had to be compiled (0 when all came from the cache)
     """
     from worldtrack.foreground import foregrounds_from_config
-    from worldtrack.foreground.config import ForegroundConfig
+    from worldtrack.runconfig import resolve_run_config
     from worldtrack.trackers import make_tracker, warm_started
     from worldtrack.trackers.base import Frame
 
@@ -122,7 +123,9 @@ def warm_up(method: str, config: Any = None, foreground: Any = None) -> tuple[fl
     before = _cache_misses()
     scene = _tiny_scene()
     backgrounds, frames = _frames(scene)
-    fg = foregrounds_from_config(scene, backgrounds, foreground if foreground is not None else ForegroundConfig())
+    if foreground is None:                  # the method's own foreground model, as a run without settings has
+        foreground = resolve_run_config(method=method).foreground
+    fg = foregrounds_from_config(scene, backgrounds, foreground)
     tracker = make_tracker(method, scene, fg, config)
     if method in _PUT_ON_MAP:
         for track_id, n in enumerate(_ON_FLOOR_AT_START, start=1):

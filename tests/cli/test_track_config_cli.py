@@ -32,6 +32,16 @@ def test_config_file_flags_and_set_in_that_order(tmp_path, capsys):
     assert cfg.preset == "paper" and cfg.section("ellipsoid") == resolve_run_config(preset="paper").section("ellipsoid")
 
 
+def test_each_method_runs_on_its_own_foreground_unless_one_is_chosen(tmp_path):
+    assert resolve_run_config(method="ellipsoid").foreground.kind == "colour"
+    assert resolve_run_config(method="particle").foreground.kind == "grey"
+    assert resolve_run_config(method="particle", flags={"threshold": 12}).foreground.kind == "grey"
+    assert resolve_run_config(method="particle", flags={"foreground": "colour"}).foreground.kind == "colour"
+    assert resolve_run_config({"foreground": {"kind": "mog2"}}, method="particle").foreground.kind == "mog2"
+    assert resolve_run_config(method="particle", sets=[("foreground.kind", "knn")]).foreground.kind == "knn"
+    assert resolve_run_config({"method": "particle", "foreground": {"threshold": 9}}).foreground.threshold == 9
+
+
 @pytest.mark.parametrize("args, message", [
     (["--set", "blobs.filter.gat=4"], "error: blobs.filter.gat: unknown setting (expected one of: process_noise, "
                                       "measurement_noise_m, initial_speed_sigma, gate)"),

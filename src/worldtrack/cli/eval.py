@@ -1,7 +1,7 @@
 """``worldtrack eval GT PRED``: score tracks against ground truth on the floor, in metres.
 
 Prints CLEAR-MOT and identity metrics (motmetrics, Euclidean distance on the floor with a gate
-in metres) and the papers' mean position error, |ΔX| and |ΔY|; optionally per-frame counts
+in metres), HOTA (TrackEval, similarity 1 − distance / gate) and the papers' mean position error, |ΔX| and |ΔY|; optionally per-frame counts
 (CSV), a plot (PNG) or the metrics as JSON.
 """
 
@@ -28,11 +28,12 @@ MAX_AREA_POINTS = 1000
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "eval", help="score tracks against ground truth (MOTA, MOTP in metres, IDF1, errors)",
+        "eval", help="score tracks against ground truth (MOTA, MOTP in metres, IDF1, HOTA, errors)",
         description="Compare predicted tracks with ground truth frame by frame on the floor. "
                     "GT and PRED are tracks.csv / gt.csv files or MOTChallenge text with world "
                     "x,y,z (columns 8-10). Frames evaluated: every GT frame, plus predicted "
-                    "frames inside the GT frame range (their predictions are false positives).")
+                    "frames inside the GT frame range (their predictions are false positives). "
+                    "HOTA is TrackEval's, with similarity max(0, 1 - distance/gate).")
     p.add_argument("gt", metavar="GT", help="ground-truth tracks (gt.csv, tracks.csv or MOT txt)")
     p.add_argument("pred", metavar="PRED", help="predicted tracks (tracks.csv or MOT txt)")
     p.add_argument("--gate", default="0.5", metavar="METRES",
@@ -161,6 +162,8 @@ def plot_title(pred: str, gt: str, m: dict[str, Any]) -> str:
 
 def format_table(m: dict[str, Any]) -> str:
     """The metrics as an aligned two-column table."""
+    from worldtrack.eval.hota import INSTALL_HINT
+
     def f3(v: Any) -> str:
         return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3f}"
 
@@ -182,8 +185,8 @@ def format_table(m: dict[str, Any]) -> str:
         ("misses", str(m["num_misses"])),
         ("matches / GT objects / predictions",
          f"{m['num_matches']} / {m['num_objects']} / {m['num_predictions']}"),
-        ("HOTA", "n/a (not available, see worldtrack.eval.mot)" if m["hota"] is None
-         else f3(m["hota"])),
+        ("HOTA (DetA / AssA / LocA)", f"n/a (TrackEval not installed: {INSTALL_HINT})" if m["hota"] is None
+         else f"{f3(m['hota'])} ({f3(m['hota_deta'])} / {f3(m['hota_assa'])} / {f3(m['hota_loca'])})"),
         ("mean error", metres(m["mean_error_m"])),
         ("mean |dX|", metres(m["mean_abs_dx_m"])),
         ("mean |dY|", metres(m["mean_abs_dy_m"])),

@@ -69,9 +69,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--print-config", action="store_true",
                    help="print every setting (with a comment on each) as YAML and stop")
     p.add_argument("--foreground", choices=("grey", "colour", "mog2", "knn"), default=None,
-                   help="foreground model: colour (default; with cast shadows set aside) or grey difference "
-                        "against the background with a fixed threshold (the paper's), or OpenCV's adaptive "
-                        "mog2/knn with shadow detection")
+                   help="foreground model: colour difference with cast shadows set aside, grey difference "
+                        "against the background with a fixed threshold (the papers'), or OpenCV's adaptive "
+                        "mog2/knn with shadow detection (default: the method's own, colour for ellipsoid and "
+                        "blobs, grey for particle)")
     p.add_argument("--threshold", type=float, default=None,
                    help="difference threshold (grey levels, or RGB distance for colour) for every method; "
                         "default 25 / 30 (30 suits compressed video; try 20 for a clean camera)")

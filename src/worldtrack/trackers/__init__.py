@@ -54,17 +54,17 @@ def method_config(method: str, preset: str = "default", overrides: Mapping[str, 
     return config
 
 
-def _override(config: Any, overrides: Mapping[str, Any], method: str) -> Any:
-    if isinstance(config, Section):
-        return with_overrides(config, overrides, root=method)
-    # A configuration not yet moved to sections: flat fields (``dataclasses.replace``).
-    from dataclasses import replace
-    try:
-        return replace(config, **dict(overrides))
-    except TypeError as e:
-        raise InputError(f"{method} tracker: {e}") from None
-    except ValueError as e:
-        raise InputError(f"{method} tracker: {e}") from None
+def _override(config: Section, overrides: Mapping[str, Any], method: str) -> Section:
+    return with_overrides(config, overrides, root=method)
+
+
+def default_foreground(method: str) -> str:
+    """The foreground model ``method`` runs on when none is chosen (``foreground.kind``).
+
+    >>> default_foreground("ellipsoid"), default_foreground("particle")
+    ('colour', 'grey')
+    """
+    return CONFIGS[method].foreground_kind
 
 
 def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *, preset: str = "default",
@@ -95,4 +95,4 @@ def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *
 
 
 __all__ = ["CONFIGS", "METHODS", "PRESETS", "TRACKERS", "Frame", "Person", "PositionMap", "Track", "Tracker",
-           "TrackerBase", "make_tracker", "method_config", "warm_started"]
+           "TrackerBase", "default_foreground", "make_tracker", "method_config", "warm_started"]

@@ -80,6 +80,8 @@ class BlobConfig(Section):
     """The blobs baseline (MOG2 blobs + Stone Soup), by step."""
 
     path: ClassVar[str] = "blobs"
+    #: The foreground model a run of this method gets when none is chosen (it detects with its own MOG2).
+    foreground_kind: ClassVar[str] = "colour"
     foreground: BlobForeground = Field(BlobForeground(), description="MOG2 foreground and morphology")
     detection: BlobDetection = Field(BlobDetection(), description="blobs to floor points")
     filter: BlobFilter = Field(BlobFilter(), description="Kalman filter and assignment")

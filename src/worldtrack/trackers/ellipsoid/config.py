@@ -217,6 +217,8 @@ class EllipsoidConfig(Section):
     """Parameters of the ellipsoid tracker, by step of the method; defaults are worldtrack's."""
 
     path: ClassVar[str] = "ellipsoid"
+    #: The foreground model a run of this method gets when none is chosen (``foreground.kind``).
+    foreground_kind: ClassVar[str] = "colour"
 
     score: ScoreConfig = Field(ScoreConfig(), description="eq. 5 and the simulated image")
     match: MatchConfig = Field(MatchConfig(), description="the matching rounds and the motion between frames")

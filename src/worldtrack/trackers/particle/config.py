@@ -95,10 +95,9 @@ class LikelihoodConfig(Section):
     path: ClassVar[str] = "particle.likelihood"
     model: Literal["column-ratio", "column-count", "point"] = Field(
         "column-ratio", description="column-ratio: the likelihood ratio of an object standing there (sharp along "
-        "the line of sight); column-count: π = samples on F > γ (the paper, eq. 11); point: π = F at the particle "
+        "the line of sight); column-count: π = samples on F > γ (the paper, eq. 11; γ is foreground.threshold); "
+        "point: π = F at the particle "
         "(eq. 7, the paper's baseline)")
-    gamma: float = _finite(25.0, "γ: background differences F ≤ γ (Euclidean RGB distance, 0–441) are background",
-                           ge=0)
     hit_rate_object: float = _finite(0.6, "column-ratio: chance that a sample on an object reads F > γ (much of a "
                                      "body below the waist does not)", gt=0, lt=1)
     hit_rate_background: float = _finite(0.05, "column-ratio: chance that a sample on the background reads F > γ",
@@ -246,6 +245,10 @@ class ParticleConfig(Section):
     """Parameters of :class:`~worldtrack.trackers.particle.ParticleTracker`, by step of the method."""
 
     path: ClassVar[str] = "particle"
+    #: The foreground model a run of this method gets when none is chosen (``foreground.kind``): the
+    #: grey difference (paper 004 thresholds the RGB distance), better for this tracker on PETS 2009
+    #: and on the synthetic entries (``benchmarks/results/tuning_foreground.md``).
+    foreground_kind: ClassVar[str] = "grey"
     seed: StrictInt = Field(0, description="seed of the tracker's random generator: same seed and input, same "
                             "tracks")
     motion: MotionConfig = Field(MotionConfig(), description="prediction (eqs. 1–2)")
