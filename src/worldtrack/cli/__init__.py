@@ -31,7 +31,7 @@ COMMANDS = {
     "track": "track people in videos of a calibrated scene",
     "smooth": "estimate head trajectories across cameras that do not share views (paper 002)",
     "pose": "track the pose of a face, an upper body or a rigid object (paper 003)",
-    "eval": "score tracks against ground truth (MOTA, MOTP in metres, IDF1, errors)",
+    "eval": "score tracks against ground truth (MOTA, MOTP in metres, IDF1, HOTA, errors)",
     "background": "estimate an empty-scene background image from a video",
     "gt": "ground-truth tools: import image-box GT (CVML, MOTChallenge) as world GT",
 }
