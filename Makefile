@@ -14,6 +14,8 @@ $(STAMP): pyproject.toml Makefile
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test,baseline,redis,serve,browser]'
 	$(PY) -m pip install --quiet --no-deps '$(TRACKEVAL)'
+	@echo "compiling the trackers' kernels once (cached in src/**/__pycache__; a few minutes on a small machine)"
+	$(PY) -m worldtrack.warmup
 	touch $(STAMP)
 
 demo: $(STAMP)

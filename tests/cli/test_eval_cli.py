@@ -104,7 +104,7 @@ def test_non_numeric_value_is_one_line_exit_2(tmp_path, capsys):
 @pytest.mark.parametrize("extra, fragment", [
     (["--gate", "-1"], "--gate: expected a positive distance"),
     (["--gate", "wide"], "--gate: expected a distance in metres, got 'wide'"),
-    (["--area", "0,0,1,1"], "--area: expected x1,y1,x2,y2,... with at least 3"),
+    (["--area", "0,0,1,1"], "--area: expected x1,y1,x2,y2,... with 3 to 1000 finite (x, y) points, got 4"),
     (["--area", "0,0,1,x,1,1"], "no such file, and not numbers x1,y1,x2,y2"),
 ])
 def test_bad_options_are_one_line_exit_2(capsys, extra, fragment):

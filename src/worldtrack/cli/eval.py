@@ -14,11 +14,16 @@ import math
 import re
 import sys
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from worldtrack.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+
+#: Most vertices of an --area polygon.
+MAX_AREA_POINTS = 1000
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -59,6 +64,9 @@ def parse_gate(text: str) -> float:
 
 def read_area(text: str) -> np.ndarray:
     """``--area``: a polygon file (numbers x1,y1,x2,y2,…, '#' comments) or the numbers, → (M, 2) m."""
+
+
+    import numpy as np
     path = Path(text)
     if path.is_file():
         try:
@@ -78,13 +86,16 @@ def read_area(text: str) -> np.ndarray:
 
 def parse_area(text: str) -> np.ndarray:
     """``--area x1,y1,x2,y2,…`` → (M, 2) polygon in metres, M ≥ 3."""
+
+
+    import numpy as np
     parts = [s.strip() for s in text.split(",")]
     try:
         values = [float(s) for s in parts]
     except ValueError:
         raise InputError(f"--area: expected numbers x1,y1,x2,y2,... in metres, got {text!r}") from None
-    if len(values) % 2 or len(values) < 6 or not all(math.isfinite(v) for v in values):
-        raise InputError(f"--area: expected x1,y1,x2,y2,... with at least 3 (x, y) points, "
+    if len(values) % 2 or not 6 <= len(values) <= 2 * MAX_AREA_POINTS or not all(math.isfinite(v) for v in values):
+        raise InputError(f"--area: expected x1,y1,x2,y2,... with 3 to {MAX_AREA_POINTS} finite (x, y) points, "
                          f"got {len(values)} numbers")
     return np.asarray(values, dtype=float).reshape(-1, 2)
 
@@ -112,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from worldtrack.viz.eval_plots import plot_evaluation
         plot_evaluation(args.plot, gt_in, pred_in, result.pairs, gate=gate, area=area,
-                        title=f"{args.pred} vs {args.gt}")
+                        title=plot_title(args.pred, args.gt, metrics))
 
     if args.json:
         print(json.dumps({k: _json_value(v) for k, v in metrics.items()}, sort_keys=False))
@@ -131,6 +142,22 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         print(f"plot: {args.plot}")
     return 0
+
+
+def plot_title(pred: str, gt: str, m: dict[str, Any]) -> str:
+    """A short title: the predictions by folder and name, the ground truth by name, and the scores.
+
+    >>> plot_title("/data/run3/tracks.csv", "/data/gt.csv", {"mota": 0.91, "idf1": 0.85, "gate_m": 0.5})
+    'run3/tracks.csv vs gt.csv: MOTA 0.910, IDF1 0.850 (0.5 m gate)'
+    """
+    def name(path: str) -> str:
+        p = Path(path)
+        return f"{p.parent.name}/{p.name}" if p.parent.name else p.name
+
+    def f3(v: Any) -> str:
+        return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3f}"
+
+    return f"{name(pred)} vs {Path(gt).name}: MOTA {f3(m['mota'])}, IDF1 {f3(m['idf1'])} ({m['gate_m']:g} m gate)"
 
 
 def format_table(m: dict[str, Any]) -> str:
@@ -169,6 +196,9 @@ def format_table(m: dict[str, Any]) -> str:
 
 
 def _within(frames: np.ndarray, gt_frames: np.ndarray) -> np.ndarray:
+
+
+    import numpy as np
     return (frames >= gt_frames.min()) & (frames <= gt_frames.max())
 
 
@@ -191,6 +221,9 @@ def _write_per_frame(path: str, per_frame: dict[str, np.ndarray]) -> None:
 
 
 def _json_value(v: Any) -> Any:
+
+
+    import numpy as np
     if v is None or isinstance(v, (bool, str)):
         return v
     if isinstance(v, (int, np.integer)):

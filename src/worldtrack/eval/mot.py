@@ -47,6 +47,9 @@ from worldtrack.scene.floor import points_in_polygon
 
 #: The default gate: a prediction more than this many metres from a person cannot match them.
 DEFAULT_GATE_M = 0.5
+#: Most rows (people) one frame of either table may hold: the frame's distance matrix and its
+#: assignment grow with the square and the cube of it.
+MAX_PER_FRAME = 2000
 
 #: motmetrics metric names computed by :func:`summarize`.
 MOTMETRICS_NAMES: tuple[str, ...] = (
@@ -207,6 +210,8 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         raise InputError(f"{gt.source or 'ground truth'}: no rows to evaluate against")
     gt, pred = gt.sorted(), pred.sorted()
     frames = evaluated_frames(gt, pred)
+    for table in (gt, pred):
+        _check_per_frame(table)
     if area is not None:
         ring = _check_area(area)
         gt = gt.select(inside_area(gt, ring))
@@ -315,6 +320,18 @@ def _count_per_frame(row_frames: np.ndarray, frames: np.ndarray) -> np.ndarray:
     """How many of the sorted ``row_frames`` fall on each of ``frames``."""
     lo, hi = _frame_bounds(row_frames, frames)
     return (hi - lo).astype(np.int64)
+
+
+def _check_per_frame(table: TrackTable) -> None:
+    """:class:`InputError` if a frame of the sorted ``table`` holds more than :data:`MAX_PER_FRAME` rows."""
+    if len(table) <= MAX_PER_FRAME:
+        return
+    starts = np.flatnonzero(np.r_[True, np.diff(table.frame) != 0])
+    counts = np.diff(np.r_[starts, len(table)])
+    k = int(np.argmax(counts))
+    if counts[k] > MAX_PER_FRAME:
+        raise InputError(f"{table.source or 'tracks'}: frame {table.frame[starts[k]]} has {counts[k]:,} rows; "
+                         f"at most {MAX_PER_FRAME:,} people per frame are evaluated")
 
 
 def _check_area(area: ArrayLike) -> np.ndarray:

@@ -151,7 +151,7 @@ def parse_size(size) -> tuple[int, int]:
         try:
             w, h = (int(x) for x in size.lower().split("x"))
         except ValueError:
-            raise InputError(f"size: expected WIDTHxHEIGHT in pixels (e.g. 320x240), got {size!r}") from None
+            raise InputError(f"size: expected WxH in pixels (e.g. 320x240), got {size!r}") from None
     else:
         try:
             w, h = (int(x) for x in size)
@@ -293,7 +293,7 @@ def _serpentine(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return out
 
 
-@_register("static-grid", "seed 000 Table 1: one person standing still at the measurement grid points")
+@_register("static-grid", "paper 000 Table 1: one person standing still at the measurement grid points")
 def static_grid(seed: int, common: Common, *, size=None, frames=None, camera: str = "cam1", dwell: float = 1.5,
                 height: float | None = 1.66, width: float | None = 0.42, speed: float = 0.6) -> Scenario:
     """One person walks slowly between the paper's grid points and stands still ``dwell`` seconds at each.
@@ -320,7 +320,7 @@ def static_grid(seed: int, common: Common, *, size=None, frames=None, camera: st
     people = [Person(1, shape, _trim(_pad(track, n), n))]
     return Scenario("static-grid", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
                     _options(common, 0.1), _rigs(scene, common), seed,
-                    description="seed 000 Table 1: a person standing still at grid points (speed 0 while standing)")
+                    description="paper 000 Table 1: a person standing still at grid points (speed 0 while standing)")
 
 
 def _pad(track: Track, n: int) -> Track:
@@ -339,7 +339,7 @@ def _pad(track: Track, n: int) -> Track:
 DESK_ROWS = (0.0, 1.0, 2.0, 3.0)
 
 
-@_register("desk-occlusion", "seed 000 Table 2: a 0.73 m desk hides the feet (and the image border the head)")
+@_register("desk-occlusion", "paper 000 Table 2: a 0.73 m desk hides the feet (and the image border the head)")
 def desk_occlusion(seed: int, common: Common, *, size=None, frames=None, hide: str = "feet", dwell: float = 1.5,
                    height: float | None = 1.66, width: float | None = 0.42, speed: float = 0.6,
                    camera: str = "cam1") -> Scenario:
@@ -375,10 +375,10 @@ def desk_occlusion(seed: int, common: Common, *, size=None, frames=None, hide: s
     people = [Person(1, shape, _trim(_pad(track, n), n))]
     return Scenario("desk-occlusion", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
                     _options(common, 0.1), _rigs(scene, common), seed,
-                    description=f"seed 000 Table 2: desks hide the feet ({hide})")
+                    description=f"paper 000 Table 2: desks hide the feet ({hide})")
 
 
-@_register("two-crossing", "seed 000 Fig. 9-10: two people crossing in camera 1's image (and passing close by)")
+@_register("two-crossing", "paper 000 Fig. 9-10: two people crossing in camera 1's image (and passing close by)")
 def two_crossing(seed: int, common: Common, *, size=None, frames=None, passing: str = "image",
                  speed: float = 0.9, heights: tuple | None = (1.73, 1.66),
                  widths: tuple | None = (0.48, 0.42)) -> Scenario:
@@ -417,7 +417,7 @@ def two_crossing(seed: int, common: Common, *, size=None, frames=None, passing: 
     people = [Person(i + 1, shapes[i], _trim(_pad(tracks[i], n), n)) for i in range(2)]
     return Scenario("two-crossing", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
                     _options(common, 0.12), _rigs(scene, common), seed,
-                    description=f"seed 000 Fig. 9-10: two people crossing ({passing})")
+                    description=f"paper 000 Fig. 9-10: two people crossing ({passing})")
 
 
 def _synchronise_last_leg(routes, tracks, shapes, fps):
@@ -436,7 +436,7 @@ def _synchronise_last_leg(routes, tracks, shapes, fps):
     return out
 
 
-@_register("sit-down", "seed 000's posture change: a person walks to a stool, sits down, stands up, walks on")
+@_register("sit-down", "paper 000's posture change: a person walks to a stool, sits down, stands up, walks on")
 def sit_down(seed: int, common: Common, *, size=None, frames=None, sit_seconds: float = 5.0,
              height: float | None = None, width: float | None = None) -> Scenario:
     """The kato lab with a stool at (−1.8, 1.0): a person comes in by the door, sits facing camera 1
@@ -456,7 +456,7 @@ def sit_down(seed: int, common: Common, *, size=None, frames=None, sit_seconds: 
     n = frames or _route_length([track], 1.0, common.fps, _MAX_FRAMES)
     people = [Person(1, shape, _trim(_pad(track, n), n))]
     return Scenario("sit-down", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
-                    _options(common, 0.1), _rigs(scene, common), seed, description="seed 000: sitting down")
+                    _options(common, 0.1), _rigs(scene, common), seed, description="paper 000: sitting down")
 
 
 # ------------------------------------------------------------------------------------ crowd
@@ -523,7 +523,7 @@ def two_rooms(seed: int, common: Common, *, size=None, frames=None, people: int 
 
 # ------------------------------------------------------------------------------------ seed 004
 
-@_register("entry", "seed 004: people enter side by side through a door region, then split up and leave")
+@_register("entry", "paper 004: people enter side by side through a door region, then split up and leave")
 def entry(seed: int, common: Common, *, size=None, frames=None, pairs: int = 2, singles: int = 1,
           spacing: float = 0.5, split_after: float = 2.0, interval: float = 6.0, speed: float = 1.0,
           backlight: bool = True) -> Scenario:
@@ -574,7 +574,7 @@ def entry(seed: int, common: Common, *, size=None, frames=None, pairs: int = 2, 
     persons = [Person(i + 1, shapes[i], _trim(_pad(tracks[i], n), n)) for i in range(len(tracks))]
     light = Light(ambient=0.6, direct=0.5, direction=light_direction(250.0, 60.0))
     return Scenario("entry", scene, common.fps, n, persons, env, _lighting(common, rng, light), _options(common),
-                    _rigs(scene, common), seed, description="seed 004: pairs entering side by side, then splitting")
+                    _rigs(scene, common), seed, description="paper 004: pairs entering side by side, then splitting")
 
 
 # ------------------------------------------------------------------------------------ seed 001
@@ -583,7 +583,7 @@ SUN_WARM = (0.86, 0.97, 1.08)      # BGR tint of sunlight
 SHADE_BLUE = (1.15, 1.0, 0.86)     # BGR tint of skylight in shade
 
 
-@_register("follow-target", "seed 001: a robot's stereo camera follows a target among 3 others; "
+@_register("follow-target", "paper 001: a robot's stereo camera follows a target among 3 others; "
                             "front light, backlight, shade; white-balance jumps")
 def follow_target(seed: int, common: Common, *, size=None, frames=None, others: int = 3, baseline: float = 0.12,
                   distance: float = 1.8, camera_height: float = 1.1, wb_jumps: tuple = (),
@@ -668,7 +668,7 @@ def follow_target(seed: int, common: Common, *, size=None, frames=None, others: 
     rigs["robot"].white_balance.threshold = 30
     return Scenario("follow-target", scene, fps, n, persons, env,
                     _lighting(common, rng, Light(tint=SUN_WARM), tuple(segs)), _options(common), rigs, seed,
-                    description="seed 001: robot stereo camera following person 1 (the target)")
+                    description="paper 001: robot stereo camera following person 1 (the target)")
 
 
 def _crosser(scene: Scene, robot, target: Track, fps: float, n: int, height: float, at: tuple) -> Track:
@@ -702,7 +702,7 @@ def _crosser(scene: Scene, robot, target: Track, fps: float, n: int, height: flo
 
 # ------------------------------------------------------------------------------------ seed 002
 
-@_register("non-overlapping", "seed 002: an office with walls and desks seen by 4 cameras whose views do not overlap")
+@_register("non-overlapping", "paper 002: an office with walls and desks seen by 4 cameras whose views do not overlap")
 def non_overlapping(seed: int, common: Common, *, size=None, frames=None, people: int = 2, legs: int = 14,
                     speed: tuple = (1.0, 1.3), layout: str = "open") -> Scenario:
     """A 16 × 8 m office: a corridor along y = 4 m with desks and partitions on both sides and four
@@ -739,7 +739,7 @@ def non_overlapping(seed: int, common: Common, *, size=None, frames=None, people
     light = Light(ambient=0.6, direct=0.45, direction=light_direction(70.0, 70.0))
     return Scenario("non-overlapping", scene, common.fps, n, persons, env, _lighting(common, rng, light),
                     _options(common), _rigs(scene, common), seed,
-                    description="seed 002: four non-overlapping cameras in an office")
+                    description="paper 002: four non-overlapping cameras in an office")
 
 
 def _office_graph(layout: str = "open"):
@@ -809,7 +809,7 @@ def _quat(R: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q)
 
 
-@_register("face-pose", "seed 003: RGB-D close-up of a face with small or large 6-DoF head motion")
+@_register("face-pose", "paper 003: RGB-D close-up of a face with small or large 6-DoF head motion")
 def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str = "small", distance: float = 0.8,
               depth_step_mm: float = 5.0, height: float = 1.72) -> Scenario:
     """A person stands facing a Kinect-like camera ``distance`` m in front of the head and moves the
@@ -848,10 +848,10 @@ def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str 
     light = Light(ambient=0.55, direct=0.6, direction=light_direction(-60.0, 35.0))
     return Scenario("face-pose", scene, fps, n, [person], env, _lighting(common, rng, light), _options(common),
                     _rigs(scene, common, sensors), seed, pose_rows=rows,
-                    description=f"seed 003: face pose, {motion} motion")
+                    description=f"paper 003: face pose, {motion} motion")
 
 
-@_register("upper-body", "seed 003: RGB-D view of an upper body with 14-DoF motion "
+@_register("upper-body", "paper 003: RGB-D view of an upper body with 14-DoF motion "
                           "(torso 6, shoulders 2+2, elbows 2+2)")
 def upper_body(seed: int, common: Common, *, size=None, frames=None, distance: float = 1.9,
                depth_step_mm: float = 5.0, height: float = 1.72) -> Scenario:
@@ -907,7 +907,7 @@ def upper_body(seed: int, common: Common, *, size=None, frames=None, distance: f
     light = Light(ambient=0.55, direct=0.6, direction=light_direction(-60.0, 40.0))
     return Scenario("upper-body", scene, fps, n, [person], env, _lighting(common, rng, light), _options(common),
                     _rigs(scene, common, sensors), seed, pose_rows=rows,
-                    description="seed 003: upper-body pose, 14 DoF")
+                    description="paper 003: upper-body pose, 14 DoF")
 
 
 SCENARIOS = tuple(_REGISTRY)
