@@ -15,7 +15,7 @@ from worldtrack import __version__
 from worldtrack.errors import InputError
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
-_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "eval", "background", "gt")
+_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "eval", "background", "gt", "follow")
 
 
 def build_parser() -> argparse.ArgumentParser:
