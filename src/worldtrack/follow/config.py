@@ -61,8 +61,8 @@ class FollowConfig:
         (2.0 m/s², a walker turning). measurement_sigma : candidate position noise (0.08 m).
     Illumination weight and decision (eq. 3)
         weighting : "illumination" (α = p·|W|, the paper), "colour" (α ≡ 0) or "position" (α ≡ 1).
-        p : 0.25 (paper). alpha_th : 0.8 (paper). wb_unit : gain steps per unit of |W| (see
-        :func:`worldtrack.follow.dissimilarity.illumination_weight` for why 64). alpha_floor :
+        p : 0.25 (paper). alpha_th : 0.8 (paper). wb_unit : gain steps per unit of |W| (70,
+        measured: see :mod:`worldtrack.follow.dissimilarity`). alpha_floor :
         α never falls below this (0 in the paper; 0.5: colour and position weigh the same when
         the light is steady). threshold : largest D accepted (0.5, ours). gate : largest distance
         from the prediction accepted (inf in the paper; 1.0 m), growing by gate_growth m/s while
@@ -104,7 +104,7 @@ class FollowConfig:
     weighting: str = "illumination"
     p: float = 0.25
     alpha_th: float = 0.8
-    wb_unit: float = 64.0
+    wb_unit: float = 70.0
     alpha_floor: float = 0.5
     threshold: float = 0.5
     gate: float = 1.0

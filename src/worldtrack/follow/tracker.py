@@ -142,6 +142,7 @@ class FollowTracker:
         self.P = np.eye(4)
         self.t = 0.0
         self.last_seen = 0.0
+        self._alpha = 0.0
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -220,6 +221,7 @@ class FollowTracker:
         w = wb_change(obs.wb, self.templates.registered_wb)
         alpha = float(illumination_weight(w, cfg.p, cfg.wb_unit, cfg.alpha_floor, cfg.weighting))
         D = dissimilarity(rb, E, alpha, cfg.alpha_th)
+        self._alpha = alpha
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
         allowed = E / cfg.k <= gate
         if cfg.track_others:
@@ -264,19 +266,22 @@ class FollowTracker:
             owner[cand] = others.ids[matched]
         others.expire(t)
         if chosen < 0:
-            chosen = self._reidentify(obs, owner, t)
+            chosen = self._reidentify(obs, owner, D, t)
         free = np.flatnonzero(owner == 0)
         owner[free] = others.add(c.xy[free], obs.hists[free], t)
         return chosen, owner
 
-    def _reidentify(self, obs: Observation, owner: np.ndarray, t: float) -> int:
-        """Re-identify the lost target by colour among the people who appeared since it was last seen.
+    def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, t: float) -> int:
+        """Re-identify the lost target among the people who appeared since it was last seen.
 
         Somebody seen at the same time as the target cannot be the target, so only candidates
-        nobody owns and those of tracks born after the target's last sighting qualify; they must
-        match the target's templates (RBhat < ``reid_rbhat``) and be no farther from its
-        prediction than a walker could have gone (``gate + reid_speed·unseen``). A track taken over
-        ends. Changes ``owner`` in place; returns the candidate's index or −1.
+        nobody owns and those of tracks born after the target's last sighting qualify (a person
+        who reappears half hidden is often first taken for somebody new), and not one who may be
+        hiding the target. They must look like it (RBhat < ``reid_rbhat``) or score like it (D <
+        ``threshold``, E counting only the distance beyond half of what a walker could have strayed
+        from the prediction while unseen), and be no farther from it than a walker could have gone
+        (``gate + reid_speed·unseen``); the smallest D wins. A track taken over ends. Changes
+        ``owner`` in place; returns the candidate's index or −1.
         """
         cfg = self.config
         others = self.others
@@ -289,10 +294,14 @@ class FollowTracker:
         c = obs.candidates
         rb = self.templates.rbhat(obs.hists[eligible])
         dist = np.hypot(*(c.xy[eligible] - self.x[:2]).T)
-        ok = (rb < cfg.reid_rbhat) & (dist <= cfg.gate + cfg.reid_speed * (t - self.last_seen))
+        unseen = t - self.last_seen
+        # Position counts only beyond half of what a walker could have strayed from the prediction.
+        e = cfg.k * np.maximum(0.0, dist - 0.5 * cfg.reid_speed * unseen)
+        d = dissimilarity(rb, e, self._alpha, cfg.alpha_th)
+        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & (dist <= cfg.gate + cfg.reid_speed * unseen)
         if not ok.any():
             return -1
-        pick = int(eligible[np.flatnonzero(ok)[np.argmin(rb[ok])]])
+        pick = int(eligible[np.flatnonzero(ok)[np.argmin(d[ok])]])
         if owner[pick] > 1:
             others.remove(others.ids != owner[pick])
         owner[pick] = 1
