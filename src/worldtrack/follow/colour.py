@@ -92,11 +92,12 @@ def normalise_colour(image: np.ndarray, gains_rb: tuple[float, float] | None, mo
 
 
 def bin_index(image: np.ndarray, config: FollowConfig) -> np.ndarray:
-    """(H, W) int32 histogram bin of every pixel (HSV of the BGR ``image``)."""
-    hsv = cv2.cvtColor(image, cv2.COLOR_BGR2HSV)
-    h = hsv[:, :, 0].astype(np.int32)
-    s = hsv[:, :, 1].astype(np.int32)
-    v = hsv[:, :, 2].astype(np.int32)
+    """Histogram bin (int32) of every pixel of the BGR ``image`` (..., 3) — an image or a list of pixels."""
+    pixels = np.ascontiguousarray(image, dtype=np.uint8).reshape(-1, 1, 3)
+    hsv = cv2.cvtColor(pixels, cv2.COLOR_BGR2HSV).reshape(image.shape)
+    h = hsv[..., 0].astype(np.int32)
+    s = hsv[..., 1].astype(np.int32)
+    v = hsv[..., 2].astype(np.int32)
     idx = (h * config.hue_bins // 180) * config.sat_bins + (s * config.sat_bins // 256)
     if config.grey_bins > 0:
         grey = (s < config.achromatic_sat) | (v < config.achromatic_val)
@@ -121,7 +122,7 @@ def histograms(image: np.ndarray, labels: np.ndarray, n: int, config: FollowConf
         return np.zeros((0, B), np.float32)
     flat = labels.ravel()
     px = np.flatnonzero(flat)
-    bins = bin_index(image, config).ravel()[px]
+    bins = bin_index(image.reshape(-1, 3)[px], config)             # only the silhouettes' pixels
     counts = np.bincount((flat[px] - 1).astype(np.int64) * B + bins, minlength=n * B)[:n * B].reshape(n, B)
     total = counts.sum(axis=1, keepdims=True)
     return (counts / np.maximum(total, 1)).astype(np.float32)

@@ -75,6 +75,8 @@ class FollowConfig:
         others_max_coast : an unseen other is dropped after this (1.5 s). reid_rbhat : a person who
         appeared while the target was lost is taken for it when their RBhat is under this (0.3).
         reid_speed : and no farther from its prediction than ``gate + reid_speed·unseen`` (1.5 m/s).
+        occluders : a person nearer the camera who covers the image box where the target should
+        stand may be hiding it, and is never taken for it (True; False in the paper).
     """
 
     cell: float = 0.05
@@ -117,6 +119,7 @@ class FollowConfig:
     others_max_coast: float = 1.5
     reid_rbhat: float = 0.3
     reid_speed: float = 1.5
+    occluders: bool = True
 
     def __post_init__(self) -> None:
         if self.normalise not in NORMALISATIONS:
@@ -148,7 +151,7 @@ class FollowConfig:
         ('none', True)
         """
         paper = dict(normalise="none", grey_bins=0, alpha_floor=0.0, gate=1e6, max_gate=1e6, gate_growth=0.0,
-                     short_term_tau=0.0, track_others=False)
+                     short_term_tau=0.0, track_others=False, occluders=False)
         undo = dict(paper, normalise="gains+greyworld")
         table = {
             "default": {},

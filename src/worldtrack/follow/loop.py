@@ -39,7 +39,7 @@ class Robot:
     yaw: float
     v: float = 0.0
     w: float = 0.0
-    max_speed: float = 2.0
+    max_speed: float = 1.6
     max_turn_rate: float = 1.5
     accel: float = 1.5
     turn_accel: float = 4.0

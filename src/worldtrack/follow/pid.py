@@ -49,7 +49,7 @@ class PIDFollower:
     distance: float = 1.8
     distance_gains: tuple = (1.2, 0.1, 0.1)
     bearing_gains: tuple = (2.5, 0.1, 0.1)
-    max_speed: float = 2.0
+    max_speed: float = 1.6
     max_reverse: float = 0.5
     max_turn_rate: float = 1.5
     feed_forward: bool = True

@@ -20,7 +20,7 @@ points, pushed back by ``surface_offset`` along the view ray (the camera sees th
 >>> depth = np.zeros((240, 320), np.float32)
 >>> depth[60:230, 150:170] = 3.0          # a 0.4 m wide, 1.7 m high board 3 m in front
 >>> cands = detect(depth, cam, FollowConfig())
->>> len(cands), np.round(cands.xy[0], 1).tolist()
+>>> len(cands), [round(float(v), 1) + 0.0 for v in cands.xy[0]]
 (1, [3.1, 0.0])
 """
 

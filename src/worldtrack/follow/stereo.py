@@ -58,8 +58,8 @@ class StereoMatcher:
 def disparity_to_depth(disparity: np.ndarray, fx: float, baseline: float) -> np.ndarray:
     """``Z = fx·B / d`` (metres) where ``d > 0``, else 0.
 
-    >>> disparity_to_depth(np.array([[0.0, 12.0]], np.float32), 240.0, 0.12).tolist()
-    [[0.0, 2.4000000953674316]]
+    >>> [round(float(z), 4) for z in disparity_to_depth(np.array([0.0, 12.0], np.float32), 240.0, 0.12)]
+    [0.0, 2.4]
     """
     d = np.asarray(disparity, dtype=np.float32)
     out = np.zeros_like(d)

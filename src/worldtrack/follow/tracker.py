@@ -19,10 +19,11 @@ Per frame (:meth:`FollowTracker.step`):
 >>> from worldtrack.follow import FollowTracker, frame_from_synth
 >>> sc = make_scenario("follow-target", size=(160, 120), frames=12, seed=1, others=0)
 >>> tracker = FollowTracker(scene=sc.scene)
->>> steps = [tracker.follow(frame_from_synth(b), b.views["robot"].camera,
-...                         start_xy=(b.gt[0]["x"], b.gt[0]["y"]) if b.frame == 0 else None) for b in sc.frames()]
->>> sum(s.found for s in steps), bool(np.hypot(*(steps[-1].xy - (b.gt[0]["x"], b.gt[0]["y"]))) < 0.15)
-(12, True)
+>>> for b in sc.frames():
+...     truth = (b.gt[0]["x"], b.gt[0]["y"])
+...     step = tracker.follow(frame_from_synth(b), b.views["robot"].camera, start_xy=truth if b.frame == 0 else None)
+>>> bool(step.found), bool(np.hypot(*(step.xy - truth)) < 0.15)
+(True, True)
 """
 
 from __future__ import annotations
@@ -49,7 +50,9 @@ from worldtrack.scene.model import Scene
 OTHERS_MIN_ALPHA = 0.5
 #: A person within this distance (m) of the target makes its silhouette unsafe to learn from.
 CLEAR_RADIUS = 1.0
-#: A nearer person covering this share of the target's expected image box may be hiding it.
+#: A person this much nearer the camera (m) covering this share of the target's expected image box
+#: may be hiding it.
+HIDE_MARGIN = 0.25
 HIDE_SHARE = 0.3
 #: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
 COAST_S = 1.5
@@ -223,9 +226,10 @@ class FollowTracker:
         D = dissimilarity(rb, E, alpha, cfg.alpha_th)
         self._alpha = alpha
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
-        allowed = E / cfg.k <= gate
+        hiding = self._hiding(obs)
+        allowed = (E / cfg.k <= gate) & ~hiding
         if cfg.track_others:
-            chosen, owner = self._assign_all(obs, D, allowed, alpha, t, dt)
+            chosen, owner = self._assign_all(obs, D, allowed, hiding, t, dt)
         else:
             chosen = decide(D, cfg.threshold, allowed)
             owner = np.zeros(len(c), dtype=np.int64)
@@ -239,7 +243,7 @@ class FollowTracker:
         return self._result(t, obs, chosen, D, rb, E, alpha, w, owner, gate)
 
     # ------------------------------------------------------------------ internals
-    def _assign_all(self, obs: Observation, D: np.ndarray, allowed: np.ndarray, alpha: float, t: float,
+    def _assign_all(self, obs: Observation, D: np.ndarray, allowed: np.ndarray, hiding: np.ndarray, t: float,
                     dt: float) -> tuple[int, np.ndarray]:
         """One assignment of all candidates to the target (row 0) and the others; new tracks for the rest."""
         cfg = self.config
@@ -249,7 +253,7 @@ class FollowTracker:
         if len(others):
             E_o = position_error(c.xy, others.x[:, :2], cfg.k)
             rb_o = bhattacharyya(obs.hists, others.hist)
-            alpha_o = max(alpha, OTHERS_MIN_ALPHA)
+            alpha_o = max(self._alpha, OTHERS_MIN_ALPHA)
             D_o = dissimilarity(rb_o, E_o, alpha_o, cfg.alpha_th)
             gate_o = others.gate(t, cfg.gate, cfg.gate_growth, cfg.max_gate)
             D_o = np.where(E_o / cfg.k <= gate_o[None], D_o, np.inf)
@@ -266,12 +270,12 @@ class FollowTracker:
             owner[cand] = others.ids[matched]
         others.expire(t)
         if chosen < 0:
-            chosen = self._reidentify(obs, owner, D, t)
+            chosen = self._reidentify(obs, owner, D, hiding, t)
         free = np.flatnonzero(owner == 0)
         owner[free] = others.add(c.xy[free], obs.hists[free], t)
         return chosen, owner
 
-    def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, t: float) -> int:
+    def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, hiding: np.ndarray, t: float) -> int:
         """Re-identify the lost target among the people who appeared since it was last seen.
 
         Somebody seen at the same time as the target cannot be the target, so only candidates
@@ -286,8 +290,7 @@ class FollowTracker:
         cfg = self.config
         others = self.others
         young_ids = others.ids[others.born > self.last_seen]
-        eligible = (owner == 0) | np.isin(owner, young_ids)
-        eligible &= ~self._hiding(obs)
+        eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
         eligible = np.flatnonzero(eligible)
         if len(eligible) == 0:
             return -1
@@ -308,15 +311,16 @@ class FollowTracker:
         return pick
 
     def _hiding(self, obs: Observation) -> np.ndarray:
-        """(N,) candidates that may be hiding the target: nearer the camera than its prediction and
-        covering at least ``HIDE_SHARE`` of the image box where it should stand. Such a person
-        appears just as the target vanishes, where it vanishes; they are not re-identified as it."""
+        """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
+        than its prediction and covering at least ``HIDE_SHARE`` of the image box where it should
+        stand. Such a person appears just as the target vanishes, where it vanishes; they are not
+        taken for it (``occluders``; the paper has no such rule)."""
         n = len(obs.candidates)
-        if obs.camera is None or n == 0:
+        if not self.config.occluders or obs.camera is None or n == 0:
             return np.zeros(n, dtype=bool)
         cover = covering(obs.silhouettes, n, person_box(obs.camera, self.x[:2]))
         centre = obs.camera.centre[:2]
-        nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre))
+        nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
         return nearer & (cover >= HIDE_SHARE)
 
     def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, alpha: float, dt: float) -> None:

@@ -32,11 +32,11 @@ from worldtrack.io.text import read_text
 
 
 def _table(path: str | Path, what: str) -> tuple[list[str], list[dict]]:
-    text = read_text(path, what)
-    rows = list(csv.DictReader(io.StringIO(text)))
+    reader = csv.DictReader(io.StringIO(read_text(path, what)))
+    rows = list(reader)
     if not rows:
         raise InputError(f"{path}: no rows (expected {what})")
-    return list(rows[0].keys()), rows
+    return [c for c in reader.fieldnames or [] if c is not None], rows
 
 
 def _number(row: dict, key: str, path, line: int) -> float:
