@@ -43,8 +43,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, render_images, save_result  # noqa: E402
 
 from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, synthetic_tracker  # noqa: E402
-from worldtrack.io.sources import Frame  # noqa: E402
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.trackers.base import Frame  # noqa: E402
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 

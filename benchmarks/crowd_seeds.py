@@ -19,7 +19,7 @@ Usage::
     .venv/bin/python benchmarks/crowd_seeds.py                    # seeds 0-79, ~10 min
     .venv/bin/python benchmarks/crowd_seeds.py --seeds 0-9        # ~1.5 min
     .venv/bin/python benchmarks/crowd_seeds.py --quick            # smoke run: 2 seeds, 40 frames
-    .venv/bin/python benchmarks/crowd_seeds.py --seeds 0 1 --set rescue_gain=0.1 --quick
+    .venv/bin/python benchmarks/crowd_seeds.py --seeds 0 1 --set rescue.gain=0.1 --quick
     .venv/bin/python benchmarks/crowd_seeds.py --texture-ncc 0     # the foreground's texture test on
 
 Writes ``benchmarks/results/crowd_seeds.md`` (not with ``--quick``, ``--set`` or ``--texture-ncc``).
@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--frames", type=int, default=None, help=f"default {FRAMES} (40 with --quick)")
     p.add_argument("--people", type=int, default=PEOPLE)
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="an EllipsoidConfig option (e.g. rescue_gain=0.1); results are then only printed")
+                   help="an ellipsoid setting by dotted path (e.g. rescue.gain=0.1); results are then only printed")
     p.add_argument("--texture-ncc", type=float, default=None,
                    help="the foreground's texture test of shadow-like pixels (off by default); results are then only printed")
     p.add_argument("--quick", action="store_true",

@@ -33,7 +33,7 @@ from worldtrack.follow.colour import histograms, normalise_colour  # noqa: E402
 from worldtrack.follow.planview import detect  # noqa: E402
 from worldtrack.follow.silhouette import silhouettes  # noqa: E402
 from worldtrack.follow.stereo import StereoMatcher, disparity_to_depth  # noqa: E402
-from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 
 BASELINE = 0.12

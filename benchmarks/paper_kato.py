@@ -147,7 +147,7 @@ def track_static(seq: Sequence, preset: str, foreground: str) -> Run:
     seconds, n = 0.0, 0
     for frames in dwell_segments(seq.gt):
         first = by_frame[int(frames[0])]
-        tracker = _tracker(seq, preset, foreground, births="none")
+        tracker = _tracker(seq, preset, foreground, overrides={"births.where": "none"})
         for r in first.gt:
             tracker.init_track(r["x"], r["y"], track_id=int(r["id"]), t=first.time)
         seconds += _step_all(tracker, [by_frame[int(f)] for f in frames], rows)

@@ -23,20 +23,21 @@ For each tracker configuration and scenario seed this prints, from ``worldtrack.
 * box contains centre: the share of matched frames whose box ``(x, y, z) ± (sx, sy, sz)`` holds the
   true body centre ``(x, y, height / 2)``.
 
-Every scenario seed runs with each tracker seed (``ParticleConfig.seed``, default 0 and 1): the
+Every scenario seed runs with each tracker seed (``particle.seed``, default 0 and 1): the
 tracker's random draws alone move these figures by about as much as many a change does, so the
 table gives each figure's mean over all runs ± its spread over tracker seeds.
 
 Configurations: ``paper-column`` and ``paper-point`` (the method as published:
-``ParticleConfig.paper`` with ``likelihood="column"`` / ``"point"``) and ``default-column`` /
-``default-point`` (with worldtrack's extensions).
+``ParticleConfig.paper()`` with ``likelihood.model`` ``column-count`` / ``point``) and ``default-column``
+/ ``default-point`` (with worldtrack's extensions: ``column-ratio``, and ``point`` with
+``weights.power=1``).
 
 Usage::
 
     .venv/bin/python benchmarks/particle_entry.py                  # 3 seeds × 2 tracker seeds, 320x240, all configs
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 1 2 3 4 5 --tracker-seeds 0 1 2 --configs default-column --jobs 2
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 --configs default-column
-    .venv/bin/python benchmarks/particle_entry.py --set gamma=30 --set alpha=0.4
+    .venv/bin/python benchmarks/particle_entry.py --set likelihood.gamma=30 --set detection.alpha=0.4
     .venv/bin/python benchmarks/particle_entry.py --scenario limb_swing=0 --configs default-column --no-single
         # walkers glide (no leg or arm swing): the error the gait causes is the difference
 
@@ -56,6 +57,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, render_images, write_result  # noqa: E402
 
+from worldtrack.config import parse_assignment, with_overrides  # noqa: E402
 from worldtrack.eval import evaluate_detailed  # noqa: E402
 from worldtrack.experiment import gt_table  # noqa: E402
 from worldtrack.foreground.background import StaticBackground  # noqa: E402
@@ -63,11 +65,17 @@ from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
 
+
+def _config(base: ParticleConfig, settings: dict) -> ParticleConfig:
+    """``base`` with ``settings`` by dotted path (a wrong name or value is an InputError naming it)."""
+    return with_overrides(base, settings, root="particle")
+
+
 CONFIGS = {
-    "paper-column": lambda **o: ParticleConfig.paper(likelihood="column", **o),
-    "paper-point": lambda **o: ParticleConfig.paper(likelihood="point", **o),
-    "default-column": lambda **o: ParticleConfig(likelihood="column", **o),
-    "default-point": lambda **o: ParticleConfig(likelihood="point", **{"likelihood_power": 1.0, **o}),
+    "paper-column": lambda o: _config(ParticleConfig.paper(), {"likelihood.model": "column-count", **o}),
+    "paper-point": lambda o: _config(ParticleConfig.paper(), {"likelihood.model": "point", **o}),
+    "default-column": lambda o: _config(ParticleConfig(), {"likelihood.model": "column-ratio", **o}),
+    "default-point": lambda o: _config(ParticleConfig(), {"likelihood.model": "point", "weights.power": 1.0, **o}),
 }
 GATE_M = 0.5
 VIS_EVAL = 0.3      # ground truth rows count from this visible share on
@@ -290,11 +298,9 @@ def given_starts(seq: Sequence, config: ParticleConfig) -> dict:
     of the person's own track (no association needed), the share of frames within 0.25 m (an
     ended track counts as a miss) and the share of frames the track is alive.
     """
-    from dataclasses import replace
-
     sc = seq.scenario
-    tracker = ParticleTracker(sc.scene, {"cam": StaticBackground(seq.background, 30.0, "colour")},
-                              replace(config, births="none", split=False, merge=False))
+    alone = _config(config, {"detection.births": "none", "split.enabled": False, "merge.enabled": False})
+    tracker = ParticleTracker(sc.scene, {"cam": StaticBackground(seq.background, 30.0, "colour")}, alone)
     started: set[int] = set()
     errors, near, alive = [], [], []
     for k, (img, gt) in enumerate(zip(seq.images, seq.gt)):
@@ -369,7 +375,7 @@ def _pm(mean: float, spread: float, show_spread: bool) -> str:
 def _task(job: tuple) -> tuple:
     """One run: (config name, scenario seed, tracker seed) → (score, given-starts figures, s/frame)."""
     name, seq, options, tracker_seed, single = job
-    cfg = CONFIGS[name](**{**options, "seed": tracker_seed})
+    cfg = CONFIGS[name]({**options, "seed": tracker_seed})
     pred, spf = run(seq, cfg)
     return score(seq, pred), (given_starts(seq, cfg) if single else None), spf
 
@@ -378,11 +384,11 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2], help="scenario seeds")
     p.add_argument("--tracker-seeds", type=int, nargs="+", default=[0, 1],
-                   help="tracker random seeds (ParticleConfig.seed); every scenario seed runs with each")
+                   help="tracker random seeds (particle.seed); every scenario seed runs with each")
     p.add_argument("--size", default="320x240")
     p.add_argument("--configs", nargs="+", default=list(CONFIGS), choices=list(CONFIGS))
-    p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
-                   help="override a ParticleConfig field in every configuration")
+    p.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
+                   help="set a field of every configuration by its dotted path (e.g. likelihood.gamma=30)")
     p.add_argument("--scenario", action="append", default=[], metavar="NAME=VALUE",
                    help="override a scenario option (e.g. shadow_strength=0)")
     p.add_argument("--no-single", action="store_true", help="skip the runs with filters started on the truth")
@@ -392,7 +398,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--no-write", action="store_true")
     args = p.parse_args(argv)
     w, h = (int(v) for v in args.size.lower().split("x"))
-    options = {k: eval(v, {}) for k, v in (s.split("=", 1) for s in args.set)}
+    options = dict(parse_assignment(s) for s in args.set)
+    for name in args.configs:
+        CONFIGS[name](options)                  # a wrong name or value: one line, before any rendering
     scen = {k: eval(v, {}) for k, v in (s.split("=", 1) for s in args.scenario)}
 
     seqs = []

@@ -12,15 +12,15 @@ Measured, with the median over frames after a warm-up:
 * ms per frame for K = 1, 2, 5, 10, 20 objects, and the per-object cost
   ``(time(K) − time(0)) / K``, as a ratio to one ``cv2.createBackgroundSubtractorMOG2().apply`` on a
   640×480 frame measured in the same run (target ≤ 0.2);
-* the likelihood alone for one tracking filter of 500 particles (``ParticleTracker.likelihood``;
-  ``step`` makes one such call for all its tracking filters together, of which this is the case of
-  one filter) for each configuration, and the bare line-column kernel against its NumPy reference.
+* the likelihood alone for one tracking filter of 500 particles (``ParticleTracker.likelihood``, the
+  configured component; ``step`` makes one such call for all its tracking filters together, of which
+  this is the case of one filter) for each configuration, and the bare line-column kernel against its NumPy reference.
 
 Configurations: ``paper`` (500 particles, a line column of 20 heights, weights ∝ count, shadows
 count as object) and ``default`` (500 particles, a 3-line column of 20 heights with 4 samples below
-the floor and 3 above the top — ``foot_samples``, ``head_samples`` — ratio weights with the height
-prior, shadows removed, explaining away, split and merge checks, the colour model of
-``particle_appearance``) and ``no-appearance`` (the default without the colour model, to show what it
+the floor and 3 above the top — ``column.foot_samples``, ``column.head_samples`` — the column ratio
+with the height prior, shadows removed, explaining away, split and merge checks, the colour model of
+``trackers/particle/appearance.py``) and ``no-appearance`` (the default without the colour model, to show what it
 costs).
 
 Usage: ``.venv/bin/python benchmarks/particle_speed.py`` — writes ``benchmarks/results/particle_speed.md``.
@@ -42,10 +42,13 @@ from common import markdown_table, median_time, mog2_apply_time, write_result  #
 from worldtrack.foreground.background import StaticBackground  # noqa: E402
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
+from worldtrack.config import with_overrides  # noqa: E402
+from worldtrack.foreground.shadows import floor_pixels, hit_image, hit_labels, hit_labels_reference  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box  # noqa: E402
-from worldtrack.trackers.particle_likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
-                                                     floor_pixels, hit_image, hit_labels, hit_labels_reference,
-                                                     owner_image, top_edge_offsets)
+from worldtrack.trackers.particle.likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
+                                                     column_heights, column_spec, edge_spec, owner_image,
+                                                     top_edge_offsets)
+from worldtrack.trackers.particle.likelihood.models import FrameView, Readers  # noqa: E402
 
 W, H = 640, 480
 SCENE = {"name": "speed", "cameras": [{"id": "cam", "image_size": [W, H], "position": [0, -2, 3.5],
@@ -84,8 +87,8 @@ def step_time(config: ParticleConfig, k: int, scene, bg, frames) -> float:
         t0 = time.perf_counter()
         tracker.step({"cam": img}, (f + 1) / 10.0)
         times.append(time.perf_counter() - t0)
-    if len(tracker.filters) != k:
-        print(f"warning: {len(tracker.filters)} of {k} tracks left", file=sys.stderr)
+    if len(tracker.clouds) != k:
+        print(f"warning: {len(tracker.clouds)} of {k} tracks left", file=sys.stderr)
     return statistics.median(times[3:])
 
 
@@ -95,9 +98,10 @@ def main() -> int:
     cam = scene.cameras["cam"]
     rng = np.random.default_rng(0)
     bg = np.clip(cv2.GaussianBlur(rng.uniform(60, 200, (H, W, 3)).astype(np.float32), (0, 0), 3), 0, 255).astype(np.uint8)
-    configs = {"paper": ParticleConfig.paper(births="none", end_after_s=1e9),
-               "default": ParticleConfig(births="none", end_after_s=1e9),
-               "no-appearance": ParticleConfig(births="none", end_after_s=1e9, appearance_weight=0.0)}
+    held = {"detection.births": "none", "tracking.end_after_s": 1e9}     # K stays K
+    configs = {"paper": with_overrides(ParticleConfig.paper(), held),
+               "default": with_overrides(ParticleConfig(), held),
+               "no-appearance": with_overrides(ParticleConfig(), {**held, "appearance.weight": 0.0})}
     mog2 = mog2_apply_time(W, H)
     print(f"MOG2 apply {W}x{H}: {1000 * mog2:.2f} ms", file=sys.stderr)
 
@@ -105,7 +109,7 @@ def main() -> int:
     img = render(cam, bg, people_at(10, 0), rng)
     fg = StaticBackground(bg, 30.0, "colour")
     floor = floor_pixels(cam, scene.walkable.raster(0.01))
-    gamma = configs["default"].gamma
+    gamma = configs["default"].likelihood.gamma
     prep = {"F = colour distance, F > γ (paper)": median_time(lambda: hit_image(fg.difference(img), gamma)),
             "shadow-free F > γ (Numba, default)": median_time(lambda: hit_labels(img, bg, gamma, where=floor,
                                                                                  shadow=0)),
@@ -132,7 +136,7 @@ def main() -> int:
                   f"= {po / mog2:.3f} MOG2", file=sys.stderr)
 
     # The likelihood alone: one tracking filter of 500 particles about one person, read as step()
-    # reads its tracking filters with ParticleTracker.likelihood (the image it reads, the filter's
+    # reads its tracking filters with the tracker's likelihood (the image it reads, the filter's
     # own box among the track boxes when explaining away, the particles' heights).
     person = people_at(1, 0)
     img = render(cam, bg, person, rng)
@@ -142,33 +146,35 @@ def main() -> int:
     kernel_rows = []
     for name, cfg in configs.items():
         tracker = ParticleTracker(scene, {"cam": fg}, cfg)
-        if cfg.shadows == "object":
-            seen = hit_image(fg.difference(img), cfg.gamma)
+        lk = cfg.likelihood
+        if lk.shadows == "object":
+            seen = hit_image(fg.difference(img), lk.gamma)
         else:
-            seen = hit_labels(img, bg, cfg.gamma, where=floor, shadow=2 if cfg.shadows == "unknown" else 0)
-        owners = boxes = None
-        if cfg.explain == "all":
+            seen = hit_labels(img, bg, lk.gamma, where=floor, shadow=2 if lk.shadows == "unknown" else 0)
+        view = FrameView({"cam": seen})
+        if cfg.explain.filters == "all":
             box = image_box(cam, person[0, 0], person[0, 1], scene.people.width, scene.people.height,
-                            cfg.box_margin)
-            owners, boxes = {"cam": owner_image(seen.shape, [box])}, {"cam": box}
-        tk = median_time(lambda: tracker.likelihood(xyz, {"cam": seen}, owners, boxes, h, top_edge=True),
-                         repeats=200)
-        kernel_rows.append([f"ParticleTracker.likelihood, {name} config", 1000 * tk, tk / mog2])
-        if cfg.top_edge > 0 and cfg.top_sigma > 0:
-            offsets = top_edge_offsets(cfg.top_edge_step, cfg.top_edge_samples)
+                            cfg.explain.box_margin_m)
+            view = FrameView({"cam": seen}, {"cam": owner_image(seen.shape, [box])}, {"cam": [box]})
+        readers = Readers.one(len(xyz))
+        tk = median_time(lambda: tracker.likelihood(xyz, h, view, readers, top_edge=True), repeats=200)
+        kernel_rows.append([f"likelihood ({lk.model}), {name} config", 1000 * tk, tk / mog2])
+        he = cfg.height
+        if he.edge_weight > 0 and he.prior_sigma_m > 0:
+            edge = edge_spec(top_edge_offsets(he.edge_step_m, he.edge_samples), he.edge_weight,
+                             tracker.likelihood.on, tracker.likelihood.off)
             out, cl_edge = np.zeros(len(xyz)), CameraLikelihood(cam)
-            # The route step takes: the labels as they are, unless top_edge_explain reads the boxes.
-            args = (cl_edge.column_args(seen, len(xyz), cfg.heights, owner=owners["cam"] if owners else None,
-                                        box=boxes["cam"] if boxes else None)
-                    if cfg.top_edge_explain else cl_edge.column_args(seen, len(xyz), cfg.heights))
-            te = median_time(lambda: cl_edge.top_edge(args, xyz, h, offsets, cfg.top_edge, out), repeats=200)
-            kernel_rows.append([f"of which the top edge ({len(offsets)} samples), {name} config", 1000 * te, te / mog2])
+            # The route step takes with edge_explain off (every config here): the labels as they are.
+            reading = cl_edge.reading(seen, len(xyz))
+            te = median_time(lambda: cl_edge.top_edge(reading, xyz, h, edge, out), repeats=200)
+            kernel_rows.append([f"of which the top edge ({len(edge.offsets)} samples), {name} config", 1000 * te,
+                                te / mog2])
     # The bare kernel: a line column of the paper's 20 heights, against the NumPy reference.
     cl = CameraLikelihood(cam)
     hit = hit_image(fg.difference(img), gamma)
-    heights = configs["paper"].heights
-    k_line = median_time(lambda: cl.column(hit, xy, heights), repeats=200)
-    k_ref = median_time(lambda: column_counts_reference(cam, hit, xy, heights), repeats=20)
+    line = column_spec(column_heights(configs["paper"].column.max_height_m, configs["paper"].column.dz_m))
+    k_line = median_time(lambda: cl.column(hit, xy, line), repeats=200)
+    k_ref = median_time(lambda: column_counts_reference(cam, hit, xy, line), repeats=20)
     kernel_rows += [["column kernel alone (Numba), line column of 20 heights", 1000 * k_line, k_line / mog2],
                     ["NumPy reference, line column of 20 heights", 1000 * k_ref, k_ref / mog2]]
 
@@ -179,8 +185,8 @@ def main() -> int:
     text = (f"One MOG2 apply on {W}x{H}: {1000 * mog2:.2f} ms (the reference). {summary}.\n\n"
             f"Per frame, independent of the objects:\n\n{t1}\n\nTracking (median over {FRAMES - 3} frames; "
             f"per object = (ms/frame(K) − ms/frame(0)) / K):\n\n{t2}\n\nThe likelihood alone (one filter's "
-            f"500 particles, as step reads them; default: 20 heights + {configs['default'].foot_samples} below + "
-            f"{configs['default'].head_samples} above, 3 lines, and the top edge of tracking filters):\n\n{t3}\n")
+            f"500 particles, as step reads them; default: 20 heights + {configs['default'].column.foot_samples} below + "
+            f"{configs['default'].column.head_samples} above, 3 lines, and the top edge of tracking filters):\n\n{t3}\n")
     print(text)
     path = write_result("particle_speed", "Particle tracker (seed 004): speed",
                         "Command: `.venv/bin/python benchmarks/particle_speed.py`\n\n" + text)

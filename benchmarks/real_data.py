@@ -48,11 +48,11 @@ from common import DATA, ROOT, markdown_table, save_result  # noqa: E402
 from worldtrack.cli.eval import read_area  # noqa: E402
 from worldtrack.eval import evaluate_detailed, position_errors  # noqa: E402
 from worldtrack.experiment import predictions_table, step_tracker  # noqa: E402
-from worldtrack.foreground.background import estimate_background  # noqa: E402
+from worldtrack.foreground.estimate import estimate_background  # noqa: E402
 from worldtrack.io.gt_import import boxes_to_world, read_boxes  # noqa: E402
-from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
-from worldtrack.pipeline import make_foregrounds  # noqa: E402
+from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.scene.load import load_scene  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 

@@ -53,13 +53,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, median_time, mog2_apply_time, save_result  # noqa: E402
 
 from worldtrack.foreground.background import AdaptiveBackground  # noqa: E402
-from worldtrack.io.sources import Frame  # noqa: E402
+from worldtrack.trackers.base import Frame  # noqa: E402
+from worldtrack.errors import InputError  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
-from worldtrack.trackers.ellipsoid_score import ternary_real  # noqa: E402
-from worldtrack.trackers.particle_likelihood import hit_image, hit_labels  # noqa: E402
+from worldtrack.trackers.ellipsoid.real import ternary_real  # noqa: E402
+from worldtrack.foreground.shadows import hit_image, hit_labels  # noqa: E402
 
 SEED = 0
 SIZES = ((160, 120), (640, 480))
@@ -122,9 +123,11 @@ def step_times(method: str, clip: Clip) -> tuple[float, float, object]:
     fgs = make_foregrounds(clip.scene, {clip.camera: clip.background}, FOREGROUND,
                            SYNTHETIC_COLOUR_THRESHOLD if FOREGROUND == "colour" else None)
     tracker = make_tracker(method, clip.scene, fgs)
-    if hasattr(tracker, "init_track"):
+    try:
         for tid, x, y in clip.start:
             tracker.init_track(x, y, track_id=tid)
+    except InputError:
+        pass  # a tracker that starts its tracks by itself (blobs)
     times, counts = [], []
     for k, img in enumerate(clip.frames):
         t = k / clip.fps
@@ -138,13 +141,13 @@ def step_times(method: str, clip: Clip) -> tuple[float, float, object]:
 def foreground_stage(method: str, tracker, clip: Clip):
     """``image -> what the method's likelihood reads``, done as its ``step`` does it (public parts)."""
     if method == "ellipsoid":
-        cs = tracker.cams[clip.camera]
+        cs = tracker.views[clip.camera]
         return lambda img: ternary_real(cs.foreground.labels(img), cs.ring_px)
     if method == "particle":
-        gamma = tracker.config.gamma
-        if tracker.config.shadows != "object":
+        gamma = tracker.config.likelihood.gamma
+        if tracker.config.likelihood.shadows != "object":
             return lambda img: hit_labels(img, clip.background, gamma)
-        fg = tracker.foregrounds[clip.camera]
+        fg = tracker.labels.foregrounds[clip.camera]
         return lambda img: hit_image(fg.difference(img), gamma)
     model = AdaptiveBackground("mog2", background=clip.background)
     return model.labels

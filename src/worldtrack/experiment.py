@@ -20,9 +20,9 @@ import numpy as np
 
 from worldtrack.eval.mot import drop_ignored, evaluate
 from worldtrack.eval.tables import PositionErrors, position_errors
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 from worldtrack.io.tracks import TrackTable
-from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.base import warm_started
 

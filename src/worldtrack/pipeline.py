@@ -17,25 +17,12 @@ from typing import IO, Mapping
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.foreground.background import AdaptiveBackground, StaticBackground, estimate_background
+# Kept for callers of the former home of these (until every import moves to worldtrack.foreground / io).
+from worldtrack.foreground import FOREGROUND_KINDS as FOREGROUNDS  # noqa: F401
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: F401
+from worldtrack.io.sources import background_from_video  # noqa: F401
 from worldtrack.scene.model import Scene
-from worldtrack.trackers.base import warm_started
-
-FOREGROUNDS = ("grey", "colour", "mog2", "knn")
-#: Difference thresholds for the static foregrounds: grey levels, and RGB distance. 30 suits
-#: compressed surveillance video (PETS 2009: MOTA 0.85 at 30, 0.67 at 20); clean cameras and the
-#: synthetic world (noise σ ≈ 3) separate people better at 20 — pass ``threshold`` then.
-DEFAULT_THRESHOLDS = {"grey": 25.0, "colour": 30.0}
-#: The threshold the synthetic world's experiments use (see DEFAULT_THRESHOLDS).
-SYNTHETIC_COLOUR_THRESHOLD = 20.0
-#: The texture test of shadow-like pixels (:mod:`worldtrack.foreground.texture`) is off by default:
-#: it finds dark-clothed people the brightness/chroma test calls shadow on the synthetic wooden
-#: floor (10-person crowd, ``benchmarks/crowd_seeds.py``: mean MOTA 0.881 -> 0.898 over seeds 0-9,
-#: 0.832 -> 0.860 over seeds 10-19 at NCC <= 0), but on PETS 2009 (real, compressed, sunlit) it
-#: cost the ellipsoid tracker 0.04-0.05 MOTA at NCC <= 0, -0.2 and -0.4. Pass
-#: ``shadow_texture_ncc`` to :func:`make_foregrounds` to use it.
-SHADOW_TEXTURE_NCC: float | None = None
-
+from worldtrack.trackers.base import Track, Tracker, warm_started
 
 @dataclass
 class RunResult:
@@ -56,58 +43,7 @@ class RunResult:
         return self.frames / self.seconds if self.seconds > 0 else 0.0
 
 
-def make_foregrounds(scene: Scene, backgrounds: Mapping[str, np.ndarray], kind: str = "colour",
-                     threshold: float | None = None, shadows: bool | None = None,
-                     shadow_texture_ncc: float | None = SHADOW_TEXTURE_NCC) -> dict:
-    """One foreground model per camera from background images.
-
-    Parameters
-    ----------
-    backgrounds : {camera_id: (H, W, 3) uint8}
-    kind : "grey" (the paper), "colour", "mog2" or "knn"
-    threshold : grey levels / RGB distance for the static kinds; default :data:`DEFAULT_THRESHOLDS`
-    shadows : treat cast shadows as background; default: on except for "grey" (the paper's)
-    shadow_texture_ncc : for the static kinds with shadows, tell dark garments from shadows by
-        texture (see :class:`StaticBackground`); default off (:data:`SHADOW_TEXTURE_NCC`)
-    """
-    if kind not in FOREGROUNDS:
-        raise InputError(f"--foreground: expected one of {', '.join(FOREGROUNDS)}, got {kind!r}")
-    out = {}
-    for cid, bg in backgrounds.items():
-        cam = scene.camera(cid)
-        if (bg.shape[1], bg.shape[0]) != (cam.width, cam.height):
-            raise InputError(f"background for {cid}: image is {bg.shape[1]}x{bg.shape[0]} but the camera is "
-                             f"{cam.width}x{cam.height}")
-        shade = (kind != "grey") if shadows is None else shadows
-        if kind in ("grey", "colour"):
-            out[cid] = StaticBackground(bg, threshold if threshold is not None else DEFAULT_THRESHOLDS[kind], kind,
-                                        shadows=shade, shadow_texture_ncc=shadow_texture_ncc)
-        else:
-            out[cid] = AdaptiveBackground(kind, background=bg, shadows=shade)
-    return out
-
-
-def background_from_video(path: str | Path, samples: int = 50) -> np.ndarray:
-    """Temporal median of ``samples`` frames spread over a video (people must keep moving)."""
-    import cv2
-    cap = cv2.VideoCapture(str(path))
-    if not cap.isOpened():
-        raise InputError(f"{path}: cannot open as a video")
-    n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
-    frames = []
-    if n > 0:
-        for idx in np.linspace(0, n - 1, min(samples, n)).astype(int):
-            cap.set(cv2.CAP_PROP_POS_FRAMES, int(idx))
-            ok, img = cap.read()
-            if ok:
-                frames.append(img)
-    cap.release()
-    if not frames:
-        raise InputError(f"{path}: no frames could be read to estimate a background")
-    return estimate_background(frames)
-
-
-def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video: bool = True,
+def run_tracking(scene: Scene, source, tracker: Tracker, out_dir: str | Path, write_video: bool = True,
                  json_stream: IO[str] | None = None, progress: bool = True, show_ring: bool = False,
                  gt_paths: Mapping[int, np.ndarray] | None = None) -> RunResult:
     """Run ``tracker`` over ``source`` and write the outputs into ``out_dir``.
@@ -115,8 +51,8 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
     Parameters
     ----------
     source : iterable of ``(index, t, {camera_id: Frame})`` (e.g. :class:`VideoSource`)
-    tracker : object with ``step(frames, t) -> list[Track]`` (and a warm start on the first frames,
-        if it has one: :func:`worldtrack.trackers.base.warm_started`)
+    tracker : Tracker — stepped over the frames after its warm start
+        (:func:`worldtrack.trackers.base.warm_started`)
     json_stream : write one JSON object per frame (``{"frame", "time", "tracks": [...]}``) here
     gt_paths : ground-truth paths to draw dashed on the floor plan
 
@@ -135,8 +71,7 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
     out.mkdir(parents=True, exist_ok=True)
     result = RunResult(out)
     result.tracks_csv = out / "tracks.csv"
-    extra = getattr(tracker, "extra_columns", ("sigma",))
-    writer = TracksWriter(result.tracks_csv, extra_columns=extra)
+    writer = TracksWriter(result.tracks_csv, extra_columns=tracker.extra_columns)
     videos: dict[str, VideoWriter] = {}
     paths: dict[int, list[tuple[float, float]]] = {}
     fps = getattr(source, "fps", 10.0)
@@ -157,15 +92,13 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
                 json_stream.write(json.dumps({"frame": index, "time": round(t, 6), "tracks": rows}) + "\n")
                 json_stream.flush()
             if write_video:
-                masks = getattr(tracker, "last_masks", {})
                 for cid, frame in frames.items():
                     cam = scene.cameras.get(cid)
                     if cam is None:
                         continue
-                    ring = getattr(tracker, "cams", {}).get(cid)
-                    img = draw_tracks(frame.image, cam, tracks,
-                                      ring_px=(ring.ring_px if (show_ring and ring is not None) else None),
-                                      mask=masks.get(cid) if show_ring else None,
+                    shown = tracker.overlay(cid) if show_ring else None
+                    img = draw_tracks(frame.image, cam, tracks, ring_px=shown.ring_px if shown else None,
+                                      mask=shown.mask if shown else None,
                                       label=f"{cid}  frame {index}  t={t:.1f}s  {len(tracks)} people")
                     if cid not in videos:
                         videos[cid] = VideoWriter(out / f"{cid}_annotated.mp4", fps)
@@ -194,9 +127,9 @@ def run_tracking(scene: Scene, source, tracker, out_dir: str | Path, write_video
     return result
 
 
-def _row(tr) -> dict:
+def _row(tr: Track) -> dict:
     row = {"id": tr.id, "x": round(tr.x, 4), "y": round(tr.y, 4), "height": round(tr.height, 3),
            "width": round(tr.width, 3), "score": round(float(tr.score), 4), "mode": tr.mode,
-           "flags": ";".join(sorted(tr.flags)), "sigma": round(float(getattr(tr, "sigma", 0.0)), 3)}
+           "flags": ";".join(sorted(tr.flags)), "sigma": round(float(tr.sigma), 3)}
     row.update({k: (round(float(v), 4) if isinstance(v, float) else v) for k, v in tr.extra.items()})
     return row

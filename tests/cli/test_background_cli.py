@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from worldtrack.cli import main
-from worldtrack.foreground.background import estimate_background
+from worldtrack.foreground.estimate import estimate_background
 
 H, W, N = 72, 96, 50
 STILL = (slice(30, 52), slice(40, 52))           # rows, columns of the person standing still

@@ -7,7 +7,7 @@ from worldtrack.errors import InputError
 from worldtrack.eval.follow import counts, follow_labels, reacquisitions
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth
 from worldtrack.follow.tracker import observation_from_boxes
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 
 
 def follow(sc, bundles, preset="default", **overrides):

@@ -73,3 +73,21 @@ def test_relabel_kernel_equals_the_reference():
         assert (fast != ref).sum() <= 2                                   # float32 vs float64 at the threshold
         assert ((ref == 1) & (labels == 2)).sum() > 20                    # something was relabelled
         np.testing.assert_array_equal(fast[labels != 2], labels[labels != 2])
+
+
+def test_judging_shadows_tells_cloth_shadow_and_unsure_as_the_reference_does():
+    from worldtrack.foreground.texture import judge_shadows, judge_shadows_reference
+    rng = np.random.default_rng(6)
+    bg = wooden_floor(seed=4)
+    img = np.clip(bg * 0.6 + rng.normal(0, 2, bg.shape), 0, 255).astype(np.uint8)   # a shadow: pattern shows
+    img[20:40, 20:60] = rng.integers(0, 255, (20, 40, 3))                          # cloth: pattern gone
+    labels = np.full(bg.shape[:2], 2, np.uint8)
+    labels[:, :5] = 0                                                               # not candidates: untouched
+    ref = judge_shadows_reference(labels, img, bg, 0.2, 0.5)
+    fast = judge_shadows(labels.copy(), img, grey(bg), 0.2, 0.5)
+    assert (fast != ref).sum() <= 2                                                # float32 vs exact sums
+    assert (fast[25:35, 25:55] == 1).mean() > 0.8                                   # cloth
+    assert (fast[50:70, 10:80] == 3).mean() > 0.8                                   # shadow over the pattern
+    np.testing.assert_array_equal(fast[:, :5], 0)
+    never = judge_shadows(labels.copy(), img, grey(bg), 0.2)                       # no shadow threshold
+    assert not (never == 3).any() and ((never == 1) == (fast == 1)).all()

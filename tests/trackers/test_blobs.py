@@ -23,7 +23,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.foreground.background import AdaptiveBackground, StaticBackground
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 from worldtrack.scene import scene_from_dict
 
 from _render import texture  # tests/trackers/_render.py
@@ -114,7 +114,7 @@ def test_box_foot_point_leans_outwards_off_centre():
     scene = make_scene(FRONT)
     cam, bg = scene.cameras["front"], texture(0)
     img = render(cam, bg, [(-2.5, 4.0)], np.random.default_rng(0))
-    box = BlobTracker(scene, {"front": StaticBackground(bg)}, BlobConfig(foot_point="box")).detect("front", img)
+    box = BlobTracker(scene, {"front": StaticBackground(bg)}, BlobConfig(detection={"foot_point": "box"})).detect("front", img)
     bottom = BlobTracker(scene, {"front": StaticBackground(bg)}).detect("front", img)
     assert box[0, 0] < -2.5 - 0.08
     assert abs(bottom[0, 0] + 2.5) < 0.03
@@ -130,7 +130,7 @@ def test_blob_touching_the_bottom_border_gives_no_detection():
     # Without the border rule the near blob (2400 px, bottom edge on the floor at y ≈ 1.2 m)
     # would pass: no area-fraction test, so only the border can drop it.
     assert scene.walkable.contains(cam.backproject([[160.0, H - 0.5]], 0.0)[:, :2])[0]
-    tracker = BlobTracker(scene, {"front": StaticBackground(bg)}, BlobConfig(min_area_fraction=0.0))
+    tracker = BlobTracker(scene, {"front": StaticBackground(bg)}, BlobConfig(detection={"min_area_fraction": 0.0}))
     rng = np.random.default_rng(0)
     assert tracker.detect("front", render(cam, bg, [near], rng)).shape == (0, 2)
     mask = tracker.last_masks["front"]
@@ -144,10 +144,10 @@ def test_small_blobs_and_points_off_the_floor_are_dropped():
     cam, bg = scene.cameras["front"], texture(0)
     img = render(cam, bg, [(0.0, 9.0)], np.random.default_rng(0))  # behind the back wall (y ≤ 8)
     cv2.circle(img, (60, 200), 3, (0, 0, 0), -1)                     # < 30 px of "noise" on the floor
-    tracker = BlobTracker(scene, {"front": StaticBackground(bg)}, BlobConfig(min_area_fraction=0.0))
+    tracker = BlobTracker(scene, {"front": StaticBackground(bg)}, BlobConfig(detection={"min_area_fraction": 0.0}))
     assert tracker.detect("front", img).shape == (0, 2)
     _, _, stats, _ = cv2.connectedComponentsWithStats(tracker.last_masks["front"])
-    assert sorted(stats[1:, 4] >= tracker.config.min_area_px) == [False, True]  # both were foreground
+    assert sorted(stats[1:, 4] >= tracker.config.detection.min_area_px) == [False, True]  # both were foreground
 
 
 def test_merge_points_averages_across_cameras_only():
@@ -177,8 +177,8 @@ def test_two_people_walking_apart(fps):
         assert len(set(who)) == 1, f"track {tid} switched person"
         assert d.mean() < 0.06 and d.max() < 0.12, (tid, d.mean(), d.max())
         # Confirmed from the init_min_points-th frame on and never lost.
-        assert t[0] == pytest.approx((tracker.config.init_min_points - 1) / fps)
-        assert len(t) == len(history) - (tracker.config.init_min_points - 1)
+        assert t[0] == pytest.approx((tracker.config.lifecycle.init_min_points - 1) / fps)
+        assert len(t) == len(history) - (tracker.config.lifecycle.init_min_points - 1)
     assert errs[1][0][2] != errs[2][0][2]
     final = history[-1][2]
     assert all(tr.mode == "tracking" and not tr.flags and tr.score == 1.0 for tr in final)
@@ -219,7 +219,7 @@ def test_track_ends_after_the_configured_time_without_detections(delete_after_s)
         return np.array([[0.0, 3.0]]) + np.array([[0.0, 1.0]]) * t if t < gone_at else np.zeros((0, 2))
 
     tracker = BlobTracker(scene, {"front": StaticBackground(bg["front"])},
-                          BlobConfig(delete_after_s=delete_after_s))
+                          BlobConfig(lifecycle={"delete_after_s": delete_after_s}))
     history = run(tracker, scene, bg, walk, np.arange(0, 3.5, 1 / fps))
     last_update = gone_at - 1 / fps
     for t, _, tracks in history:
@@ -254,7 +254,7 @@ def test_coasting_tracks_can_be_hidden():
     def walk(t):
         return np.array([[0.0, 3.0 + t]]) if t < 1.0 else np.zeros((0, 2))
 
-    tracker = BlobTracker(scene, {"front": StaticBackground(bg["front"])}, BlobConfig(report_coasting=False))
+    tracker = BlobTracker(scene, {"front": StaticBackground(bg["front"])}, BlobConfig(lifecycle={"report_coasting": False}))
     history = run(tracker, scene, bg, walk, np.arange(0, 1.5, 0.1))
     assert [len(tracks) for t, _, tracks in history if t >= 1.0] == [0] * 5
     assert len(tracker.position_map) == 1  # still held, not reported
@@ -291,15 +291,16 @@ def test_uses_a_given_mog2_and_builds_one_otherwise():
 def test_make_tracker_builds_it_by_name_and_checks_options():
     scene = make_scene(FRONT)
     fg = {"front": StaticBackground(texture(0))}
-    tracker = make_tracker("blobs", scene, fg, delete_after_s=2.0, gate=4.0)
-    assert isinstance(tracker, BlobTracker) and tracker.config.delete_after_s == 2.0
-    assert tracker.extra_columns == ("sigma",)
-    with pytest.raises(InputError, match="no_such_option"):
+    tracker = make_tracker("blobs", scene, fg, overrides={"lifecycle.delete_after_s": 2.0, "filter.gate": 4.0})
+    assert isinstance(tracker, BlobTracker) and tracker.config.lifecycle.delete_after_s == 2.0
+    assert tracker.config.filter.gate == 4.0 and tracker.extra_columns == ("sigma",)
+    with pytest.raises(InputError, match=r"^blobs.no_such_option: unknown setting \(expected one of: foreground, "):
         make_tracker("blobs", scene, fg, no_such_option=1)
-    with pytest.raises(InputError, match="delete_after_s: expected a positive number"):
-        make_tracker("blobs", scene, fg, delete_after_s=0)
-    with pytest.raises(InputError, match="foot_point"):
-        BlobConfig(foot_point="centroid")
+    with pytest.raises(InputError, match=r"^blobs.lifecycle.delete_after_s: expected a number > 0, got 0$"):
+        make_tracker("blobs", scene, fg, overrides={"lifecycle.delete_after_s": 0})
+    with pytest.raises(InputError, match=r"^blobs.detection.foot_point: expected one of 'bottom' or 'box', "
+                                         r"got 'centroid'$"):
+        BlobConfig(detection={"foot_point": "centroid"})
 
 
 def test_unknown_camera_and_wrong_frame_size_are_input_errors():

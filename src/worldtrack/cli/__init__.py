@@ -15,7 +15,7 @@ from worldtrack import __version__
 from worldtrack.errors import InputError
 
 # Verb modules, in the order ``worldtrack --help`` lists them.
-_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "eval", "background", "gt", "follow")
+_COMMANDS = ("demo", "scene", "calibrate", "synth", "track", "smooth", "pose", "eval", "background", "gt", "follow")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -39,6 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 2 bad input, 130 interrupted)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.command_line = ["worldtrack", *(sys.argv[1:] if argv is None else argv)]
     if not getattr(args, "func", None):
         parser.print_help()
         return 2

@@ -140,7 +140,7 @@ def _progress(iterable, enabled: bool, total: int):
 def run(args: argparse.Namespace) -> int:
     import cv2
 
-    from worldtrack.foreground.background import BACKGROUND_METHODS, estimate_background
+    from worldtrack.foreground.estimate import BACKGROUND_METHODS, estimate_background
 
     samples = _positive_int(args.samples, "--samples")
     if args.method not in BACKGROUND_METHODS:

@@ -33,7 +33,8 @@ def run(args: argparse.Namespace) -> int:
     from worldtrack.experiment import visibility
     from worldtrack.io.sources import VideoSource, read_image
     from worldtrack.io.tracks import read_tracks
-    from worldtrack.pipeline import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds, run_tracking
+    from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
+    from worldtrack.pipeline import run_tracking
     from worldtrack.scene import load_scene
     from worldtrack.synth import make_scenario, write_sequence
     from worldtrack.trackers import make_tracker

@@ -1,4 +1,10 @@
-"""``worldtrack track SCENE --video CAM=PATH …``: track people and write tracks, videos and a plan."""
+"""``worldtrack track SCENE --video CAM=PATH …``: track people and write tracks, videos and a plan.
+
+The tracker's settings come from its defaults (or ``--preset paper``), a file (``--config``), the
+named flags and ``--set PATH=VALUE``, in that order (:mod:`worldtrack.runconfig`);
+``--print-config`` prints them all and stops. Every run writes ``run.yaml`` into its output folder
+first: the version, the commit if known, the command line, the inputs and the resolved settings.
+"""
 
 from __future__ import annotations
 
@@ -7,10 +13,6 @@ import sys
 from pathlib import Path
 
 from worldtrack.errors import InputError
-from worldtrack.io.sources import VideoSource, read_image
-from worldtrack.pipeline import FOREGROUNDS, background_from_video, make_foregrounds, run_tracking
-from worldtrack.scene import load_scene
-from worldtrack.trackers import METHODS, make_tracker
 
 
 def _pair(text: str, what: str) -> tuple[str, str]:
@@ -34,25 +36,34 @@ def _init(text: str) -> tuple[int, float, float]:
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "track", help="track people in videos of a calibrated scene",
-        description="Track people in world coordinates. Writes DIR/tracks.csv (one row per person per "
-                    "frame, flushed as it goes), DIR/<camera>_annotated.mp4 and DIR/floorplan.png.")
-    p.add_argument("scene", help="scene YAML file")
+        description="Track people in world coordinates. Writes DIR/run.yaml (settings and inputs), "
+                    "DIR/tracks.csv (one row per person per frame, flushed as it goes), "
+                    "DIR/<camera>_annotated.mp4 and DIR/floorplan.png.")
+    p.add_argument("scene", nargs="?", help="scene YAML file (required unless --print-config)")
     p.add_argument("--video", action="append", default=[], metavar="CAM=PATH",
                    help="video file or folder of images for camera CAM (repeat for several cameras)")
     p.add_argument("--background", action="append", default=[], metavar="CAM=PNG",
                    help="empty-scene image for CAM; default: <video folder>/<CAM>_background.png if "
                         "present, else the temporal median of frames sampled over the video")
     p.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
-    p.add_argument("--method", choices=METHODS, default="ellipsoid", help="tracker (default: ellipsoid)")
-    p.add_argument("--preset", choices=("default", "paper"), default="default",
+    p.add_argument("--method", choices=("ellipsoid", "particle", "blobs"), default=None,
+                   help="tracker (default: ellipsoid, or the --config file's)")
+    p.add_argument("--preset", choices=("default", "paper"), default=None,
                    help="'paper': the method exactly as published; 'default': with worldtrack's extensions")
-    p.add_argument("--foreground", choices=FOREGROUNDS, default="colour",
+    p.add_argument("--config", metavar="YAML", default=None,
+                   help="settings file (as --print-config writes it; any subset of it)")
+    p.add_argument("--set", action="append", default=[], metavar="PATH=VALUE", dest="sets",
+                   help="one setting by its path, e.g. particle.motion.noise_m=0.05 or foreground.threshold=20 "
+                        "(repeatable; applied last)")
+    p.add_argument("--print-config", action="store_true",
+                   help="print every setting (with a comment on each) as YAML and stop")
+    p.add_argument("--foreground", choices=("grey", "colour", "mog2", "knn"), default=None,
                    help="foreground model: colour (default; with cast shadows set aside) or grey difference "
                         "against the background with a fixed threshold (the paper's), or OpenCV's adaptive "
                         "mog2/knn with shadow detection")
     p.add_argument("--threshold", type=float, default=None,
-                   help="difference threshold (grey levels, or RGB distance for colour); default 25 / 30 "
-                        "(30 suits compressed video; try 20 for a clean camera)")
+                   help="difference threshold (grey levels, or RGB distance for colour) for every method; "
+                        "default 25 / 30 (30 suits compressed video; try 20 for a clean camera)")
     p.add_argument("--init", action="append", default=[], metavar="ID,X,Y",
                    help="start a person at (X, Y) metres with this id (repeatable)")
     p.add_argument("--births", choices=("anywhere", "entry", "none"), default=None,
@@ -66,7 +77,37 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def settings(args: argparse.Namespace):
+    """The run's resolved configuration from the file, the flags and ``--set``."""
+    from worldtrack.config import load_yaml, parse_assignment
+    from worldtrack.runconfig import resolve_run_config
+
+    data = load_yaml(args.config) if args.config else None
+    sets = [parse_assignment(text) for text in args.sets]
+    flags = {"foreground": args.foreground, "threshold": args.threshold, "births": args.births}
+    try:
+        cfg = resolve_run_config(data, method=args.method, preset=args.preset, flags=flags)
+    except InputError as e:
+        raise InputError(f"{args.config}: {e}" if args.config else str(e)) from None
+    return resolve_run_config(data, method=args.method, preset=args.preset, flags=flags, sets=sets) if sets else cfg
+
+
 def run(args: argparse.Namespace) -> int:
+    from worldtrack.runconfig import dump_run_config
+
+    cfg = settings(args)
+    if args.print_config:
+        sys.stdout.write(dump_run_config(cfg))
+        return 0
+    if not args.scene:
+        raise InputError("track: give a scene file (worldtrack track SCENE --video CAM=PATH …)")
+    from worldtrack.foreground import foregrounds_from_config
+    from worldtrack.io.runinfo import write_run_info
+    from worldtrack.io.sources import VideoSource, background_from_video, read_image
+    from worldtrack.pipeline import run_tracking
+    from worldtrack.scene import load_scene
+    from worldtrack.trackers import make_tracker
+
     scene = load_scene(args.scene)
     videos = dict(_pair(v, "--video") for v in args.video)
     if not videos:
@@ -76,31 +117,33 @@ def run(args: argparse.Namespace) -> int:
         if not Path(vpath).exists():
             raise InputError(f"{cid}: {vpath}: no such file or folder")
     explicit = dict(_pair(b, "--background") for b in args.background)
-    backgrounds = {}
+    backgrounds, background_files = {}, {}
     for cid, vpath in videos.items():
         cam = scene.camera(cid)
         if cid in explicit:
             backgrounds[cid] = read_image(explicit[cid], cam, "background")
+            background_files[cid] = explicit[cid]
             continue
         guess = Path(vpath).parent / f"{cid}_background.png"
         if guess.is_file():
             backgrounds[cid] = read_image(guess, cam, "background")
+            background_files[cid] = str(guess)
             print(f"{cid}: background {guess}", file=sys.stderr)
         elif Path(vpath).is_file():
             backgrounds[cid] = background_from_video(vpath)
+            background_files[cid] = "estimated from the video (temporal median)"
             print(f"{cid}: no background image given; estimated from the video (temporal median)", file=sys.stderr)
         else:
             raise InputError(f"{cid}: no background image: give --background {cid}=PNG")
-    options = {}
-    if args.births is not None:
-        options["births"] = args.births
-    foregrounds = make_foregrounds(scene, backgrounds, args.foreground, args.threshold)
-    tracker = make_tracker(args.method, scene, foregrounds, preset=args.preset, **options)
+    foregrounds = foregrounds_from_config(scene, backgrounds, cfg.foreground)
+    tracker = make_tracker(cfg.method, scene, foregrounds, cfg.section())
     for text in args.init:
         tid, x, y = _init(text)
-        if not hasattr(tracker, "init_track"):
-            raise InputError(f"--init: the {args.method} tracker starts tracks by itself")
         tracker.init_track(x, y, track_id=tid)
+    write_run_info(Path(args.out), cfg.to_mapping(), inputs={
+        "scene": args.scene, "videos": videos, "backgrounds": background_files,
+        "init": list(args.init), "fps": args.fps, "frames": args.frames},
+        argv=getattr(args, "command_line", None))
     source = VideoSource(videos, scene.cameras, fps=args.fps, stop=args.frames)
     result = run_tracking(scene, source, tracker, args.out, write_video=not args.no_video,
                           json_stream=sys.stdout if args.json else None, progress=not args.quiet,

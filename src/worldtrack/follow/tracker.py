@@ -43,7 +43,7 @@ from worldtrack.follow.planview import Candidates, detect
 from worldtrack.follow.silhouette import box_silhouettes, covering, person_box, silhouettes
 from worldtrack.follow.templates import Templates
 from worldtrack.geometry.camera import Camera
-from worldtrack.io.sources import Frame
+from worldtrack.trackers.base import Frame
 from worldtrack.scene.model import Scene
 
 #: Others are tracked mostly by position: their α is at least this (their templates are recent).

@@ -116,41 +116,64 @@ def texture_at(grey_image, grey_background, vs, us, window):
 
 
 @njit(cache=True)
-def _relabel(labels, grey_image, grey_background, window, min_sd, max_ncc, candidate, cloth):
+def _judge(labels, grey_image, grey_background, window, min_sd, cloth_at_most, shadow_at_least, candidate, cloth,
+           shadow):
     H, W = labels.shape
     for v in range(H):
         for u in range(W):
             if labels[v, u] == candidate:
                 ncc, sd = _ncc_at(grey_image, grey_background, v, u, window // 2)
-                if sd >= min_sd and ncc <= max_ncc:
-                    labels[v, u] = cloth
+                if sd >= min_sd:
+                    if ncc <= cloth_at_most:
+                        labels[v, u] = cloth
+                    elif ncc >= shadow_at_least:
+                        labels[v, u] = shadow
 
 
-def relabel_cloth(labels: np.ndarray, image: np.ndarray, grey_background: np.ndarray, max_ncc: float,
-                  candidate: int = 2, cloth: int = 1) -> np.ndarray:
-    """Shadow-like pixels that hide the background's texture are foreground, in place.
+def judge_shadows(labels: np.ndarray, image: np.ndarray, grey_background: np.ndarray, cloth_at_most: float,
+                  shadow_at_least: float = np.inf, candidate: int = 2, cloth: int = 1, shadow: int = 3) -> np.ndarray:
+    """Judge shadow-like pixels by whether the background's texture shows through, in place.
 
     Pixels labelled ``candidate`` where the background is textured (σ ≥ ``TEXTURE_MIN_SD`` over a
-    ``TEXTURE_WINDOW`` window) and the image does not correlate with it (NCC ≤ ``max_ncc``; a flat
-    image window has NCC 0) become ``cloth``; the others keep their label. One pass of a Numba
-    kernel over the labels; :func:`relabel_cloth_reference` is the same with the box filters.
+    ``TEXTURE_WINDOW`` window) become ``cloth`` when the image does not correlate with it (NCC ≤
+    ``cloth_at_most``; a flat image window has NCC 0: the pattern is gone) and ``shadow`` when it
+    does (NCC ≥ ``shadow_at_least``: the pattern shows through, darker); the others — a plain floor,
+    or in between — keep their label (cannot be told). One pass of a Numba kernel over the labels
+    (exact integer window sums); :func:`judge_shadows_reference` is the same with OpenCV box filters.
 
     Parameters
     ----------
     labels : (H, W) uint8, C-contiguous
     image : (H, W, 3) uint8 BGR
     grey_background : (H, W) uint8 — :func:`grey` of the background
-    max_ncc : float — correlation at or below which the pattern is gone
+    cloth_at_most, shadow_at_least : float — NCC thresholds (``shadow_at_least = inf``: never shadow)
+    candidate, cloth, shadow : int — the labels read and written
     """
-    _relabel(labels, grey(image), grey_background, TEXTURE_WINDOW, float(TEXTURE_MIN_SD), float(max_ncc),
-             candidate, cloth)
+    _judge(labels, grey(image), grey_background, TEXTURE_WINDOW, float(TEXTURE_MIN_SD), float(cloth_at_most),
+           float(shadow_at_least), candidate, cloth, shadow)
     return labels
+
+
+def judge_shadows_reference(labels: np.ndarray, image: np.ndarray, background: np.ndarray, cloth_at_most: float,
+                            shadow_at_least: float = np.inf, candidate: int = 2, cloth: int = 1,
+                            shadow: int = 3) -> np.ndarray:
+    """:func:`judge_shadows` over the whole image with :func:`texture_correlation` (a new array)."""
+    ncc, sd = texture_correlation(image, background, TEXTURE_WINDOW)
+    out = labels.copy()
+    textured = (labels == candidate) & (sd >= TEXTURE_MIN_SD)
+    out[textured & (ncc <= cloth_at_most)] = cloth
+    out[textured & ~(ncc <= cloth_at_most) & (ncc >= shadow_at_least)] = shadow
+    return out
+
+
+def relabel_cloth(labels: np.ndarray, image: np.ndarray, grey_background: np.ndarray, max_ncc: float,
+                  candidate: int = 2, cloth: int = 1) -> np.ndarray:
+    """Shadow-like pixels that hide the background's texture are foreground, in place: the cloth half
+    of :func:`judge_shadows` (NCC ≤ ``max_ncc`` → ``cloth``; never shadow)."""
+    return judge_shadows(labels, image, grey_background, max_ncc, np.inf, candidate, cloth, candidate)
 
 
 def relabel_cloth_reference(labels: np.ndarray, image: np.ndarray, background: np.ndarray, max_ncc: float,
                             candidate: int = 2, cloth: int = 1) -> np.ndarray:
     """:func:`relabel_cloth` over the whole image with :func:`texture_correlation` (a new array)."""
-    ncc, sd = texture_correlation(image, background, TEXTURE_WINDOW)
-    out = labels.copy()
-    out[(labels == candidate) & (sd >= TEXTURE_MIN_SD) & (ncc <= max_ncc)] = cloth
-    return out
+    return judge_shadows_reference(labels, image, background, max_ncc, np.inf, candidate, cloth, candidate)

@@ -30,7 +30,7 @@ import scipy.optimize
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
-from worldtrack.geometry.camera import Camera, normalise_projection
+from worldtrack.geometry.camera import Camera, normalise_projection, radial_factor
 from worldtrack.geometry.rotation import rodrigues, rotation_to_rodrigues
 
 MIN_POINTS = 6
@@ -334,7 +334,7 @@ def _project(W: np.ndarray, fx: float, fy: float, cx: float, cy: float, R: np.nd
     pc = W @ R.T + t
     xy = pc[:, :2] / pc[:, 2:3]
     r2 = np.einsum("ij,ij->i", xy, xy)
-    radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[2]))
+    radial = radial_factor(r2, k[0], k[1], k[2])
     return np.column_stack([fx * xy[:, 0] * radial + cx, fy * xy[:, 1] * radial + cy])
 
 

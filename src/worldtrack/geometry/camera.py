@@ -36,6 +36,12 @@ def _as_points(points: ArrayLike, dim: int) -> tuple[np.ndarray, tuple[int, ...]
     return p.reshape(-1, dim), p.shape[:-1]
 
 
+def radial_factor(r2: np.ndarray, k1: float, k2: float, k3: float) -> np.ndarray:
+    """OpenCV's radial distortion factor ``1 + k1·r² + k2·r⁴ + k3·r⁶`` at ``r2 = r²`` (NumPy; the
+    compiled kernels' is :func:`worldtrack.geometry._kernels.radial_factor`)."""
+    return 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+
+
 def normalise_projection(P: ArrayLike) -> np.ndarray:
     """Scale a 3×4 projection matrix so that ‖P[2, :3]‖ = 1 and det(P[:, :3]) > 0.
 
@@ -254,7 +260,7 @@ class Camera:
         k1, k2, p1, p2, k3 = self.dist
         x, y = xy[:, 0], xy[:, 1]
         r2 = x * x + y * y
-        radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+        radial = radial_factor(r2, k1, k2, k3)
         xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
         yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
         return np.stack([xd, yd], axis=1)
@@ -274,7 +280,7 @@ class Camera:
         x, y = xd.copy(), yd.copy()
         for _ in range(max_iterations):
             r2 = x * x + y * y
-            radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+            radial = radial_factor(r2, k1, k2, k3)
             dx = 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
             dy = p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
             xn = (xd - dx) / radial

@@ -27,7 +27,8 @@ from worldtrack.errors import InputError
 from worldtrack.follow.stereo import StereoMatcher, disparity_to_depth
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.rotation import rodrigues
-from worldtrack.io.sources import Frame, _CameraReader
+from worldtrack.io.sources import _CameraReader
+from worldtrack.trackers.base import Frame
 from worldtrack.io.text import read_text
 
 

@@ -6,7 +6,6 @@ problems into :class:`~worldtrack.errors.InputError` with the camera, file and f
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator, Mapping, Sequence
 
@@ -14,29 +13,11 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
+from worldtrack.foreground.estimate import estimate_background
 from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Frame
 
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
-
-
-@dataclass
-class Frame:
-    """One camera's image at one time.
-
-    Attributes
-    ----------
-    image : (H, W, 3) uint8 — BGR (OpenCV order)
-    t : float — time stamp, seconds
-    index : int — frame number from 0
-    depth : (H, W) float32 or None — metres along the optical axis (RGB-D sensors)
-    meta : dict — e.g. white-balance gains
-    """
-
-    image: np.ndarray
-    t: float
-    index: int
-    depth: np.ndarray | None = None
-    meta: dict = field(default_factory=dict)
 
 
 class _CameraReader:
@@ -174,3 +155,22 @@ def read_image(path: str | Path, camera: Camera | None = None, what: str = "imag
         raise InputError(f"{path}: {what} is {img.shape[1]}x{img.shape[0]} but camera {camera.id!r} "
                          f"is {camera.width}x{camera.height}")
     return img
+
+
+def background_from_video(path: str | Path, samples: int = 50) -> np.ndarray:
+    """Temporal median of ``samples`` frames spread over a video (people must keep moving)."""
+    cap = cv2.VideoCapture(str(path))
+    if not cap.isOpened():
+        raise InputError(f"{path}: cannot open as a video")
+    n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
+    frames = []
+    if n > 0:
+        for idx in np.linspace(0, n - 1, min(samples, n)).astype(int):
+            cap.set(cv2.CAP_PROP_POS_FRAMES, int(idx))
+            ok, img = cap.read()
+            if ok:
+                frames.append(img)
+    cap.release()
+    if not frames:
+        raise InputError(f"{path}: no frames could be read to estimate a background")
+    return estimate_background(frames)

@@ -21,10 +21,12 @@ agree on small images.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from worldtrack.geometry._kernels import distort, undistort
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.raycast import ray_capsule, ray_ellipsoid
 
@@ -115,48 +117,63 @@ def _pixel_ray(u, v, intr):
     k1, k2, p1, p2, k3 = intr[5], intr[6], intr[7], intr[8], intr[9]
     if k1 != 0.0 or k2 != 0.0 or p1 != 0.0 or p2 != 0.0 or k3 != 0.0:
         xd, yd = x, y
-        for _ in range(200):  # the fixed-point inversion of Camera.undistort_normalised
-            r2 = x * x + y * y
-            radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-            ddx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
-            ddy = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
-            xn = (xd - ddx) / radial
-            yn = (yd - ddy) / radial
-            change = max(abs(xn - x), abs(yn - y))
-            x, y = xn, yn
-            if not change > 1e-12:
-                break
+        # The fixed-point inversion of Camera.undistort_normalised.
+        x, y = undistort(xd, yd, k1, k2, p1, p2, k3, 200, 1e-12)
         # Beyond the lens's monotonic range the pixel has no ray (as in Camera): no hit.
-        r2 = x * x + y * y
-        radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-        ex = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) - xd
-        ey = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y - yd
-        if not max(abs(ex), abs(ey)) <= 1e-7:
+        ex, ey = distort(x, y, k1, k2, p1, p2, k3)
+        if not max(abs(ex - xd), abs(ey - yd)) <= 1e-7:
             return math.nan, math.nan, math.nan
     n = math.sqrt(x * x + y * y + 1.0)
     return x / n, y / n, 1.0 / n
 
 
-@njit(cache=True)
-def trace_people(rays, Rt, origin, axis, intr, geom, part_box, person_box, person_start, person_id,
-                 zbuf, inst, part_hit, alone):
-    """Z-buffered ray casting of people (modifies ``zbuf``, ``inst``, ``part_hit``, ``alone``).
+class RayCamera(NamedTuple):
+    """A camera as :func:`trace_people` casts rays from it.
 
-    Parameters
-    ----------
     rays : (H, W, 3) float64 — unit rays of the image's pixels in the camera frame
     Rt : (3, 3) — camera → world rotation (``Rᵀ``); origin : (3,) camera centre, metres
     axis : (3,) — optical axis in world coordinates (depth = s·(d·axis))
     intr : (10,) — [fx, fy, cx, cy, skew, k1, k2, p1, p2, k3], for pixels outside the image
+    """
+
+    rays: np.ndarray
+    Rt: np.ndarray
+    origin: np.ndarray
+    axis: np.ndarray
+    intr: np.ndarray
+
+
+class PackedPeople(NamedTuple):
+    """People's parts as :func:`trace_people` reads them.
+
     geom : (P, 17) — packed parts, person-major
     part_box : (P, 4) int — pixel box [u0, u1) × [v0, v1) outside which part p is never hit
     person_box : (N, 4) int — union of the person's part boxes (may extend beyond the image)
     person_start : (N + 1,) int — parts of person n are ``person_start[n]:person_start[n + 1]``
     person_id : (N,) int — value written to ``inst``
+    """
+
+    geom: np.ndarray
+    part_box: np.ndarray
+    person_box: np.ndarray
+    person_start: np.ndarray
+    person_id: np.ndarray
+
+
+@njit(cache=True)
+def trace_people(camera, people, zbuf, inst, part_hit, alone):
+    """Z-buffered ray casting of people (modifies ``zbuf``, ``inst``, ``part_hit``, ``alone``).
+
+    Parameters
+    ----------
+    camera : RayCamera
+    people : PackedPeople
     zbuf : (H, W) float32 — depth along the optical axis (m) of what is already drawn
     inst : (H, W) int32; part_hit : (H, W) int32 — global part index, −1 where no person
     alone : (N,) int64 — out: pixels the person covers when rendered alone, image border ignored
     """
+    rays, Rt, origin, axis, intr = camera
+    geom, part_box, person_box, person_start, person_id = people
     H, W = zbuf.shape
     for n in range(person_start.shape[0] - 1):
         p0, p1 = person_start[n], person_start[n + 1]

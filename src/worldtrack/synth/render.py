@@ -272,10 +272,11 @@ def people_pass(camera: Camera, rays: np.ndarray, parts: PartArrays, n_people: i
     pbox = np.column_stack([
         np.minimum.reduceat(boxes[:, 0], start[:-1]), np.maximum.reduceat(boxes[:, 1], start[:-1]),
         np.minimum.reduceat(boxes[:, 2], start[:-1]), np.maximum.reduceat(boxes[:, 3], start[:-1])]).astype(np.int64)
-    kernels.trace_people(rays, np.ascontiguousarray(camera.R.T), camera.centre.astype(np.float64),
-                         camera.optical_axis.astype(np.float64), _intrinsics(camera),
-                         np.ascontiguousarray(parts.geometry()), boxes, pbox, start,
-                         np.asarray(person_ids, dtype=np.int64), zbuf, inst, part_hit, alone)
+    ray_camera = kernels.RayCamera(rays, np.ascontiguousarray(camera.R.T), camera.centre.astype(np.float64),
+                                   camera.optical_axis.astype(np.float64), _intrinsics(camera))
+    people = kernels.PackedPeople(np.ascontiguousarray(parts.geometry()), boxes, pbox, start,
+                                  np.asarray(person_ids, dtype=np.int64))
+    kernels.trace_people(ray_camera, people, zbuf, inst, part_hit, alone)
     return PeopleBuffers(zbuf, inst, part_hit, alone)
 
 

@@ -95,6 +95,17 @@ OFFICE_4CAMS = {
     "people": {"height": 1.70, "width": 0.45},
 }
 
+# The same office with a screen across the corridor between every two cameras, each leaving one
+# 0.8 m passage, on alternate sides (north at x = 4 and 12 m, south at x = 8 m): nobody can walk
+# straight from one camera's view to the next (seed 002's detours).
+OFFICE_4CAMS_DETOURS = copy.deepcopy(OFFICE_4CAMS)
+OFFICE_4CAMS_DETOURS["name"] = "office-4cams-detours"
+OFFICE_4CAMS_DETOURS["obstacles"] = OFFICE_4CAMS["obstacles"] + [
+    {"name": f"screen{k + 1}", "type": "box", "centre": [x, yc, 0.9], "size": [0.05, 2.0, 1.8]}
+    for k, (x, yc) in enumerate(((4.0, 3.6), (8.0, 4.4), (12.0, 3.6)))]
+#: The passage through each screen (x, y of its middle), for walkers' routes.
+OFFICE_DOORS = ((4.0, 5.0), (8.0, 3.0), (12.0, 5.0))
+
 # A 16 x 12 m paved courtyard between buildings, open to the sky (seed 001's robot follows a
 # person here). The camera is the robot's stereo head; its pose here is only the first frame's.
 COURTYARD = {
@@ -127,7 +138,7 @@ BOOTH = {
 }
 
 BUILTIN = {"kato_lab": KATO_LAB, "hall": HALL, "lobby": LOBBY, "office_4cams": OFFICE_4CAMS,
-           "courtyard": COURTYARD, "booth": BOOTH}
+           "office_4cams_detours": OFFICE_4CAMS_DETOURS, "courtyard": COURTYARD, "booth": BOOTH}
 
 
 def scene_dict(name: str) -> dict:

@@ -1,0 +1,240 @@
+"""New people: foreground that the simulated image of everybody already known does not explain.
+
+Paper 000 §5.2 starts a person entering the view in *capture mode*; it does not say where the
+person comes from. Here each camera's foreground minus everybody's ellipses (slightly dilated),
+cleaned of speckle and with the holes of one body closed, is cut into blobs; a blob large enough
+to be (the visible part of) a person standing at its foot point proposes one there. Where they may
+appear is a component chosen by name (``ellipsoid.births.where``, :data:`BIRTH_PLACES`).
+
+>>> BIRTH_PLACES["none"]().proposes, BIRTH_PLACES["anywhere"]().proposes
+(False, True)
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Callable, Mapping, Protocol, Sequence
+
+import cv2
+import numpy as np
+
+from worldtrack.foreground.components import blob_extent, blobs
+from worldtrack.registry import Registry
+from worldtrack.trackers.ellipsoid.args import People
+from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
+from worldtrack.trackers.ellipsoid.config import BirthConfig
+from worldtrack.trackers.ellipsoid.forms import ellipse_crop
+
+#: A proposal: a floor place (2,) m and the camera whose foreground proposed it.
+Proposal = tuple[np.ndarray, str]
+
+
+class BirthPlaces(Protocol):
+    """Where new people may appear: ``proposes`` (False: never), and which proposals to keep."""
+
+    proposes: bool
+
+    def keep(self, proposals: list[Proposal], scene, first_frame: bool) -> list[Proposal]:
+        ...
+
+
+#: :class:`BirthPlaces` by name (``ellipsoid.births.where``).
+BIRTH_PLACES: Registry[type] = Registry("ellipsoid.births.where")
+
+
+@BIRTH_PLACES.register("anywhere")
+class Anywhere:
+    """Anywhere in view."""
+
+    proposes = True
+
+    def keep(self, proposals: list[Proposal], scene, first_frame: bool) -> list[Proposal]:
+        return proposals
+
+
+@BIRTH_PLACES.register("entry")
+class InEntryRegions:
+    """Only in the scene's entry regions (doors), and anywhere on the first frame (people already in
+    the room); anywhere in a scene without entry regions."""
+
+    proposes = True
+
+    def keep(self, proposals: list[Proposal], scene, first_frame: bool) -> list[Proposal]:
+        if first_frame or not scene.entry_regions:
+            return proposals
+        return [(p, cid) for p, cid in proposals if scene.entry_region_index([p])[0] >= 0]
+
+
+@BIRTH_PLACES.register("none")
+class Nowhere:
+    """Never: people only from ``--init``."""
+
+    proposes = False
+
+    def keep(self, proposals: list[Proposal], scene, first_frame: bool) -> list[Proposal]:
+        return []
+
+
+class Births:
+    """Proposes new people in the cameras of one tracker.
+
+    Parameters
+    ----------
+    views : {camera_id: CameraView}
+    scene : Scene — its walkable floor, entry regions and default person size
+    walkable : callable — (M, 2) floor points → (M,) bool
+    config : BirthConfig
+    """
+
+    def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
+                 config: BirthConfig):
+        self.views = views
+        self.scene = scene
+        self.walkable = walkable
+        self.config = config
+        self.places: BirthPlaces = BIRTH_PLACES[config.where]()
+        self._floor: np.ndarray | None = None
+
+    def propose(self, masks: Mapping[str, np.ndarray], people: People, first_frame: bool) -> list[Proposal]:
+        """Places of new people in this frame's foreground ``masks`` ({camera_id: (H, W) uint8}),
+        clear of ``people`` and of each other by ``min_separation_m``, in proposal order."""
+        if not self.places.proposes:
+            return []
+        proposals: list[Proposal] = []
+        for cid in masks:
+            proposals += self._in_camera(cid, masks[cid], people)
+        if not proposals:
+            return []
+        proposals = self.places.keep(proposals, self.scene, first_frame)
+        # Each proposal is already clear of the existing people; keep the proposals apart too.
+        kept: list[Proposal] = []
+        for p, cid in proposals:
+            if not any(np.hypot(*(q - p)) < self.config.min_separation_m for q, _ in kept):
+                kept.append((p, cid))
+        return kept
+
+    def _in_camera(self, cid: str, mask: np.ndarray, people: People) -> list[Proposal]:
+        """Proposals from one camera's foreground that ``people`` do not explain."""
+        cfg, view = self.config, self.views[cid]
+        cam = view.camera
+        xy = people.xy
+        explained = np.zeros_like(mask)
+        if len(xy):
+            inner, _, box, valid, _ = view.forms(*people)
+            render_union(explained, inner, box, valid, view.grid, cam.has_distortion)
+            explained = cv2.dilate(explained, disc(2))
+        un = mask & (1 - explained)
+        # Remove speckle, then join the pieces of one body that holes in the mask split.
+        r_open, r_close = 1, max(1, view.ring_px // 2)
+        un = cv2.morphologyEx(un, cv2.MORPH_OPEN, disc(r_open))
+        un = cv2.morphologyEx(un, cv2.MORPH_CLOSE, np.ones((2 * r_close + 1, 2 * r_close + 1), np.uint8))
+        if not cv2.countNonZero(un):
+            return []
+        h0, w0 = self.scene.people.height, self.scene.people.width
+        min_area = max(10 * cam.width * cam.height / (160 * 120),
+                       0.1 * view.smallest_person_px(self.walkable_floor(), h0, w0))
+        out: list[Proposal] = []
+        # Components found at ~320 px wide (each blob then read back at full resolution):
+        # labelling the whole 640x480 frame was a third of the births' time.
+        for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
+            p = blob_position(view, blob, (x0, y0), centroid, h0)
+            if p is None:
+                continue
+            pxy = self.nearest_walkable(p[:2], 0.6)
+            if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
+                continue  # off the floor, or somebody already there
+            # Is the blob big enough to be (the visible part of) a person standing there?
+            expected = view.visible_pixels(pxy, h0, w0)
+            if expected <= 0 or area < cfg.min_blob_fraction * expected:
+                continue
+            out.append((pxy, cid))
+        return out
+
+    def walkable_floor(self) -> np.ndarray:
+        """(N, 2) walkable points of the scene on a 0.25 m grid (computed once)."""
+        if self._floor is None:
+            x0, x1, y0, y1 = self.scene.walkable.bounds
+            gx, gy = np.meshgrid(np.arange(x0, x1, 0.25), np.arange(y0, y1, 0.25))
+            xy = np.column_stack([gx.ravel(), gy.ravel()])
+            self._floor = xy[self.walkable(xy)]
+        return self._floor
+
+    def nearest_walkable(self, xy: np.ndarray, radius: float) -> np.ndarray | None:
+        """``xy`` if walkable, else the nearest walkable point within ``radius`` m (5 cm grid), else
+        None. A proposal from a head seen above a desk can land on the desk's footprint."""
+        if self.walkable([xy])[0]:
+            return np.asarray(xy, float)
+        offsets = disc_offsets(radius)
+        cand = xy + offsets
+        ok = self.walkable(cand)
+        if not ok.any():
+            return None
+        d = np.hypot(offsets[ok, 0], offsets[ok, 1])
+        return cand[ok][int(np.argmin(d))]
+
+
+def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
+                  height: float) -> np.ndarray | None:
+    """Floor position (3,) of a person seen as ``blob``, or None.
+
+    ``blob`` is a boolean crop of the image whose top-left pixel is ``origin`` (u, v);
+    ``centroid`` is in full-image pixels.
+
+    The feet are the end of the blob in the direction in which world verticals point down in
+    the image — the bottom for an oblique camera, the end nearest the image centre for one that
+    looks straight down. They are back-projected to the floor, unless the blob ends there at the
+    image border or on an obstacle (a desk hides the feet): then its other end, the top of the
+    head, is back-projected to the default ``height`` (m).
+    """
+    cam = view.camera
+    down = view.down_direction(centroid)
+    if down is None:
+        return None
+    # The ends: the extreme pixel along ``down``, laterally at the mean of the extreme 2 %.
+    along_min, along_max, spread_min, spread_max, spread_low, spread_high = blob_extent(
+        blob, int(origin[0]), int(origin[1]), float(centroid[0]), float(centroid[1]), float(down[0]),
+        float(down[1]), 50)
+    across = np.array([-down[1], down[0]])
+    foot = centroid + (along_max + 0.5) * down + spread_high * across
+    head = centroid + (along_min - 0.5) * down + spread_low * across
+    # Just beyond the feet, across the blob's width: image border or obstacle → feet hidden.
+    half = max(1.0, 0.4 * (spread_max - spread_min))  # most of the blob's width
+    beyond = foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across
+    feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, view.occ, beyond)).mean() > 0.5
+    if not feet_hidden:
+        p = cam.backproject(foot[None], 0.0)[0]
+    elif pixel_clear(cam, None, head - 2 * down):  # the head inside the image
+        p = cam.backproject(head[None], height)[0]
+    else:
+        return None
+    return p if np.isfinite(p).all() else None
+
+
+@lru_cache(maxsize=8)
+def disc_offsets(radius: float) -> np.ndarray:
+    """(K, 2) floor offsets (m) on a 5 cm grid within ``radius`` of the origin, row by row."""
+    g = np.arange(-radius, radius + 1e-9, 0.05)
+    offsets = np.array([(a, b) for a in g for b in g])
+    offsets = offsets[np.hypot(offsets[:, 0], offsets[:, 1]) <= radius]
+    offsets.setflags(write=False)
+    return offsets
+
+
+def disc(radius: int) -> np.ndarray:
+    """Elliptical structuring element of the given radius (pixels)."""
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+
+
+def render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: np.ndarray,
+                 grid: np.ndarray, has_dist: bool) -> None:
+    """Set ``out`` to 1 inside the given ellipses (normal forms (N, 5)), within their boxes (in place)."""
+    for k in range(len(forms)):
+        if not valid[k]:
+            continue
+        u0, u1, v0, v1 = boxes[k]
+        if u0 >= u1 or v0 >= v1:
+            continue
+        out[v0:v1, u0:u1] |= ellipse_crop(forms[k], boxes[k], grid, has_dist).astype(np.uint8)
+
+
+__all__ = ["BIRTH_PLACES", "BirthPlaces", "Births", "Proposal", "blob_position", "disc_offsets"]

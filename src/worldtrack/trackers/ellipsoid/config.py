@@ -1,0 +1,243 @@
+"""Settings of the ellipsoid tracker (paper 000), one section per step of the method.
+
+``EllipsoidConfig()`` is worldtrack's default; :meth:`EllipsoidConfig.paper` the method as
+published (s = 50 mm, K = 3, every pixel, eq. 5 as printed, no prediction, no searches, fixed
+1.65 m people). Durations are in seconds and turned into frames with the real frame interval
+(:func:`worldtrack.trackers.lifecycle.frames_for`). Why each default is what it is, with the
+measurements, is in ``benchmarks/results/tuning_ellipsoid.md``.
+
+Light on purpose (pydantic and worldtrack.config only): the command line imports it for
+``--help`` and ``--print-config``.
+
+>>> cfg = EllipsoidConfig()
+>>> cfg.match.step_m, cfg.end.leave_after_s
+(0.05, 0.2)
+>>> EllipsoidConfig.paper().score.kind
+'paper'
+>>> EllipsoidConfig(match={"step_m": -1})
+Traceback (most recent call last):
+...
+worldtrack.errors.InputError: ellipsoid.match.step_m: expected a number > 0, got -1
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar, Literal
+
+from pydantic import Field, model_validator
+
+from worldtrack.config import Section, with_overrides
+
+
+class ScoreConfig(Section):
+    """Eq. 5 and the simulated image it compares (paper 000 §4)."""
+
+    path: ClassVar[str] = "ellipsoid.score"
+
+    kind: Literal["symmetric", "paper"] = Field(
+        "symmetric", description="eq. 5 as published ('paper'), or with the foreground no ellipse explains added to "
+        "the denominator for tracked people ('symmetric': drifting off the feet costs)")
+    camera_weights: Literal["current", "candidate"] = Field(
+        "current", description="several cameras: weigh each camera as at the person's current place ('current'), so "
+        "a candidate cannot gain by sliding out of a camera that fits badly, or at the candidate")
+    target_pixels: int = Field(
+        1500, ge=0, description="pixels visited per candidate set, on a stride (0 = every pixel, as published); "
+        "keeps the cost independent of the image size")
+    ring_px_160: float = Field(
+        5.0, gt=0, description="width of the -1 ring at 160x120, px (paper: 5), scaled with the image's linear size")
+    ring_fraction: float = Field(
+        2.0, ge=0, description="the ring is at most this fraction of the ellipse's semi-minor axis (0 = always the "
+        "scaled width, as published): a far, small person gets a ring no wider than itself")
+    min_depth_m: float = Field(
+        0.1, ge=0, description="ellipsoids nearer than this to a camera's image plane are not drawn, m")
+
+
+class MatchConfig(Section):
+    """The matching rounds: 9 candidates per person, K rounds, coarse to fine; the motion between frames."""
+
+    path: ClassVar[str] = "ellipsoid.match"
+
+    step_m: float = Field(0.05, gt=0, description="candidate step s, m (paper: 50 mm)")
+    iterations: int = Field(3, ge=1, description="rounds over all people per frame (paper: K = 3)")
+    adaptive_step: bool = Field(
+        True, description="halve the step when 'stay' wins, double it (to max_step_m) when still moving after K "
+        "rounds: fast walkers are followed and the final place is finer than the grid")
+    min_gain: float = Field(
+        0.002, ge=0, description="with the adaptive step, a move must raise E by this much (smaller gains are "
+        "noise and count as 'stay')")
+    min_step_m: float = Field(0.025, gt=0, description="smallest adaptive step, m")
+    max_step_m: float = Field(0.4, gt=0, description="largest adaptive step, m")
+    max_iterations: int = Field(6, ge=1, description="cap on rounds with the adaptive step")
+    predict: bool = Field(True, description="constant-velocity prediction before matching")
+    velocity_smoothing: float = Field(
+        0.5, ge=0, le=1, description="weight of each frame's velocity measurement (0..1)")
+    max_speed_mps: float = Field(3.0, gt=0, description="velocities are clipped to this speed (a running person), m/s")
+    rounds: Literal["compiled", "python"] = Field(
+        "compiled", description="the compiled rounds, or their readable Python reference (same tracks, slower)")
+
+    @model_validator(mode="after")
+    def _steps_in_order(self) -> "MatchConfig":
+        if self.min_step_m > self.max_step_m:
+            raise ValueError(f"min_step_m: expected ≤ max_step_m ({self.max_step_m}), got {self.min_step_m}")
+        return self
+
+
+class BirthConfig(Section):
+    """Where new people come from: foreground the simulation does not explain."""
+
+    path: ClassVar[str] = "ellipsoid.births"
+
+    where: Literal["anywhere", "entry", "none"] = Field(
+        "anywhere", description="new people appear anywhere in view, only in the scene's entry regions (and on the "
+        "first frame), or never (tracks only from --init)")
+    min_blob_fraction: float = Field(
+        0.25, ge=0, description="an unexplained blob proposes a person when its area is this share of the area a "
+        "person standing there would have")
+    min_separation_m: float = Field(
+        0.4, ge=0, description="no person is proposed, kept in capture, or rescued onto a place this close to "
+        "another, m (two bodies' centres are rarely nearer)")
+    search_m: float = Field(
+        1.0, ge=0, description="a new person is placed by a grid search this far along the proposing camera's line "
+        "of sight, m (0 = start at the foot point, as the paper's capture does)")
+
+
+class RescueConfig(Section):
+    """The rescue search along the lines of sight: a track stuck at a second peak of E jumps back."""
+
+    path: ClassVar[str] = "ellipsoid.rescue"
+
+    search_m: float = Field(
+        1.5, ge=0, description="search each seeing camera's line of sight this far, m (0 = never, as published)")
+    gain: float = Field(0.08, ge=0, description="a place must score E higher by this much to be taken")
+    every_s: float = Field(
+        1.0, ge=0, description="every person is searched this often, s, besides failing tracks (0 = only failing "
+        "tracks)")
+    retry_s: float = Field(
+        0.3, ge=0, description="after a search that found nothing, a failing track waits this long before the "
+        "next, s")
+
+
+class ConfirmConfig(Section):
+    """Capture mode: when a proposed person becomes a tracked one (paper 000 §5.2)."""
+
+    path: ClassVar[str] = "ellipsoid.confirm"
+
+    capture_threshold: float = Field(
+        0.7, description="E (capture mode) above which a person is confirmed at once (paper: 0.7)")
+    symmetric_threshold: float = Field(
+        0.3, description="with the symmetric score: E (capture mode) a person must hold for held_s to be "
+        "confirmed; an articulated body covers only 30-80 % of its ellipse")
+    held_s: float = Field(0.3, ge=0, description="time the capture tests must hold in a row, s")
+    within_s: float = Field(1.0, ge=0, description="a person not confirmed within this time of being proposed is dropped, s")
+    views: int = Field(
+        2, ge=0, description="a person passing the capture tests while at least this many cameras show their own "
+        "foreground is confirmed at once (0 = never)")
+
+
+class SupportConfig(Section):
+    """How much foreground a person must explain to be confirmed and kept (see the support module)."""
+
+    path: ClassVar[str] = "ellipsoid.support"
+
+    min_support: float = Field(
+        0.25, ge=0, le=1, description="share of a person's own pixels (visible, nobody else's) that must be "
+        "foreground; below it a track is failing, and a captured person is not confirmed")
+    min_own_share: float = Field(
+        0.25, ge=0, le=1, description="a young or captured person whose visible pixels are more than 1 - this "
+        "covered by others duplicates them")
+    min_evidence: float = Field(
+        0.2, ge=0, le=1, description="a tracked person is failing when no camera shows this share of its ellipse as "
+        "own foreground or explained by others (past the border, on empty floor)")
+    min_seen_share: float = Field(
+        0.3, ge=0, le=1, description="a captured person is confirmed only once some camera shows this share of its "
+        "ellipse (a sliver at the border fits anything)")
+    empty_support: float = Field(
+        0.1, ge=0, le=1, description="a failing track with support below this (its own pixels nearly all floor) "
+        "counts double toward end.lost_after_s (0 = never)")
+
+
+class EndConfig(Section):
+    """When a person's track ends: evidence gone, left every view, or a duplicate."""
+
+    path: ClassVar[str] = "ellipsoid.end"
+
+    keep_score: float = Field(
+        0.2, description="with the paper's score: a tracked person whose E stays below this for lost_after_s ends")
+    lost_after_s: float = Field(1.0, ge=0, description="time a track may fail in a row before it ends, s")
+    young_s: float = Field(
+        3.0, ge=0, description="a track younger than this that lives inside someone else's silhouette is a "
+        "duplicate, s")
+    leave_after_s: float = Field(
+        0.2, ge=0, description="time unseen by every camera on the map before a track ends, s")
+    merge_distance_m: float = Field(0.25, ge=0, description="two tracks closer than this are duplicates, m")
+    merge_after_s: float = Field(0.3, ge=0, description="time two tracks must stay that close before the younger ends, s")
+
+
+class HeightConfig(Section):
+    """Measuring each person's height where a camera sees them whole and alone (the paper fixes 1.65 m)."""
+
+    path: ClassVar[str] = "ellipsoid.height"
+
+    measure: bool = Field(
+        True, description="measure heights: a wrong model height puts an oblique camera's person at the wrong depth")
+    range_m: tuple[float, float] = Field((1.3, 2.1), description="plausible heights (min, max), m")
+    samples: int = Field(25, ge=1, description="the height is the median of the last this many measurements")
+    deadband_m: float = Field(
+        0.05, ge=0, description="the measured height replaces the default only when it differs by more than this, m "
+        "(the measurement's own scatter would add depth error)")
+    min_px: int = Field(
+        60, ge=0, description="measure in one view only where the person is at least this tall, px, and seen at "
+        "more than 45 degrees from the vertical")
+    ray_gap_m: float = Field(
+        0.03, ge=0, description="head rays of several cameras give a height only when each passes this close to "
+        "their nearest common point, m (else some view took another head for this one's)")
+    depth_offset_m: float = Field(
+        1.0, ge=0, description="in one view, the feet found may be this far from the track along the line of "
+        "sight, m (0.4 m across it)")
+
+    @model_validator(mode="after")
+    def _range_in_order(self) -> "HeightConfig":
+        lo, hi = self.range_m
+        if not 0 < lo < hi:
+            raise ValueError(f"range_m: expected 0 < min < max, got {list(self.range_m)}")
+        return self
+
+
+class WarmStartConfig(Section):
+    """Starting on the first frame with the people already in view."""
+
+    path: ClassVar[str] = "ellipsoid.warm_start"
+
+    frames: int = Field(
+        10, ge=0, description="track this many first frames forwards and back before reporting frame 0 (0 = start "
+        "empty, as published); skipped for learning foregrounds and hand-placed people")
+
+
+class EllipsoidConfig(Section):
+    """Parameters of the ellipsoid tracker, by step of the method; defaults are worldtrack's."""
+
+    path: ClassVar[str] = "ellipsoid"
+
+    score: ScoreConfig = Field(ScoreConfig(), description="eq. 5 and the simulated image")
+    match: MatchConfig = Field(MatchConfig(), description="the matching rounds and the motion between frames")
+    births: BirthConfig = Field(BirthConfig(), description="new people from unexplained foreground")
+    rescue: RescueConfig = Field(RescueConfig(), description="the search along lines of sight")
+    confirm: ConfirmConfig = Field(ConfirmConfig(), description="capture mode: confirming new people")
+    support: SupportConfig = Field(SupportConfig(), description="foreground a person must explain")
+    end: EndConfig = Field(EndConfig(), description="when tracks end")
+    height: HeightConfig = Field(HeightConfig(), description="measuring people's heights")
+    warm_start: WarmStartConfig = Field(WarmStartConfig(), description="starting with the people in view")
+
+    @classmethod
+    def paper(cls) -> "EllipsoidConfig":
+        """The method exactly as published: fixed 50 mm steps, K = 3, every pixel, eq. 5 as printed,
+        no prediction, no searches, no height measurement, no warm start."""
+        return with_overrides(cls(), {
+            "score.kind": "paper", "score.target_pixels": 0, "score.ring_fraction": 0.0,
+            "match.adaptive_step": False, "match.predict": False,
+            "births.search_m": 0.0, "rescue.search_m": 0.0, "height.measure": False, "warm_start.frames": 0,
+        }, root="ellipsoid")
+
+
+__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "HeightConfig", "MatchConfig",
+           "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

@@ -1,0 +1,200 @@
+"""X* = argmin of eq. 9 from several starts, keeping the lowest objective (seed 002, section 2.4).
+
+:func:`estimate_trajectory` is the whole method for one person: the time grid from the
+observations' time stamps, the three starts of :mod:`.starts`, banded Levenberg–Marquardt from
+each, the winner, its per-step covariance, each term's cost and where the barrier pushes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.scene.floor import FloorGrid
+from worldtrack.trajectory.environment import Barrier, EnvironmentModel, HeightPrior
+from worldtrack.trajectory.model import POS, VEL, MotionPrior, TimeGrid, frame_interval
+from worldtrack.trajectory.objective import Problem
+from worldtrack.trajectory.observation import Observations
+from worldtrack.trajectory.solver import LevenbergMarquardt, SolveResult, SolverOptions, levenberg_marquardt
+from worldtrack.trajectory.starts import START_NAMES, shortest_path_start, straight_start
+from worldtrack.trajectory.uncertainty import marginal_covariances
+
+
+@dataclass(frozen=True)
+class TrajectoryOptions:
+    """Everything :func:`estimate_trajectory` can be told; the defaults suit walking adults.
+
+    Parameters
+    ----------
+    dt : float or None, seconds — grid step; None: the cameras' frame interval (:func:`frame_interval`)
+    motion : MotionPrior — eq. 4's noise (m²/s³)
+    height : float, metres — the person's head height for e_v and the starts
+    height_sigma : float, metres — e_v's spread
+    clearance : float, metres — the barrier starts this far from obstacles and walls
+    barrier_scale : float, metres — a penetration of this much costs 1 per sample
+    substeps : int or None — barrier samples per step; None: enough for 2.5 m/s (:meth:`Barrier.substeps_for`)
+    weight : float — λ, the environment's weight
+    robust : float or None — Huber threshold for the reprojection errors, in σ
+    starts : tuple of str — a subset of ``("straight", "map", "shortest")``
+    environment : bool — False: no barrier at all (the paper's comparison without e_h)
+    race_iterations : int or None — every start gets this many iterations; only the one with the
+        lowest objective then goes on to convergence (None: every start converges, as the paper)
+    solver : SolverOptions
+    """
+
+    dt: float | None = None
+    motion: MotionPrior = field(default_factory=MotionPrior)
+    height: float = 1.70
+    height_sigma: float = 0.05
+    clearance: float = 0.2
+    barrier_scale: float = 0.02
+    substeps: int | None = None
+    weight: float = 1.0
+    robust: float | None = None
+    starts: tuple[str, ...] = START_NAMES
+    environment: bool = True
+    race_iterations: int | None = 5
+    solver: SolverOptions = field(default_factory=SolverOptions)
+
+    def __post_init__(self) -> None:
+        unknown = [s for s in self.starts if s not in START_NAMES]
+        if unknown or not self.starts:
+            raise InputError(f"starts: expected some of {', '.join(START_NAMES)}, got {', '.join(self.starts) or 'none'}")
+        if self.robust is not None and not self.robust > 0:
+            raise InputError(f"robust: expected a positive Huber threshold in sigmas, got {self.robust}")
+        if not self.weight > 0:
+            raise InputError(f"weight: expected λ > 0, got {self.weight}")
+
+
+@dataclass
+class TrajectoryEstimate:
+    """The MAP trajectory of one person and what it rests on.
+
+    Attributes
+    ----------
+    times : (n,) seconds
+    X : (n, 6) states (u, u̇, v, v̇, w, ẇ) in m and m/s
+    covariance : (n, 6, 6) — diagonal blocks of the inverse Gauss–Newton matrix at X
+    costs : dict — each term of the objective at X, and the total
+    start : str — the start whose optimum won
+    start_objectives : dict str → float — every start's final objective
+    observed : (n,) int — observations at each step
+    barrier_active : (n,) bool — steps where the barrier pushes (a sample inside the clearance)
+    without_barrier : (n, 6) — the MAP without the barrier (start ``map``), for comparison
+    results : dict str → SolveResult — per start
+    """
+
+    times: np.ndarray
+    X: np.ndarray
+    covariance: np.ndarray
+    costs: dict[str, float]
+    start: str
+    start_objectives: dict[str, float]
+    observed: np.ndarray
+    barrier_active: np.ndarray
+    without_barrier: np.ndarray
+    results: dict[str, SolveResult]
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(n, 3) head positions, metres."""
+        return self.X[:, POS]
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """(n, 3) head velocities, m/s."""
+        return self.X[:, VEL]
+
+    @property
+    def position_covariance(self) -> np.ndarray:
+        """(n, 3, 3) covariance of the head position, m²."""
+        return self.covariance[:, POS[:, None], POS[None, :]]
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """(n, 3) standard deviation of x, y, z, metres."""
+        return np.sqrt(np.maximum(np.diagonal(self.position_covariance, axis1=1, axis2=2), 0.0))
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The columns of ``trajectory.csv``."""
+        p, v, s = self.positions, self.velocities, self.sigma
+        C = self.position_covariance
+        rho = C[:, 0, 1] / np.maximum(s[:, 0] * s[:, 1], 1e-300)
+        return {"t": self.times, "x": p[:, 0], "y": p[:, 1], "z": p[:, 2], "vx": v[:, 0], "vy": v[:, 1],
+                "vz": v[:, 2], "sigma_x": s[:, 0], "sigma_y": s[:, 1], "sigma_z": s[:, 2], "rho_xy": rho,
+                "observed": self.observed, "barrier": self.barrier_active.astype(int)}
+
+
+def build_environment(options: TrajectoryOptions, field: FloorGrid | None, dt: float) -> EnvironmentModel:
+    """The environment model the options describe for a grid step ``dt`` (s)."""
+    height = HeightPrior(options.height, options.height_sigma)
+    if field is None or not options.environment:
+        return EnvironmentModel(None, height, options.weight)
+    substeps = options.substeps or Barrier.substeps_for(dt, options.clearance)
+    barrier = Barrier(field, options.clearance, options.barrier_scale, substeps)
+    return EnvironmentModel(barrier, height, options.weight)
+
+
+def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
+                        options: TrajectoryOptions = TrajectoryOptions()) -> TrajectoryEstimate:
+    """The MAP trajectory of one person from their head pixels (seed 002).
+
+    Parameters
+    ----------
+    obs : Observations — one person's head pixels, in time order
+    field : FloorGrid or None — signed distance to obstacles and walls (``Scene.distance_field()``);
+        None: no barrier
+    options : TrajectoryOptions
+
+    Examples
+    --------
+    >>> from worldtrack.geometry.camera import Camera
+    >>> cams = {c: Camera.look_at(c, 320, 240, position=(x, 0, 3), target=(x, 0.3, 0), hfov_deg=60)
+    ...         for c, x in (("a", 0.0), ("b", 4.0))}
+    >>> t = np.arange(0, 4.01, 0.1); path = np.column_stack([t, 0 * t, 0 * t + 1.7])   # 1 m/s along x
+    >>> seen = (np.abs(t - 0) < 0.6) | (np.abs(t - 4) < 0.6)
+    >>> ids = np.where(t < 2, "a", "b")[seen]
+    >>> obs = Observations.from_points(t[seen], ids, path[seen], cams)
+    >>> est = estimate_trajectory(obs)
+    >>> float(np.abs(est.positions[:, 0] - t).max()) < 0.01      # the gap is bridged at 1 m/s
+    True
+    """
+    dt = options.dt or frame_interval(obs.time, obs.camera)
+    grid = TimeGrid.covering(obs.time, dt)
+    env = build_environment(options, field, dt)
+    problem = Problem.build(obs, grid, options.motion, env, options.robust)
+    free = problem.with_environment(env.without_barrier())
+    straight = straight_start(problem.observations, grid, options.height)
+    results: dict[str, SolveResult] = {}
+    without = levenberg_marquardt(free, straight, options.solver)
+    starts = {"straight": straight, "map": without.X}
+    if env.barrier is not None and "shortest" in options.starts:
+        starts["shortest"] = shortest_path_start(problem.observations, grid, options.height, env.barrier.field,
+                                                 options.clearance, max(env.barrier.field.resolution, 0.1))
+    runs = {}
+    for name in options.starts:
+        if name not in starts:
+            continue
+        if env.barrier is None and name == "map":
+            results[name] = without
+            continue
+        runs[name] = LevenbergMarquardt(problem, starts[name], options.solver)
+        runs[name].run(options.race_iterations)
+    if runs:                        # the race: only the leader goes on to convergence
+        leader = min(runs, key=lambda k: runs[k].lin.costs.total)
+        runs[leader].run()
+        results.update({name: run.result for name, run in runs.items()})
+    objectives = {name: r.costs.total for name, r in results.items()}
+    best = min(objectives, key=objectives.get)
+    win = results[best]
+    observed = np.bincount(problem.observations.step, minlength=grid.n)
+    covariance = marginal_covariances(win.linearisation.D, win.linearisation.B)
+    return TrajectoryEstimate(grid.times, win.X, covariance, win.costs.as_dict(), best, objectives, observed,
+                              win.linearisation.barrier_steps, without.X, results)
+
+
+def with_height(options: TrajectoryOptions, height: float) -> TrajectoryOptions:
+    """The same options for a person of another head height (m)."""
+    return replace(options, height=float(height))

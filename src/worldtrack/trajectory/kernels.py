@@ -1,0 +1,268 @@
+"""Compiled kernels of the normal equations, each beside the NumPy reference it is tested against.
+
+At T = 100 000 an iteration touches arrays of tens of megabytes; done with NumPy, the scatters
+(adding the barrier samples' outer products into the blocks with ``np.add.at``, copying the blocks
+into LAPACK's band storage by fancy indexing) and the temporaries of the motion term dominate
+it. These are plain loops in Numba over buffers that are allocated once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+STATE = 6
+BANDWIDTH = 2 * STATE - 1
+
+
+@njit(cache=True)
+def add_motion_terms(X: np.ndarray, A: np.ndarray, W: np.ndarray, g: np.ndarray) -> float:  # pragma: no cover
+    """In place: the motion residuals r_t = W·(x_{t+1} − A·x_t) added into the half-gradient g (n, 6)
+    (∂r_t/∂x_t = −W·A, ∂r_t/∂x_{t+1} = W); returns Σ‖r_t‖². One pass, no temporaries."""
+    n = X.shape[0]
+    WA = W @ A
+    e = np.empty(STATE)
+    r = np.empty(STATE)
+    cost = 0.0
+    for t in range(n - 1):
+        for i in range(STATE):
+            acc = X[t + 1, i]
+            for j in range(STATE):
+                acc -= A[i, j] * X[t, j]
+            e[i] = acc
+        for i in range(STATE):
+            acc = 0.0
+            for j in range(STATE):
+                acc += W[i, j] * e[j]
+            r[i] = acc
+            cost += acc * acc
+        for j in range(STATE):
+            down, up = 0.0, 0.0
+            for i in range(STATE):
+                down += WA[i, j] * r[i]
+                up += W[i, j] * r[i]
+            g[t, j] -= down
+            g[t + 1, j] += up
+    return cost
+
+
+def add_motion_terms_reference(X: np.ndarray, A: np.ndarray, W: np.ndarray, g: np.ndarray) -> float:
+    """NumPy reference of :func:`add_motion_terms`."""
+    r = (X[1:] - X[:-1] @ A.T) @ W.T
+    g[:-1] -= r @ (W @ A)
+    g[1:] += r @ W
+    return float(np.sum(r * r))
+
+
+@njit(cache=True)
+def add_pair_terms(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray, J: np.ndarray,
+                   r: np.ndarray, weight: np.ndarray) -> None:  # pragma: no cover (compiled)
+    """In place: residuals r (M,) with Jacobians J (M, 12) on (x_t, x_{t+1}), t = step, added into
+    the diagonal blocks D and upper blocks B (as weight·JᵀJ) and the half-gradient g (as Jᵀr)."""
+    for m in range(step.shape[0]):
+        if r[m] == 0.0:                # a sample left out (beyond the barrier's reach): nothing to add
+            continue
+        t = step[m]
+        w = weight[m]
+        for i in range(2 * STATE):
+            ji = J[m, i]
+            if ji == 0.0:
+                continue
+            if i < STATE:
+                g[t, i] += ji * r[m]
+            else:
+                g[t + 1, i - STATE] += ji * r[m]
+            for j in range(2 * STATE):
+                v = w * ji * J[m, j]
+                if i < STATE and j < STATE:
+                    D[t, i, j] += v
+                elif i >= STATE and j >= STATE:
+                    D[t + 1, i - STATE, j - STATE] += v
+                elif i < STATE:
+                    B[t, i, j - STATE] += v
+
+
+def add_pair_terms_reference(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray, J: np.ndarray,
+                             r: np.ndarray, weight: np.ndarray) -> None:
+    """NumPy reference of :func:`add_pair_terms` (``np.add.at`` over the samples)."""
+    J0, J1 = J[:, :STATE], J[:, STATE:]
+    w = weight[:, None, None]
+    np.add.at(D, step, w * J0[:, :, None] * J0[:, None, :])
+    np.add.at(D, step + 1, w * J1[:, :, None] * J1[:, None, :])
+    np.add.at(B, step, w * J0[:, :, None] * J1[:, None, :])
+    np.add.at(g, step, J0 * r[:, None])
+    np.add.at(g, step + 1, J1 * r[:, None])
+
+
+@njit(cache=True)
+def block_matvec(D: np.ndarray, B: np.ndarray, x: np.ndarray) -> np.ndarray:  # pragma: no cover (compiled)
+    """H·x (n, 6) for the block-tridiagonal H of diagonal blocks D (n, 6, 6), upper blocks B (n − 1, 6, 6)."""
+    n = D.shape[0]
+    y = np.zeros_like(x)
+    for t in range(n):
+        for i in range(STATE):
+            acc = 0.0
+            for j in range(STATE):
+                acc += D[t, i, j] * x[t, j]
+                if t + 1 < n:
+                    acc += B[t, i, j] * x[t + 1, j]
+                if t > 0:
+                    acc += B[t - 1, j, i] * x[t - 1, j]
+            y[t, i] = acc
+    return y
+
+
+def block_matvec_reference(D: np.ndarray, B: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """NumPy reference of :func:`block_matvec`."""
+    y = np.einsum("nij,nj->ni", D, x)
+    y[:-1] += np.einsum("nij,nj->ni", B, x[1:])
+    y[1:] += np.einsum("nji,nj->ni", B, x[:-1])
+    return y
+
+
+@njit(cache=True)
+def block_cholesky_solve(D: np.ndarray, B: np.ndarray, damping: np.ndarray, rhs: np.ndarray, L: np.ndarray,
+                         C: np.ndarray, y: np.ndarray, x: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """Solve (H + diag(damping))·x = rhs for the SPD block-tridiagonal H of D (n, 6, 6), B (n − 1, 6, 6):
+    the banded Cholesky factorisation done block by block (S_t = D_t − C_{t−1}ᵀC_{t−1} = L_t·L_tᵀ,
+    C_t = L_t⁻¹·B_t, then forward and back substitution). L, C (n, 6, 6), y, x (n, 6) are work and
+    output buffers; returns False if H is not positive definite."""
+    n = D.shape[0]
+    S = np.empty((STATE, STATE))
+    for t in range(n):
+        # S = D_t + diag(damping_t) - C_{t-1}^T C_{t-1}
+        for i in range(STATE):
+            for j in range(i + 1):
+                acc = D[t, i, j]
+                if t > 0:
+                    for k in range(STATE):
+                        acc -= C[t - 1, k, i] * C[t - 1, k, j]
+                S[i, j] = acc
+            S[i, i] += damping[t, i]
+        # Cholesky S = L L^T (lower)
+        for j in range(STATE):
+            acc = S[j, j]
+            for k in range(j):
+                acc -= L[t, j, k] * L[t, j, k]
+            if not acc > 0.0:
+                return False
+            d = np.sqrt(acc)
+            L[t, j, j] = d
+            for i in range(j + 1, STATE):
+                acc = S[i, j]
+                for k in range(j):
+                    acc -= L[t, i, k] * L[t, j, k]
+                L[t, i, j] = acc / d
+            for i in range(j):
+                L[t, i, j] = 0.0
+        # forward: y_t = L^-1 (rhs_t - C_{t-1}^T y_{t-1})
+        for i in range(STATE):
+            acc = rhs[t, i]
+            if t > 0:
+                for k in range(STATE):
+                    acc -= C[t - 1, k, i] * y[t - 1, k]
+            for k in range(i):
+                acc -= L[t, i, k] * y[t, k]
+            y[t, i] = acc / L[t, i, i]
+        # C_t = L^-1 B_t
+        if t < n - 1:
+            for col in range(STATE):
+                for i in range(STATE):
+                    acc = B[t, i, col]
+                    for k in range(i):
+                        acc -= L[t, i, k] * C[t, k, col]
+                    C[t, i, col] = acc / L[t, i, i]
+    for t in range(n - 1, -1, -1):
+        for i in range(STATE - 1, -1, -1):
+            acc = y[t, i]
+            if t < n - 1:
+                for k in range(STATE):
+                    acc -= C[t, i, k] * x[t + 1, k]
+            for k in range(i + 1, STATE):
+                acc -= L[t, k, i] * x[t, k]
+            x[t, i] = acc / L[t, i, i]
+    return True
+
+
+@njit(cache=True)
+def fill_banded(D: np.ndarray, B: np.ndarray, ab: np.ndarray) -> None:  # pragma: no cover (compiled)
+    """In place: LAPACK upper band storage ``ab[u + i − j, j] = H[i, j]`` (u = 11) of the
+    block-tridiagonal H with diagonal blocks D (n, 6, 6) and upper blocks B (n − 1, 6, 6)."""
+    n = D.shape[0]
+    for t in range(n):
+        for b in range(STATE):
+            col = STATE * t + b
+            for a in range(b + 1):
+                ab[BANDWIDTH + a - b, col] = D[t, a, b]
+            if t > 0:
+                for a in range(STATE):
+                    ab[BANDWIDTH - STATE + a - b, col] = B[t - 1, a, b]
+
+
+def fill_banded_reference(D: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """NumPy reference of :func:`fill_banded`: the band storage (12, 6n) by fancy indexing."""
+    n = len(D)
+    ab = np.zeros((BANDWIDTH + 1, STATE * n))
+    a, b = np.triu_indices(STATE)
+    t = np.arange(n)[:, None]
+    ab[BANDWIDTH + a - b, STATE * t + b] = D[:, a, b]
+    ao, bo = np.indices((STATE, STATE)).reshape(2, -1)
+    ab[BANDWIDTH + ao - bo - STATE, STATE * (t[:-1] + 1) + bo] = B.reshape(n - 1, -1)
+    return ab
+
+
+@njit(cache=True)
+def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: float, values: np.ndarray,
+                    origin: np.ndarray, res: float, clearance: float, softness: float,
+                    gain: float):  # pragma: no cover (compiled)
+    """The barrier at every sample in one pass (see ``environment.barrier_samples_reference``):
+    Hermite point of (x_t, x_{t+1}) at α, bilinear distance and gradient (extrapolated outside the
+    grid), rounded hinge r, its Jacobian J (M, 12), the distance d (M,) and the curvature factor."""
+    m_count = step.shape[0]
+    ny, nx = values.shape
+    hi_x = origin[0] + res * (nx - 1)
+    hi_y = origin[1] + res * (ny - 1)
+    r = np.empty(m_count)
+    J = np.zeros((m_count, 2 * STATE))
+    d_out = np.empty(m_count)
+    curvature = np.empty(m_count)
+    for m in range(m_count):
+        t, a = step[m], alpha[m]
+        h0 = 2 * a ** 3 - 3 * a ** 2 + 1
+        h1 = (a ** 3 - 2 * a ** 2 + a) * dt
+        h2 = -2 * a ** 3 + 3 * a ** 2
+        h3 = (a ** 3 - a ** 2) * dt
+        px = h0 * X[t, 0] + h1 * X[t, 1] + h2 * X[t + 1, 0] + h3 * X[t + 1, 1]
+        py = h0 * X[t, 2] + h1 * X[t, 3] + h2 * X[t + 1, 2] + h3 * X[t + 1, 3]
+        cx = min(max(px, origin[0]), hi_x)
+        cy = min(max(py, origin[1]), hi_y)
+        fi = (cx - origin[0]) / res
+        fj = (cy - origin[1]) / res
+        i0 = min(int(fi), nx - 2)
+        j0 = min(int(fj), ny - 2)
+        u, v = fi - i0, fj - j0
+        v00, v01 = values[j0, i0], values[j0, i0 + 1]
+        v10, v11 = values[j0 + 1, i0], values[j0 + 1, i0 + 1]
+        d = (1 - u) * (1 - v) * v00 + u * (1 - v) * v01 + (1 - u) * v * v10 + u * v * v11
+        gx = ((1 - v) * (v01 - v00) + v * (v11 - v10)) / res
+        gy = ((1 - u) * (v10 - v00) + u * (v11 - v01)) / res
+        ox, oy = cx - px, cy - py
+        gap = np.sqrt(ox * ox + oy * oy)
+        if gap > 0:                    # d(p) = d(c(p)) − |c(p) − p|, c the clamped point
+            d -= gap
+            gx = (0.0 if ox != 0 else gx) + ox / gap
+            gy = (0.0 if oy != 0 else gy) + oy / gap
+        z = (clearance - d) / softness
+        d_out[m] = d
+        if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
+            r[m] = 0.0
+            curvature[m] = 1.0
+            continue
+        soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
+        sig = 1.0 / (1.0 + np.exp(-z))
+        r[m] = gain * softness * soft
+        curvature[m] = 1.0 + r[m] * (1.0 - sig) / (gain * softness * sig)
+        sx, sy = -gain * sig * gx, -gain * sig * gy
+        J[m, 0], J[m, 1], J[m, 6], J[m, 7] = sx * h0, sx * h1, sx * h2, sx * h3
+        J[m, 2], J[m, 3], J[m, 8], J[m, 9] = sy * h0, sy * h1, sy * h2, sy * h3
+    return r, J, d_out, curvature

@@ -1,0 +1,170 @@
+"""The objective of eq. 9 and its Gauss–Newton normal equations in block-tridiagonal form.
+
+    F(X) = Xᵀ·Λ_X·X  +  Σ_(t,i)∈o ρ(‖(π_i(x_t) − y_t^i)/σ‖)  −  λ·Σ_t (e_h + e_v)
+
+(ρ(e) = e², or Huber's e² / 2ke − k² with ``robust = k``). Every residual touches one state
+(observations, height) or two neighbouring states (motion, barrier samples), so JᵀJ is
+block-tridiagonal with 6 × 6 blocks: ``D[t]`` on the diagonal, ``B[t] = H[t, t+1]`` above it.
+Assembly is vectorised over all steps; no Python loop runs over time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from worldtrack.trajectory.environment import (EnvironmentModel, barrier_residuals, height_residuals)
+from worldtrack.trajectory.kernels import add_motion_terms, add_pair_terms
+from worldtrack.trajectory.model import STATE, MotionPrior, TimeGrid, motion_blocks, motion_residuals
+from worldtrack.trajectory.observation import ObservationTerm, Observations
+
+_W = 4  # index of the head height w in the state
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """One person's MAP problem: grid, observations, motion prior, environment, robust loss.
+
+    Parameters
+    ----------
+    grid : TimeGrid
+    observations : ObservationTerm
+    motion : MotionPrior
+    environment : EnvironmentModel
+    robust : float or None — Huber threshold in σ (e.g. 3.0); None = plain squares
+    """
+
+    grid: TimeGrid
+    observations: ObservationTerm
+    motion: MotionPrior
+    environment: EnvironmentModel
+    robust: float | None = None
+
+    @classmethod
+    def build(cls, obs: Observations, grid: TimeGrid, motion: MotionPrior, environment: EnvironmentModel,
+              robust: float | None = None) -> "Problem":
+        return cls(grid, ObservationTerm.on_grid(obs, grid), motion, environment, robust)
+
+    def with_environment(self, environment: EnvironmentModel) -> "Problem":
+        return Problem(self.grid, self.observations, self.motion, environment, self.robust)
+
+    @cached_property
+    def A(self) -> np.ndarray:
+        return self.motion.transition(self.grid.dt)
+
+    @cached_property
+    def W(self) -> np.ndarray:
+        return self.motion.whitener(self.grid.dt)
+
+    @cached_property
+    def motion_normal(self) -> tuple[np.ndarray, np.ndarray]:
+        """Λ_X as blocks (D, B) — constant, computed once."""
+        return motion_blocks(self.A, self.W, self.grid.n)
+
+    @cached_property
+    def observation_groups(self) -> tuple[np.ndarray, np.ndarray]:
+        """(first row of each run of equal steps, that step): observations are in time order."""
+        step = self.observations.step
+        starts = np.flatnonzero(np.r_[True, step[1:] != step[:-1]])
+        return starts, step[starts]
+
+
+@dataclass
+class Costs:
+    """Each term of the objective at a trajectory (sums of squared whitened residuals)."""
+
+    motion: float
+    observation: float
+    barrier: float
+    height: float
+
+    @property
+    def total(self) -> float:
+        return self.motion + self.observation + self.barrier + self.height
+
+    def as_dict(self) -> dict[str, float]:
+        return {"motion": self.motion, "observation": self.observation, "barrier": self.barrier,
+                "height": self.height, "total": self.total}
+
+
+@dataclass
+class Linearisation:
+    """Costs, half-gradient g = Jᵀ·Wr (n, 6) and Gauss–Newton blocks D (n, 6, 6), B (n − 1, 6, 6)."""
+
+    costs: Costs
+    g: np.ndarray
+    D: np.ndarray
+    B: np.ndarray
+    barrier_steps: np.ndarray
+
+
+def huber(e: np.ndarray, k: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """ρ(e) and the IRLS weight ρ'(e)/(2e) for residual norms e ≥ 0 (k None: e² and 1)."""
+    if k is None:
+        return e * e, np.ones_like(e)
+    big = e > k
+    rho = np.where(big, 2 * k * e - k * k, e * e)
+    weight = np.where(big, k / np.where(big, e, 1.0), 1.0)
+    return rho, weight
+
+
+def evaluate(problem: Problem, X: np.ndarray) -> Costs:
+    """The objective's terms at X (n, 6); ``inf`` observation cost if a head goes behind a camera."""
+    rm = motion_residuals(X, problem.A, problem.W)
+    r, _, depth = problem.observations.residuals(X, with_jacobian=False)
+    rho, _ = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
+    obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
+    env = problem.environment
+    barrier = height = 0.0
+    if env.barrier is not None:
+        br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt)
+        barrier = float(br.r @ br.r)
+    if env.height is not None:
+        rh, _ = height_residuals(X, env.height, env.weight)
+        height = float(rh @ rh)
+    return Costs(float(np.sum(rm * rm)), obs_cost, barrier, height)
+
+
+def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None) -> Linearisation:
+    """Costs, gradient and the block-tridiagonal Gauss–Newton matrix at X (n, 6).
+
+    ``out``: a linearisation of the same problem whose arrays are overwritten (an iteration's
+    tens of megabytes are then allocated once, not every time).
+    """
+    n = problem.grid.n
+    D0, B0 = problem.motion_normal
+    if out is None:
+        D, B, g, barrier_steps = np.empty_like(D0), np.empty_like(B0), np.empty((n, STATE)), np.empty(n, dtype=bool)
+    else:
+        D, B, g, barrier_steps = out.D, out.B, out.g, out.barrier_steps
+    np.copyto(D, D0)                                 # Λ_X, then the other terms on top
+    np.copyto(B, B0)
+    g.fill(0.0)
+    barrier_steps.fill(False)
+    motion_cost = add_motion_terms(X, problem.A, problem.W, g)
+    # observations, each on one state; rows come in runs of equal steps (time order)
+    r, J, depth = problem.observations.residuals(X)
+    rho, w = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
+    starts, steps = problem.observation_groups
+    JtJ = np.einsum("nki,nkj->nij", J, J * w[:, None, None])
+    Jtr = np.einsum("nki,nk->ni", J, r * w[:, None])
+    D[steps] += np.add.reduceat(JtJ, starts, axis=0)
+    g[steps] += np.add.reduceat(Jtr, starts, axis=0)
+    obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
+    env = problem.environment
+    barrier_cost = height_cost = 0.0
+    if env.barrier is not None:
+        br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
+        if len(br.r):
+            add_pair_terms(D, B, g, br.step, br.J, br.r, br.curvature)      # skips the r = 0 samples
+            barrier_cost = float(br.r @ br.r)
+            barrier_steps[br.step[br.inside]] = True
+    if env.height is not None:
+        rh, gain = height_residuals(X, env.height, env.weight)
+        D[:, _W, _W] += gain * gain
+        g[:, _W] += gain * rh
+        height_cost = float(rh @ rh)
+    costs = Costs(motion_cost, obs_cost, barrier_cost, height_cost)
+    return Linearisation(costs, g, D, B, barrier_steps)

@@ -1,0 +1,64 @@
+"""The 14-DoF upper body: kinematics (eqs. 11–15), the rotation mean, and tracking a synthetic body."""
+
+import numpy as np
+import pytest
+
+from worldtrack.geometry.rotation import rot_y, rot_z
+from worldtrack.pose import axis_angle_deg
+from worldtrack.pose.body import body_geometry, body_transforms, body_transforms_reference, limb_axes
+from worldtrack.pose.body_tracker import BodyConfig, BodyTracker, mean_body_pose
+from worldtrack.synth.upper_body import body_sequence
+
+
+def test_transforms_match_4x4_products():
+    m = body_geometry(0.02)
+    p = np.random.default_rng(0).normal(0, 0.8, (6, 14))
+    np.testing.assert_allclose(body_transforms(p, m), body_transforms_reference(p, m), atol=1e-12)
+
+
+def test_joint_geometry():
+    m = body_geometry(0.02)
+    p = np.zeros(14)
+    p[2] = 2.0
+    T = body_transforms(p, m)[0]
+    np.testing.assert_allclose(T[1, :, 3], m.shoulder[0] + [0, 0, 2.0])           # shoulder at t_S
+    np.testing.assert_allclose(T[2, :, 3], T[1, :, 3] + [m.elbow[0][0], 0, 0])     # elbow at t_E along the arm
+    ax = limb_axes(p[None], m)
+    np.testing.assert_allclose(ax["l_upper_arm"][0], [1, 0, 0], atol=1e-12)        # rest: arms point outwards
+    np.testing.assert_allclose(ax["r_upper_arm"][0], [-1, 0, 0], atol=1e-12)
+    q = p.copy()
+    q[8] = np.radians(90)                                                           # left elbow Rz by 90°
+    assert float(axis_angle_deg(limb_axes(q[None], m)["l_forearm"][0], [1, 0, 0])) == pytest.approx(90)
+    assert float(axis_angle_deg(limb_axes(q[None], m)["l_upper_arm"][0], [1, 0, 0])) == pytest.approx(0, abs=1e-9)
+
+
+def test_mean_pose_uses_rotation_means():
+    P = np.zeros((2, 14))
+    P[:, 6] = [np.radians(170), np.radians(-170)]                  # angles across ±180°
+    m = mean_body_pose(P, np.array([0.5, 0.5]))
+    R = rot_z(m[6]) @ rot_y(m[7])
+    np.testing.assert_allclose(R, rot_z(np.pi), atol=1e-9)        # not the naive 0°
+
+
+def test_tracks_a_synthetic_upper_body():
+    seq = body_sequence(2, n_frames=6, size=(320, 240))
+    frames = [seq.render(k) for k in range(6)]
+    tr = BodyTracker(seq.true_model, seq.intr, frames[0].params, BodyConfig(n_candidates=400, lm_iterations=8))
+    errs = []
+    for f in frames[1:]:
+        est = tr.step(f.image, f.depth)
+        ax = limb_axes(est.params[None], seq.true_model)
+        errs.append([float(axis_angle_deg(f.axes[n], ax[n][0])) for n in f.axes])
+    errs = np.array(errs)
+    assert errs.mean() < 3.0 and errs.max() < 8.0, errs
+    assert abs(est.params[2] - frames[-1].params[2]) < 0.02
+
+
+def test_elbow_limit_keeps_the_forearm_off_the_upper_arm():
+    from worldtrack.pose.body import BodySpace
+
+    space = BodySpace(model=body_geometry(0.05), elbow_limit=np.radians(150))
+    X = np.zeros((1, 14))
+    out = space.retract(X, np.r_[[0] * 8, np.radians(170), 0, 0, 0, np.radians(-200), np.radians(30)][None])
+    np.testing.assert_allclose(np.degrees(out[0, [8, 12, 13]]), [150, -150, 30])
+    assert BodySpace(model=body_geometry(0.05)).retract(X, np.full((1, 14), 4.0))[0, 8] == 4.0   # no limit

@@ -1,0 +1,64 @@
+"""Births: proposals from unexplained foreground, and where people may appear (components by name)."""
+
+import numpy as np
+import pytest
+from _ellipsoid_seen import one_person_seen
+
+from worldtrack.errors import InputError
+from worldtrack.pipeline import make_foregrounds
+from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
+from worldtrack.trackers.ellipsoid.args import People
+from worldtrack.trackers.ellipsoid.births import BIRTH_PLACES, Anywhere, InEntryRegions, Nowhere
+
+
+def _proposals(tracker, people=People(np.zeros((0, 2)), np.zeros(0), np.zeros(0)), first_frame=True):
+    return tracker.births.propose(dict(tracker.last_masks), people, first_frame)
+
+
+def test_a_person_nobody_explains_is_proposed_at_their_feet_by_each_camera_once():
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    proposals = _proposals(tracker)
+    # Both cameras' blobs point at the same person: the second is within min_separation_m of the
+    # first and is dropped. The proposer is recorded.
+    assert len(proposals) == 1
+    xy, cid = proposals[0]
+    assert cid in scene.cameras and np.hypot(*(xy - person)) < 0.35
+    # A person already there explains the blob: nothing proposed.
+    assert _proposals(tracker, People(person[None], np.array([1.65]), np.array([0.4]))) == []
+
+
+def test_stepping_records_the_proposing_camera_on_the_person_not_in_the_output():
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    for config in (EllipsoidConfig(), EllipsoidConfig.paper()):
+        fresh = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), config)
+        reported = fresh.step(images, 0.0)
+        assert reported and all(tr.extra == {} for tr in reported)
+        assert all(p.birth_camera in scene.cameras for p in fresh.position_map)
+
+
+def test_where_people_may_appear_is_a_component_chosen_by_name():
+    assert isinstance(BIRTH_PLACES["anywhere"](), Anywhere)
+    assert isinstance(BIRTH_PLACES["entry"](), InEntryRegions) and isinstance(BIRTH_PLACES["none"](), Nowhere)
+    with pytest.raises(InputError, match=r"^ellipsoid\.births\.where: expected one of anywhere, entry, none, got 'door'$"):
+        BIRTH_PLACES["door"]
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    never = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(births={"where": "none"}))
+    assert never.step(images, 0.0) == [] and len(never.position_map) == 0
+    # Only in entry regions after the first frame: this scene has none, so anywhere.
+    entry = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), EllipsoidConfig(births={"where": "entry"}))
+    entry.last_masks = tracker.last_masks
+    assert len(_proposals(entry, first_frame=False)) == 1
+
+
+def test_entry_regions_keep_only_proposals_inside_them_after_the_first_frame():
+    class Scene:
+        entry_regions = ["door"]
+
+        @staticmethod
+        def entry_region_index(points):
+            return np.array([0 if p[0] > 0 else -1 for p in points])
+
+    proposals = [(np.array([1.0, 0.0]), "c1"), (np.array([-1.0, 0.0]), "c2")]
+    entry = InEntryRegions()
+    assert entry.keep(proposals, Scene, first_frame=True) == proposals
+    assert [cid for _, cid in entry.keep(proposals, Scene, first_frame=False)] == ["c1"]
