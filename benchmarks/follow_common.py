@@ -12,6 +12,8 @@ a route clear of the kiosk, a robot that steers round obstacles, and others who 
 
 from __future__ import annotations
 
+import pickle
+import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -187,3 +189,30 @@ def person_candidate_d(step, people_ids: np.ndarray, people_xy: np.ndarray) -> d
     """{person id: D of the candidate matched to them} for one synthetic frame."""
     m = match_candidates(step.candidates.xy, people_xy)
     return {int(pid): float(step.D[j]) for pid, j in zip(people_ids, m) if j >= 0}
+
+
+# ------------------------------------------------------------------------------------ per-seed cache
+
+def seed_cached(cache: str | None, key: str, compute):
+    """``compute()``, or its result kept from an earlier run under ``cache/key-<src>.pkl`` (``<src>``: the
+    committed tree of ``src/``, so a change to worldtrack starts afresh; commit before using it).
+
+    Long benchmarks (a seed takes minutes on a shared core) keep each seed's records, so seeds can be
+    run in several processes (``--seeds 0-4`` and ``--seeds 5-9`` with the same ``--cache``) and a
+    last run over all of them only tabulates. Without ``cache`` it is ``compute()``.
+    """
+    if not cache:
+        return compute()
+    tree = subprocess.run(["git", "rev-parse", "--short", "HEAD:src"], cwd=ROOT, capture_output=True,
+                          text=True).stdout.strip() or "unknown"
+    path = Path(cache) / f"{key}-{tree}.pkl"
+    if path.exists():
+        with open(path, "rb") as f:
+            return pickle.load(f)
+    value = compute()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    with open(tmp, "wb") as f:
+        pickle.dump(value, f)
+    tmp.replace(path)
+    return value

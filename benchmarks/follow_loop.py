@@ -27,7 +27,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from follow_common import SCENARIO  # noqa: E402
+from follow_common import SCENARIO, seed_cached  # noqa: E402
 from follow_synth import parse_seeds  # noqa: E402
 
 from worldtrack.follow import PIDFollower  # noqa: E402
@@ -57,6 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", default="0-9")
     ap.add_argument("--frames", type=int, default=1500)
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
+    ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     args = ap.parse_args(argv)
     seeds = [100] if args.quick else parse_seeds(args.seeds)
     frames = 200 if args.quick else args.frames
@@ -65,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     totals = {"contacts": 0, "collisions": 0, "bumps": 0}
     for seed in seeds:
         ts = time.perf_counter()
-        s = run_seed(seed, frames, (160, 120))
+        s = seed_cached(args.cache, f"loop-{seed}-{frames}", lambda: run_seed(seed, frames, (160, 120)))
         r = s["result"]
         err = np.abs(r.distance - DISTANCE)
         all_within.append(s["within"])

@@ -33,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from follow_common import SCENARIO, person_candidate_d  # noqa: E402
+from follow_common import SCENARIO, person_candidate_d, seed_cached  # noqa: E402
 
 from worldtrack.eval.follow import counts, counts_by, follow_labels, reacquisitions, swaps  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth  # noqa: E402
@@ -176,6 +176,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--frames", type=int, default=1500)
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--quick", action="store_true", help="dev seeds 100, 101 × 300 frames (a smoke run; prints only)")
+    ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     args = ap.parse_args(argv)
     seeds = [100, 101] if args.quick else parse_seeds(args.seeds)       # quick: development seeds
     frames = 300 if args.quick else args.frames
@@ -184,7 +185,8 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     for seed in seeds:
         ts = time.perf_counter()
-        results.append(run_seed(seed, frames, size, VARIANTS))
+        results.append(seed_cached(args.cache, f"synth-{seed}-{frames}-{size[0]}x{size[1]}",
+                                   lambda: run_seed(seed, frames, size, VARIANTS)))
         d = summarise(results[-1:], "worldtrack default")
         print(f"seed {seed}: default precision {d['all'].precision:.4f} recall {d['all'].recall:.4f} "
               f"swaps {sum(d['swaps'])} ({time.perf_counter() - ts:.0f} s)", file=sys.stderr, flush=True)
