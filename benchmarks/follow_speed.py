@@ -62,7 +62,7 @@ def time_follow(sc, views, repeats: int) -> tuple[list[float], dict]:
         for b, v in views:
             t0 = time.perf_counter()
             depth = disparity_to_depth(v.disparity, fx, BASELINE)
-            frame = Frame(v.image, b.time, b.frame, depth, {"wb_gains": v.wb_gains})
+            frame = Frame(v.image, b.time, b.frame, depth, meta={"wb_gains": v.wb_gains})
             start = (b.gt[0]["x"], b.gt[0]["y"]) if b.frame == 0 else None
             tracker.follow(frame, v.camera, start_xy=start)
             if b.frame > 0:

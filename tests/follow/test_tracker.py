@@ -65,7 +65,8 @@ def test_start_needs_somebody_near_the_given_position_and_depth_of_the_image_siz
     with pytest.raises(InputError, match="nobody found within 1 m"):
         tracker.start(frame_from_synth(b), b.views["robot"].camera, (1.0, 11.0))
     frame = frame_from_synth(b)
-    bad = Frame(frame.image, frame.t, 0, frame.depth[:, :-2], frame.meta)
+    assert frame.meta["wb_gains"] == tuple(b.views["robot"].wb_gains) and frame.disparity is None
+    bad = Frame(frame.image, frame.t, 0, frame.depth[:, :-2], meta=frame.meta)
     with pytest.raises(InputError, match="depth is 158x120 but the colour image is 160x120"):
         tracker.observe(bad, b.views["robot"].camera)
     with pytest.raises(InputError, match="start"):

@@ -123,7 +123,8 @@ def observation_from_boxes(image: np.ndarray, boxes: np.ndarray, xy: np.ndarray,
 def frame_from_synth(bundle, camera_id: str = "robot") -> Frame:
     """A :class:`~worldtrack.io.sources.Frame` (image, measured depth, gains) from a synthetic bundle."""
     v = bundle.views[camera_id]
-    return Frame(v.image, float(bundle.time), int(bundle.frame), v.sensor_depth, {"wb_gains": tuple(v.wb_gains)})
+    return Frame(v.image, float(bundle.time), int(bundle.frame), v.sensor_depth,
+                 meta={"wb_gains": tuple(v.wb_gains)})
 
 
 class FollowTracker:

@@ -167,7 +167,7 @@ class RGBDSource:
                     if i not in self.poses:
                         raise InputError(f"camera_poses.csv: no pose of camera {cam.id!r} for frame {i}")
                     cam = cam.moved(*self.poses[i])
-                yield Frame(img, t, i, depth, meta), cam
+                yield Frame(img, t, i, depth, meta=meta), cam
                 i += 1
         finally:
             self.reader.close()
