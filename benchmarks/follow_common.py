@@ -23,6 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import DATA, ROOT  # noqa: E402
+from real_data import read_video  # noqa: E402
 
 from worldtrack.eval.follow import match_candidates  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker  # noqa: E402
@@ -98,14 +99,7 @@ def load_pets(limit: int | None = None) -> PetsData | None:
         return None
     cam = load_scene(PETS_SCENE).camera("View_001")
     table = boxes_to_world(read_boxes(gt_path), cam, scale=PETS_SCALE, fps=PETS_FPS).table
-    cap = cv2.VideoCapture(str(video))
-    frames = []
-    while limit is None or len(frames) < limit:
-        ok, img = cap.read()
-        if not ok:
-            break
-        frames.append(img)
-    cap.release()
+    frames = read_video(video, limit)
     ids, xy, boxes, visible = [], [], [], []
     ex = table.extra
     for k in range(len(frames)):
