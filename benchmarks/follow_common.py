@@ -13,6 +13,7 @@ a route clear of the kiosk, a robot that steers round obstacles, and others who 
 from __future__ import annotations
 
 import pickle
+import shlex
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -22,7 +23,7 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import DATA, ROOT  # noqa: E402
+from common import DATA, ROOT, save_result, write_result  # noqa: E402
 from real_data import read_video  # noqa: E402
 
 from worldtrack.eval.follow import match_candidates  # noqa: E402
@@ -210,3 +211,15 @@ def seed_cached(cache: str | None, key: str, compute):
         pickle.dump(value, f)
     tmp.replace(path)
     return value
+
+
+def save_tagged(name: str, tag: str, title: str, text: str, quick: bool, seconds: float) -> None:
+    """:func:`common.save_result`, or with ``tag`` ``results/<name><tag>.md`` (a run beside the main one)
+    whose Command line still names ``benchmarks/<name>.py``."""
+    if not tag or quick:
+        save_result(name, title, text, quick, seconds)
+        return
+    args = " ".join(shlex.quote(a) for a in sys.argv[1:])
+    path = write_result(name + tag, title, f"Command: `.venv/bin/python benchmarks/{name}.py {args}` ({seconds:.0f} s)"
+                                           f"\n\n{text}")
+    print(f"wrote {path} in {seconds:.0f} s", file=sys.stderr)

@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from follow_common import SCENARIO, seed_cached  # noqa: E402
+from common import markdown_table  # noqa: E402
+from follow_common import SCENARIO, save_tagged, seed_cached  # noqa: E402
 from follow_synth import parse_seeds  # noqa: E402
 
 from worldtrack.follow import PIDFollower  # noqa: E402
@@ -58,6 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--frames", type=int, default=1500)
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
+    ap.add_argument("--tag", default="", help=f"write results/{name}<TAG>.md (a run beside the main one)")
     args = ap.parse_args(argv)
     seeds = [100] if args.quick else parse_seeds(args.seeds)
     frames = 200 if args.quick else args.frames
@@ -93,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
             f"**{totals['collisions']}** frames; contacts of any kind {totals['contacts']}; bumper stops "
             f"{totals['bumps']}\n\n{table}\n")
     print(text)
-    save_result("follow_loop", "The closed loop: a simulated robot follows (seed 001)", text, args.quick,
+    save_tagged("follow_loop", args.tag, "The closed loop: a simulated robot follows (seed 001)", text, args.quick,
                 time.perf_counter() - t0)
     return 0
 

@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from follow_common import SCENARIO, person_candidate_d, seed_cached  # noqa: E402
+from common import markdown_table  # noqa: E402
+from follow_common import SCENARIO, person_candidate_d, save_tagged, seed_cached  # noqa: E402
 
 from worldtrack.eval.follow import counts, counts_by, follow_labels, reacquisitions, swaps  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth  # noqa: E402
@@ -177,6 +177,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--quick", action="store_true", help="dev seeds 100, 101 × 300 frames (a smoke run; prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
+    ap.add_argument("--tag", default="", help=f"write results/{name}<TAG>.md (a run beside the main one)")
     args = ap.parse_args(argv)
     seeds = [100, 101] if args.quick else parse_seeds(args.seeds)       # quick: development seeds
     frames = 300 if args.quick else args.frames
@@ -195,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
             f"`follow-target` with {', '.join(f'{k}={v}' for k, v in SCENARIO.items())}. ms/frame: the follower "
             f"alone (detection, colour, decision), one core.\n\n" + tables(summaries, len(seeds)) + "\n")
     print(text)
-    save_result("follow_synth", "Following one target in the synthetic courtyard (seed 001)", text, args.quick,
+    save_tagged("follow_synth", args.tag, "Following one target in the synthetic courtyard (seed 001)", text, args.quick,
                 time.perf_counter() - t0)
     return 0
 
