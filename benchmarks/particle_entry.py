@@ -37,7 +37,7 @@ Usage::
     .venv/bin/python benchmarks/particle_entry.py                  # 3 seeds × 2 tracker seeds, 320x240, all configs
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 1 2 3 4 5 --tracker-seeds 0 1 2 --configs default-column --jobs 2
     .venv/bin/python benchmarks/particle_entry.py --seeds 0 --configs default-column
-    .venv/bin/python benchmarks/particle_entry.py --set likelihood.gamma=30 --set detection.alpha=0.4
+    .venv/bin/python benchmarks/particle_entry.py --threshold 25 --set detection.alpha=0.4
     .venv/bin/python benchmarks/particle_entry.py --scenario limb_swing=0 --configs default-column --no-single
         # walkers glide (no leg or arm swing): the error the gait causes is the difference
 
@@ -60,7 +60,7 @@ from common import markdown_table, render_images, write_result  # noqa: E402
 from worldtrack.config import parse_assignment, with_overrides  # noqa: E402
 from worldtrack.eval import evaluate_detailed  # noqa: E402
 from worldtrack.experiment import gt_table  # noqa: E402
-from worldtrack.foreground.background import StaticBackground  # noqa: E402
+from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
@@ -107,10 +107,20 @@ def render(seed: int, size: tuple[int, int], **overrides) -> Sequence:
     return Sequence(seed, sc, render_images(sc), sc.background("cam"))
 
 
+#: The foreground's colour threshold (the particle tracker's γ): the synthetic world's, as every
+#: synthetic benchmark uses (``--threshold``).
+THRESHOLD = [SYNTHETIC_COLOUR_THRESHOLD]
+
+
+def foreground(seq: Sequence) -> dict:
+    """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart)."""
+    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, "colour", THRESHOLD[0])
+
+
 def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
     """Track the sequence; (predictions, seconds per frame)."""
     sc = seq.scenario
-    tracker = ParticleTracker(sc.scene, {"cam": StaticBackground(seq.background, 30.0, "colour")}, config)
+    tracker = ParticleTracker(sc.scene, foreground(seq), config)
     rows = []
     t0 = time.perf_counter()
     for k, img in enumerate(seq.images):
@@ -300,7 +310,7 @@ def given_starts(seq: Sequence, config: ParticleConfig) -> dict:
     """
     sc = seq.scenario
     alone = _config(config, {"detection.births": "none", "split.enabled": False, "merge.enabled": False})
-    tracker = ParticleTracker(sc.scene, {"cam": StaticBackground(seq.background, 30.0, "colour")}, alone)
+    tracker = ParticleTracker(sc.scene, foreground(seq), alone)
     started: set[int] = set()
     errors, near, alive = [], [], []
     for k, (img, gt) in enumerate(zip(seq.images, seq.gt)):
@@ -388,7 +398,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--size", default="320x240")
     p.add_argument("--configs", nargs="+", default=list(CONFIGS), choices=list(CONFIGS))
     p.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
-                   help="set a field of every configuration by its dotted path (e.g. likelihood.gamma=30)")
+                   help="set a field of every configuration by its dotted path (e.g. detection.alpha=0.4)")
     p.add_argument("--scenario", action="append", default=[], metavar="NAME=VALUE",
                    help="override a scenario option (e.g. shadow_strength=0)")
     p.add_argument("--no-single", action="store_true", help="skip the runs with filters started on the truth")
@@ -396,7 +406,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", default=None, metavar="PATH", help="also write every run's figures as JSON")
     p.add_argument("--name", default="particle_entry", help="result file benchmarks/results/NAME.md")
     p.add_argument("--no-write", action="store_true")
+    p.add_argument("--threshold", type=float, default=SYNTHETIC_COLOUR_THRESHOLD,
+                   help=f"the foreground's colour threshold, the particle tracker's γ (default {SYNTHETIC_COLOUR_THRESHOLD:g})")
     args = p.parse_args(argv)
+    THRESHOLD[0] = args.threshold
     w, h = (int(v) for v in args.size.lower().split("x"))
     options = dict(parse_assignment(s) for s in args.set)
     for name in args.configs:

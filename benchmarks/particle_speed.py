@@ -43,7 +43,7 @@ from worldtrack.foreground.background import StaticBackground  # noqa: E402
 from worldtrack.geometry.quadric import ellipse_mask, ellipsoid_conics, person_ellipsoid  # noqa: E402
 from worldtrack.scene import scene_from_dict  # noqa: E402
 from worldtrack.config import with_overrides  # noqa: E402
-from worldtrack.foreground.shadows import floor_pixels, hit_image, hit_labels, hit_labels_reference  # noqa: E402
+from worldtrack.foreground.shadows import floor_pixels, read_shadows, read_shadows_reference  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker, image_box  # noqa: E402
 from worldtrack.trackers.particle.likelihood import (CameraLikelihood, column_counts_reference,  # noqa: E402
                                                      column_heights, column_spec, edge_spec, owner_image,
@@ -79,7 +79,7 @@ def render(cam, bg, xy, rng) -> np.ndarray:
 
 def step_time(config: ParticleConfig, k: int, scene, bg, frames) -> float:
     """Median seconds per ``step`` with k tracking filters."""
-    tracker = ParticleTracker(scene, {"cam": StaticBackground(bg, 30.0, "colour")}, config)
+    tracker = ParticleTracker(scene, {"cam": StaticBackground(bg, 30.0, "colour", shadows=True)}, config)
     for x, y in people_at(k, 0):
         tracker.init_track(x, y)
     times = []
@@ -107,15 +107,13 @@ def main() -> int:
 
     # Per-frame image preparation, as ParticleTracker._images does it (shadows only on the floor).
     img = render(cam, bg, people_at(10, 0), rng)
-    fg = StaticBackground(bg, 30.0, "colour")
+    fg = StaticBackground(bg, 30.0, "colour", shadows=True)
     floor = floor_pixels(cam, scene.walkable.raster(0.01))
-    gamma = configs["default"].likelihood.gamma
-    prep = {"F = colour distance, F > γ (paper)": median_time(lambda: hit_image(fg.difference(img), gamma)),
-            "shadow-free F > γ (Numba, default)": median_time(lambda: hit_labels(img, bg, gamma, where=floor,
-                                                                                 shadow=0)),
-            "shadow-free F > γ (NumPy reference)": median_time(lambda: hit_labels_reference(img, bg, gamma,
-                                                                                            where=floor, shadow=0),
-                                                               repeats=5)}
+    labels = fg.labels(img)
+    prep = {"foreground labels, F > γ with shadow-like changes apart": median_time(lambda: fg.labels(img)),
+            "shadows judged on the floor (Numba, default)": median_time(lambda: read_shadows(labels, img, bg, floor, 0)),
+            "shadows judged (box-filter reference)": median_time(lambda: read_shadows_reference(labels, img, bg, floor, 0),
+                                                                 repeats=5)}
     prep_rows = [[k, 1000 * v, v / mog2] for k, v in prep.items()]
 
     # Tracking cost against the number of objects.
@@ -147,10 +145,7 @@ def main() -> int:
     for name, cfg in configs.items():
         tracker = ParticleTracker(scene, {"cam": fg}, cfg)
         lk = cfg.likelihood
-        if lk.shadows == "object":
-            seen = hit_image(fg.difference(img), lk.gamma)
-        else:
-            seen = hit_labels(img, bg, lk.gamma, where=floor, shadow=2 if lk.shadows == "unknown" else 0)
+        seen = tracker.labels.read({"cam": img}).images["cam"]
         view = FrameView({"cam": seen})
         if cfg.explain.filters == "all":
             box = image_box(cam, person[0, 0], person[0, 1], scene.people.width, scene.people.height,
@@ -171,7 +166,7 @@ def main() -> int:
                                 te / mog2])
     # The bare kernel: a line column of the paper's 20 heights, against the NumPy reference.
     cl = CameraLikelihood(cam)
-    hit = hit_image(fg.difference(img), gamma)
+    hit = (labels != 0).astype(np.uint8)
     line = column_spec(column_heights(configs["paper"].column.max_height_m, configs["paper"].column.dz_m))
     k_line = median_time(lambda: cl.column(hit, xy, line), repeats=200)
     k_ref = median_time(lambda: column_counts_reference(cam, hit, xy, line), repeats=20)

@@ -60,7 +60,6 @@ from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 from worldtrack.trackers.ellipsoid.real import ternary_real  # noqa: E402
-from worldtrack.foreground.shadows import hit_image, hit_labels  # noqa: E402
 
 SEED = 0
 SIZES = ((160, 120), (640, 480))
@@ -144,11 +143,8 @@ def foreground_stage(method: str, tracker, clip: Clip):
         cs = tracker.views[clip.camera]
         return lambda img: ternary_real(cs.foreground.labels(img), cs.ring_px)
     if method == "particle":
-        gamma = tracker.config.likelihood.gamma
-        if tracker.config.likelihood.shadows != "object":
-            return lambda img: hit_labels(img, clip.background, gamma)
-        fg = tracker.labels.foregrounds[clip.camera]
-        return lambda img: hit_image(fg.difference(img), gamma)
+        # The foreground's labels and the shadows judged, as the particle tracker reads a frame.
+        return lambda img: tracker.labels.read({clip.camera: img})
     model = AdaptiveBackground("mog2", background=clip.background)
     return model.labels
 

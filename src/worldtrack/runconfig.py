@@ -55,16 +55,7 @@ class RunConfig:
     def to_mapping(self) -> dict[str, Any]:
         """Plain nested values, in the layout of a configuration file."""
         return {"method": self.method, "preset": self.preset, "foreground": to_mapping(self.foreground),
-                **{m: _mapping(s) for m, s in self.methods.items()}}
-
-
-def _mapping(section: Any) -> dict[str, Any]:
-    # TRANSITION (issue 33): configurations not yet moved to sections are dataclasses.
-    if isinstance(section, Section):
-        return to_mapping(section)
-    import json
-    from dataclasses import asdict
-    return json.loads(json.dumps(asdict(section)))
+                **{m: to_mapping(s) for m, s in self.methods.items()}}
 
 
 def _method_config_class(method: str) -> type[Section]:
@@ -118,10 +109,7 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
     for m in METHODS:
         base = _base(m, preset)
         given = data.get(m)
-        if given is not None and not isinstance(base, Section):     # TRANSITION (issue 33)
-            from dataclasses import replace
-            base = replace(base, **given)
-        elif given is not None:
+        if given is not None:
             if not isinstance(given, Mapping):
                 raise InputError(f"{m}: expected a mapping of settings, got {given!r}"[:120])
             base = from_mapping(type(base), _deep_merge(to_mapping(base), given), root=m)
@@ -132,10 +120,7 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
                   if v is not None}
     if fg_changes:
         foreground = with_overrides(foreground, fg_changes, root="foreground")
-    if flags.get("births") is not None and not isinstance(methods[method], Section):  # TRANSITION (issue 33)
-        from dataclasses import replace
-        methods[method] = replace(methods[method], births=flags["births"])
-    elif flags.get("births") is not None:
+    if flags.get("births") is not None:
         path = _find_field(methods[method], "births")
         if path is None:
             raise InputError(f"--births: the {method} tracker has no births setting")
@@ -189,9 +174,7 @@ def dump_run_config(cfg: RunConfig, described: bool = True) -> str:
     head = yaml.safe_dump({"method": cfg.method, "preset": cfg.preset}, sort_keys=False)
     parts = [head.rstrip(), "foreground:", _indent(dump_yaml(cfg.foreground, described))]
     for m, section in cfg.methods.items():
-        text = dump_yaml(section, described) if isinstance(section, Section) else \
-            yaml.safe_dump(_mapping(section), sort_keys=False, default_flow_style=None)
-        parts += [f"{m}:", _indent(text)]
+        parts += [f"{m}:", _indent(dump_yaml(section, described))]
     return "\n".join(p.rstrip("\n") for p in parts) + "\n"
 
 

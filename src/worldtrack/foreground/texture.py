@@ -60,12 +60,13 @@ def texture_correlation(image: np.ndarray, background: np.ndarray, window: int) 
 
 @njit(cache=True, inline="always")
 def _reflect(i, n):
-    """OpenCV's BORDER_REFLECT (``fedcba|abcdef``) for an index at most n outside [0, n)."""
+    """OpenCV's BORDER_REFLECT (``fedcba|abcdef``) for an index at most n outside [0, n), kept inside
+    the image when it is narrower than the window reaches."""
     if i < 0:
-        return -i - 1
-    if i >= n:
-        return 2 * n - i - 1
-    return i
+        i = -i - 1
+    elif i >= n:
+        i = 2 * n - i - 1
+    return min(max(i, 0), n - 1)
 
 
 @njit(cache=True, inline="always")

@@ -74,9 +74,10 @@ def run(tracker, scene, backgrounds, paths, n, seed=0):
 
 
 def foregrounds(scene, scene_seed=0):
-    """Static colour backgrounds (textures) of the scene's cameras: ({camera: model}, {camera: image})."""
+    """Static colour backgrounds (textures) of the scene's cameras, threshold 25 (the particle tracker's
+    former γ) with shadows set apart: ({camera: model}, {camera: image})."""
     bgs = {cid: texture(i + 10 * scene_seed) for i, cid in enumerate(scene.cameras)}
-    return {cid: StaticBackground(bg, 30.0, "colour") for cid, bg in bgs.items()}, bgs
+    return {cid: StaticBackground(bg, 25.0, "colour", shadows=True) for cid, bg in bgs.items()}, bgs
 
 
 def config(**settings) -> ParticleConfig:
@@ -124,3 +125,14 @@ def column_reference(cam, hit, xy, heights, **args) -> ColumnOut:
     """:func:`column_counts_reference` with the arguments of :func:`column`."""
     spec, read, tops = column_parts(heights, **args)
     return column_counts_reference(cam, hit, xy, spec, read, tops)
+
+
+def hit_image(F: np.ndarray, gamma: float) -> np.ndarray:
+    """``F > γ`` as (H, W) uint8: the labels a foreground without shadows gives (test input)."""
+    return np.ascontiguousarray(np.asarray(F) > gamma).astype(np.uint8)
+
+
+def thresholded_difference(F: np.ndarray, gamma: float) -> np.ndarray:
+    """F with ``F ≤ γ`` set to 0, float32: what the point likelihood reads (test input)."""
+    f = np.asarray(F, dtype=np.float32)
+    return np.ascontiguousarray(np.where(f > gamma, f, np.float32(0.0)))

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from worldtrack.foreground.background import StaticBackground
-from worldtrack.foreground.shadows import hit_image, thresholded_difference
 from worldtrack.trackers.particle.likelihood import (CameraLikelihood, column_spec, occluder_layers, owner_image,
                                                      point_values_reference)
 from worldtrack.trackers.particle.likelihood.boxes import image_box
 
+from particle_scenes import hit_image, thresholded_difference  # noqa: E402
 from particle_scenes import (CAM, DISTORTION, HEIGHT, RING_HEIGHTS, H, W, WIDTH, column, column_reference,
                              make_scene, render, texture)
 

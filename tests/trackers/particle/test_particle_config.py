@@ -47,6 +47,7 @@ from particle_scenes import config, foregrounds, make_scene
                                          "'background', got 'object'"),
     ("motion.velocity", "state", "particle.motion.velocity: unknown setting (expected one of: model, noise_xy"),
     ("gamma", 30, "particle.gamma: unknown setting"),
+    ("likelihood.gamma", 30, "particle.likelihood.gamma: unknown setting"),      # γ is foreground.threshold
 ])
 def test_bad_settings_are_input_errors_naming_the_field(setting, value, message):
     with pytest.raises(InputError) as e:
@@ -71,7 +72,7 @@ def test_the_configuration_round_trips_through_yaml():
         assert from_mapping(ParticleConfig, yaml.safe_load(text)) == cfg
         assert from_mapping(ParticleConfig, to_mapping(cfg)) == cfg
     text = dump_yaml(ParticleConfig())
-    assert "likelihood:  # the likelihood (eqs. 7, 11)" in text and "  gamma: 25.0  # γ" in text
+    assert "likelihood:  # the likelihood (eqs. 7, 11)" in text and "  shadows: background  # cast shadows" in text
     # Every section stays small and every field says what it is.
     for name, field in ParticleConfig.model_fields.items():
         assert field.description, name
@@ -89,7 +90,7 @@ def test_the_paper_preset_is_the_method_as_published():
     assert paper.explain.filters == "detection" and not paper.split.enabled and not paper.merge.enabled
     assert paper.tracking.end_after_s == 0.0 and paper.detection.lost_hold_s == 0.0
     # Numbers the paper does not state stay ours.
-    assert paper.tracking.particles == default.tracking.particles and paper.likelihood.gamma == default.likelihood.gamma
+    assert paper.tracking.particles == default.tracking.particles and paper.column.dz_m == default.column.dz_m
     assert method_config("particle", "paper") == paper
     assert method_config("particle", "paper", {"likelihood.model": "point"}).likelihood.model == "point"
     assert default.likelihood.out_of_view == "unknown"                  # the documented default

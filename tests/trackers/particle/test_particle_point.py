@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from worldtrack.foreground.shadows import thresholded_difference
 from worldtrack.trackers.particle.likelihood import CameraLikelihood, owner_image, point_values_reference
 
-from particle_scenes import H, W, make_scene
+from particle_scenes import thresholded_difference, H, W, make_scene
 
 
 def test_point_kernel_agrees_with_reference():

@@ -95,10 +95,9 @@ class LikelihoodConfig(Section):
     path: ClassVar[str] = "particle.likelihood"
     model: Literal["column-ratio", "column-count", "point"] = Field(
         "column-ratio", description="column-ratio: the likelihood ratio of an object standing there (sharp along "
-        "the line of sight); column-count: π = samples on F > γ (the paper, eq. 11); point: π = F at the particle "
+        "the line of sight); column-count: π = samples on F > γ (the paper, eq. 11; γ is foreground.threshold); "
+        "point: π = F at the particle "
         "(eq. 7, the paper's baseline)")
-    gamma: float = _finite(25.0, "γ: background differences F ≤ γ (Euclidean RGB distance, 0–441) are background",
-                           ge=0)
     hit_rate_object: float = _finite(0.6, "column-ratio: chance that a sample on an object reads F > γ (much of a "
                                      "body below the waist does not)", gt=0, lt=1)
     hit_rate_background: float = _finite(0.05, "column-ratio: chance that a sample on the background reads F > γ",

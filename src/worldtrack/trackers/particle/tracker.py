@@ -85,7 +85,7 @@ class ParticleTracker(TrackerBase):
         walkable = scene.walkable.raster(0.01)
         self.likelihood = LIKELIHOODS[cfg.likelihood.model](cfg, self.cameras, walkable)
         lk = self.likelihood
-        self.labels = FrameLabels(scene, foregrounds, cfg.likelihood.gamma, cfg.likelihood.shadows, lk,
+        self.labels = FrameLabels(scene, foregrounds, cfg.likelihood.shadows, lk,
                                   colour=cfg.appearance.weight > 0)
         self.stack = CloudStack()
         self.heights = HeightState(cfg, scene.people.height, lk.top_sigma > 0, self.rng)

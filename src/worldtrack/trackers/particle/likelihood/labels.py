@@ -1,9 +1,11 @@
-"""What the likelihood reads of each camera's frame: ``F > γ`` labels, cast shadows set apart.
+"""What the likelihood reads of each camera's frame: the foreground's labels, cast shadows judged.
 
-Per camera and frame, from its foreground model: the labels 0 background, 1 object, 2 no evidence
-(:mod:`worldtrack.foreground.shadows`) — ``F > γ`` with the paper's F (``shadows="object"``), or with
-cast shadows on the floor read as background or as no evidence — and what the likelihood reads of
-them (:meth:`~.models.Likelihood.image`: the labels, or F thresholded at γ for the point).
+Per camera and frame, from its foreground model (the :class:`~worldtrack.foreground.Foreground`
+protocol, whose threshold is the paper's γ): the labels 0 background, 1 object, 2 no evidence —
+every change counted as object (``shadows="object"``, the paper's F > γ), or with shadow-like
+changes on the floor judged by texture (:func:`~worldtrack.foreground.shadows.read_shadows`) and the
+shadows read as background or as no evidence — and what the likelihood reads of them
+(:meth:`~.models.Likelihood.image`: the labels, or F where they say object for the point).
 """
 
 from __future__ import annotations
@@ -13,7 +15,9 @@ from typing import Mapping
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.foreground.shadows import floor_pixels, hit_image, hit_labels
+from worldtrack.foreground import Foreground
+from worldtrack.foreground.shadows import floor_pixels, read_shadows
+from worldtrack.foreground.texture import grey
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import frame_image
 from worldtrack.trackers.particle.likelihood.models import FrameView, Likelihood
@@ -25,10 +29,9 @@ class FrameLabels:
     Parameters
     ----------
     scene : Scene
-    foregrounds : {camera_id: foreground model} — each with ``difference(image)`` (F, the Euclidean RGB
-        distance); unless ``shadows == "object"`` also a background image (``.background`` or
-        ``.model.getBackgroundImage()``)
-    gamma : float — γ; shadows : {"background", "unknown", "object"}
+    foregrounds : {camera_id: Foreground}
+    shadows : {"background", "unknown", "object"} — what a judged cast shadow reads as (object: shadows
+        are not set apart, every change is object)
     likelihood : Likelihood — what it reads of the labels
     colour : bool — keep the BGR frames for the colour term
 
@@ -37,19 +40,14 @@ class FrameLabels:
     masks : {camera_id: (H, W) uint8} — this frame's labels (for overlays)
     """
 
-    def __init__(self, scene: Scene, foregrounds: Mapping[str, object], gamma: float, shadows: str,
+    def __init__(self, scene: Scene, foregrounds: Mapping[str, Foreground], shadows: str,
                  likelihood: Likelihood, colour: bool):
-        self.foregrounds, self.gamma, self.likelihood, self.colour = dict(foregrounds), gamma, likelihood, colour
+        self.foregrounds, self.likelihood, self.colour = dict(foregrounds), likelihood, colour
         self.cameras = {cid: scene.camera(cid) for cid in self.foregrounds}
-        self.shadow = {"background": 0, "unknown": 2, "object": None}[shadows]
-        for cid, fg in self.foregrounds.items():
-            if not callable(getattr(fg, "difference", None)):
-                raise InputError(f"particle tracker: the foreground model of {cid} has no difference(image)")
-            if self.shadow is not None and background_image(fg) is None:
-                raise InputError(f"particle tracker: shadows={shadows!r} needs the background image of {cid}'s "
-                                 "foreground model (use a static background, or set shadows='object')")
+        self.shadow_as = {"background": 0, "unknown": 2, "object": None}[shadows]
         self.floor: dict[str, np.ndarray] = {}
-        if self.shadow is not None:
+        self._grey: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        if self.shadow_as is not None:
             walk = scene.walkable.raster(0.01)
             for cid in self.foregrounds:
                 occ = scene.occlusion(cid).floor_distance if scene.obstacles else None
@@ -70,27 +68,30 @@ class FrameLabels:
                 raise InputError(f"{cid}: frame is {image.shape[1]}x{image.shape[0]} but the camera is "
                                  f"{cam.width}x{cam.height}")
             fg = self.foregrounds[cid]
-            F = fg.difference(image) if (self.likelihood.reads_difference or self.shadow is None) else None
-            if self.shadow is None:
-                hit = hit_image(F, self.gamma)
+            labels = fg.labels(image)
+            if self.shadow_as is None:
+                hit = (labels != 0).astype(np.uint8)
             else:
-                hit = hit_labels(image, background_image(fg), self.gamma, where=self.floor[cid], shadow=self.shadow)
+                background = fg.background_image()
+                if background is None:                      # an adaptive model before its first frame
+                    hit = np.where(labels == 2, 2, labels).astype(np.uint8)
+                else:
+                    hit = read_shadows(labels, image, background, self.floor[cid], self.shadow_as,
+                                       self._grey_of(cid, background))
             self.masks[cid] = hit
             if self.colour:
                 colour[cid] = image
+            F = fg.difference(image) if self.likelihood.reads_difference else None
             images[cid] = self.likelihood.image(hit, F)
         return FrameView(images, colour=colour)
 
-
-def background_image(fg: object) -> np.ndarray | None:
-    """The background image of a foreground model: ``.model.getBackgroundImage()`` or ``.background``."""
-    model = getattr(fg, "model", None)
-    if model is not None and hasattr(model, "getBackgroundImage"):
-        bg = model.getBackgroundImage()
-        if bg is not None:
-            return bg
-    bg = getattr(fg, "background", None)
-    return bg if isinstance(bg, np.ndarray) else None
+    def _grey_of(self, cid: str, background: np.ndarray) -> np.ndarray:
+        """The grey levels of a camera's background image, kept while it is the same image."""
+        held = self._grey.get(cid)
+        if held is None or held[0] is not background:
+            held = (background, grey(background))
+            self._grey[cid] = held
+        return held[1]
 
 
-__all__ = ["FrameLabels", "background_image"]
+__all__ = ["FrameLabels"]

@@ -21,7 +21,6 @@ from typing import TYPE_CHECKING, Mapping, Protocol, Sequence
 
 import numpy as np
 
-from worldtrack.foreground.shadows import thresholded_difference
 from worldtrack.registry import Registry
 from worldtrack.scene.floor import WalkableRaster
 from worldtrack.trackers.particle.appearance import column_penalties
@@ -133,7 +132,7 @@ class _Common:
     def __init__(self, cfg: "ParticleConfig", cameras: Mapping[str, CameraLikelihood], walkable: WalkableRaster):
         lk, col = cfg.likelihood, cfg.column
         self.cameras, self.raster, self.blocks = cameras, walkable, raster_blocks(walkable)
-        self.gamma, self.max_height = lk.gamma, col.max_height_m
+        self.max_height = col.max_height_m
         self.likely_count, self.dz = col.likely_count, col.dz_m
         self.surface_offset, self.colour_weight = col.surface_offset_m, cfg.appearance.weight
         self.margin = cfg.explain.occlusion_margin_m
@@ -235,13 +234,14 @@ class ColumnCount(_Common):
 
 @LIKELIHOODS.register("point")
 class Point(_Common):
-    """Eq. 7: ``π = F(u, v)`` at the particle's own point (F ≤ γ set to 0), over ``F_MAX``."""
+    """Eq. 7: ``π = F(u, v)`` at the particle's own point where the foreground says object (0 elsewhere:
+    F ≤ γ, γ being the foreground's threshold), over ``F_MAX``."""
 
     reads_difference = True
     column = False
 
     def image(self, labels: np.ndarray, difference: np.ndarray | None) -> np.ndarray:
-        return thresholded_difference(np.where(labels == 1, difference, 0), self.gamma)
+        return object_difference(labels, difference)
 
     def __call__(self, xyz, h, frame, readers, hidden=None, top_edge=False):
         n = len(xyz)
@@ -258,5 +258,12 @@ class Point(_Common):
         return np.where(valid, logpi, -np.inf), likely & valid, col / np.maximum(n_seen, 1)
 
 
-__all__ = ["LIKELIHOODS", "REFERENCE_DEPTH", "ColumnCount", "ColumnRatio", "FrameView", "Likelihood", "Point",
+def object_difference(labels: np.ndarray, difference: np.ndarray) -> np.ndarray:
+    """(H, W) float32, C-contiguous: the background difference F where ``labels`` say object, 0 elsewhere
+    (what the point likelihood reads)."""
+    return np.ascontiguousarray(np.where(labels == 1, np.asarray(difference, dtype=np.float32), np.float32(0.0)))
+
+
+__all__ = ["LIKELIHOODS", "REFERENCE_DEPTH", "object_difference", "ColumnCount", "ColumnRatio", "FrameView", "Likelihood", "Point",
            "Readers"]
+
