@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--frames", type=int, default=1500)
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
-    ap.add_argument("--tag", default="", help=f"write results/{name}<TAG>.md (a run beside the main one)")
+    ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")
     args = ap.parse_args(argv)
     seeds = [100] if args.quick else parse_seeds(args.seeds)
     frames = 200 if args.quick else args.frames

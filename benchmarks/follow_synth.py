@@ -177,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--quick", action="store_true", help="dev seeds 100, 101 × 300 frames (a smoke run; prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
-    ap.add_argument("--tag", default="", help=f"write results/{name}<TAG>.md (a run beside the main one)")
+    ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")
     args = ap.parse_args(argv)
     seeds = [100, 101] if args.quick else parse_seeds(args.seeds)       # quick: development seeds
     frames = 300 if args.quick else args.frames
