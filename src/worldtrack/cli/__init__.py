@@ -34,6 +34,7 @@ COMMANDS = {
     "eval": "score tracks against ground truth (MOTA, MOTP in metres, IDF1, HOTA, errors)",
     "background": "estimate an empty-scene background image from a video",
     "gt": "ground-truth tools: import image-box GT (CVML, MOTChallenge) as world GT",
+    "follow": "follow one person with a moving stereo / RGB-D camera (paper 001)",
     "replay": "rebuild tracks.csv, the floor plan and a plan video from a shared map",
     "map": "a shared map on Redis: status, fusion, reset",
     "serve": "a floor-plan view in the browser: a finished run (worldtrack serve out/) or the live map",
