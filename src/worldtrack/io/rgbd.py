@@ -118,9 +118,11 @@ class RGBDSource:
     def _depth(self, i: int, left: np.ndarray) -> np.ndarray:
         shape = left.shape[:2]
         if self.right is not None:
-            right = self.right.read()
-            if right is None:
+            status, right = self.right.read()
+            if status == "end":
                 raise InputError(f"--right: no frame {i} (the right camera's input is shorter)")
+            if right is None:
+                raise InputError(f"--right: frame {i} cannot be decoded")
             t0 = time.perf_counter()
             depth = self.matcher.depth(left, self._fit(right, shape, "--right", i))
             self.stereo_seconds += time.perf_counter() - t0
@@ -149,9 +151,11 @@ class RGBDSource:
         i = 0
         try:
             while self.stop is None or i < self.stop:
-                img = self.reader.read()
-                if img is None:
+                status, img = self.reader.read()
+                if status == "end":
                     return
+                if img is None:         # a frame the decoder cannot read: its depth would pair with the next
+                    raise InputError(f"--rgb: frame {i} cannot be decoded")
                 if (img.shape[1], img.shape[0]) != (self.camera.width, self.camera.height):
                     raise InputError(f"--rgb: frame {i} is {img.shape[1]}x{img.shape[0]} but camera "
                                      f"{self.camera.id!r} is {self.camera.width}x{self.camera.height}")
