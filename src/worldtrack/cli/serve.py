@@ -95,8 +95,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("give a finished run's folder (worldtrack serve out/) or the live map (--map redis://…)")
     if args.trail <= 0:
         raise InputError(f"--trail: expected seconds > 0, got {args.trail}")
-    sock = bind(args.host, args.port)          # first: a port in use is the commonest mistake
-    source = _run_source(args) if args.run else _live_source(args)
+    source = _run_source(args) if args.run else _live_source(args)   # the user's inputs first, then the port
+    sock = bind(args.host, args.port)
     token = resolve_token(args.host, args.token)
     host = f"[{args.host}]" if ":" in args.host else args.host
     url = f"http://{host}:{sock.getsockname()[1]}/"

@@ -127,11 +127,13 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if not args.scene:
         raise InputError("track: give a scene file (worldtrack track SCENE --video CAM=PATH …)")
+    from worldtrack.cli._args import positive, positive_int
     from worldtrack.io.live import is_live, parse_source
+    args.fps = positive(args.fps, "--fps", "25") if args.fps is not None else None
+    args.frames = positive_int(args.frames, "--frames", "100") if args.frames is not None else None
     if args.map or any(is_live(parse_source(_pair(v, "--video")[1])) for v in args.video):
         from worldtrack.cli.track_live import run_live
         return run_live(args, cfg)
-    from worldtrack.cli._args import positive, positive_int
     from worldtrack.cli.eval import read_area
     from worldtrack.io.runinfo import prepare_output, write_run_info
     from worldtrack.io.sources import VideoSource
@@ -139,8 +141,7 @@ def run(args: argparse.Namespace) -> int:
     from worldtrack.scene import load_scene
     from worldtrack.warmup import say_warm_up
 
-    fps = positive(args.fps, "--fps", "25") if args.fps is not None else None
-    frames = positive_int(args.frames, "--frames", "100") if args.frames is not None else None
+    fps, frames = args.fps, args.frames
     max_bad = positive_int(args.max_bad_frames, "--max-bad-frames", "25")
     area = read_area(args.area) if args.area else None
     scene = load_scene(args.scene)
