@@ -24,11 +24,7 @@ from typing import IO, Any, Callable, Mapping
 import numpy as np
 
 from worldtrack.errors import InputError
-# Kept for callers of the former home of these (until every import moves to worldtrack.foreground / io).
-from worldtrack.foreground import FOREGROUND_KINDS as FOREGROUNDS  # noqa: F401
-from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: F401
 from worldtrack.interrupts import StopRequests, interrupt_in, signal_of
-from worldtrack.io.sources import background_from_video  # noqa: F401
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import Track, Tracker, warm_started
 
