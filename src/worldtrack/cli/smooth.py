@@ -44,6 +44,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--sigma-px", default="2", metavar="PX", help="pixel noise where sigma_px is not given (default 2)")
     p.add_argument("--q", default=None, metavar="M2S3",
                    help=f"horizontal acceleration noise, m²/s³ (default {MotionPrior().q_horizontal:g})")
+    p.add_argument("--first-velocity-sigma", default=None, metavar="M/S",
+                   help=f"spread of the prior on the first velocity, per axis (default "
+                        f"{MotionPrior().first_velocity_sigma:g} m/s; 'none': the paper's flat start)")
     p.add_argument("--clearance", default=None, metavar="M",
                    help=f"distance people keep from obstacles and walls (default {TrajectoryOptions().clearance:g} m)")
     p.add_argument("--weight", default=None, metavar="LAMBDA", help="λ, the environment's weight (default 1)")
@@ -64,6 +67,10 @@ def _options(args: argparse.Namespace) -> TrajectoryOptions:
         opts = replace(opts, dt=positive(args.dt, "--dt", "0.1"))
     if args.q is not None:
         opts = replace(opts, motion=replace(opts.motion, q_horizontal=positive(args.q, "--q", "1.0")))
+    if args.first_velocity_sigma is not None:
+        sigma = (None if args.first_velocity_sigma.strip().lower() == "none"
+                 else positive(args.first_velocity_sigma, "--first-velocity-sigma", "2"))
+        opts = replace(opts, motion=replace(opts.motion, first_velocity_sigma=sigma))
     if args.clearance is not None:
         opts = replace(opts, clearance=positive(args.clearance, "--clearance", "0.2"))
     if args.weight is not None:

@@ -1,8 +1,9 @@
 """The objective of eq. 9 and its Gauss–Newton normal equations in block-tridiagonal form.
 
-    F(X) = Xᵀ·Λ_X·X  +  Σ_(t,i)∈o ρ(‖(π_i(x_t) − y_t^i)/σ‖)  −  λ·Σ_t (e_h + e_v)
+    F(X) = Xᵀ·Λ_X·X + ‖ẋ_1/σ₁‖²  +  Σ_(t,i)∈o ρ(‖(π_i(x_t) − y_t^i)/σ‖)  −  λ·Σ_t (e_h + e_v)
 
-(ρ(e) = e², or Huber's e² / 2ke − k² with ``robust = k``). Every residual touches one state
+(ρ(e) = e², or Huber's e² / 2ke − k² with ``robust = k``; ‖ẋ_1/σ₁‖² is the prior on the first
+velocity of :class:`~.model.MotionPrior`, counted in the motion cost). Every residual touches one state
 (observations, height) or two neighbouring states (motion, barrier samples), so JᵀJ is
 block-tridiagonal with 6 × 6 blocks: ``D[t]`` on the diagonal, ``B[t] = H[t, t+1]`` above it.
 Assembly is vectorised over all steps; no Python loop runs over time.
@@ -17,7 +18,8 @@ import numpy as np
 
 from worldtrack.trajectory.environment import (EnvironmentModel, barrier_residuals, height_residuals)
 from worldtrack.trajectory.kernels import add_motion_terms, add_pair_terms
-from worldtrack.trajectory.model import STATE, MotionPrior, TimeGrid, motion_blocks, motion_residuals
+from worldtrack.trajectory.model import (STATE, VEL, MotionPrior, TimeGrid, first_velocity_residuals, motion_blocks,
+                                        motion_residuals)
 from worldtrack.trajectory.observation import ObservationTerm, Observations
 
 _W = 4  # index of the head height w in the state
@@ -60,8 +62,10 @@ class Problem:
 
     @cached_property
     def motion_normal(self) -> tuple[np.ndarray, np.ndarray]:
-        """Λ_X as blocks (D, B) — constant, computed once."""
-        return motion_blocks(self.A, self.W, self.grid.n)
+        """Λ_X as blocks (D, B), with the first velocity's prior on D[0] — constant, computed once."""
+        D, B = motion_blocks(self.A, self.W, self.grid.n)
+        D[0, VEL, VEL] += self.motion.first_velocity_gain ** 2
+        return D, B
 
     @cached_property
     def observation_groups(self) -> tuple[np.ndarray, np.ndarray]:
@@ -113,6 +117,7 @@ def huber(e: np.ndarray, k: float | None) -> tuple[np.ndarray, np.ndarray]:
 def evaluate(problem: Problem, X: np.ndarray) -> Costs:
     """The objective's terms at X (n, 6); ``inf`` observation cost if a head goes behind a camera."""
     rm = motion_residuals(X, problem.A, problem.W)
+    rv = first_velocity_residuals(X, problem.motion.first_velocity_gain)
     r, _, depth = problem.observations.residuals(X, with_jacobian=False)
     rho, _ = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
     obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
@@ -124,7 +129,7 @@ def evaluate(problem: Problem, X: np.ndarray) -> Costs:
     if env.height is not None:
         rh, _ = height_residuals(X, env.height, env.weight)
         height = float(rh @ rh)
-    return Costs(float(np.sum(rm * rm)), obs_cost, barrier, height)
+    return Costs(float(np.sum(rm * rm) + rv @ rv), obs_cost, barrier, height)
 
 
 def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None) -> Linearisation:
@@ -144,6 +149,10 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None)
     g.fill(0.0)
     barrier_steps.fill(False)
     motion_cost = add_motion_terms(X, problem.A, problem.W, g)
+    gain = problem.motion.first_velocity_gain
+    rv = first_velocity_residuals(X, gain)
+    g[0, VEL] += gain * rv
+    motion_cost += float(rv @ rv)
     # observations, each on one state; rows come in runs of equal steps (time order)
     r, J, depth = problem.observations.residuals(X)
     rho, w = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)

@@ -22,7 +22,7 @@ import scipy.optimize
 
 from worldtrack.trajectory.environment import barrier_residuals, height_residuals
 from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, block_matvec, fill_banded
-from worldtrack.trajectory.model import STATE, motion_residuals
+from worldtrack.trajectory.model import STATE, VEL, first_velocity_residuals, motion_residuals
 from worldtrack.trajectory.objective import (Costs, Linearisation, Problem, evaluate, huber,
                                              linearise)
 
@@ -219,7 +219,8 @@ def residual_vector(problem: Problem, X: np.ndarray) -> np.ndarray:
     Huber residuals enter as r·√ρ(e)/e, whose squared norm is ρ(e): the same objective, so the same
     optimum (not the same Jacobian as the IRLS weights the fast solver uses).
     """
-    parts = [motion_residuals(X, problem.A, problem.W).ravel()]
+    parts = [motion_residuals(X, problem.A, problem.W).ravel(),
+             first_velocity_residuals(X, problem.motion.first_velocity_gain)]
     r, _, _ = problem.observations.residuals(X, with_jacobian=False)
     e = np.hypot(r[:, 0], r[:, 1])
     rho, _ = huber(e, problem.robust)
@@ -242,6 +243,9 @@ def jacobian_dense(problem: Problem, X: np.ndarray) -> np.ndarray:
         block[:, STATE * t:STATE * t + STATE] = minus_WA
         block[:, STATE * (t + 1):STATE * (t + 2)] = problem.W
         rows.append(block)
+    first = np.zeros((len(VEL), STATE * n))                  # prior on the first velocity
+    first[np.arange(len(VEL)), VEL] = problem.motion.first_velocity_gain
+    rows.append(first)
     _, J, _ = problem.observations.residuals(X)
     for i, k in enumerate(problem.observations.step):          # observations: one state each
         block = np.zeros((2, STATE * n))
