@@ -36,6 +36,7 @@ class Problem:
     motion : MotionPrior
     environment : EnvironmentModel
     robust : float or None — Huber threshold in σ (e.g. 3.0); None = plain squares
+    feet : ObservationTerm or None — the feet pixels (floor points below the head), if any
     """
 
     grid: TimeGrid
@@ -43,14 +44,22 @@ class Problem:
     motion: MotionPrior
     environment: EnvironmentModel
     robust: float | None = None
+    feet: ObservationTerm | None = None
 
     @classmethod
     def build(cls, obs: Observations, grid: TimeGrid, motion: MotionPrior, environment: EnvironmentModel,
               robust: float | None = None) -> "Problem":
-        return cls(grid, ObservationTerm.on_grid(obs, grid), motion, environment, robust)
+        feet = obs.feet()
+        return cls(grid, ObservationTerm.on_grid(obs, grid), motion, environment, robust,
+                   None if feet is None else ObservationTerm.on_grid(feet, grid, floor=True))
 
     def with_environment(self, environment: EnvironmentModel) -> "Problem":
-        return Problem(self.grid, self.observations, self.motion, environment, self.robust)
+        return Problem(self.grid, self.observations, self.motion, environment, self.robust, self.feet)
+
+    @property
+    def pixel_terms(self) -> tuple[ObservationTerm, ...]:
+        """The head pixels and, when given, the feet pixels."""
+        return (self.observations,) if self.feet is None else (self.observations, self.feet)
 
     @cached_property
     def A(self) -> np.ndarray:
@@ -68,11 +77,14 @@ class Problem:
         return D, B
 
     @cached_property
-    def observation_groups(self) -> tuple[np.ndarray, np.ndarray]:
-        """(first row of each run of equal steps, that step): observations are in time order."""
-        step = self.observations.step
-        starts = np.flatnonzero(np.r_[True, step[1:] != step[:-1]])
-        return starts, step[starts]
+    def observation_groups(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per pixel term: (first row of each run of equal steps, that step); rows are in time order."""
+        out = []
+        for term in self.pixel_terms:
+            step = term.step
+            starts = np.flatnonzero(np.r_[True, step[1:] != step[:-1]])
+            out.append((starts, step[starts]))
+        return out
 
 
 @dataclass
@@ -118,9 +130,11 @@ def evaluate(problem: Problem, X: np.ndarray) -> Costs:
     """The objective's terms at X (n, 6); ``inf`` observation cost if a head goes behind a camera."""
     rm = motion_residuals(X, problem.A, problem.W)
     rv = first_velocity_residuals(X, problem.motion.first_velocity_gain)
-    r, _, depth = problem.observations.residuals(X, with_jacobian=False)
-    rho, _ = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
-    obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
+    obs_cost = 0.0
+    for term in problem.pixel_terms:
+        r, _, depth = term.residuals(X, with_jacobian=False)
+        rho, _ = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
+        obs_cost += float(rho.sum()) if np.all(depth > 1e-3) else np.inf
     env = problem.environment
     barrier = height = 0.0
     if env.barrier is not None:
@@ -130,6 +144,19 @@ def evaluate(problem: Problem, X: np.ndarray) -> Costs:
         rh, _ = height_residuals(X, env.height, env.weight)
         height = float(rh @ rh)
     return Costs(float(np.sum(rm * rm) + rv @ rv), obs_cost, barrier, height)
+
+
+def _add_pixel_term(term: ObservationTerm, starts: np.ndarray, steps: np.ndarray, robust: float | None,
+                    X: np.ndarray, D: np.ndarray, g: np.ndarray) -> float:
+    """In place: one pixel term's JᵀWJ into D and JᵀWr into g (each row on one state; rows come in
+    runs of equal steps, time order); returns its cost (inf if a point goes behind a camera)."""
+    r, J, depth = term.residuals(X)
+    rho, w = huber(np.hypot(r[:, 0], r[:, 1]), robust)
+    JtJ = np.einsum("nki,nkj->nij", J, J * w[:, None, None])
+    Jtr = np.einsum("nki,nk->ni", J, r * w[:, None])
+    D[steps] += np.add.reduceat(JtJ, starts, axis=0)
+    g[steps] += np.add.reduceat(Jtr, starts, axis=0)
+    return float(rho.sum()) if np.all(depth > 1e-3) else np.inf
 
 
 def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None) -> Linearisation:
@@ -153,15 +180,9 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None)
     rv = first_velocity_residuals(X, gain)
     g[0, VEL] += gain * rv
     motion_cost += float(rv @ rv)
-    # observations, each on one state; rows come in runs of equal steps (time order)
-    r, J, depth = problem.observations.residuals(X)
-    rho, w = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
-    starts, steps = problem.observation_groups
-    JtJ = np.einsum("nki,nkj->nij", J, J * w[:, None, None])
-    Jtr = np.einsum("nki,nk->ni", J, r * w[:, None])
-    D[steps] += np.add.reduceat(JtJ, starts, axis=0)
-    g[steps] += np.add.reduceat(Jtr, starts, axis=0)
-    obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
+    obs_cost = 0.0
+    for term, (starts, steps) in zip(problem.pixel_terms, problem.observation_groups):
+        obs_cost += _add_pixel_term(term, starts, steps, problem.robust, X, D, g)
     env = problem.environment
     barrier_cost = height_cost = 0.0
     if env.barrier is not None:

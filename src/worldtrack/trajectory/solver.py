@@ -221,10 +221,11 @@ def residual_vector(problem: Problem, X: np.ndarray) -> np.ndarray:
     """
     parts = [motion_residuals(X, problem.A, problem.W).ravel(),
              first_velocity_residuals(X, problem.motion.first_velocity_gain)]
-    r, _, _ = problem.observations.residuals(X, with_jacobian=False)
-    e = np.hypot(r[:, 0], r[:, 1])
-    rho, _ = huber(e, problem.robust)
-    parts.append((r * (np.sqrt(rho) / np.where(e > 0, e, 1.0))[:, None]).ravel() if problem.robust else r.ravel())
+    for term in problem.pixel_terms:
+        r, _, _ = term.residuals(X, with_jacobian=False)
+        e = np.hypot(r[:, 0], r[:, 1])
+        rho, _ = huber(e, problem.robust)
+        parts.append((r * (np.sqrt(rho) / np.where(e > 0, e, 1.0))[:, None]).ravel() if problem.robust else r.ravel())
     env = problem.environment
     if env.barrier is not None:
         parts.append(barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False).r)
@@ -246,11 +247,12 @@ def jacobian_dense(problem: Problem, X: np.ndarray) -> np.ndarray:
     first = np.zeros((len(VEL), STATE * n))                  # prior on the first velocity
     first[np.arange(len(VEL)), VEL] = problem.motion.first_velocity_gain
     rows.append(first)
-    _, J, _ = problem.observations.residuals(X)
-    for i, k in enumerate(problem.observations.step):          # observations: one state each
-        block = np.zeros((2, STATE * n))
-        block[:, STATE * k:STATE * k + STATE] = J[i]
-        rows.append(block)
+    for term in problem.pixel_terms:                          # observations: one state each
+        _, J, _ = term.residuals(X)
+        for i, k in enumerate(term.step):
+            block = np.zeros((2, STATE * n))
+            block[:, STATE * k:STATE * k + STATE] = J[i]
+            rows.append(block)
     env = problem.environment
     if env.barrier is not None:                               # barrier samples: two states each
         br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
