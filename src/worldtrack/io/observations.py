@@ -11,7 +11,8 @@ standard deviation in pixels (default 2), ``id`` the person (default 1), ``heigh
 head height in metres (used for e_v when given). ``u_feet, v_feet`` (optional, both or neither
 in a row; empty cells: not seen) is the pixel of the floor point below the head — the bottom centre
 of the box — with ``sigma_feet_px`` (default ``sigma_px``); with it the head height is observed. A
-box (``left,top,right,bottom`` pixels instead of ``u,v``) gives both. Rows are counted as a spreadsheet counts them
+box (``left,top,right,bottom`` pixels instead of ``u,v``) gives both — for cameras that see people
+upright (a camera looking straight down sees the head beside the feet: give ``u,v,u_feet,v_feet``). Rows are counted as a spreadsheet counts them
 (the header is row 1); every row of one person must come in time order.
 
 A worldtrack ``tracks.csv`` from one camera's run is read as observations of that camera: each
