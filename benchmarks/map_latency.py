@@ -108,7 +108,7 @@ def one_run(server: Server, scene_dir: Path, cams: list[str], out: Path, settle_
         if t >= after:
             total.append(written - t)
             received.append(got - t)
-            transport.append(written - sent)
+            transport.append(written - sent if written != never else never)
     states = [decode_map_state(f) for _, f in client.xrange(MapKeys().map_stream)]
     record = {(cam, round(t, 4)): s.written - t for s in states for cam, t, _ in s.reports}
     record = [record.get(key, never) for key in steps if key[1] >= after]
