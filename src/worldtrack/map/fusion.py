@@ -162,6 +162,15 @@ def visible_share(cameras: Sequence[Camera], xy: np.ndarray, height: float,
     return float(max(shares, default=0.0))
 
 
+def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
+    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
+    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
+    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
+    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
+    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
+    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
+
+
 def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
                       step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None
                       ) -> tuple[float, float, float]:
@@ -356,4 +365,4 @@ def _finite(v: float) -> float:
 
 
 __all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket",
-           "provisional_state", "visible_share"]
+           "in_views", "provisional_state", "visible_share"]

@@ -31,7 +31,7 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.fusion import LEAD_SHARE, floor_information, visible_share
+from worldtrack.map.fusion import LEAD_SHARE, floor_information, in_views, visible_share
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
@@ -78,15 +78,6 @@ class SharedPositionMap(PositionMap):
         return pid
 
 
-def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
-    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
-    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
-    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
-    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
-    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
-    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
-
-
 class MapLink:
     """A worker's side of the shared map: its camera leases, ids, the map it reads, what it publishes.
 
@@ -129,7 +120,7 @@ class MapLink:
         self.lockstep_wait_s = 2.0
         self._first_t: float | None = None
         #: The end (s) of the last complete bucket of the map (every live camera's report in).
-        self.complete_until = -math.inf
+        self.complete_until, self._record_id = -math.inf, ""
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
@@ -176,7 +167,16 @@ class MapLink:
 
     # ------------------------------------------------------------------ each frame
     def read_map(self) -> MapState | None:
-        """The latest map state (None before the first)."""
+        """The latest map state (None before the first): the live map, or in a batch run (lockstep) the
+        last complete bucket (every worker's reports, not whichever came first: runs repeat)."""
+        if self.lockstep:
+            last = self.client.xrevrange(self.keys.map_stream, count=1)
+            if not last:
+                return None
+            if self.state is None or last[0][0] != self._record_id:
+                self._record_id, self.state = last[0][0], decode_map_state(last[0][1])
+                self.complete_until = self.state.t + self.cfg.bucket_s
+            return self.state
         raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports",
                                                     "last_bucket"])
         if raw[0] is None:
