@@ -22,7 +22,10 @@ Steady state leaves out the first ``--settle`` seconds (the trackers' warm start
 repetition is a fresh run; the table gives every repetition and the median.
 
 Run: ``nice -n -15 .venv/bin/python benchmarks/map_latency.py [--repeats 3] [--quick]``. Writes
-``benchmarks/results/map_latency.md``.
+``benchmarks/results/map_latency.md``. On a shared Linux machine with autogroup scheduling
+(``/proc/sys/kernel/sched_autogroup_enabled`` = 1) ``nice`` acts only within the session: to give
+the run the CPU against other sessions, run it in a session of its own whose autogroup is raised,
+``setsid sh -c 'echo -15 > /proc/self/autogroup; exec nice -n -15 .venv/bin/python …'`` (root).
 """
 
 from __future__ import annotations
