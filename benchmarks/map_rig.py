@@ -82,7 +82,8 @@ def run_workers(scene_dir: Path, url: str, cameras: list[str], out: Path, sets: 
 
 def percentiles(values, qs=(50, 99)) -> list[float]:
     v = np.asarray(list(values), float)
-    return [float(np.percentile(v, q)) if len(v) else float("nan") for q in qs]
+    method = "linear" if np.isfinite(v).all() else "nearest"     # an infinite value (never) stays infinite
+    return [float(np.percentile(v, q, method=method)) if len(v) else float("nan") for q in qs]
 
 
 def load_average() -> str:

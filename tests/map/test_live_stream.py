@@ -1,6 +1,7 @@
 """A live stream: ``ffmpeg`` sends a synthetic video over UDP on 127.0.0.1, ``worldtrack track``
 reads it live (grab thread, capture time stamps), the sender stops and starts again, and the
-stream is reconnected and tracked on."""
+stream is reconnected and tracked on. An HTTP stream (``ffmpeg`` as the HTTP server) is read,
+dropped and reconnected by a camera's grab thread."""
 
 from __future__ import annotations
 
@@ -69,3 +70,57 @@ def test_a_udp_stream_is_tracked_live_and_reconnected_after_a_drop(two_rooms, tm
     gt = read_tracks(two_rooms / "gt.csv")
     d = np.linalg.norm(tracks.xy[:, None, :] - gt.xy[None, :, :], axis=2).min(axis=1)
     assert np.median(d) < 0.2 and np.mean(d < 0.5) > 0.9, (np.median(d), np.mean(d < 0.5))
+
+
+def _tcp_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _serve_http(video, port: int, start_s: float, seconds: float) -> subprocess.Popen:
+    """``ffmpeg`` as an HTTP server of one MPEG-TS stream (one client), from ``start_s`` of ``video``."""
+    return subprocess.Popen(["ffmpeg", "-loglevel", "error", "-re", "-ss", str(start_s), "-t", str(seconds), "-i",
+                             str(video), "-c:v", "mpeg2video", "-q:v", "2", "-g", "5", "-f", "mpegts", "-listen", "1",
+                             f"http://127.0.0.1:{port}/west.ts"], stdin=subprocess.DEVNULL)
+
+
+def test_an_http_stream_is_read_live_and_reconnected_after_the_server_restarts(two_rooms):
+    if shutil.which("ffmpeg") is None:
+        pytest.skip("ffmpeg is not installed (make test installs it: apt-get install ffmpeg)")
+    from worldtrack.io.grab import Grabber
+    port = _tcp_port()
+    url = f"http://127.0.0.1:{port}/west.ts"
+    server = _serve_http(two_rooms / "west.mp4", port, 0.0, 3.0)
+    grabber = Grabber("west", url, backoff_s=(0.25, 1.0))
+    frames, taken = [], -1
+
+    def take(seconds: float) -> None:
+        nonlocal taken
+        end = time.time() + seconds
+        while time.time() < end:
+            item = grabber.newest(taken, timeout=0.2)
+            if item is not None:
+                taken = item[1]
+                frames.append((time.time(), *item))
+    try:
+        time.sleep(0.5)                                           # the server listens
+        grabber.start()
+        take(4.0)
+        server.kill()                                             # (it has sent its 3 s by now)
+        server.wait(10)
+        take(1.5)                                                 # the server is gone: nothing comes
+        down = len(frames)
+        server = _serve_http(two_rooms / "west.mp4", port, 5.0, 3.0)
+        take(5.0)
+    finally:
+        server.kill()
+        grabber.stop()
+        grabber.join(10)
+    assert grabber.live and grabber.stats.reconnects >= 1 and grabber.stats.outage_s > 1.0, grabber.stats
+    assert down >= 10 and len(frames) - down >= 10, (down, len(frames))
+    stamps = np.array([t for _, t, _, _ in frames])
+    assert np.all(np.diff(stamps) > 0) and np.all(np.diff([i for _, _, i, _ in frames]) > 0)
+    # The capture time is this machine's clock when the frame was grabbed: before it was taken.
+    assert all(0 <= got - t < 1.0 for got, t, _, _ in frames)
+    assert all(img.shape == (240, 320, 3) for _, _, _, img in frames)

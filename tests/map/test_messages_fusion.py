@@ -8,7 +8,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.map.config import MapConfig, map_settings
 from worldtrack.map.connection import hide_passwords, redacted, with_credentials
-from worldtrack.map.fusion import FusionState, floor_information, fuse_bucket
+from worldtrack.map.fusion import FusionState, floor_information, fuse_bucket, provisional_state
 from worldtrack.map.messages import (Estimate, MapPerson, MapState, Observation, decode_map_state,
                                      decode_observation, encode_map_state, encode_observation)
 
@@ -51,6 +51,27 @@ def test_support_and_geometry_weigh_two_workers():
     s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(1, 2.0, 1.0, info=(100.0, 0.0, 1.0))]),
                                         obs("b", 1.0, "w2", [est(1, 3.0, 2.0, info=(10.0, 0.0, 1.0))])], cfg)
     assert s.people[0].x == pytest.approx((100 * 2.0 + 10 * 3.0) / 110) and s.people[0].y == pytest.approx(1.5)
+
+
+def test_the_live_map_refines_a_bucket_as_reports_come_and_leaves_the_others_as_they_were():
+    cfg = MapConfig()
+    state = FusionState()
+    fuse_bucket(state, 10, [obs("a", 1.0, "w1", [est(1, 2.0, 0.0)]), obs("c", 1.0, "w3", [est(3, 7.0, 1.0)])], cfg)
+    committed = state.to_json()
+    first = obs("a", 1.1, "w1", [est(1, 2.1, 0.0, 0.9)])
+    live = {p.id: p for p in provisional_state(state, {11: [first]}, cfg).people}
+    # Person 1 is where w1's report puts them; person 3, whose worker has not reported bucket 11
+    # yet, stays where bucket 10 had them, still present (not lost).
+    assert live[1].x == pytest.approx(2.1) and live[1].last_seen == pytest.approx(1.1)
+    assert live[3].x == 7.0 and live[3].mode == "tracking" and live[3].last_seen == pytest.approx(1.0)
+    # w2's later report of person 1 in the same bucket refines it, weighed as in a complete bucket.
+    second = obs("b", 1.12, "w2", [est(1, 2.5, 0.0, 0.3)])
+    live = {p.id: p for p in provisional_state(state, {11: [first, second]}, cfg).people}
+    assert live[1].x == pytest.approx((0.9 * 2.1 + 0.3 * 2.5) / 1.2) and live[1].workers == 2
+    assert state.to_json() == committed                         # the committed state is not touched
+    # Once complete, the bucket fuses to the same estimate.
+    done = {p.id: p for p in fuse_bucket(state, 11, [first, second], cfg).people}
+    assert done[1].x == pytest.approx(live[1].x) and done[3].mode == "lost"
 
 
 def test_held_estimates_count_only_when_nobody_sees_the_person():

@@ -72,6 +72,10 @@ def test_two_workers_hand_a_person_over_and_score_as_well_as_one_process(two_roo
     # the receiving worker's map from the shared one before they entered its view (not born again
     # and given the id afterwards, which scores as well here: the logs tell the two apart).
     logs = " ".join((tmp_path / f"{c}.log").read_text() for c in ("west", "east"))
+    # Each worker says where each step's time went: one row per frame it tracked.
+    steps = (tmp_path / "west" / "map_timings.csv").read_text().splitlines()
+    frames = int(re.search(r"(\d+) frames in [\d.]+ s", (tmp_path / "west.log").read_text()).group(1))
+    assert steps[0].startswith("capture_t,wait_ms,sync_ms,track_ms") and len(steps) == frames + 1
     handed = [int(n) for n in re.findall(r"(\d+) people taken from the map before they entered its views", logs)]
     assert len(handed) == 2 and sum(handed) >= 2, handed
     for person in (1, 2):

@@ -170,6 +170,7 @@ def run_live(args: argparse.Namespace, cfg) -> int:
         check_source(c, s)
     backgrounds = _backgrounds(args, scene, sources)
     worker = _Worker(args, cfg, scene, own, args.fps or 10.0) if args.map else None
+    timings_file = None
     try:
         position_map = None
         if worker is not None:
@@ -206,11 +207,14 @@ def run_live(args: argparse.Namespace, cfg) -> int:
             tid, x, y = _init(text)
             tracker.init_track(x, y, track_id=tid)
         if worker is not None:
+            from worldtrack.map.timings import StepTimings
             from worldtrack.map.worker import MapTracker
 
             def stepped(t: float) -> None:
                 worker.frames += 1
-            tracker = MapTracker(tracker, worker.link, on_step=stepped)
+            Path(args.out).mkdir(parents=True, exist_ok=True)
+            timings_file = open(Path(args.out) / "map_timings.csv", "w", buffering=1)
+            tracker = MapTracker(tracker, worker.link, on_step=stepped, timings=StepTimings(timings_file))
         from worldtrack.map.connection import hide_passwords
         argv = [hide_passwords(a) for a in (getattr(args, "command_line", None) or sys.argv)]
         write_run_info(Path(args.out), cfg.to_mapping(), inputs={
@@ -221,6 +225,8 @@ def run_live(args: argparse.Namespace, cfg) -> int:
                               json_stream=sys.stdout if args.json else None, progress=not args.quiet,
                               show_ring=args.show_ring)
     finally:
+        if timings_file is not None:
+            timings_file.close()
         if worker is not None:
             worker.close()
     for cid, s in source.stats().items():

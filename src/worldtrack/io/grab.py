@@ -55,7 +55,9 @@ def _open_capture(source: int | str, open_timeout_s: float, read_timeout_s: floa
     """An OpenCV capture of ``source``: streams through the FFmpeg backend with open and read
     timeouts (so a dead stream returns instead of blocking), devices and files as OpenCV opens them."""
     import cv2
-    os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
+    if "OPENCV_LOG_LEVEL" not in os.environ:     # read when cv2 is imported: too late here, so also set it
+        os.environ["OPENCV_LOG_LEVEL"] = "ERROR"
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
     # FFmpeg probes 5 s of a stream by default before the first frame; half a second finds a
     # camera's video stream and starts tracking (and a reconnection) seconds sooner.
     os.environ.setdefault("OPENCV_FFMPEG_CAPTURE_OPTIONS", FFMPEG_PROBE)

@@ -23,6 +23,9 @@ class MapConfig(Section):
                                                           "fall in one bucket are merged into one map state")
     max_wait_s: float = Field(0.5, gt=0, le=60, description="a bucket is written once every live camera has "
                                                               "reported it, or this long after its first observation")
+    live_updates: bool = Field(True, description="update the live map (map:current, map:updates) as soon as any "
+                                                 "worker's observation of a bucket comes, not only when the "
+                                                 "bucket is complete (the record, the map stream, waits)")
     lease_s: float = Field(1.0, gt=0.1, le=60, description="camera and fusion leases expire this long after "
                                                             "their last renewal (a dead worker's cameras are "
                                                             "free again after it)")

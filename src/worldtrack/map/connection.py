@@ -165,6 +165,11 @@ class MapKeys:
         """Hash: the last map state and what the fusion role needs to resume."""
         return self._k("map", "current")
 
+    @property
+    def updates(self) -> str:
+        """Pub/sub channel: every update of the live map (the fields of a map state, as JSON)."""
+        return self._k("map", "updates")
+
     def camera_lease(self, camera: str) -> str:
         return self._k("lease", "camera", camera)
 

@@ -24,6 +24,12 @@ each with its own cameras, share one person map — who updates a person two of 
   If two workers still start the same person at once (both saw them first in the same frame), the
   two ids are close for ``merge_after_s`` with estimates from different sets of workers: the
   younger id is folded into the elder (``aliases``), and the workers rename their copy.
+* **The map does not wait for the slowest worker.** Until a bucket is complete, the live map is
+  :func:`provisional_state`: each person reported so far in the bucket where those reports put
+  them (weighed as above; a later worker's report of the same bucket refines the estimate), and
+  everybody else as the last complete bucket had them. So a worker that is late delays only the
+  people it reports; nobody is marked lost, merged or forgotten until the bucket is complete
+  (:func:`fuse_bucket`, which writes the record).
 * A person no worker reports is ``lost`` (kept, not moved) and leaves the map after
   ``forget_after_s``, or at once when the workers that saw them last say their tracker ended them
   (walked out of the door).
@@ -45,8 +51,8 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field, fields
-from typing import Iterable, Sequence
+from dataclasses import dataclass, field, fields, replace
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -156,6 +162,15 @@ def visible_share(cameras: Sequence[Camera], xy: np.ndarray, height: float,
     return float(max(shares, default=0.0))
 
 
+def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
+    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
+    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
+    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
+    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
+    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
+    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
+
+
 def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
                       step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None
                       ) -> tuple[float, float, float]:
@@ -241,22 +256,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     """
     t = bucket * cfg.bucket_s
     estimates = _per_worker(state, observations)
-    workers_of: dict[int, set[str]] = {}
-    for pid, by_worker in estimates.items():
-        seen = [e for e in by_worker.values() if e.seen]
-        use = seen or list(by_worker.values())
-        x, y, h, w, vx, vy, score, support = _weighted(use)
-        p = state.people.get(pid)
-        if p is None:
-            p = state.people[pid] = FusedPerson(pid, x, y, h, w, born=t)
-        p.x, p.y, p.vx, p.vy, p.score, p.support = x, y, vx, vy, score, support
-        p.height = h if math.isfinite(h) else p.height
-        p.width = w if math.isfinite(w) else p.width
-        p.mode, p.last_seen, p.workers = "tracking", t, len(use)
-        p.lead = next(iter(by_worker)) if len(by_worker) == 1 else \
-            max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
-                 for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
-        workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
+    workers_of = _update_people(state.people, estimates, t)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -271,6 +271,60 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     reports = tuple((o.camera, o.t, o.sent) for o in observations)
     people = tuple(p.public() for p in sorted(state.people.values(), key=lambda p: p.id))
     return MapState(t, people, reports, aliases, written)
+
+
+def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
+                   copy: bool = False) -> dict[int, set[str]]:
+    """Set each reported person of ``people`` to the weighted estimate of the workers that report
+    them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
+    committed state stay as they are). Returns, per person, the workers that see them."""
+    workers_of: dict[int, set[str]] = {}
+    for pid, by_worker in estimates.items():
+        seen = [e for e in by_worker.values() if e.seen]
+        use = seen or list(by_worker.values())
+        x, y, h, w, vx, vy, score, support = _weighted(use)
+        p = people.get(pid)
+        if p is None:
+            p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
+        elif copy:
+            p = people[pid] = replace(p)
+        p.x, p.y, p.vx, p.vy, p.score, p.support = x, y, vx, vy, score, support
+        p.height = h if math.isfinite(h) else p.height
+        p.width = w if math.isfinite(w) else p.width
+        p.mode, p.last_seen, p.workers = "tracking", t, len(use)
+        p.lead = next(iter(by_worker)) if len(by_worker) == 1 else \
+            max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
+                 for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
+        workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
+    return workers_of
+
+
+def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation]], cfg: MapConfig,
+                      written: float = 0.0) -> MapState:
+    """The live map before the open ``buckets`` are complete: ``state`` (the last complete bucket,
+    left unchanged) refined by every observation that has come for the buckets after it.
+
+    A person reported in an open bucket is where the reports so far put them (weighed as in
+    :func:`fuse_bucket`; a later worker's report refines it); anybody else keeps their last
+    estimate and mode — a worker that has not reported yet delays only its own people, and nobody
+    is marked lost, merged or forgotten before the bucket is complete. The state's ``t`` is the
+    newest open bucket's start, its ``reports`` those of all open buckets.
+
+    >>> from worldtrack.map.messages import Estimate, Observation
+    >>> cfg, state = MapConfig(), FusionState()
+    >>> a = Observation("cam1", 5.02, "w1", 50, 5.03, (Estimate(7, 1.0, 2.0, 1.7, 0.45, 0, 0, 0.8, 0.9, True),))
+    >>> p, = provisional_state(state, {50: [a]}, cfg).people
+    >>> p.id, p.x, len(state.people)         # the committed state is not touched
+    (7, 1.0, 0)
+    """
+    people = dict(state.people)
+    for b in sorted(buckets):
+        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, copy=True)
+    t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
+    reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
+    public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
+    aliases = {young: elder for young, (elder, _) in state.aliases.items()}   # recent merges, again
+    return MapState(t, public, reports, aliases, written)
 
 
 def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
@@ -311,4 +365,4 @@ def _finite(v: float) -> float:
 
 
 __all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket",
-           "visible_share"]
+           "in_views", "provisional_state", "visible_share"]

@@ -1,13 +1,21 @@
 """The fusion role on Redis: one holder at a time (a lease), reading every camera's observations,
 writing one map state per time bucket. Any worker (or ``worldtrack map fuse``) can take it over.
 
-A bucket is written when every camera with a live lease has reported past it, or ``max_wait_s``
-after its first observation came (a slow or dead worker does not hold the map up). The map
-stream's entry id is the bucket's start in ms, and the write is fenced by the lease in one Lua
-script together with the state the next holder resumes from (``map:current``): a bucket is
-written once, by the holder of the lease, and a new holder continues from the bucket after the
-last one written, re-reading the observations from there (they stay in their streams until
-``retention_s``), so nothing in the streams is skipped on a take-over.
+The map does not wait for the slowest worker. **The live map** (the hash ``map:current``, which
+workers read before each step, and the channel ``map:updates``, on which every update is
+published) is updated as soon as observations come, with
+:func:`~worldtrack.map.fusion.provisional_state`: the open buckets' reports so far, weighed as
+in a complete bucket, on top of the last complete one; a later worker's report of the same bucket
+refines it, and a worker that has not reported yet delays only its own people (``map.live_updates``).
+
+**The record** (the stream ``map``, one entry per time bucket, what ``replay`` reads) holds each
+bucket's final state, written when every camera with a live lease has reported past it, or
+``max_wait_s`` after its first observation came (a slow or dead worker does not hold it up).
+That entry's id is the bucket's start in ms, and the write is fenced by the lease in one Lua
+script together with the state the next holder resumes from: a bucket is written once, by the
+holder of the lease, and a new holder continues from the bucket after the last one written,
+re-reading the observations from there (they stay in their streams until ``retention_s``), so
+nothing in the streams is skipped on a take-over.
 """
 
 from __future__ import annotations
@@ -20,13 +28,14 @@ from typing import Any, Callable
 
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.fusion import FusionState, fuse_bucket
+from worldtrack.map.fusion import FusionState, fuse_bucket, provisional_state
 from worldtrack.map.lease import Lease
 from worldtrack.map.messages import (MapState, Observation, bucket_index, decode_observation, encode_map_state,
                                      stream_id_ms)
 
 #: KEYS = (lease, map stream, current hash); ARGV = (owner, id, minid, state, last bucket, written, t,
-#: people count, field, value, …). 1 written, 0 not our lease, -1 bucket already written.
+#: people count, updates channel, update, field, value, …). 1 written, 0 not our lease, -1 bucket
+#: already written, 2 written but not published (an ACL user without the channel: ``&prefix:*``).
 _WRITE_MAP = """
 if redis.call('GET', KEYS[1]) ~= ARGV[1] then
   return 0
@@ -36,17 +45,37 @@ if ARGV[3] ~= '' then
   table.insert(args, 'MINID'); table.insert(args, '~'); table.insert(args, ARGV[3])
 end
 table.insert(args, ARGV[2])
-for i = 9, #ARGV do table.insert(args, ARGV[i]) end
+for i = 11, #ARGV do table.insert(args, ARGV[i]) end
 local ok = pcall(redis.call, 'XADD', unpack(args))
 if not ok then
   return -1
 end
 redis.call('HSET', KEYS[3], 'state', ARGV[4], 'last_bucket', ARGV[5], 'written', ARGV[6], 't', ARGV[7],
            'people', ARGV[8], 'holder', ARGV[1])
-for i = 9, #ARGV, 2 do
+for i = 11, #ARGV, 2 do
   if ARGV[i] == 'people' or ARGV[i] == 'aliases' or ARGV[i] == 'reports' then
     redis.call('HSET', KEYS[3], 'map_' .. ARGV[i], ARGV[i + 1])
   end
+end
+local sent = redis.pcall('PUBLISH', ARGV[9], ARGV[10])
+if type(sent) == 'table' and sent.err then
+  return 2
+end
+return 1
+"""
+
+#: The live map between complete buckets. KEYS = (lease, current hash); ARGV = (owner, updates
+#: channel, update, written, t, people count, people, aliases, reports). 1 written, 0 not our lease,
+#: 2 written but not published.
+_UPDATE_MAP = """
+if redis.call('GET', KEYS[1]) ~= ARGV[1] then
+  return 0
+end
+redis.call('HSET', KEYS[2], 'written', ARGV[4], 't', ARGV[5], 'people', ARGV[6], 'map_people', ARGV[7],
+           'map_aliases', ARGV[8], 'map_reports', ARGV[9])
+local sent = redis.pcall('PUBLISH', ARGV[2], ARGV[3])
+if type(sent) == 'table' and sent.err then
+  return 2
 end
 return 1
 """
@@ -64,6 +93,7 @@ class FusionStats:
     late: int = 0
     malformed: int = 0
     takeovers: int = 0
+    updates: int = 0
     last_written: float = 0.0
     lag_s: list[float] = field(default_factory=list)
 
@@ -88,6 +118,9 @@ class FusionRole:
         self.client, self.keys, self.cfg, self.owner, self.clock = client, keys, cfg, owner, clock
         self.lease = Lease(client, keys.fusion_lease, owner, cfg.lease_s)
         self._write = client.register_script(_WRITE_MAP)
+        self._update = client.register_script(_UPDATE_MAP)
+        self._fresh = False          # observations came that the live map does not hold yet
+        self._said_unpublished = False
         self.on_state = on_state
         self.log = log or (lambda line: None)
         self.holding = False
@@ -194,7 +227,31 @@ class FusionRole:
             self._take(replies)
         else:
             time.sleep(block_ms / 1000.0)
-        return self._close_due()
+        written = self._close_due()
+        if self._fresh and self._buckets and self.holding and self.cfg.live_updates:
+            self._update_live()
+        self._fresh = False
+        return written
+
+    def _update_live(self) -> None:
+        """Write the open buckets' reports so far to the live map (not to the record)."""
+        now = self.clock()
+        state = provisional_state(self.state, self._buckets, self.cfg, written=now)
+        fields = encode_map_state(state)
+        res = self._update(keys=[self.keys.fusion_lease, self.keys.current],
+                           args=[self.owner, self.keys.updates, json.dumps(fields), repr(now), repr(state.t),
+                                 str(len(state.present())), fields["people"], fields["aliases"], fields["reports"]])
+        if res == 0:
+            self.holding = False
+            return
+        self.stats.updates += 1
+        self._published(res)
+
+    def _published(self, res: int) -> None:
+        if res == 2 and not self._said_unpublished:
+            self._said_unpublished = True
+            self.log(f"fusion: this Redis user may not publish to {self.keys.updates}: the live map is kept "
+                     f"in {self.keys.current} only (grant the channel: ACL SETUSER … '&{self.keys.prefix}:*')")
 
     def _take(self, replies: Any) -> None:
         now = self.clock()
@@ -213,6 +270,7 @@ class FusionRole:
                     self._late_pending += 1
                     continue
                 self._buckets.setdefault(b, []).append(o)
+                self._fresh = True
                 self._first_arrival.setdefault(b, now)
                 self._latest[o.camera] = max(self._latest.get(o.camera, -1e18), o.t)
 
@@ -250,14 +308,15 @@ class FusionRole:
         fields = encode_map_state(state)
         minid = str(stream_id_ms(state.t - self.cfg.retention_s))
         args = [self.owner, f"{stream_id_ms(state.t)}-0", minid, self.state.to_json(), str(b), repr(now),
-                repr(state.t), str(len(state.present()))]
+                repr(state.t), str(len(state.present())), self.keys.updates, json.dumps(fields)]
         for k, v in fields.items():
             args += [k, v]
         res = self._write(keys=[self.keys.fusion_lease, self.keys.map_stream, self.keys.current], args=args)
         if res == 0:
             self.holding = False
             return False
-        self.stats.buckets += res == 1
+        self.stats.buckets += res in (1, 2)
+        self._published(res)
         self.stats.last_written = now
         self.stats.lag_s.append(now - (b + 1) * self.cfg.bucket_s)
         if len(self.stats.lag_s) > 10000:

@@ -31,10 +31,11 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.fusion import LEAD_SHARE, floor_information, visible_share
+from worldtrack.map.fusion import LEAD_SHARE, floor_information, in_views, visible_share
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
+from worldtrack.map.timings import StepTimings
 from worldtrack.trackers.base import Frame, Person, PositionMap, Track, Tracker
 
 
@@ -75,15 +76,6 @@ class SharedPositionMap(PositionMap):
         if pid in self:
             self.remove(pid)
         return pid
-
-
-def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
-    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
-    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
-    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
-    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
-    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
-    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
 
 
 class MapLink:
@@ -127,6 +119,8 @@ class MapLink:
         self.lockstep = False
         self.lockstep_wait_s = 2.0
         self._first_t: float | None = None
+        #: The end (s) of the last complete bucket of the map (every live camera's report in).
+        self.complete_until, self._record_id = -math.inf, ""
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
@@ -173,11 +167,23 @@ class MapLink:
 
     # ------------------------------------------------------------------ each frame
     def read_map(self) -> MapState | None:
-        """The latest map state (None before the first)."""
-        raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports"])
+        """The latest map state (None before the first): the live map, or in a batch run (lockstep) the
+        last complete bucket (every worker's reports, not whichever came first: runs repeat)."""
+        if self.lockstep:
+            last = self.client.xrevrange(self.keys.map_stream, count=1)
+            if not last:
+                return None
+            if self.state is None or last[0][0] != self._record_id:
+                self._record_id, self.state = last[0][0], decode_map_state(last[0][1])
+                self.complete_until = self.state.t + self.cfg.bucket_s
+            return self.state
+        raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports",
+                                                    "last_bucket"])
         if raw[0] is None:
             return None
-        if self.state is None or float(raw[2]) != self.state.t:
+        if raw[5] is not None:
+            self.complete_until = (int(raw[5]) + 1) * self.cfg.bucket_s
+        if self.state is None or float(raw[2]) != self.state.t or float(raw[3] or 0) != self.state.written:
             fields = {"v": FORMAT_VERSION, "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}",
                       "written": raw[3] or "0",
                       "reports": raw[4] or "[]"}
@@ -191,8 +197,8 @@ class MapLink:
             return
         deadline = time.monotonic() + self.lockstep_wait_s
         while time.monotonic() < deadline:
-            state = self.read_map()
-            if state is not None and state.captured >= t - 1.5 / self.fps:
+            # The bucket of the previous frame complete: every worker's report of it is in.
+            if self.read_map() is not None and self.complete_until > t - max(1.0 / self.fps, self.cfg.bucket_s):
                 return
             time.sleep(0.002)
 
@@ -286,7 +292,7 @@ class MapLink:
                 for c in cams]
 
     def publish(self, observations: Sequence[Observation]) -> None:
-        """Append the observations to their cameras' streams (only while this worker holds the camera)."""
+        """Append the observations to their cameras' streams (only while this worker holds them)."""
         pipe = self.client.pipeline(transaction=False)
         for o in observations:
             fields = encode_observation(o)
@@ -340,8 +346,9 @@ class MapTracker:
     map's ids.
     """
 
-    def __init__(self, inner: Tracker, link: MapLink, on_step: Callable[[float], None] | None = None):
-        self.inner, self.link, self.on_step = inner, link, on_step
+    def __init__(self, inner: Tracker, link: MapLink, on_step: Callable[[float], None] | None = None,
+                 timings: StepTimings | None = None):
+        self.inner, self.link, self.on_step, self.timings = inner, link, on_step, timings
         self.extra_columns = inner.extra_columns
 
     @property
@@ -374,9 +381,17 @@ class MapTracker:
         return self.inner.overlay(camera_id)
 
     def step(self, frames: Mapping[str, Frame], t: float) -> list[Track]:
+        clock, marks = self.link.clock, [t, self.link.clock()]
         self.link.sync(self.inner, t)
+        marks.append(clock())
         tracks = self.inner.step(frames, t)
-        self.link.publish(self.link.observations(self.inner, tracks, t, frames))
+        marks.append(clock())
+        observations = self.link.observations(self.inner, tracks, t, frames)
+        marks.append(clock())
+        self.link.publish(observations)
+        marks.append(clock())
+        if self.timings is not None:
+            self.timings.write(marks)
         if self.on_step is not None:
             self.on_step(t)
         return tracks

@@ -1,0 +1,92 @@
+"""Two workers on the shared map against one process with both cameras, on held-out two-rooms seeds.
+
+Question (issue 39): do the fused tracks of two ``worldtrack track --map`` workers (one camera
+each) score at least as well (MOTA, IDF1, 0.5 m gate) as one ``worldtrack track`` with both
+cameras, and where they do not, in which frames and why?
+
+Set-up: ``two-rooms`` seeds 2-6 (held out: the map was developed on seeds 0 and 1, the test uses
+seed 1), 320x240, 10 frames/s; the workers in batch (``map.pace_files=false``: each waits for
+the complete bucket of its previous frame, so runs repeat), their tracks from ``worldtrack
+replay``. Per run: MOTA, IDF1, switches of both, and the frames in which the fused tracks have a
+miss or a false positive the one process does not have (``worse frames``), with the first of them.
+
+Run: ``nice -n 10 .venv/bin/python benchmarks/map_two_workers.py [--seeds 2,3,4,5,6] [--repeats 2]``.
+Writes ``benchmarks/results/map_two_workers.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import markdown_table, save_result  # noqa: E402
+from map_rig import WORLDTRACK, Server, load_average, run_workers  # noqa: E402
+
+from worldtrack.eval.mot import evaluate_detailed  # noqa: E402
+from worldtrack.io.tracks import read_tracks  # noqa: E402
+from worldtrack.map.connection import MapKeys, connect  # noqa: E402
+from worldtrack.map.replay import replay  # noqa: E402
+from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
+
+
+def worse_frames(one, fused) -> list[int]:
+    """Frames where the fused tracks have more misses + false positives than the one process."""
+    a, b = one.per_frame, fused.per_frame
+    errors = {int(f): int(m + fp) for f, m, fp in zip(a["frame"], a["misses"], a["false_positives"])}
+    return [int(f) for f, m, fp in zip(b["frame"], b["misses"], b["false_positives"]) if m + fp > errors.get(int(f), 0)]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--seeds", default="2,3,4,5,6")
+    ap.add_argument("--repeats", type=int, default=2)
+    ap.add_argument("--quick", action="store_true", help="seed 2, one run; prints only")
+    args = ap.parse_args()
+    seeds, repeats = ([2], 1) if args.quick else ([int(s) for s in args.seeds.split(",")], args.repeats)
+    start, rows, gaps = time.time(), [], {"mota": [], "idf1": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        server = Server(tmp)
+        try:
+            for seed in seeds:
+                sc = make_scenario("two-rooms", seed=seed)
+                seq = tmp / f"seed{seed}"
+                write_sequence(sc, seq, progress=False)
+                gt = read_tracks(seq / "gt.csv")
+                subprocess.run([*WORLDTRACK, "track", str(seq / "scene.yaml"),
+                                *[a for c in sc.camera_ids for a in ("--video", f"{c}={seq / (c + '.mp4')}")],
+                                "--out", str(seq / "one"), "--quiet", "--no-video"], check=True, capture_output=True)
+                one = evaluate_detailed(gt, read_tracks(seq / "one" / "tracks.csv"))
+                for k in range(repeats):
+                    server.flush()
+                    run_workers(seq, server.url, sc.camera_ids, seq / f"workers{k}", sets=["map.pace_files=false"])
+                    fused = evaluate_detailed(gt, read_tracks(replay(connect(server.url), MapKeys(),
+                                                                     seq / f"replay{k}").tracks_csv))
+                    worse = worse_frames(one, fused)
+                    m1, m2 = one.metrics, fused.metrics
+                    rows.append([seed, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],
+                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—"])
+                    for key in gaps:
+                        gaps[key].append(m2[key] - m1[key])
+                    print(rows[-1], file=sys.stderr)
+        finally:
+            server.stop()
+    table = markdown_table(["seed", "run", "MOTA one", "MOTA workers", "IDF1 one", "IDF1 workers", "switches one",
+                            "switches workers", "worse frames", "from–to"], rows)
+    text = (f"{table}\n\nWorkers − one process over all runs: MOTA mean {statistics.mean(gaps['mota']):+.3f} "
+            f"(worse in {sum(g < 0 for g in gaps['mota'])} of {len(rows)}), IDF1 mean "
+            f"{statistics.mean(gaps['idf1']):+.3f} (worse in {sum(g < 0 for g in gaps['idf1'])} of {len(rows)}). "
+            f"Load average at the end: {load_average()} (2 cores shared with other work).\n")
+    print(text)
+    save_result("map_two_workers", "Two workers on the shared map against one process (two-rooms, held-out seeds)",
+                text, args.quick, time.time() - start)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,68 @@
+"""The live map on a real Redis server: updated as soon as one worker's observation comes, not
+when the slowest worker has reported; the record (the map stream) waits for the bucket."""
+
+from __future__ import annotations
+
+import json
+import time
+
+from _mapkit import wait_until
+from worldtrack.map.config import MapConfig
+from worldtrack.map.connection import MapKeys, connect
+from worldtrack.map.fusion_role import FusionRole, run_fusion_thread
+from worldtrack.map.messages import (Estimate, Observation, bucket_index, decode_map_state, encode_observation,
+                                     stream_id_ms)
+
+
+def _publish(client, keys, camera: str, t: float, pid: int, x: float) -> None:
+    e = Estimate(pid, x, 1.0, 1.7, 0.45, 0.0, 0.0, 0.8, 0.7, True)
+    o = Observation(camera, t, f"w-{camera}", 0, time.time(), (e,))
+    client.xadd(keys.observations(camera), encode_observation(o), id=f"{stream_id_ms(t)}-*")
+
+
+def _live_people(client, keys) -> dict[int, tuple[float, str]]:
+    raw = client.hmget(keys.current, ["map_people", "t"])
+    if raw[0] is None:
+        return {}
+    state = decode_map_state({"v": "2", "t": raw[1], "people": raw[0]})
+    return {p.id: (p.x, p.mode) for p in state.people}
+
+
+def test_a_slow_worker_delays_only_its_own_people(redis_url):
+    client = connect(redis_url)
+    keys, cfg = MapKeys(), MapConfig(max_wait_s=3.0)
+    for cam in ("fast", "slow"):     # two live cameras: a bucket is complete when both have reported
+        client.hset(keys.cameras, cam, json.dumps({"fps": 10.0, "worker": f"w-{cam}"}))
+        client.set(keys.camera_lease(cam), f"w-{cam}", px=30000)
+    updates = client.pubsub(ignore_subscribe_messages=True)
+    updates.subscribe(keys.updates)
+    role = FusionRole(client, keys, cfg, "fuser")
+    thread, stop = run_fusion_thread(role)
+    try:
+        wait_until(lambda: role.holding, 10, what="the fusion role")
+        t0 = (bucket_index(time.time(), cfg.bucket_s) + 0.5) * cfg.bucket_s
+        _publish(client, keys, "fast", t0, 1, 2.0)
+        _publish(client, keys, "slow", t0, 2, 6.0)
+        wait_until(lambda: client.xlen(keys.map_stream) == 1, 10, what="the first complete bucket")
+        # The next bucket: only the fast camera reports. Its person moves on the live map at once,
+        # long before the bucket is complete or max_wait_s (3 s) has passed; the slow camera's
+        # person stays where they were, present.
+        sent = time.time()
+        _publish(client, keys, "fast", t0 + 0.1, 1, 2.1)
+        wait_until(lambda: _live_people(client, keys).get(1, (0, ""))[0] == 2.1, 2.0, every=0.005,
+                   what="the fast worker's report on the live map")
+        took = time.time() - sent
+        assert _live_people(client, keys)[2] == (6.0, "tracking")
+        assert client.xlen(keys.map_stream) == 1            # the record waits for the slow camera
+        message = wait_until(lambda: updates.get_message(timeout=0.1), 2.0, what="updates")
+        assert decode_map_state(json.loads(message["data"])).reports
+        # The slow camera's report refines the same bucket and completes it.
+        _publish(client, keys, "slow", t0 + 0.1, 2, 6.1)
+        wait_until(lambda: client.xlen(keys.map_stream) == 2, 2.0, what="the second complete bucket")
+        last = decode_map_state(client.xrevrange(keys.map_stream, count=1)[0][1])
+        assert {p.id: p.x for p in last.present()} == {1: 2.1, 2: 6.1}
+    finally:
+        stop.set()
+        thread.join(10)
+    print(f"the fast worker's report was on the live map {took * 1000:.0f} ms after it was published")
+    assert took < 1.0
