@@ -20,7 +20,7 @@ of :mod:`worldtrack.trackers.ellipsoid.velocity`) and the tracker's internal vel
 * **Velocity**: RMSE of the speed and of the velocity vector, before (internal) and after
   (filter). The positions are the same either way (the filter moves nobody).
 * ``--fit``: refits the constants of :mod:`worldtrack.trackers.ellipsoid.uncertainty`
-  (κ, c_min, s_px) on the **training** seeds by Gaussian maximum likelihood and prints them
+  (κ, c_min and the failing factor) on the **training** seeds by Gaussian maximum likelihood and prints them
   beside the module's values. Only the held-out seeds and scenarios are used to judge.
 
 Training seeds (the constants were fitted on them): crowd 1–3, crowd with 1 camera 4–5,
@@ -85,10 +85,9 @@ def run(name: str, params: dict, seed: int) -> dict:
         p = tracker.position_map.get(tr.id)
         parts = tracker.uncertainty.components.get(p) if p is not None else None
         fresh = parts is not None and parts.t == t
-        geo = parts.geometry if fresh else np.full((2, 2), np.nan)
         return (index, t, tr.id, tr.x, tr.y, tr.sigma, tr.mode, tr.vx, tr.vy, p.vx, p.vy,
                 *(parts.curvature if fresh else (np.nan, np.nan)), *(parts.along if fresh else (np.nan, np.nan)),
-                geo[0, 0], geo[0, 1], geo[1, 1], bool(fresh and parts.unmeasurable), bool(fresh and parts.failing))
+                bool(fresh and parts.unmeasurable), bool(fresh and parts.failing))
 
     rows, _ = step_tracker(tracker, bundle_frames(bundles), row=row)
     gt_all = gt_table(bundles)
@@ -117,7 +116,7 @@ def pair_rows(rows: list, gt, gt_v: dict) -> dict:
     index = {(int(r[0]), int(r[2])): k for k, r in enumerate(rows)}
     gt_index = {(int(f), int(i)): k for k, (f, i) in enumerate(zip(gt.frame, gt.id))}
     out: dict[str, list] = {k: [] for k in ("err", "dx", "dy", "sigma", "mode", "v", "v_old", "v_gt", "curv",
-                                             "along", "geo", "unmeasurable", "failing")}
+                                             "along", "unmeasurable", "failing")}
     for f, g, p in zip(pairs["frame"], pairs["gt_id"], pairs["pred_id"]):
         r = rows[index[(int(f), int(p))]]
         truth = gt.xy[gt_index[(int(f), int(g))]]
@@ -131,9 +130,8 @@ def pair_rows(rows: list, gt, gt_v: dict) -> dict:
         out["v_gt"].append(gt_v[(int(f), int(g))])
         out["curv"].append(r[11:13])
         out["along"].append(r[13:15])
-        out["geo"].append(r[15:18])
-        out["unmeasurable"].append(r[18])
-        out["failing"].append(r[19])
+        out["unmeasurable"].append(r[15])
+        out["failing"].append(r[16])
     return {k: np.array(v) for k, v in out.items()}
 
 
@@ -165,27 +163,22 @@ def speed_errors(d: dict) -> list:
             len(np.unique(np.round(np.hypot(*d["v_old"].T), 4))), len(np.unique(np.round(np.hypot(*d["v"].T), 4)))]
 
 
-def fit_constants(d: dict) -> tuple[float, float, float, float]:
-    """κ, c_min, s_px and the failing factor by Gaussian maximum likelihood of the per-axis errors (along and across the line of
+def fit_constants(d: dict) -> tuple[float, float, float]:
+    """κ, c_min and the failing factor by Gaussian maximum likelihood of the per-axis errors (along and across the line of
     sight) of the rows measured this frame and not unmeasurable."""
     ok = np.isfinite(d["curv"]).all(axis=1) & ~d["unmeasurable"].astype(bool)
     along = d["along"][ok]
     across = np.column_stack([-along[:, 1], along[:, 0]])
     dxy = np.column_stack([d["dx"], d["dy"]])[ok]
     e = np.column_stack([(dxy * along).sum(1), (dxy * across).sum(1)])
-    gxx, gxy, gyy = d["geo"][ok].T
-
-    def g(u):
-        return u[:, 0] ** 2 * gxx + 2 * u[:, 0] * u[:, 1] * gxy + u[:, 1] ** 2 * gyy
-    geo = np.column_stack([g(along), g(across)])
     curv = d["curv"][ok]
     failing = d["failing"][ok].astype(bool)[:, None]
 
     def nll(w):
-        k, cmin, spx, fail = np.exp(w)
-        var = (k ** 2 / np.maximum(curv, cmin) + spx ** 2 * geo) * np.where(failing, fail ** 2, 1.0)
+        k, cmin, fail = np.exp(w)
+        var = k ** 2 / np.maximum(curv, cmin) * np.where(failing, fail ** 2, 1.0)
         return float(np.mean(0.5 * np.log(var) + e ** 2 / (2 * var)))
-    res = minimize(nll, np.log([unc.SCORE_NOISE, unc.MIN_CURVATURE, unc.MODEL_PX, unc.FAILING_FACTOR]),
+    res = minimize(nll, np.log([unc.SCORE_NOISE, unc.MIN_CURVATURE, unc.FAILING_FACTOR]),
                    method="Nelder-Mead", options={"maxiter": 4000, "xatol": 1e-4, "fatol": 1e-6})
     return tuple(float(v) for v in np.exp(res.x))
 
@@ -273,10 +266,10 @@ def report(results: dict[str, dict[str, dict]], fit: bool) -> str:
         parts.append(f"Velocity against the truth, {group} (m/s; before = the tracker's internal velocity, "
                      "after = the reported filter):\n\n" + markdown_table(spd_head, rows))
     if fit and "training" in totals:
-        k, cmin, spx, fail = fit_constants(totals["training"])
+        k, cmin, fail = fit_constants(totals["training"])
         parts.append(f"Constants refitted on the training seeds: κ = {k:.3f}, c_min = {cmin:.3f} 1/m², "
-                     f"s_px = {spx:.3f} px, failing factor {fail:.2f} (the module's: κ = {unc.SCORE_NOISE}, "
-                     f"c_min = {unc.MIN_CURVATURE}, s_px = {unc.MODEL_PX}, failing factor {unc.FAILING_FACTOR}).")
+                     f"failing factor {fail:.2f} (the module's: κ = {unc.SCORE_NOISE}, c_min = {unc.MIN_CURVATURE}, "
+                     f"failing factor {unc.FAILING_FACTOR}).")
     return "\n\n".join(parts)
 
 

@@ -4,21 +4,16 @@ Paper 000 gives a position and nothing about how far it can be off. worldtrack a
 
 * **σ**, the 1-σ position error in metres (per floor axis, so a 2-D Gaussian error falls within
   1 σ of the truth 39 % of the time and within 2 σ 86 %). Each frame a camera shows the person,
-  their position covariance is
-  ``Rᵀ diag(κ² / max(c_ray, c_min) + s_px² g_ray, κ² / max(c_across, c_min) + s_px² g_across) R``:
+  their position covariance is ``Rᵀ diag(κ² / max(c_ray, c_min), κ² / max(c_across, c_min)) R``:
 
   - ``c`` is the curvature of the match's own score E (eq. 5) around the chosen place, along
     and across the line of sight of the camera that shows the person largest, from E at ±10 cm
     (:func:`score_curvature`). A sharp peak means a well-placed person; a flat ridge along the
-    line of sight (one camera, or two facing each other) does not. E acts as a log-likelihood
-    of weight 1 / κ² (:data:`SCORE_NOISE`); ``c_min`` (:data:`MIN_CURVATURE`) caps a flat
-    score's share at κ / √c_min ≈ 0.29 m.
-  - ``g`` is the inverse of the cameras' floor information at the person's place, per pixel²
-    (:func:`worldtrack.map.fusion.floor_information`: five points on the person's axis, those
-    hidden by obstacles or outside the image left out). ``s_px`` (:data:`MODEL_PX`) is the pixel
-    error of an ellipsoid standing in for a body. The fit gives it little weight (0.05 px): the
-    curvature of E already says how many pixels a step moves the person at that distance, from
-    those cameras. It matters where the cameras show none of the person's axis (σ ≈ 1 m).
+    line of sight (one camera, or two facing each other) does not. The curvature already holds
+    the cameras' geometry (how many pixels a step moves the person at that distance, in those
+    views) and what is seen of the person (hidden pixels do not change E). E acts as a
+    log-likelihood of weight 1 / κ² (:data:`SCORE_NOISE`); ``c_min`` (:data:`MIN_CURVATURE`)
+    caps a flat score at κ / √c_min ≈ 0.29 m.
   - While the person's evidence is failing (the life cycle is counting down to end the track),
     σ is :data:`FAILING_FACTOR` times larger.
   - A person flagged ``unmeasurable`` (head and feet hidden in every view, paper 000 Table 2 (b))
@@ -28,7 +23,11 @@ Paper 000 gives a position and nothing about how far it can be off. worldtrack a
   has grown since the last measurement (:mod:`.velocity`). The constants were fitted (Gaussian
   maximum likelihood, ``benchmarks/uncertainty.py --training --fit``) on synthetic scenes: the
   crowd with 2 cameras (seeds 1–3) and 1 camera (4–5), two-crossing (0–1) and entry (0–1).
-  ``benchmarks/uncertainty.py`` measures the calibration on other seeds and scenarios.
+  ``benchmarks/uncertainty.py`` measures the calibration on other seeds and scenarios. (A
+  geometric term, the inverse of the cameras' floor information of
+  :func:`worldtrack.map.fusion.floor_information` times a pixel error, got a weight of
+  0.007–0.05 px in that fit, nothing beside the curvature, for a quarter of the tracker's time:
+  it was left out.)
 * **vx, vy, speed** from the constant-velocity filter of :mod:`.velocity` over the positions
   and their covariance, instead of the tracker's internal velocity (which moves in steps of the
   matching grid). The positions are not changed.
@@ -40,7 +39,7 @@ Paper 000 gives a position and nothing about how far it can be off. worldtrack a
 ``width`` is not measured: it is the body width the tracker draws the person with (the scene's
 ``people`` sizes), reported as such.
 
->>> cov = position_covariance(np.array([4.0, 40.0]), np.array([1.0, 0.0]), np.zeros((2, 2)), False)
+>>> cov = position_covariance(np.array([4.0, 40.0]), np.array([1.0, 0.0]))
 >>> np.round(np.sqrt(np.diag(cov)), 3).tolist()          # along the ray (x) 3× across (y)
 [0.13, 0.041]
 """
@@ -49,12 +48,10 @@ from __future__ import annotations
 
 import math
 import weakref
-from typing import TYPE_CHECKING, Mapping, NamedTuple, Sequence
+from typing import TYPE_CHECKING, Mapping, NamedTuple
 
 import numpy as np
 
-from worldtrack.geometry.camera import Camera
-from worldtrack.map.fusion import floor_information
 from worldtrack.trackers.base import Person, PositionMap, Track
 from worldtrack.trackers.ellipsoid import velocity
 from worldtrack.trackers.ellipsoid.velocity import Motion
@@ -69,8 +66,6 @@ SCORE_STEP_M = 0.1
 SCORE_NOISE = 0.26
 #: Least curvature of E counted, 1/m² (a flat score: at most κ / √c_min = 0.29 m from the score).
 MIN_CURVATURE = 0.8
-#: Pixel error of the ellipsoid body model on the person's axis points (fitted), px.
-MODEL_PX = 0.05
 #: σ of a person whose evidence is failing (:mod:`.life` counts down to end them) is this many
 #: times larger (fitted).
 FAILING_FACTOR = 1.9
@@ -102,27 +97,14 @@ def score_curvature(joint: "JointImage", k: int, step_m: float = SCORE_STEP_M) -
     return np.array([2 * e[0] - e[1] - e[2], 2 * e[0] - e[3] - e[4]]) / step_m ** 2, d
 
 
-def geometry_covariance(cameras: Sequence[Camera], occlusion: Sequence[np.ndarray | None], xy: np.ndarray,
-                        height: float) -> np.ndarray:
-    """(2, 2) m² per px²: the inverse of the cameras' floor information at ``xy`` for a person of
-    ``height`` m (:func:`~worldtrack.map.fusion.floor_information`, one-pixel errors); 1/MODEL_PX²
-    times the identity (σ = 1 m) when no camera shows a point of the person's axis."""
-    info = np.array(floor_information(cameras, np.asarray(xy, float), height, 1.0, occlusion=occlusion))
-    m = np.array([[info[0], info[1]], [info[1], info[2]]])
-    if not np.isfinite(m).all() or np.linalg.det(m) <= 1e-12:
-        return np.eye(2) / MODEL_PX ** 2
-    return np.linalg.inv(m)
-
-
-def position_covariance(curvature: np.ndarray, along: np.ndarray, geometry: np.ndarray,
-                        unmeasurable: bool = False, failing: bool = False) -> np.ndarray:
+def position_covariance(curvature: np.ndarray, along: np.ndarray, unmeasurable: bool = False,
+                        failing: bool = False) -> np.ndarray:
     """(2, 2) m²: one frame's position covariance from the score's ``curvature`` (2,) 1/m² along
-    and across the unit floor direction ``along`` (2,), and the cameras' ``geometry`` (2, 2) m²/px²;
-    times :data:`FAILING_FACTOR`² while the person's evidence is ``failing`` (see the module's
-    docstring)."""
+    and across the unit floor direction ``along`` (2,); times :data:`FAILING_FACTOR`² while the
+    person's evidence is ``failing``; at least :data:`UNMEASURABLE_M` along the line of sight
+    when ``unmeasurable`` (see the module's docstring)."""
     axes = np.column_stack([along, [-along[1], along[0]]])
-    geo = np.einsum("ji,jk,ki->i", axes, geometry, axes)            # diag(axesᵀ G axes)
-    var = SCORE_NOISE ** 2 / np.maximum(curvature, MIN_CURVATURE) + MODEL_PX ** 2 * geo
+    var = SCORE_NOISE ** 2 / np.maximum(np.asarray(curvature, float), MIN_CURVATURE)
     if failing:
         var *= FAILING_FACTOR ** 2
     if unmeasurable:
@@ -137,7 +119,6 @@ class Components(NamedTuple):
     ----------
     curvature : (2,) float, 1/m² — of E along and across the line of sight
     along : (2,) float — the unit floor direction of the line of sight
-    geometry : (2, 2) float, m²/px² — the inverse floor information of the cameras
     unmeasurable : bool — head and feet hidden in every view
     failing : bool — the person's evidence failed this frame (the life cycle's ``low`` counter)
     t : float — the time stamp, s
@@ -145,7 +126,6 @@ class Components(NamedTuple):
 
     curvature: np.ndarray
     along: np.ndarray
-    geometry: np.ndarray
     unmeasurable: bool
     failing: bool
     t: float
@@ -185,16 +165,12 @@ class PositionUncertainty:
         covs: dict[int, np.ndarray] = {}
         if shown:
             joint = tracker.joint_image({cid: real[cid] for cid in cams}, people)
-            cameras = [tracker.views[cid].camera for cid in cams]
-            occlusion = [tracker.views[cid].args.occ for cid in cams]
             for k in shown:
                 p = people[k]
                 curvature, along = score_curvature(joint, k)
-                geometry = geometry_covariance(cameras, occlusion, joint.xy[k], p.height)
-                parts = Components(curvature, along, geometry, "unmeasurable" in p.flags, p.count("low") > 0,
-                                   float(t))
+                parts = Components(curvature, along, "unmeasurable" in p.flags, p.count("low") > 0, float(t))
                 self.components[p] = parts
-                covs[k] = position_covariance(*parts[:5])
+                covs[k] = position_covariance(*parts[:4])
         for k, p in enumerate(people):
             if p.confirmed and p.once("uncertainty", t):
                 self._advance(p, covs.get(k), t)
@@ -228,6 +204,6 @@ class PositionUncertainty:
         return [self.track(p, t) for p in position_map if p.confirmed]
 
 
-__all__ = ["Components", "FAILING_FACTOR", "MIN_CURVATURE", "MODEL_PX", "OCCLUDED_OWN_SHARE", "PositionUncertainty", "SCORE_NOISE",
-           "SCORE_STEP_M", "UNMEASURABLE_M", "UNMEASURED_M", "geometry_covariance", "position_covariance",
+__all__ = ["Components", "FAILING_FACTOR", "MIN_CURVATURE", "OCCLUDED_OWN_SHARE", "PositionUncertainty", "SCORE_NOISE",
+           "SCORE_STEP_M", "UNMEASURABLE_M", "UNMEASURED_M", "position_covariance",
            "reported_mode", "score_curvature"]
