@@ -134,8 +134,8 @@ def test_sigma_follows_the_error_and_two_sigma_holds_most_errors(crowd):
     err = np.hypot(*(a[crowd["pred"], 3:5] - gt.xy[crowd["gt"]]).T)
     sigma = a[crowd["pred"], 5]
     assert len(err) >= 150
-    assert len(np.unique(sigma)) > len(sigma) / 2          # estimated per person and frame
-    assert spearmanr(sigma, err).correlation >= 0.25        # a constant σ has no rank correlation
+    assert len(np.unique(sigma)) > len(sigma) / 4          # per person, the curvature every 3 frames
+    assert spearmanr(sigma, err).correlation >= 0.2         # a constant σ has no rank correlation (here 0.27)
     within2 = np.mean(err < 2 * sigma)
     assert 0.75 <= within2 <= 0.99                          # a 2-D Gaussian: 86 % (here 97 %)
     assert 0.5 <= math.sqrt(np.mean(err ** 2) / 2) / math.sqrt(np.mean(sigma ** 2)) <= 1.5

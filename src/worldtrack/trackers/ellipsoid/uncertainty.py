@@ -8,7 +8,7 @@ Paper 000 gives a position and nothing about how far it can be off. worldtrack a
 
   - ``c`` is the curvature of the match's own score E (eq. 5) around the chosen place, along
     and across the line of sight of the camera that shows the person largest, from E at ±10 cm
-    (:func:`score_curvature`). A sharp peak means a well-placed person; a flat ridge along the
+    (:func:`score_curvature`), read every :data:`CURVATURE_EVERY` frames. A sharp peak means a well-placed person; a flat ridge along the
     line of sight (one camera, or two facing each other) does not. The curvature already holds
     the cameras' geometry (how many pixels a step moves the person at that distance, in those
     views) and what is seen of the person (hidden pixels do not change E). E acts as a
@@ -64,6 +64,9 @@ if TYPE_CHECKING:
 SCORE_STEP_M = 0.1
 #: κ: E behaves as a log-likelihood of weight 1 / κ² (fitted, see the module's docstring).
 SCORE_NOISE = 0.26
+#: The curvature of E is read for each person every this many frames (in turn) and reused in
+#: between: scoring five places is most of the cost of σ.
+CURVATURE_EVERY = 3
 #: Least curvature of E counted, 1/m² (a flat score: at most κ / √c_min = 0.29 m from the score).
 MIN_CURVATURE = 0.8
 #: σ of a person whose evidence is failing (:mod:`.life` counts down to end them) is this many
@@ -121,7 +124,8 @@ class Components(NamedTuple):
     along : (2,) float — the unit floor direction of the line of sight
     unmeasurable : bool — head and feet hidden in every view
     failing : bool — the person's evidence failed this frame (the life cycle's ``low`` counter)
-    t : float — the time stamp, s
+    t : float — the time stamp, s (the curvature may have been read up to
+        :data:`CURVATURE_EVERY` − 1 frames earlier)
     """
 
     curvature: np.ndarray
@@ -150,10 +154,12 @@ class PositionUncertainty:
     and advance once per time stamp, so trackers sharing a map do not count a frame twice.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, curvature_every: int = CURVATURE_EVERY) -> None:
         self._motion: "weakref.WeakKeyDictionary[Person, Motion]" = weakref.WeakKeyDictionary()
         #: Per person, the parts of their last measured covariance (for calibrating the constants).
         self.components: "weakref.WeakKeyDictionary[Person, Components]" = weakref.WeakKeyDictionary()
+        self.curvature_every = max(1, int(curvature_every))
+        self._frames = 0
 
     def measure(self, tracker: "EllipsoidTracker", real: Mapping[str, np.ndarray], t: float) -> None:
         """Measure the covariance of every confirmed person the tracker's cameras show at ``t``
@@ -162,15 +168,19 @@ class PositionUncertainty:
         cams = [cid for cid in real if cid in tracker.views]
         shown = [k for k, p in enumerate(people)
                  if p.confirmed and p.mode == "tracking" and p.seen_now(t) and set(p.seen_by) & set(cams)]
+        # The curvature is read for each person every `curvature_every` frames, in turn (by id),
+        # and reused in between: it is most of this step's cost.
+        due = [k for k in shown if people[k] not in self.components
+               or (self._frames + people[k].id) % self.curvature_every == 0]
+        self._frames += 1
+        joint = tracker.joint_image({cid: real[cid] for cid in cams}, people) if due else None
         covs: dict[int, np.ndarray] = {}
-        if shown:
-            joint = tracker.joint_image({cid: real[cid] for cid in cams}, people)
-            for k in shown:
-                p = people[k]
-                curvature, along = score_curvature(joint, k)
-                parts = Components(curvature, along, "unmeasurable" in p.flags, p.count("low") > 0, float(t))
-                self.components[p] = parts
-                covs[k] = position_covariance(*parts[:4])
+        for k in shown:
+            p = people[k]
+            curvature, along = score_curvature(joint, k) if k in due else self.components[p][:2]
+            parts = Components(curvature, along, "unmeasurable" in p.flags, p.count("low") > 0, float(t))
+            self.components[p] = parts
+            covs[k] = position_covariance(*parts[:4])
         for k, p in enumerate(people):
             if p.confirmed and p.once("uncertainty", t):
                 self._advance(p, covs.get(k), t)
@@ -204,6 +214,6 @@ class PositionUncertainty:
         return [self.track(p, t) for p in position_map if p.confirmed]
 
 
-__all__ = ["Components", "FAILING_FACTOR", "MIN_CURVATURE", "OCCLUDED_OWN_SHARE", "PositionUncertainty", "SCORE_NOISE",
+__all__ = ["CURVATURE_EVERY", "Components", "FAILING_FACTOR", "MIN_CURVATURE", "OCCLUDED_OWN_SHARE", "PositionUncertainty", "SCORE_NOISE",
            "SCORE_STEP_M", "UNMEASURABLE_M", "UNMEASURED_M", "position_covariance",
            "reported_mode", "score_curvature"]
