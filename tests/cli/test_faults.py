@@ -71,3 +71,39 @@ def test_damaged_video_stops_after_n_bad_frames_with_ffmpeg_quiet_unless_verbose
     assert "@ 0x" in loud.stderr and loud.returncode == 2
     written = (tmp_path / "oFalse" / "tracks.csv").read_text().splitlines()
     assert len(written) > 1 and written[0].startswith("frame,time,id")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(__import__("shutil").which("ffmpeg") is None, reason="ffmpeg is not on PATH (OpenCV writes the video)")
+def test_sigkill_leaves_the_annotated_video_playable(sequence, tmp_path):
+    import subprocess
+    import time
+
+    import cv2
+
+    frames = long_sequence(sequence, tmp_path / "frames", 400)
+    out = tmp_path / "o"
+    proc = subprocess.Popen(track_command(sequence, frames, out), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    csv_path, t0 = out / "tracks.csv", time.perf_counter()
+    while proc.poll() is None and time.perf_counter() - t0 < 240:
+        if csv_path.exists() and len({ln.split(",")[0] for ln in csv_path.read_text().splitlines()[1:]}) >= 15:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before it could be killed"
+    proc.kill()                                          # SIGKILL: nothing of worldtrack's runs after it
+    proc.wait()
+    tracked = len({ln.split(",")[0] for ln in csv_path.read_text().splitlines()[1:] if ln.count(",") > 5})
+
+    def readable() -> int:
+        cap = cv2.VideoCapture(str(out / "cam1_annotated.mp4"))
+        n = 0
+        while cap.isOpened() and cap.read()[0]:
+            n += 1
+        cap.release()
+        return n
+    counts = [readable()]
+    while time.perf_counter() - t0 < 300 and not (counts[-1] > 0 and len(counts) > 1 and counts[-1] == counts[-2]):
+        time.sleep(0.5)                                  # FFmpeg finishes the file once its input ends
+        counts.append(readable())
+    assert counts[-1] >= max(10, tracked - 2), (counts, tracked)

@@ -8,9 +8,12 @@ Two headered CSV formats that open in a spreadsheet, plus MOTChallenge text for 
 
 ``frame`` counts from 0, ``time`` is seconds (to the microsecond), ``id`` is an integer from 1,
 ``x, y, height, width`` are metres, ``vx, vy, speed`` metres per second, ``mode`` is a word
-(``capture``, ``tracking``…) and ``flags`` is a ``;``-separated list of words
-(``unmeasurable``), possibly empty. Trackers may append columns (``sigma``, the 1-σ position
-uncertainty in metres; ``sx,sy,sz`` box sizes…); readers keep them.
+(``capture``, ``tracking``, ``occluded``, ``lost``) and ``flags`` is a ``;``-separated list of
+words (``unmeasurable``), possibly empty. Trackers may append columns (``sigma``, the 1-σ
+position error per floor axis in metres; ``sx,sy,sz`` box sizes…); readers keep them. What each
+tracker puts in them differs: the ellipsoid tracker's ``sigma`` is estimated per person and frame
+and its ``width`` is the width it models the person with (the scene's ``people`` sizes), not a
+measurement (:mod:`worldtrack.trackers.ellipsoid.uncertainty`).
 
 ``gt.csv`` (ground truth from the synthetic-world renderer)::
 

@@ -18,8 +18,10 @@ from typing import Iterator, Sequence
 import numpy as np
 
 #: Person modes. ``capture``: just found, matched without the −1 ring until confirmed (paper 000
-#: §5.2). ``tracking``: normal. ``lost``: kept in the map, not updated.
-MODES = ("capture", "tracking", "lost")
+#: §5.2). ``tracking``: normal. ``lost``: kept in the map, not updated (in output records: no
+#: camera shows them, or their evidence is failing). ``occluded`` (output records only): shown,
+#: but mostly hidden behind others or with head and feet hidden.
+MODES = ("capture", "tracking", "lost", "occluded")
 
 
 @dataclass
@@ -35,7 +37,7 @@ class Track:
     score : float — the tracker's match score of the last update (ellipsoid: E in [−1, 1])
     mode : str — one of :data:`MODES`
     flags : set of str — e.g. ``unmeasurable`` (head and feet hidden in every view)
-    sigma : float — position uncertainty (1-σ, metres)
+    sigma : float — position uncertainty (1-σ per floor axis, metres)
     born, last_seen : float — times (s) of creation and of the last update with evidence
     extra : dict — method-specific output columns (e.g. the particle tracker's ``z, sx, sy, sz``)
     """

@@ -203,8 +203,9 @@ def flag_unmeasurable(people: Sequence[Person], cameras: Sequence[Camera], occlu
                       t: float) -> None:
     """Flag people whose head and feet are both hidden in every camera (paper 000 Table 2 (b)).
 
-    Such a person's place along the line of sight is unknown: ``unmeasurable`` with σ = 1 m instead
-    of a confident wrong place; otherwise σ = 0.1 m. Vectorised over people. Trackers sharing a map
+    Such a person's place along the line of sight is unknown: ``unmeasurable``, and their σ
+    along it is at least 1 m instead of a confident wrong place (:mod:`.uncertainty`).
+    Vectorised over people. Trackers sharing a map
     flag a person only if none of them sees its head or feet at ``t`` (counter ``hidden``).
 
     Parameters
@@ -229,10 +230,8 @@ def flag_unmeasurable(people: Sequence[Person], cameras: Sequence[Camera], occlu
     for k, p in enumerate(people):
         if counts_for(p, "hidden", t, bool(seen[k] and not head_or_feet[k])) > 0:
             p.flags.add("unmeasurable")
-            p.sigma = 1.0
         else:
             p.flags.discard("unmeasurable")
-            p.sigma = 0.1
 
 
 __all__ = ["MIN_OWN_PIXELS", "Support", "flag_unmeasurable", "measure_support", "track_support",

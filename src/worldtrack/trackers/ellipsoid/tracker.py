@@ -9,7 +9,9 @@ One :meth:`EllipsoidTracker.step`:
    :mod:`.score`), and failing tracks are rescued along their lines of sight (:mod:`.search`);
 4. propose new people from unexplained foreground (:mod:`.births`) and match them;
 5. measure each person's support (:mod:`.support`), then confirm, follow or end them
-   (:mod:`.life`), flag the unmeasurable, measure heights (:mod:`.height`), end duplicates.
+   (:mod:`.life`), flag the unmeasurable, measure heights (:mod:`.height`), end duplicates;
+6. measure each person's position uncertainty σ, filter their velocity and say their state
+   (:mod:`.uncertainty`).
 
 Everything needed to continue a person is on the :class:`~worldtrack.trackers.base.Person` in the
 map, so several trackers, each with its own cameras, can share one map: each moves and judges the
@@ -39,6 +41,7 @@ from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS, flag_unmeasurable, measure_support
+from worldtrack.trackers.ellipsoid.uncertainty import PositionUncertainty
 from worldtrack.trackers.ellipsoid.warm_start import frames_wanted, warm_start
 from worldtrack.trackers.lifecycle import frames_for
 
@@ -90,6 +93,8 @@ class EllipsoidTracker(TrackerBase):
         self._other_views: dict[str, CameraView] = {}
         self.last_masks: dict[str, np.ndarray] = {}
         self.last_labels: dict[str, np.ndarray] = {}
+        #: σ, reported velocity and mode of each person (:mod:`.uncertainty`).
+        self.uncertainty = PositionUncertainty()
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -137,9 +142,10 @@ class EllipsoidTracker(TrackerBase):
         if born:
             scores += self._match(born, real, t, judged + bystanders)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
+        self.uncertainty.measure(self, real, t)
         self._last_t = t
         self.frames_stepped += 1
-        return self.position_map.tracks()
+        return self.uncertainty.tracks(self.position_map, t)
 
     # ------------------------------------------------------------------ steps
     def _read(self, frames: Mapping[str, Frame]) -> dict[str, np.ndarray]:
