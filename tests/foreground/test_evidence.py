@@ -9,7 +9,7 @@ from worldtrack.errors import InputError
 from worldtrack.foreground import ForegroundConfig, StaticBackground
 from worldtrack.foreground.background import UNSURE
 from worldtrack.foreground.evidence import (EvidenceSettings, brightness_ratio, judge_by_evidence,
-                                            judge_by_evidence_reference, texture_evidence)
+                                            judge_by_evidence_reference, texture_evidence, texture_evidence_reference)
 
 SHADOW = 3
 
@@ -83,7 +83,22 @@ def test_without_texture_nothing_is_decided_but_cloth_darker_than_the_frames_sha
     # Without enough sure shadows the frame's shadow darkness is not known: all unsure on the plain floor.
     few = judge_by_evidence(labels, img, bg, EvidenceSettings(min_sure_px=10 ** 6))
     assert np.all(few[45:75, 65:115][labels[45:75, 65:115] == UNSURE] == UNSURE)
-    assert float(np.median(brightness_ratio(img, bg)[5:35, 5:55])) == pytest.approx(0.6, abs=0.01)
+    sure = np.zeros(labels.shape, bool)
+    sure[5:35, 5:55] = True
+    assert float(np.median(brightness_ratio(img, bg, sure))) == pytest.approx(0.6, abs=0.01)
+
+
+def test_the_kernel_equals_the_box_filter_reference_also_at_the_border():
+    rng = np.random.default_rng(5)
+    bg = tiled_floor(50, 70, seed=2)[..., 1]
+    img = np.clip(bg * rng.uniform(0.3, 1.0, bg.shape) + rng.normal(0, 5, bg.shape), 0, 255).astype(np.uint8)
+    for window, samples in ((5, 0.25), (7, 1.0)):
+        ref = texture_evidence_reference(img, bg, window, samples)
+        np.testing.assert_allclose(texture_evidence(img, bg, window, samples), ref, rtol=1e-6, atol=1e-6)
+    where = rng.random(bg.shape) < 0.3
+    part = texture_evidence(img, bg, where=where)
+    np.testing.assert_allclose(part[where], texture_evidence_reference(img, bg)[where], rtol=1e-6, atol=1e-6)
+    assert np.all(part[~where] == 0)
 
 
 def test_the_cropped_judge_equals_the_whole_image_reference():

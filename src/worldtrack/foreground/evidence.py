@@ -21,8 +21,10 @@ tests, each decided only where the image carries the information:
    judged a shadow, is cloth: one light on one floor does not cast shadows of two darknesses.
    Used only when at least ``min_sure_px`` pixels are judged shadows.
 
-Everything is OpenCV box filters over the bounding box of the candidate pixels (with a margin
-that makes the result the same as over the whole image, :func:`judge_by_evidence_reference`).
+The evidence comes from exact integral images and one Numba pass (:func:`texture_evidence`; its
+reference :func:`texture_evidence_reference` is OpenCV box filters), the pooling from OpenCV box
+filters, over the bounding box of the candidate pixels with a margin that makes the result the same
+as over the whole image (:func:`judge_by_evidence_reference`).
 
 >>> import numpy as np
 >>> rng = np.random.default_rng(0)
@@ -40,6 +42,8 @@ from typing import NamedTuple
 
 import cv2
 import numpy as np
+
+from numba import njit
 
 from worldtrack.foreground.texture import grey
 
@@ -60,10 +64,11 @@ def _box(x: np.ndarray, side: int) -> np.ndarray:
     return cv2.boxFilter(x, -1, (side, side), borderType=cv2.BORDER_REFLECT)
 
 
-def texture_evidence(grey_image: np.ndarray, grey_background: np.ndarray, window: int = 5,
-                     samples: float = 0.25) -> np.ndarray:
+def texture_evidence_reference(grey_image: np.ndarray, grey_background: np.ndarray, window: int = 5,
+                               samples: float = 0.25) -> np.ndarray:
     """Per-pixel log-likelihood ratio, shadow (the background's pattern at the shadow's ratio) against
-    cloth (no pattern): ``(β − r/2)·r / s²`` (module docstring), (H, W) float32, unclipped.
+    cloth (no pattern): ``(β − r/2)·r / s²`` (module docstring), (H, W) float64, unclipped; with
+    OpenCV box filters in float64 (the reference of :func:`texture_evidence`).
 
     Parameters
     ----------
@@ -72,13 +77,13 @@ def texture_evidence(grey_image: np.ndarray, grey_background: np.ndarray, window
     samples : float — effective independent samples per window pixel
 
     >>> b = np.tile(np.array([100, 140], np.uint8), (9, 5))[:, :9]          # stripes
-    >>> float(texture_evidence((b * 0.5).astype(np.uint8), b)[4, 4]) > 10     # the stripes, darker: shadow
+    >>> float(texture_evidence_reference((b * 0.5).astype(np.uint8), b)[4, 4]) > 10     # darker stripes: shadow
     True
-    >>> float(texture_evidence(np.full_like(b, 60), b)[4, 4]) < -10            # flat: the stripes are gone
+    >>> float(texture_evidence_reference(np.full_like(b, 60), b)[4, 4]) < -10            # flat: stripes gone
     True
     """
-    a = grey_image.astype(np.float32)
-    b = grey_background.astype(np.float32)
+    a = grey_image.astype(np.float64)
+    b = grey_background.astype(np.float64)
     ma, mb = _box(a, window), _box(b, window)
     va = np.maximum(_box(a * a, window) - ma * ma, 0.0)
     vb = np.maximum(_box(b * b, window) - mb * mb, 1e-3)
@@ -87,29 +92,93 @@ def texture_evidence(grey_image: np.ndarray, grey_background: np.ndarray, window
     r = ma / np.maximum(mb, 1.0)                                         # the window's brightness ratio
     resid = np.maximum(va - beta * cov, 0.0)                             # var(a) not explained by b
     s2 = resid / vb / (window * window * samples) + 1e-6                 # squared standard error of β
-    return ((beta - 0.5 * r) * r / s2).astype(np.float32)
+    return (beta - 0.5 * r) * r / s2
 
 
-def brightness_ratio(image: np.ndarray, background: np.ndarray) -> np.ndarray:
-    """``I·B / ‖B‖²`` per pixel (the colour test's brightness ratio), (H, W) float32."""
-    img = image.astype(np.float32)
-    bg = background.astype(np.float32)
-    return np.einsum("hwc,hwc->hw", img, bg) / np.maximum(np.einsum("hwc,hwc->hw", bg, bg), 1.0)
+class Sums(NamedTuple):
+    """Integral images (H + 1, W + 1) float64 of a padded grey image ``a``, background ``b`` and products."""
+
+    a: np.ndarray
+    b: np.ndarray
+    aa: np.ndarray
+    bb: np.ndarray
+    ab: np.ndarray
+
+
+@njit(cache=True, inline="always")
+def _window_mean(s, v, u, window, n):
+    return (s[v + window, u + window] - s[v, u + window] - s[v + window, u] + s[v, u]) / n
+
+
+@njit(cache=True)
+def _evidence_kernel(sums, window, samples, where, out):
+    """``out[v, u]`` where ``where[v, u]`` from the integral images :class:`Sums` of the padded image."""
+    H, W = out.shape
+    n = float(window * window)
+    for v in range(H):
+        for u in range(W):
+            if not where[v, u]:
+                continue
+            ma = _window_mean(sums.a, v, u, window, n)
+            mb = _window_mean(sums.b, v, u, window, n)
+            va = max(_window_mean(sums.aa, v, u, window, n) - ma * ma, 0.0)
+            vb = max(_window_mean(sums.bb, v, u, window, n) - mb * mb, 1e-3)
+            cov = _window_mean(sums.ab, v, u, window, n) - ma * mb
+            beta = cov / vb
+            r = ma / max(mb, 1.0)
+            resid = max(va - beta * cov, 0.0)
+            s2 = resid / vb / (n * samples) + 1e-6
+            out[v, u] = (beta - 0.5 * r) * r / s2
+
+
+def texture_evidence(grey_image: np.ndarray, grey_background: np.ndarray, window: int = 5,
+                     samples: float = 0.25, where: np.ndarray | None = None) -> np.ndarray:
+    """:func:`texture_evidence_reference` from exact integral images (OpenCV) in one Numba pass:
+    (H, W) float64, the same values to rounding; only at the pixels ``where`` ((H, W) bool, default
+    all), 0 elsewhere.
+
+    >>> b = np.tile(np.array([100, 140], np.uint8), (9, 5))[:, :9]
+    >>> bool(np.allclose(texture_evidence(b // 2, b), texture_evidence_reference(b // 2, b)))
+    True
+    """
+    m = window // 2
+    pad = lambda x: cv2.copyMakeBorder(np.ascontiguousarray(x), m, m, m, m, cv2.BORDER_REFLECT)
+    a, b = pad(grey_image), pad(grey_background)
+    integral = lambda x: cv2.integral(x, sdepth=cv2.CV_64F)               # exact: sums of integers
+    product = lambda x, y: integral(cv2.multiply(x, y, dtype=cv2.CV_32F))  # products < 2²⁴: exact in float32
+    sums = Sums(integral(a), integral(b), product(a, a), product(b, b), product(a, b))
+    where = np.ones(grey_image.shape, np.bool_) if where is None else np.ascontiguousarray(where, np.bool_)
+    out = np.zeros(grey_image.shape, np.float64)
+    _evidence_kernel(sums, window, float(samples), where, out)
+    return out
+
+
+def brightness_ratio(image: np.ndarray, background: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """``I·B / ‖B‖²`` (the colour test's brightness ratio) at the pixels ``where`` (H, W) bool: (K,) float64."""
+    img = image[where].astype(np.float64)
+    bg = background[where].astype(np.float64)
+    return np.einsum("kc,kc->k", img, bg) / np.maximum(np.einsum("kc,kc->k", bg, bg), 1.0)
 
 
 def _judge(labels: np.ndarray, image: np.ndarray, background: np.ndarray, grey_background: np.ndarray,
-           settings: EvidenceSettings, candidate: int, cloth: int, shadow: int) -> np.ndarray:
+           settings: EvidenceSettings, candidate: int, cloth: int, shadow: int, reference: bool = False) -> np.ndarray:
     """The decision on arrays already cut to the region judged (a new array)."""
     s = settings
     cand = labels == candidate
     weight = cand.astype(np.float32)
-    e = np.clip(texture_evidence(grey(image), grey_background, s.window, s.samples), -s.clip, s.clip) * weight
+    if reference:
+        e = texture_evidence_reference(grey(image), grey_background, s.window, s.samples)
+    else:                                   # only the candidates' evidence is pooled
+        e = texture_evidence(grey(image), grey_background, s.window, s.samples, where=cand)
+    e = np.clip(e, -s.clip, s.clip).astype(np.float32) * weight
     pooled = _box(e, s.spread) / np.maximum(_box(weight, s.spread), 1e-6)
     is_shadow = cand & (pooled > s.decide)
     is_cloth = cand & (pooled < -s.decide)
     if np.count_nonzero(is_shadow) >= s.min_sure_px:
-        ratio = brightness_ratio(image, background)
-        is_cloth |= cand & ~is_shadow & (ratio < np.median(ratio[is_shadow]) - s.darker_by)
+        shadow_ratio = np.median(brightness_ratio(image, background, is_shadow))
+        open_ = cand & ~is_shadow & ~is_cloth
+        dark = brightness_ratio(image, background, open_) < shadow_ratio - s.darker_by
+        is_cloth[open_] = dark
     out = labels.copy()
     out[is_shadow] = shadow
     out[is_cloth] = cloth
@@ -154,8 +223,8 @@ def judge_by_evidence_reference(labels: np.ndarray, image: np.ndarray, backgroun
                                 settings: EvidenceSettings = EvidenceSettings(), candidate: int = 2, cloth: int = 1,
                                 shadow: int = 3) -> np.ndarray:
     """:func:`judge_by_evidence` over the whole image (the reference)."""
-    return _judge(labels, image, background, grey(background), settings, candidate, cloth, shadow)
+    return _judge(labels, image, background, grey(background), settings, candidate, cloth, shadow, reference=True)
 
 
 __all__ = ["EvidenceSettings", "brightness_ratio", "judge_by_evidence", "judge_by_evidence_reference",
-           "texture_evidence"]
+           "texture_evidence", "texture_evidence_reference"]
