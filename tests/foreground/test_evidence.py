@@ -6,7 +6,7 @@ import pytest
 
 from worldtrack.config import from_mapping
 from worldtrack.errors import InputError
-from worldtrack.foreground import ForegroundConfig, StaticBackground
+from worldtrack.foreground import FOREGROUNDS, ForegroundConfig, StaticBackground
 from worldtrack.foreground.background import UNSURE
 from worldtrack.foreground.evidence import (EvidenceSettings, brightness_ratio, judge_by_evidence,
                                             judge_by_evidence_reference, texture_evidence, texture_evidence_reference)
@@ -127,5 +127,7 @@ def test_static_background_with_the_evidence_test_and_its_setting():
     with pytest.raises(InputError, match="shadow test: expected 'colour' or 'evidence', got 'texture'"):
         StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test="texture")
     assert ForegroundConfig().shadow_test == "colour"
+    for kind in ("grey", "colour"):                                          # the registry passes it on
+        assert FOREGROUNDS[kind](bg, 20.0, True, None, "evidence").shadow_test == "evidence"
     with pytest.raises(InputError, match="foreground.shadow_test"):
         from_mapping(ForegroundConfig, {"shadow_test": "texture"}, root="foreground")
