@@ -16,10 +16,10 @@ tests, each decided only where the image carries the information:
    One pixel's ``e`` is clipped to ±``clip`` and **pooled** over the shadow-like pixels of a
    ``spread`` neighbourhood (their mean), so a patch of cloth or of shadow decides together.
 2. **Darker than the frame's shadows** (:func:`judge_by_evidence`). The shadow-like pixels whose
-   pooled texture says shadow give the frame's shadow ratio (their median brightness ratio
-   ``I·B/‖B‖²``); a shadow-like pixel more than ``darker_by`` darker than that, and not itself
-   judged a shadow, is cloth: one light on one floor does not cast shadows of two darknesses.
-   Used only when at least ``min_sure_px`` pixels are judged shadows.
+   pooled texture says shadow give the frame's shadow ratio (nearly the darkest of their brightness
+   ratios ``I·B/‖B‖²``: the ``quantile`` 0.05); a shadow-like pixel more than ``darker_by``
+   darker than that, and not itself judged, is cloth: one light on one floor casts shadows of about
+   one darkness. Used only when at least ``min_sure_px`` pixels are judged shadows.
 
 The evidence comes from exact integral images and one Numba pass (:func:`texture_evidence`; its
 reference :func:`texture_evidence_reference` is OpenCV box filters), the pooling from OpenCV box
@@ -55,8 +55,9 @@ class EvidenceSettings(NamedTuple):
     spread: int = 21          #: side of the neighbourhood whose candidates' evidence is pooled (odd)
     clip: float = 10.0        #: the most evidence one pixel carries either way
     decide: float = 1.5       #: pooled evidence above this is a shadow, below minus this cloth
-    darker_by: float = 0.06   #: a candidate this much darker (brightness ratio) than the frame's shadows is cloth
+    darker_by: float = 0.05   #: a candidate this much darker (brightness ratio) than the frame's shadows is cloth
     min_sure_px: int = 200    #: judged shadows needed before the frame's shadow ratio is used
+    quantile: float = 0.05    #: the frame's shadow ratio: this quantile of the judged shadows' ratios (nearly the darkest)
     samples: float = 0.25     #: independent samples per window pixel (blur and smooth textures correlate them)
 
 
@@ -175,7 +176,7 @@ def _judge(labels: np.ndarray, image: np.ndarray, background: np.ndarray, grey_b
     is_shadow = cand & (pooled > s.decide)
     is_cloth = cand & (pooled < -s.decide)
     if np.count_nonzero(is_shadow) >= s.min_sure_px:
-        shadow_ratio = np.median(brightness_ratio(image, background, is_shadow))
+        shadow_ratio = np.quantile(brightness_ratio(image, background, is_shadow), s.quantile)
         open_ = cand & ~is_shadow & ~is_cloth
         dark = brightness_ratio(image, background, open_) < shadow_ratio - s.darker_by
         is_cloth[open_] = dark
