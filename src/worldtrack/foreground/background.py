@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
+from worldtrack.foreground.evidence import judge_by_evidence
 from worldtrack.foreground.kernels import colour_labels, shadow_like
 from worldtrack.foreground.texture import relabel_cloth
 
@@ -94,13 +95,18 @@ class StaticBackground:
         correlate with the background's (NCC at most this over a 5-pixel window) is foreground — a
         dark garment of the floor's colour hides the floor's pattern, a shadow keeps it (see
         :mod:`worldtrack.foreground.texture`). None: no texture test.
+    shadow_test : {"colour", "evidence"}
+        With ``shadows``: ``"colour"`` leaves every shadow-like change unsure; ``"evidence"`` judges
+        them (:func:`~worldtrack.foreground.evidence.judge_by_evidence`): the ones whose
+        neighbourhood hides the floor's pattern, or that are darker than the frame's shadows, are
+        foreground (cloth of the floor's colour); the rest stay unsure.
     """
 
     learns = False  #: a fixed background: the same frame always gives the same labels
 
     def __init__(self, background: np.ndarray, threshold: float = 30.0, mode: str = "grey", open_px: int = 0,
                  shadows: bool = False, shadow_min_ratio: float = 0.45, shadow_distortion: float = 0.08,
-                 shadow_texture_ncc: float | None = None):
+                 shadow_texture_ncc: float | None = None, shadow_test: str = "colour"):
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise InputError(f"background: expected an (H, W, 3) uint8 colour image, got {background.shape} "
                              f"{background.dtype}")
@@ -109,7 +115,10 @@ class StaticBackground:
         self.background = background
         self.grey = cv2.cvtColor(background, cv2.COLOR_BGR2GRAY)
         self.threshold = float(threshold)
+        if shadow_test not in ("colour", "evidence"):
+            raise InputError(f"shadow test: expected 'colour' or 'evidence', got {shadow_test!r}")
         self.mode = mode
+        self.shadow_test = shadow_test
         self.kernel = (cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * open_px + 1, 2 * open_px + 1))
                        if open_px > 0 else None)
         self.shadows = bool(shadows)
@@ -135,7 +144,8 @@ class StaticBackground:
 
         A shadow-like change may be a cast shadow or a dark, grey garment over a grey floor;
         trackers that can should treat it as no evidence either way rather than as background.
-        With ``shadow_texture_ncc`` the garments that hide a textured floor are told apart (1).
+        With ``shadow_test="evidence"`` or ``shadow_texture_ncc`` the garments that hide a textured
+        floor, or are darker than the frame's shadows, are told apart (1).
         """
         self._check(image)
         if self.mode == "grey":
@@ -147,6 +157,9 @@ class StaticBackground:
         else:
             out = colour_labels(np.ascontiguousarray(image), self.background, self._bg_norm2, self.threshold,
                                 self.shadows, self.shadow_min_ratio, self.shadow_distortion)
+        if self.shadows and self.shadow_test == "evidence":
+            out = judge_by_evidence(out, image, self.background, candidate=UNSURE, cloth=1, shadow=UNSURE,
+                                    grey_background=self.grey)
         if self.shadows and self.shadow_texture_ncc is not None:
             relabel_cloth(out, image, self.grey, self.shadow_texture_ncc, candidate=UNSURE)
         return _open_foreground(out, self.kernel)
