@@ -77,6 +77,13 @@ class FollowConfig:
         reid_speed : and no farther from its prediction than ``gate + reid_speed·unseen`` (1.5 m/s).
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
+    Identity kept open (:mod:`~worldtrack.follow.identity`; ours, the paper has none)
+        identity_margin : another track whose running RBhat against the target's templates is
+        lower than the followed one's by this much takes the target's place (0.2; 0 = never).
+        identity_tau : time constant of those running averages (0.5 s: five
+        frames at 10 fps, more than the one or two frames a mixed silhouette spoils).
+        probation : the templates do not learn for this long after the target is found again
+        after 0.3 s or more unseen, or taken over from another track (2 s).
     """
 
     cell: float = 0.05
@@ -120,6 +127,9 @@ class FollowConfig:
     reid_rbhat: float = 0.3
     reid_speed: float = 1.5
     occluders: bool = True
+    identity_margin: float = 0.2
+    identity_tau: float = 0.5
+    probation: float = 1.0
 
     def __post_init__(self) -> None:
         if self.normalise not in NORMALISATIONS:
@@ -151,7 +161,8 @@ class FollowConfig:
         ('none', True)
         """
         paper = dict(normalise="none", grey_bins=0, alpha_floor=0.0, gate=1e6, max_gate=1e6, gate_growth=0.0,
-                     short_term_tau=0.0, track_others=False, occluders=False)
+                     short_term_tau=0.0, track_others=False, occluders=False,
+                     identity_margin=0.0, probation=0.0)
         undo = dict(paper, normalise="gains+greyworld")
         table = {
             "default": {},

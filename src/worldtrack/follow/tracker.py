@@ -11,8 +11,12 @@ Per frame (:meth:`FollowTracker.step`):
    prediction, the illumination weight α and D (eq. 3) (:mod:`~worldtrack.follow.dissimilarity`);
 4. the decision: the paper's smallest D under the threshold, or (``track_others``) one assignment
    of all candidates to the target and the others (:mod:`~worldtrack.follow.others`);
-5. the Kalman update with the chosen candidate, the template rules
-   (:mod:`~worldtrack.follow.templates`), new and ended tracks of the others.
+5. the identity kept open (:mod:`~worldtrack.follow.identity`): each person's colour against the
+   target's templates is averaged over time, and another track that clearly fits better takes the
+   target's place (a wrong pick at a cut-in is undone when the target shows itself again);
+6. the Kalman update with the chosen candidate, the template rules
+   (:mod:`~worldtrack.follow.templates`; nothing is learnt while the identity is on probation),
+   new and ended tracks of the others.
 
 >>> import numpy as np
 >>> from worldtrack.synth import make_scenario
@@ -38,6 +42,7 @@ from worldtrack.follow.colour import bhattacharyya, histograms, n_bins, normalis
 from worldtrack.follow.config import FollowConfig
 from worldtrack.follow.dissimilarity import (decide, dissimilarity, illumination_weight, position_error,
                                              wb_change)
+from worldtrack.follow.identity import IdentityEvidence
 from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
 from worldtrack.follow.silhouette import box_silhouettes, covering, person_box, silhouettes
@@ -56,6 +61,8 @@ HIDE_MARGIN = 0.25
 HIDE_SHARE = 0.3
 #: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
 COAST_S = 1.5
+#: Found again after being unseen this long (s), the target's identity is on probation.
+REACQUIRED_AFTER = 0.3
 
 
 @dataclass
@@ -147,6 +154,8 @@ class FollowTracker:
         self.t = 0.0
         self.last_seen = 0.0
         self._alpha = 0.0
+        self.identity = IdentityEvidence(self.config.identity_tau)
+        self.probation_until = -np.inf
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -182,6 +191,8 @@ class FollowTracker:
         x, P = kalman.initial_state(c.xy[i:i + 1], self.config.measurement_sigma)
         self.x, self.P = x[0], P[0]
         self.t = self.last_seen = t
+        self.identity = IdentityEvidence(self.config.identity_tau)
+        self.probation_until = -np.inf
         self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
                              self.config.others_max_coast)
         rest = np.arange(len(c)) != i
@@ -231,6 +242,7 @@ class FollowTracker:
         allowed = (E / cfg.k <= gate) & ~hiding
         if cfg.track_others:
             chosen, owner = self._assign_all(obs, D, allowed, hiding, t, dt)
+            chosen = self._weigh_identity(obs, rb, chosen, owner, t, dt)
         else:
             chosen = decide(D, cfg.threshold, allowed)
             owner = np.zeros(len(c), dtype=np.int64)
@@ -239,8 +251,10 @@ class FollowTracker:
         if chosen >= 0:
             x, P = kalman.update(self.x[None], self.P[None], c.xy[chosen][None], cfg.measurement_sigma)
             self.x, self.P = x[0], P[0]
+            if t - self.last_seen >= REACQUIRED_AFTER:
+                self.probation_until = t + cfg.probation
             self.last_seen = t
-        self._update_templates(obs, chosen, D, alpha, dt)
+        self._update_templates(obs, chosen, D, rb, alpha, dt)
         return self._result(t, obs, chosen, D, rb, E, alpha, w, owner, gate)
 
     # ------------------------------------------------------------------ internals
@@ -311,6 +325,39 @@ class FollowTracker:
         owner[pick] = 1
         return pick
 
+    def _weigh_identity(self, obs: Observation, rb: np.ndarray, chosen: int, owner: np.ndarray, t: float,
+                        dt: float) -> int:
+        """Add this frame's colour evidence (:mod:`~worldtrack.follow.identity`); when another track
+        seen now fits the target's templates clearly better than the followed one, exchange them
+        (the target takes over its state, the followed person becomes that track). Changes ``owner``
+        in place; returns the target's candidate."""
+        cfg = self.config
+        if cfg.identity_margin <= 0:
+            return chosen
+        others = self.others
+        self.identity.keep(others.ids)
+        if self._alpha >= cfg.alpha_th:
+            return chosen
+        seen = np.flatnonzero(owner > 1)
+        self.identity.observe(dt, float(rb[chosen]) if chosen >= 0 else None, owner[seen], rb[seen])
+        better = self.identity.better(cfg.identity_margin)
+        if better is None or better not in owner:
+            return chosen
+        row = int(np.flatnonzero(others.ids == better)[0])
+        new = int(np.flatnonzero(owner == better)[0])
+        x, P, seen_at = self.x.copy(), self.P.copy(), self.last_seen
+        self.x, self.P, self.last_seen = others.x[row].copy(), others.P[row].copy(), float(others.last_seen[row])
+        others.x[row], others.P[row], others.last_seen[row] = x, P, seen_at
+        if chosen >= 0:
+            others.hist[row] = obs.hists[chosen]
+            owner[chosen] = better
+        owner[new] = 1
+        self.identity.exchange(better)
+        self.probation_until = t + cfg.probation
+        if self.templates.short is not None:     # it may have learnt the wrong person: restart it
+            self.templates.short, self.templates.short_wb = self.templates.long.copy(), self.templates.long_wb
+        return new
+
     def _hiding(self, obs: Observation) -> np.ndarray:
         """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
         than its prediction and covering at least ``HIDE_SHARE`` of the image box where it should
@@ -324,12 +371,15 @@ class FollowTracker:
         nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
         return nearer & (cover >= HIDE_SHARE)
 
-    def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, alpha: float, dt: float) -> None:
+    def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, rb: np.ndarray, alpha: float,
+                          dt: float) -> None:
         cfg = self.config
         hist = obs.hists[chosen] if chosen >= 0 else None
         d = float(D[chosen]) if chosen >= 0 else np.inf
+        if self.t < self.probation_until:        # identity on probation: nothing learnt yet
+            hist = None
         self.templates.paper_update(hist, obs.wb, alpha, d, cfg.alpha_th, cfg.update_max_d, cfg.update_every)
-        if chosen < 0 or self.templates.short is None:
+        if hist is None or self.templates.short is None:
             return
         # Learn when position alone is sure: close to the prediction and nobody else near. Not D:
         # after a change of light the target's D stays high until the template has learnt it.
