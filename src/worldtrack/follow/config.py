@@ -74,7 +74,10 @@ class FollowConfig:
         track_others : track every candidate and assign all at once (True; False in the paper).
         others_max_coast : an unseen other is dropped after this (1.5 s). reid_rbhat : a person who
         appeared while the target was lost is taken for it when their RBhat is under this (0.3).
-        reid_speed : and no farther from its prediction than ``gate + reid_speed·unseen`` (1.5 m/s).
+        reid_near, reid_speed, reid_accel : and no farther from its (constant-velocity) prediction
+        than ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)`` (0.5 m, 1.5 m/s, 3 m/s²:
+        how far a walker who turns or stops gets from where it was predicted — a look-alike 0.9 m
+        away 0.3 s after the target vanished is not the target).
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
     Identity kept open (:mod:`~worldtrack.follow.identity`; ours, the paper has none)
@@ -126,6 +129,8 @@ class FollowConfig:
     others_max_coast: float = 1.5
     reid_rbhat: float = 0.3
     reid_speed: float = 1.5
+    reid_near: float = 0.5
+    reid_accel: float = 3.0
     occluders: bool = True
     identity_margin: float = 0.2
     identity_tau: float = 0.5

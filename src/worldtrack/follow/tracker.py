@@ -57,8 +57,7 @@ OTHERS_MIN_ALPHA = 0.5
 CLEAR_RADIUS = 1.0
 #: A person this much nearer the camera (m) covering this share of the target's expected image box
 #: may be hiding it.
-HIDE_MARGIN = 0.25
-HIDE_SHARE = 0.3
+HIDE_MARGIN, HIDE_SHARE = 0.25, 0.3
 #: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
 COAST_S = 1.5
 #: Found again after being unseen this long (s), the target's identity is on probation.
@@ -287,24 +286,26 @@ class FollowTracker:
         if chosen < 0:
             chosen = self._reidentify(obs, owner, D, hiding, t)
         free = np.flatnonzero(owner == 0)
-        owner[free] = others.add(c.xy[free], obs.hists[free], t)
+        owner[free] = others.add(c.xy[free], obs.hists[free], t, self._within_reach(c.xy[free], t))
         return chosen, owner
 
     def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, hiding: np.ndarray, t: float) -> int:
         """Re-identify the lost target among the people who appeared since it was last seen.
 
         Somebody seen at the same time as the target cannot be the target, so only candidates
-        nobody owns and those of tracks born after the target's last sighting qualify (a person
-        who reappears half hidden is often first taken for somebody new), and not one who may be
+        nobody owns and those of tracks born after the target's last sighting, within its reach
+        (a person who reappears half hidden is often first taken for somebody new; one who appeared
+        beyond where the target could have got to is somebody else), qualify, and not one who may be
         hiding the target. They must look like it (RBhat < ``reid_rbhat``) or score like it (D <
         ``threshold``, E counting only the distance beyond half of what a walker could have strayed
         from the prediction while unseen), and be no farther from it than a walker could have gone
-        (``gate + reid_speed·unseen``); the smallest D wins. A track taken over ends. Changes
+        (``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)`` from the velocity-consistent
+        prediction); the smallest D wins. A track taken over ends. Changes
         ``owner`` in place; returns the candidate's index or −1.
         """
         cfg = self.config
         others = self.others
-        young_ids = others.ids[others.born > self.last_seen]
+        young_ids = others.ids[(others.born > self.last_seen) & others.maybe_target]
         eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
         eligible = np.flatnonzero(eligible)
         if len(eligible) == 0:
@@ -316,7 +317,7 @@ class FollowTracker:
         # Position counts only beyond half of what a walker could have strayed from the prediction.
         e = cfg.k * np.maximum(0.0, dist - 0.5 * cfg.reid_speed * unseen)
         d = dissimilarity(rb, e, self._alpha, cfg.alpha_th)
-        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & (dist <= cfg.gate + cfg.reid_speed * unseen)
+        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & self._within_reach(c.xy[eligible], t)
         if not ok.any():
             return -1
         pick = int(eligible[np.flatnonzero(ok)[np.argmin(d[ok])]])
@@ -327,29 +328,22 @@ class FollowTracker:
 
     def _weigh_identity(self, obs: Observation, rb: np.ndarray, chosen: int, owner: np.ndarray, t: float,
                         dt: float) -> int:
-        """Add this frame's colour evidence (:mod:`~worldtrack.follow.identity`); when another track
-        seen now fits the target's templates clearly better than the followed one, exchange them
-        (the target takes over its state, the followed person becomes that track). Changes ``owner``
-        in place; returns the target's candidate."""
+        """Add this frame's colour evidence (:mod:`~worldtrack.follow.identity`); another track seen now
+        that fits the target's templates clearly better than the followed one exchanges roles with it.
+        Changes ``owner`` in place; returns the target's candidate."""
         cfg = self.config
-        if cfg.identity_margin <= 0:
-            return chosen
-        others = self.others
-        self.identity.keep(others.ids)
-        if self._alpha >= cfg.alpha_th:
+        self.identity.keep(self.others.ids)
+        if cfg.identity_margin <= 0 or self._alpha >= cfg.alpha_th:
             return chosen
         seen = np.flatnonzero(owner > 1)
         self.identity.observe(dt, float(rb[chosen]) if chosen >= 0 else None, owner[seen], rb[seen])
         better = self.identity.better(cfg.identity_margin)
         if better is None or better not in owner:
             return chosen
-        row = int(np.flatnonzero(others.ids == better)[0])
         new = int(np.flatnonzero(owner == better)[0])
-        x, P, seen_at = self.x.copy(), self.P.copy(), self.last_seen
-        self.x, self.P, self.last_seen = others.x[row].copy(), others.P[row].copy(), float(others.last_seen[row])
-        others.x[row], others.P[row], others.last_seen[row] = x, P, seen_at
+        hist = obs.hists[chosen] if chosen >= 0 else None
+        self.x, self.P, self.last_seen = self.others.exchange(better, self.x, self.P, self.last_seen, hist)
         if chosen >= 0:
-            others.hist[row] = obs.hists[chosen]
             owner[chosen] = better
         owner[new] = 1
         self.identity.exchange(better)
@@ -357,6 +351,13 @@ class FollowTracker:
         if self.templates.short is not None:     # it may have learnt the wrong person: restart it
             self.templates.short, self.templates.short_wb = self.templates.long.copy(), self.templates.long_wb
         return new
+
+    def _within_reach(self, xy: np.ndarray, t: float) -> np.ndarray:
+        """(N,) positions (N, 2) the lost target could have reached: no farther from its constant-velocity
+        prediction than ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
+        cfg, unseen = self.config, t - self.last_seen
+        reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
+        return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
 
     def _hiding(self, obs: Observation) -> np.ndarray:
         """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
