@@ -28,7 +28,7 @@ from real_data import read_video  # noqa: E402
 
 from worldtrack.eval.follow import match_candidates  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker  # noqa: E402
-from worldtrack.follow.tracker import observation_from_boxes  # noqa: E402
+from worldtrack.follow.observation import observation_from_boxes  # noqa: E402
 
 SCENARIO = dict(others=3, crossers=2, crossings=6, cross_speed=(0.6, 1.0), cross_pause=(0.3, 1.1), lookalike=1,
                 wb_jump_steps=400, wb_jump_every=(1.0, 2.0), clear_route=True)

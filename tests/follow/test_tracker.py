@@ -6,7 +6,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.eval.follow import counts, follow_labels, reacquisitions
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth
-from worldtrack.follow.tracker import observation_from_boxes
+from worldtrack.follow.observation import observation_from_boxes
 from worldtrack.trackers.base import Frame
 
 

@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from worldtrack.follow.pid import PIDFollower
-from worldtrack.follow.tracker import FollowStep, FollowTracker, frame_from_synth
+from worldtrack.follow.observation import frame_from_synth
+from worldtrack.follow.tracker import FollowStep, FollowTracker
 from worldtrack.geometry.camera import look_at_rotation
 
 CAMERA_FORWARD = 0.1       # m, camera ahead of the robot's centre

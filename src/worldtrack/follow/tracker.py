@@ -43,9 +43,10 @@ from worldtrack.follow.config import FollowConfig
 from worldtrack.follow.dissimilarity import (decide, dissimilarity, illumination_weight, position_error,
                                              wb_change)
 from worldtrack.follow.identity import IdentityEvidence
+from worldtrack.follow.observation import Observation
 from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
-from worldtrack.follow.silhouette import box_silhouettes, covering, person_box, silhouettes
+from worldtrack.follow.silhouette import covering, person_box, silhouettes
 from worldtrack.follow.templates import Templates
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
@@ -58,22 +59,12 @@ CLEAR_RADIUS = 1.0
 #: A person this much nearer the camera (m) covering this share of the target's expected image box
 #: may be hiding it.
 HIDE_MARGIN, HIDE_SHARE = 0.25, 0.3
+#: ... unless it stands this close (m) to the target's way since it was last measured (the target, stopped).
+STOPPED_RADIUS = 0.3
 #: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
 COAST_S = 1.5
 #: Found again after being unseen this long (s), the target's identity is on probation.
 REACQUIRED_AFTER = 0.3
-
-
-@dataclass
-class Observation:
-    """What one frame shows: candidates, silhouettes (H, W) int32, histograms (N, B), the white
-    balance α reads (r, b) and the camera."""
-
-    candidates: Candidates
-    silhouettes: np.ndarray
-    hists: np.ndarray
-    wb: tuple[float, float]
-    camera: Camera
 
 
 @dataclass
@@ -112,27 +103,6 @@ class FollowStep:
     others_xy: np.ndarray
 
 
-def observation_from_boxes(image: np.ndarray, boxes: np.ndarray, xy: np.ndarray, gains_rb, config: FollowConfig,
-                           camera: Camera | None = None) -> Observation:
-    """An :class:`Observation` whose candidates are given: floor positions ``xy`` (N, 2) metres and
-    image boxes (N, 4) ``(left, top, width, height)`` pixels (e.g. ground truth, or another detector).
-    ``gains_rb``: the frame's white balance (r, b) or None."""
-    sil = box_silhouettes(image.shape[:2], boxes)
-    n = len(xy)
-    b = np.asarray(boxes, float).reshape(-1, 4)
-    cands = Candidates(np.asarray(xy, float).reshape(-1, 2), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n),
-                       -(b[:, 1] + b[:, 3]), sil, 1)
-    normalised, wb = normalise_colour(image, gains_rb, config.normalise, sil > 0)
-    return Observation(cands, sil, histograms(normalised, sil, n, config), wb, camera)
-
-
-def frame_from_synth(bundle, camera_id: str = "robot") -> Frame:
-    """A :class:`~worldtrack.io.sources.Frame` (image, measured depth, gains) from a synthetic bundle."""
-    v = bundle.views[camera_id]
-    return Frame(v.image, float(bundle.time), int(bundle.frame), v.sensor_depth,
-                 meta={"wb_gains": tuple(v.wb_gains)})
-
-
 class FollowTracker:
     """Follows one target person (id 1) among others; see the module docstring.
 
@@ -152,6 +122,7 @@ class FollowTracker:
         self.P = np.eye(4)
         self.t = 0.0
         self.last_seen = 0.0
+        self.last_xy = np.full(2, np.nan)
         self._alpha = 0.0
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
@@ -192,6 +163,7 @@ class FollowTracker:
         self.t = self.last_seen = t
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
+        self.last_xy = c.xy[i].copy()
         self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
                              self.config.others_max_coast)
         rest = np.arange(len(c)) != i
@@ -252,7 +224,7 @@ class FollowTracker:
             self.x, self.P = x[0], P[0]
             if t - self.last_seen >= REACQUIRED_AFTER:
                 self.probation_until = t + cfg.probation
-            self.last_seen = t
+            self.last_seen, self.last_xy = t, c.xy[chosen].copy()
         self._update_templates(obs, chosen, D, rb, alpha, dt)
         return self._result(t, obs, chosen, D, rb, E, alpha, w, owner, gate)
 
@@ -363,14 +335,19 @@ class FollowTracker:
         """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
         than its prediction and covering at least ``HIDE_SHARE`` of the image box where it should
         stand. Such a person appears just as the target vanishes, where it vanishes; they are not
-        taken for it (``occluders``; the paper has no such rule)."""
+        taken for it (``occluders``; the paper has no such rule). Except one standing on the target's
+        way from where it was last measured to its prediction (within ``STOPPED_RADIUS``): that is
+        the target, stopped while its constant-velocity prediction walked on."""
         n = len(obs.candidates)
         if not self.config.occluders or obs.camera is None or n == 0:
             return np.zeros(n, dtype=bool)
         cover = covering(obs.silhouettes, n, person_box(obs.camera, self.x[:2]))
         centre = obs.camera.centre[:2]
         nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
-        return nearer & (cover >= HIDE_SHARE)
+        way = self.x[:2] - self.last_xy
+        along = np.clip((obs.candidates.xy - self.last_xy) @ way / max(way @ way, 1e-12), 0.0, 1.0)
+        stopped = np.hypot(*(obs.candidates.xy - self.last_xy - along[:, None] * way).T) <= STOPPED_RADIUS
+        return nearer & (cover >= HIDE_SHARE) & ~stopped
 
     def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, rb: np.ndarray, alpha: float,
                           dt: float) -> None:
