@@ -22,7 +22,7 @@ teach them their colours before the evidence has spoken.
 >>> ev = IdentityEvidence(tau=0.5, min_frames=3)
 >>> for _ in range(5):
 ...     ev.observe(0.1, 0.6, np.array([7]), np.array([0.15]))   # followed: 0.6; track 7: 0.15
->>> ev.better(margin=0.2)
+>>> ev.better(margin=0.4)
 7
 """
 
