@@ -28,7 +28,7 @@ from real_data import read_video  # noqa: E402
 
 from worldtrack.eval.follow import match_candidates  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker  # noqa: E402
-from worldtrack.follow.tracker import observation_from_boxes  # noqa: E402
+from worldtrack.follow.observation import observation_from_boxes  # noqa: E402
 
 SCENARIO = dict(others=3, crossers=2, crossings=6, cross_speed=(0.6, 1.0), cross_pause=(0.3, 1.1), lookalike=1,
                 wb_jump_steps=400, wb_jump_every=(1.0, 2.0), clear_route=True)
@@ -211,6 +211,56 @@ def seed_cached(cache: str | None, key: str, compute):
         pickle.dump(value, f)
     tmp.replace(path)
     return value
+
+
+@dataclass
+class CachedView:
+    """What the follower and the benchmark read of one rendered view."""
+
+    image: np.ndarray
+    sensor_depth: np.ndarray
+    wb_gains: tuple
+    camera: object
+
+
+@dataclass
+class CachedBundle:
+    """What the follower and the benchmark read of one :class:`~worldtrack.synth.sequence.SynthBundle`."""
+
+    frame: int
+    time: float
+    views: dict
+    gt: list
+    meta: dict
+
+
+def synth_frames(scenario, cache: str | None, key: str, camera_id: str = "robot"):
+    """The frames of ``scenario`` (open loop: the robot drives the scenario's own path), rendered once.
+
+    With ``cache`` the rendered frames (image, measured depth, gains, camera, ground truth) are kept
+    under ``cache/render-key-<synth>.pkl`` (``<synth>``: the committed tree of ``src/worldtrack/synth``),
+    so the follower can be changed and re-run without rendering again. Without it, the scenario's
+    own lazy frames.
+    """
+    if not cache:
+        return scenario.frames()
+    tree = subprocess.run(["git", "rev-parse", "--short", "HEAD:src/worldtrack/synth"], cwd=ROOT,
+                          capture_output=True, text=True).stdout.strip() or "unknown"
+    path = Path(cache) / f"render-{key}-{tree}.pkl"
+    if path.exists():
+        with open(path, "rb") as f:
+            return pickle.load(f)
+    out = []
+    for b in scenario.frames():
+        v = b.views[camera_id]
+        out.append(CachedBundle(b.frame, b.time, {camera_id: CachedView(v.image, v.sensor_depth, tuple(v.wb_gains),
+                                                                          v.camera)}, b.gt, b.meta))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    with open(tmp, "wb") as f:
+        pickle.dump(out, f, protocol=pickle.HIGHEST_PROTOCOL)
+    tmp.replace(path)
+    return out
 
 
 def save_tagged(name: str, tag: str, title: str, text: str, quick: bool, seconds: float) -> None:

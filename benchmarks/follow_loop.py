@@ -65,6 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     rows, all_within, all_free_within = [], [], []
     totals = {"contacts": 0, "collisions": 0, "bumps": 0}
+    causes: dict = {}
+    collision_rows = []
     for seed in seeds:
         ts = time.perf_counter()
         s = seed_cached(args.cache, f"loop-{seed}-{frames}", lambda: run_seed(seed, frames, (160, 120)))
@@ -74,6 +76,11 @@ def main(argv: list[str] | None = None) -> int:
         all_free_within.append(s["within"][s["free"]])
         for k in totals:
             totals[k] += getattr(r, k)
+        for c in getattr(r, "collision_causes", []):
+            causes[c.cause] = causes.get(c.cause, 0) + 1
+            collision_rows.append([seed, c.frame, c.person, f"{c.distance:.2f}", f"{c.robot_speed:.2f}",
+                                   f"{c.person_speed:.2f}", f"{c.visible:.2f}", "yes" if c.tracked else "no",
+                                   "yes" if c.blocked else "no", c.cause])
         rows.append([seed, f"{s['within'].mean():.3f}", f"{s['within'][s['free']].mean():.3f}",
                      f"{s['blocked'].mean():.3f}", f"{np.median(err):.2f}", f"{np.percentile(err, 95):.2f}",
                      f"{err.max():.2f}", f"{r.found.mean():.3f}", r.contacts, r.collisions, r.bumps,
@@ -92,7 +99,15 @@ def main(argv: list[str] | None = None) -> int:
             f"{pooled_free:.3f} of the frames when nobody held the robot up (those frames and the {RECOVER_S:g} s "
             f"after left out)\n- collisions (the robot driving at someone within 0.5 m, centre to centre): "
             f"**{totals['collisions']}** frames; contacts of any kind {totals['contacts']}; bumper stops "
-            f"{totals['bumps']}\n\n{table}\n")
+            f"{totals['bumps']}\n- collisions by cause: "
+            + (", ".join(f"{k} {v}" for k, v in sorted(causes.items())) or "none")
+            + f"\n\n{table}\n")
+    if collision_rows:
+        text += ("\n## Every collision frame\n\nspeeds towards each other (m/s); visible: the person's largest "
+                 "visible share in the robot's camera over the last second; tracked: a candidate or track of the "
+                 "follower within 0.5 m; held: the path check held the robot.\n\n"
+                 + markdown_table(["seed", "frame", "person", "distance m", "robot speed", "person speed", "visible",
+                                   "tracked", "held", "cause"], collision_rows) + "\n")
     print(text)
     save_tagged("follow_loop", args.tag, "The closed loop: a simulated robot follows (seed 001)", text, args.quick,
                 time.perf_counter() - t0)

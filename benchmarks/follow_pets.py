@@ -29,8 +29,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from follow_common import PETS, follow_pets, gain_jumps, load_pets, pets_observations, pets_targets  # noqa: E402
+from common import markdown_table  # noqa: E402
+from follow_common import (PETS, follow_pets, gain_jumps, load_pets, pets_observations, pets_targets,  # noqa: E402
+                           save_tagged)
 
 from worldtrack.eval.follow import counts  # noqa: E402
 from worldtrack.follow import FollowConfig  # noqa: E402
@@ -51,7 +52,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="first 200 frames, one jump sequence (prints only)")
     ap.add_argument("--sizes", default=",".join(map(str, SIZES)), help="jump sizes in gain steps (default 0-400 by 100)")
     ap.add_argument("--jump-seeds", default="0,1,2", help="seeds of the jump sequences (default 0,1,2)")
+    ap.add_argument("--default-only", action="store_true", help="only the two worldtrack default rows")
     args = ap.parse_args(argv)
+    variants = {k: v for k, v in VARIANTS.items() if k.startswith("worldtrack")} if args.default_only else VARIANTS
     t0 = time.perf_counter()
     pets = load_pets(200 if args.quick else None)
     if pets is None:
@@ -60,12 +63,12 @@ def main(argv: list[str] | None = None) -> int:
     targets = pets_targets(pets, 20 if args.quick else 70)
     sizes = [int(v) for v in args.sizes.split(",")]
     jump_seeds = (0,) if args.quick else tuple(int(v) for v in args.jump_seeds.split(","))
-    results = {name: {} for name in VARIANTS}
+    results = {name: {} for name in variants}
     for size in sizes:
         for js in jump_seeds:
             gains = gain_jumps(np.random.default_rng(js), pets.n, 7.0, float(size))
             cache = {}
-            for name, (preset, over) in VARIANTS.items():
+            for name, (preset, over) in variants.items():
                 cfg = FollowConfig.preset(preset, **over)
                 key = (cfg.normalise, cfg.grey_bins)
                 if key not in cache:
@@ -88,8 +91,8 @@ def main(argv: list[str] | None = None) -> int:
             f"size; candidates = the visible ground-truth people. Gains jump every 1–2 s by exactly the stated "
             f"|ΔR| + |ΔB|.\n\n{table}\n")
     print(text)
-    save_result("follow_pets", "Following on PETS 2009 S2.L1 with white-balance jumps (seed 001)", text, args.quick,
-                time.perf_counter() - t0)
+    save_tagged("follow_pets", "_default" if args.default_only else "",
+                "Following on PETS 2009 S2.L1 with white-balance jumps (seed 001)", text, args.quick, time.perf_counter() - t0)
     return 0
 
 

@@ -33,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table  # noqa: E402
-from follow_common import SCENARIO, person_candidate_d, save_tagged, seed_cached  # noqa: E402
+from follow_common import SCENARIO, person_candidate_d, save_tagged, seed_cached, synth_frames  # noqa: E402
 
 from worldtrack.eval.follow import counts, counts_by, follow_labels, reacquisitions, swaps  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth  # noqa: E402
@@ -61,15 +61,16 @@ def parse_seeds(text: str) -> list[int]:
     return out
 
 
-def run_seed(seed: int, frames: int, size, variants: dict) -> dict:
-    """Render one sequence and follow its person 1 with every variant; per-variant records and the truth."""
+def run_seed(seed: int, frames: int, size, variants: dict, render_cache: str | None = None) -> dict:
+    """Render one sequence (or read it from ``render_cache``) and follow its person 1 with every variant;
+    per-variant records and the truth."""
     sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, **SCENARIO)
     trackers = {name: FollowTracker(FollowConfig.preset(p, **o), sc.scene) for name, (p, o) in variants.items()}
     n = sc.n_frames
     truth = {"xy": np.full((n, 2), np.nan), "vis": np.zeros(n), "others": [], "segment": [], "cam": np.zeros((n, 2))}
     rec = {name: {"reported": np.full((n, 2), np.nan), "xy": np.zeros((n, 2)), "D": {}, "seconds": 0.0}
            for name in variants}
-    for b in sc.frames():
+    for b in synth_frames(sc, render_cache, f"{seed}-{frames}-{size[0]}x{size[1]}"):
         k = b.frame
         people = {r["id"]: r for r in b.gt}
         if 1 in people:
@@ -178,20 +179,32 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="dev seeds 100, 101 × 300 frames (a smoke run; prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")
+    ap.add_argument("--render-cache", help="keep each seed's rendered frames in this folder (re-run the follower "
+                                           "without rendering again)")
+    ap.add_argument("--render-only", action="store_true", help="only render the seeds into --render-cache")
+    ap.add_argument("--default-only", action="store_true", help="run only the worldtrack default (no ablations)")
     args = ap.parse_args(argv)
     seeds = [100, 101] if args.quick else parse_seeds(args.seeds)       # quick: development seeds
     frames = 300 if args.quick else args.frames
     size = tuple(int(v) for v in args.size.lower().split("x"))
+    variants = {"worldtrack default": VARIANTS["worldtrack default"]} if args.default_only else VARIANTS
     t0 = time.perf_counter()
+    if args.render_only:
+        for seed in seeds:
+            sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, **SCENARIO)
+            synth_frames(sc, args.render_cache, f"{seed}-{frames}-{size[0]}x{size[1]}")
+            print(f"seed {seed} rendered ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+        return 0
     results = []
     for seed in seeds:
         ts = time.perf_counter()
-        results.append(seed_cached(args.cache, f"synth-{seed}-{frames}-{size[0]}x{size[1]}",
-                                   lambda: run_seed(seed, frames, size, VARIANTS)))
+        key = f"synth-{seed}-{frames}-{size[0]}x{size[1]}" + ("-default" if args.default_only else "")
+        results.append(seed_cached(args.cache, key,
+                                   lambda: run_seed(seed, frames, size, variants, args.render_cache)))
         d = summarise(results[-1:], "worldtrack default")
         print(f"seed {seed}: default precision {d['all'].precision:.4f} recall {d['all'].recall:.4f} "
               f"swaps {sum(d['swaps'])} ({time.perf_counter() - ts:.0f} s)", file=sys.stderr, flush=True)
-    summaries = {name: summarise(results, name) for name in VARIANTS}
+    summaries = {name: summarise(results, name) for name in variants}
     text = (f"Seeds {', '.join(map(str, seeds))}; {frames} frames each at 10 fps, {size[0]}x{size[1]}; scenario "
             f"`follow-target` with {', '.join(f'{k}={v}' for k, v in SCENARIO.items())}. ms/frame: the follower "
             f"alone (detection, colour, decision), one core.\n\n" + tables(summaries, len(seeds)) + "\n")

@@ -13,7 +13,7 @@ CAM = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1)
 
 
 def step(xy, velocity=(0.0, 0.0), found=True, others=()):
-    return SimpleNamespace(found=found, xy=np.array(xy, float), velocity=np.array(velocity, float),
+    return SimpleNamespace(found=found, xy=np.array(xy, float), velocity=np.array(velocity, float), chosen=0,
                            candidates=SimpleNamespace(xy=np.array([xy], float)),
                            others_xy=np.array(others, float).reshape(-1, 2))
 
@@ -47,6 +47,8 @@ def test_somebody_in_the_path_stops_the_robot_and_a_lost_target_only_turns_it():
     assert v == 0.0 and pid.blocked
     v, _ = PIDFollower().command(step((3.5, 0.0), others=[(0.6, 1.5)]), CAM, 0.0)
     assert v > 0                                                          # beside the path: no stop
+    v, _ = PIDFollower().command(step((3.5, 0.0), others=[(1.2, 0.1)]), CAM, 0.0)
+    assert v == pytest.approx(np.sqrt(2 * 1.2 * 0.5) - 1.2 * 0.1)         # slows to stop 0.7 m short of them
     pid = PIDFollower()
     pid.command(step((3.5, 0.0)), CAM, 0.0)
     v, w = pid.command(step((3.5, 2.0), found=False), CAM, 1.5)
@@ -74,7 +76,9 @@ def test_closed_loop_keeps_the_distance_without_collisions():
     result = run_closed_loop(sc)
     err = np.abs(result.distance - 1.8)
     assert result.found.mean() > 0.95
-    assert np.mean(err <= 0.3) > 0.85 and err.max() < 0.8
-    assert result.collisions == 0 and result.bumps == 0
+    # a person crosses 0.6-0.9 m in front of the robot: it waits (it used to pass them at 0.51 m,
+    # centre to centre, with contact at 0.5), then catches up
+    assert np.mean(err <= 0.3) > 0.75 and err.max() < 1.4
+    assert result.collisions == 0 and result.bumps == 0 and result.nearest_person.min() > 0.65
     # the camera was where the robot put it: the frames were drawn from the closed loop
     assert np.linalg.norm(result.camera_xy[-1] - result.robot_xy[-1]) == pytest.approx(0.1, abs=1e-6)

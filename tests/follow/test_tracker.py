@@ -6,7 +6,7 @@ import pytest
 from worldtrack.errors import InputError
 from worldtrack.eval.follow import counts, follow_labels, reacquisitions
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth
-from worldtrack.follow.tracker import observation_from_boxes
+from worldtrack.follow.observation import observation_from_boxes
 from worldtrack.trackers.base import Frame
 
 
@@ -137,3 +137,41 @@ def test_a_person_appearing_in_front_of_the_target_as_it_vanishes_is_not_taken_f
         labels.append(who[step.chosen] if step.found else "-")
     assert "X" not in labels, "".join(labels)
     assert labels[:10].count("T") == 10 and labels[25:].count("T") >= 9
+
+
+@pytest.mark.parametrize("margin, recovers", [(0.4, True), (0.0, False)])
+def test_a_wrong_pick_is_undone_when_the_target_shows_itself(margin, recovers):
+    """The red target walks and vanishes; a person in red and (mostly) blue steps out 0.45 m ahead of where
+    it should be and is taken for it (colour half right, position right). The target reappears
+    0.3 s later 0.8 m behind, having turned back, and stands. The colour evidence kept open hands
+    the target back within 0.4 s of its return; without it (margin 0) the follower stays on the
+    wrong person, whom position favours."""
+    cfg = FollowConfig(identity_margin=margin)
+    tracker = FollowTracker(cfg)
+    red, blue = (50, 70, 160), (160, 70, 50)
+    labels = []
+    for k in range(30):
+        t = k / 10
+        people, who = [], []
+        if k < 10 or k >= 13:
+            people.append([-1.0 + 0.5 * t if k < 10 else -0.85, 0.0])
+            who.append("T")
+        if k >= 10:
+            people.append([-0.05, 0.0])
+            who.append("X")
+        xy = np.array(people)
+        u = 100 + 60 * xy[:, 0]
+        boxes = np.column_stack([u - 8, np.full(len(xy), 20.0), np.full(len(xy), 16.0), np.full(len(xy), 80.0)])
+        frame = np.full((120, 200, 3), 120, np.uint8)
+        for (left, *_), name in zip(boxes, who):
+            frame[20:100, int(left):int(left) + 16] = red
+            if name == "X":
+                frame[45:100, int(left):int(left) + 16] = blue
+        obs = observation_from_boxes(frame, boxes, xy, (512, 512), cfg)
+        step = tracker.start_with(obs, t, xy[0]) if k == 0 else tracker.step_with(obs, t)
+        labels.append(who[step.chosen] if step.found else ".")
+    assert labels[:10] == ["T"] * 10 and "X" in labels[10:13], "".join(labels)   # the wrong pick
+    if recovers:
+        assert labels[17:] == ["T"] * 13, "".join(labels)
+    else:
+        assert "T" not in labels[12:], "".join(labels)

@@ -24,6 +24,7 @@ Modules, one per step of the paper: :mod:`planview` (detection from depth), :mod
 
 from worldtrack.follow.config import PRESETS, FollowConfig
 from worldtrack.follow.pid import PIDFollower
-from worldtrack.follow.tracker import FollowStep, FollowTracker, frame_from_synth
+from worldtrack.follow.observation import frame_from_synth
+from worldtrack.follow.tracker import FollowStep, FollowTracker
 
 __all__ = ["PRESETS", "FollowConfig", "FollowStep", "FollowTracker", "PIDFollower", "frame_from_synth"]

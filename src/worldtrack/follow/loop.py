@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from worldtrack.follow.pid import PIDFollower
-from worldtrack.follow.tracker import FollowStep, FollowTracker, frame_from_synth
+from worldtrack.follow.observation import frame_from_synth
+from worldtrack.follow.tracker import FollowStep, FollowTracker
 from worldtrack.geometry.camera import look_at_rotation
 
 CAMERA_FORWARD = 0.1       # m, camera ahead of the robot's centre
@@ -89,7 +90,8 @@ class LoopResult:
     bumps : frames the bumper stopped the robot; contacts : frames with a person within
     ``robot.radius + 0.2`` m of the robot's centre; collisions : of those, frames where the robot
     was driving towards that person (faster than 0.05 m/s) — the robot's doing, not a person
-    walking into it standing; steps : the FollowSteps (if kept)
+    walking into it standing; collision_causes : one :class:`Collision` per collision frame;
+    steps : the FollowSteps (if kept)
     """
 
     times: np.ndarray
@@ -104,7 +106,56 @@ class LoopResult:
     bumps: int
     contacts: int
     collisions: int
+    collision_causes: list = field(default_factory=list)
     steps: list = field(default_factory=list)
+
+
+@dataclass
+class Collision:
+    """One collision frame, and why (``cause``):
+
+    * ``"walked into the robot"`` — the person closed in faster than the robot drove at them;
+    * ``"unseen"`` — the person was not visible to the robot's camera in the last ``SEEN_S`` s
+      (beside or behind it, or hidden): a forward camera cannot stop for them;
+    * ``"seen, not stopped"`` — the robot saw them and still drove into them: the follower's fault.
+
+    frame; person id; distance (m, robot centre to person); robot_speed, person_speed (m/s towards
+    each other); visible : the person's largest visible share in the last ``SEEN_S`` s; tracked :
+    the follower had a candidate or track within 0.5 m of them; blocked : the path check held the
+    robot back.
+    """
+
+    frame: int
+    person: int
+    distance: float
+    robot_speed: float
+    person_speed: float
+    visible: float
+    tracked: bool
+    blocked: bool
+    cause: str
+
+
+SEEN_S = 1.0
+
+
+def _collision(k: int, pid: int, rel: np.ndarray, robot, person_velocity: np.ndarray, visible: float, step,
+               blocked: bool) -> Collision:
+    """Classify one collision (see :class:`Collision`); ``rel`` person − robot (m)."""
+    dist = float(np.hypot(*rel))
+    towards = rel / max(dist, 1e-9)
+    robot_speed = robot.v * float(towards @ np.array([np.cos(robot.yaw), np.sin(robot.yaw)]))
+    person_speed = -float(person_velocity @ towards)
+    known = [a for a in (step.candidates.xy, step.others_xy, np.asarray(step.xy)[None]) if len(a)]
+    person_xy = np.array([robot.x, robot.y]) + rel
+    tracked = bool(np.hypot(*(np.vstack(known) - person_xy).T).min() < 0.5) if known else False
+    if person_speed > robot_speed:
+        cause = "walked into the robot"
+    elif visible < 0.2:
+        cause = "unseen"
+    else:
+        cause = "seen, not stopped"
+    return Collision(k, pid, dist, robot_speed, person_speed, visible, tracked, blocked, cause)
 
 
 def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PIDFollower | None = None,
@@ -128,6 +179,9 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PI
     rec = {k: np.zeros((n, 2)) for k in ("robot", "camera", "target", "cmd")}
     near, clear, found = np.full(n, np.inf), np.zeros(n), np.zeros(n, bool)
     bumps = contacts = collisions = 0
+    causes: list[Collision] = []
+    previous: dict = {}
+    visible: dict = {}
     steps: list[FollowStep] = []
     frames = scenario.frames()
     for k in range(n):
@@ -135,6 +189,8 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PI
         bundle = next(frames)
         cam = bundle.views[camera_id].camera
         people = {r["id"]: np.array([r["x"], r["y"]]) for r in bundle.gt}
+        for r in bundle.gt:
+            visible.setdefault(r["id"], []).append(float(r.get(f"vis_{camera_id}", 1.0)))
         start = people.get(1) if k == 0 else None
         step = tracker.follow(frame_from_synth(bundle, camera_id), cam, start_xy=start)
         v, w = follower.command(step, cam, bundle.time)
@@ -152,6 +208,12 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PI
             contacts += int(touching.any())
             towards = robot.v * (rel @ heading) / np.maximum(dist, 1e-9) > 0.05
             collisions += int(np.any(touching & towards))
+            for j in np.flatnonzero(touching & towards):
+                pid = list(people)[j]
+                vel = (people[pid] - previous.get(pid, people[pid])) * scenario.fps
+                seen = max(visible[pid][-int(SEEN_S * scenario.fps) - 1:])
+                causes.append(_collision(k, pid, rel[j], robot, vel, seen, step, bool(getattr(follower, "blocked", False))))
+        previous = people
         clear[k] = clearance_at(rec["robot"][k][None])[0]
         if keep_steps:
             steps.append(step)
@@ -161,4 +223,4 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PI
         bumps += int(not robot.drive(v, w, dt, clearance_at))
     distance = np.hypot(*(rec["target"] - rec["camera"]).T)
     return LoopResult(np.arange(n) / scenario.fps, rec["robot"], rec["camera"], rec["target"], distance, rec["cmd"],
-                      near, clear, found, bumps, contacts, collisions, steps)
+                      near, clear, found, bumps, contacts, collisions, causes, steps)

@@ -56,6 +56,7 @@ class Others:
         self.hist = np.zeros((0, n_bins))
         self.last_seen = np.zeros(0)
         self.born = np.zeros(0)
+        self.maybe_target = np.zeros(0, dtype=bool)
         self.next_id = 2
         self.accel_sigma = accel_sigma
         self.measurement_sigma = measurement_sigma
@@ -81,8 +82,9 @@ class Others:
         self.hist[rows[has]] = blended[has] / np.maximum(blended[has].sum(axis=1, keepdims=True), 1e-12)
         self.last_seen[rows] = t
 
-    def add(self, xy: np.ndarray, hists: np.ndarray, t: float) -> np.ndarray:
-        """Start tracks at positions (K, 2) with histograms (K, B); returns their ids."""
+    def add(self, xy: np.ndarray, hists: np.ndarray, t: float, maybe_target: np.ndarray | None = None) -> np.ndarray:
+        """Start tracks at positions (K, 2) with histograms (K, B); returns their ids. ``maybe_target``
+        (K,) bool: born where the lost target could have been (default False)."""
         k = len(xy)
         if k == 0:
             return np.zeros(0, dtype=np.int64)
@@ -95,12 +97,25 @@ class Others:
         self.hist = np.concatenate([self.hist, hists.astype(np.float64)])
         self.last_seen = np.concatenate([self.last_seen, np.full(k, t)])
         self.born = np.concatenate([self.born, np.full(k, t)])
+        maybe = np.zeros(k, bool) if maybe_target is None else np.asarray(maybe_target, bool)
+        self.maybe_target = np.concatenate([self.maybe_target, maybe])
         return new_ids
 
     def remove(self, keep: np.ndarray) -> None:
         """Keep only the tracks where ``keep`` (bool) is True."""
-        for name in ("ids", "x", "P", "hist", "last_seen", "born"):
+        for name in ("ids", "x", "P", "hist", "last_seen", "born", "maybe_target"):
             setattr(self, name, getattr(self, name)[keep])
+
+    def exchange(self, track_id: int, x: np.ndarray, P: np.ndarray, last_seen: float,
+                 hist: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+        """Track ``track_id`` and the target exchange roles: it gets the target's state (x (4,), P (4, 4),
+        last seen, and ``hist`` if given); returns its own former (x, P, last seen)."""
+        r = int(np.flatnonzero(self.ids == track_id)[0])
+        out = self.x[r].copy(), self.P[r].copy(), float(self.last_seen[r])
+        self.x[r], self.P[r], self.last_seen[r] = x, P, last_seen
+        if hist is not None:
+            self.hist[r] = hist
+        return out
 
     def expire(self, t: float) -> None:
         """End tracks unseen for longer than ``max_coast`` seconds."""

@@ -14,10 +14,14 @@ noisy detection does not kick the output. Limits: ``−max_reverse ≤ v ≤ max
 off when the target walks at it), ``|ω| ≤ max_turn_rate``; the integrals are clamped (anti-windup)
 and reset when the target is lost.
 
-Safety: the robot does not drive forward while anybody (target or other) is in its path — ahead
-of it, within ``stop_distance`` metres and ``corridor`` metres to either side — and stops driving
-when the target has not been seen for ``lost_timeout`` seconds; then it only turns (at most
-``search_turn_rate``) towards where the target should be, to look for it.
+Safety: everybody the follower knows of (the target, every candidate, every other person's track,
+including those coasting out of view) who stands in the robot's path — ahead, within ``corridor``
+metres to either side — limits the forward speed to what lets it stop ``stop_distance`` metres
+short of them braking at ``brake`` m/s² after one frame's delay, ``v ≤ √(2·brake·gap) − brake·dt``;
+nobody within ``stop_distance`` ahead at all (path or not) lets it move forward. So the robot slows
+as it nears anybody in its way instead of stopping late. It stops driving when the target has not
+been seen for ``lost_timeout`` seconds; then it only turns (at most ``search_turn_rate``) towards
+where the target should be, to look for it.
 
 >>> import numpy as np
 >>> from types import SimpleNamespace
@@ -53,8 +57,9 @@ class PIDFollower:
     max_reverse: float = 0.5
     max_turn_rate: float = 1.5
     feed_forward: bool = True
-    stop_distance: float = 0.8
+    stop_distance: float = 0.7
     corridor: float = 0.6
+    brake: float = 1.2
     lost_timeout: float = 1.0
     search_turn_rate: float = 0.5
     integral_limit: float = 0.5
@@ -92,10 +97,9 @@ class PIDFollower:
         s["t"] = t
         v = float(np.clip(v, -self.max_reverse, self.max_speed))
         w = float(np.clip(w, -self.max_turn_rate, self.max_turn_rate))
-        s["blocked"] = self._blocked(step, pos, fwd)
-        if s["blocked"]:
-            v = min(v, 0.0)
-        return v, w
+        limit = self._speed_limit(step, pos, fwd, dt if dt > 0 else 0.1)
+        s["blocked"] = bool(limit < v)
+        return min(v, limit), w
 
     @property
     def blocked(self) -> bool:
@@ -113,14 +117,22 @@ class PIDFollower:
         s[name + "_i"], s[name + "_e"] = integral, error
         return kp * error + ki * integral + kd * deriv
 
-    def _blocked(self, step, pos: np.ndarray, fwd: np.ndarray) -> bool:
-        """Somebody in the robot's path: ahead, within ``stop_distance`` and ``corridor`` to the side."""
+    def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float) -> float:
+        """Largest forward speed (m/s) that stops ``stop_distance`` short of anybody in the path (the
+        target only by the stop distance: the distance control keeps the robot back from it)."""
         people = [np.asarray(step.xy, float)[None]]
-        if len(step.candidates.xy):
-            people.append(step.candidates.xy)
+        cands = np.asarray(step.candidates.xy, float).reshape(-1, 2)
+        chosen = getattr(step, "chosen", -1)
+        if len(cands):
+            people.append(np.delete(cands, chosen, axis=0) if step.found and chosen >= 0 else cands)
         if len(step.others_xy):
             people.append(step.others_xy)
         rel = np.vstack(people) - pos
         ahead = rel @ fwd
         side = np.abs(rel @ np.array([-fwd[1], fwd[0]]))
-        return bool(np.any((ahead > -0.1) & (ahead < self.stop_distance) & (side < self.corridor)))
+        if np.any((ahead > 0) & (np.hypot(ahead, side) < self.stop_distance)):
+            return 0.0
+        gap = ahead[1:][(ahead[1:] > 0) & (side[1:] < self.corridor)] - self.stop_distance
+        if len(gap) == 0:
+            return np.inf
+        return float(max(0.0, np.sqrt(2 * self.brake * max(gap.min(), 0.0)) - self.brake * dt))

@@ -11,8 +11,12 @@ Per frame (:meth:`FollowTracker.step`):
    prediction, the illumination weight α and D (eq. 3) (:mod:`~worldtrack.follow.dissimilarity`);
 4. the decision: the paper's smallest D under the threshold, or (``track_others``) one assignment
    of all candidates to the target and the others (:mod:`~worldtrack.follow.others`);
-5. the Kalman update with the chosen candidate, the template rules
-   (:mod:`~worldtrack.follow.templates`), new and ended tracks of the others.
+5. the identity kept open (:mod:`~worldtrack.follow.identity`): each person's colour against the
+   target's templates is averaged over time, and another track that clearly fits better takes the
+   target's place (a wrong pick at a cut-in is undone when the target shows itself again);
+6. the Kalman update with the chosen candidate, the template rules
+   (:mod:`~worldtrack.follow.templates`; nothing is learnt while the identity is on probation),
+   new and ended tracks of the others.
 
 >>> import numpy as np
 >>> from worldtrack.synth import make_scenario
@@ -38,9 +42,11 @@ from worldtrack.follow.colour import bhattacharyya, histograms, n_bins, normalis
 from worldtrack.follow.config import FollowConfig
 from worldtrack.follow.dissimilarity import (decide, dissimilarity, illumination_weight, position_error,
                                              wb_change)
+from worldtrack.follow.identity import IdentityEvidence
+from worldtrack.follow.observation import Observation
 from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
-from worldtrack.follow.silhouette import box_silhouettes, covering, person_box, silhouettes
+from worldtrack.follow.silhouette import covering, person_box, silhouettes
 from worldtrack.follow.templates import Templates
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
@@ -52,22 +58,13 @@ OTHERS_MIN_ALPHA = 0.5
 CLEAR_RADIUS = 1.0
 #: A person this much nearer the camera (m) covering this share of the target's expected image box
 #: may be hiding it.
-HIDE_MARGIN = 0.25
-HIDE_SHARE = 0.3
+HIDE_MARGIN, HIDE_SHARE = 0.25, 0.3
+#: ... unless it stands this close (m) to the target's way since it was last measured (the target, stopped).
+STOPPED_RADIUS = 0.3
 #: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
 COAST_S = 1.5
-
-
-@dataclass
-class Observation:
-    """What one frame shows: candidates, silhouettes (H, W) int32, histograms (N, B), the white
-    balance α reads (r, b) and the camera."""
-
-    candidates: Candidates
-    silhouettes: np.ndarray
-    hists: np.ndarray
-    wb: tuple[float, float]
-    camera: Camera
+#: Found again after being unseen this long (s), the target's identity is on probation.
+REACQUIRED_AFTER = 0.3
 
 
 @dataclass
@@ -106,27 +103,6 @@ class FollowStep:
     others_xy: np.ndarray
 
 
-def observation_from_boxes(image: np.ndarray, boxes: np.ndarray, xy: np.ndarray, gains_rb, config: FollowConfig,
-                           camera: Camera | None = None) -> Observation:
-    """An :class:`Observation` whose candidates are given: floor positions ``xy`` (N, 2) metres and
-    image boxes (N, 4) ``(left, top, width, height)`` pixels (e.g. ground truth, or another detector).
-    ``gains_rb``: the frame's white balance (r, b) or None."""
-    sil = box_silhouettes(image.shape[:2], boxes)
-    n = len(xy)
-    b = np.asarray(boxes, float).reshape(-1, 4)
-    cands = Candidates(np.asarray(xy, float).reshape(-1, 2), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n),
-                       -(b[:, 1] + b[:, 3]), sil, 1)
-    normalised, wb = normalise_colour(image, gains_rb, config.normalise, sil > 0)
-    return Observation(cands, sil, histograms(normalised, sil, n, config), wb, camera)
-
-
-def frame_from_synth(bundle, camera_id: str = "robot") -> Frame:
-    """A :class:`~worldtrack.io.sources.Frame` (image, measured depth, gains) from a synthetic bundle."""
-    v = bundle.views[camera_id]
-    return Frame(v.image, float(bundle.time), int(bundle.frame), v.sensor_depth,
-                 meta={"wb_gains": tuple(v.wb_gains)})
-
-
 class FollowTracker:
     """Follows one target person (id 1) among others; see the module docstring.
 
@@ -146,7 +122,10 @@ class FollowTracker:
         self.P = np.eye(4)
         self.t = 0.0
         self.last_seen = 0.0
+        self.last_xy = np.full(2, np.nan)
         self._alpha = 0.0
+        self.identity = IdentityEvidence(self.config.identity_tau)
+        self.probation_until = -np.inf
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -182,6 +161,9 @@ class FollowTracker:
         x, P = kalman.initial_state(c.xy[i:i + 1], self.config.measurement_sigma)
         self.x, self.P = x[0], P[0]
         self.t = self.last_seen = t
+        self.identity = IdentityEvidence(self.config.identity_tau)
+        self.probation_until = -np.inf
+        self.last_xy = c.xy[i].copy()
         self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
                              self.config.others_max_coast)
         rest = np.arange(len(c)) != i
@@ -231,6 +213,7 @@ class FollowTracker:
         allowed = (E / cfg.k <= gate) & ~hiding
         if cfg.track_others:
             chosen, owner = self._assign_all(obs, D, allowed, hiding, t, dt)
+            chosen = self._weigh_identity(obs, rb, chosen, owner, t, dt)
         else:
             chosen = decide(D, cfg.threshold, allowed)
             owner = np.zeros(len(c), dtype=np.int64)
@@ -239,8 +222,10 @@ class FollowTracker:
         if chosen >= 0:
             x, P = kalman.update(self.x[None], self.P[None], c.xy[chosen][None], cfg.measurement_sigma)
             self.x, self.P = x[0], P[0]
-            self.last_seen = t
-        self._update_templates(obs, chosen, D, alpha, dt)
+            if t - self.last_seen >= REACQUIRED_AFTER:
+                self.probation_until = t + cfg.probation
+            self.last_seen, self.last_xy = t, c.xy[chosen].copy()
+        self._update_templates(obs, chosen, D, rb, alpha, dt)
         return self._result(t, obs, chosen, D, rb, E, alpha, w, owner, gate)
 
     # ------------------------------------------------------------------ internals
@@ -273,24 +258,26 @@ class FollowTracker:
         if chosen < 0:
             chosen = self._reidentify(obs, owner, D, hiding, t)
         free = np.flatnonzero(owner == 0)
-        owner[free] = others.add(c.xy[free], obs.hists[free], t)
+        owner[free] = others.add(c.xy[free], obs.hists[free], t, self._within_reach(c.xy[free], t))
         return chosen, owner
 
     def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, hiding: np.ndarray, t: float) -> int:
         """Re-identify the lost target among the people who appeared since it was last seen.
 
         Somebody seen at the same time as the target cannot be the target, so only candidates
-        nobody owns and those of tracks born after the target's last sighting qualify (a person
-        who reappears half hidden is often first taken for somebody new), and not one who may be
+        nobody owns and those of tracks born after the target's last sighting, within its reach
+        (a person who reappears half hidden is often first taken for somebody new; one who appeared
+        beyond where the target could have got to is somebody else), qualify, and not one who may be
         hiding the target. They must look like it (RBhat < ``reid_rbhat``) or score like it (D <
         ``threshold``, E counting only the distance beyond half of what a walker could have strayed
         from the prediction while unseen), and be no farther from it than a walker could have gone
-        (``gate + reid_speed·unseen``); the smallest D wins. A track taken over ends. Changes
+        (``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)`` from the velocity-consistent
+        prediction); the smallest D wins. A track taken over ends. Changes
         ``owner`` in place; returns the candidate's index or −1.
         """
         cfg = self.config
         others = self.others
-        young_ids = others.ids[others.born > self.last_seen]
+        young_ids = others.ids[(others.born > self.last_seen) & others.maybe_target]
         eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
         eligible = np.flatnonzero(eligible)
         if len(eligible) == 0:
@@ -302,7 +289,7 @@ class FollowTracker:
         # Position counts only beyond half of what a walker could have strayed from the prediction.
         e = cfg.k * np.maximum(0.0, dist - 0.5 * cfg.reid_speed * unseen)
         d = dissimilarity(rb, e, self._alpha, cfg.alpha_th)
-        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & (dist <= cfg.gate + cfg.reid_speed * unseen)
+        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & self._within_reach(c.xy[eligible], t)
         if not ok.any():
             return -1
         pick = int(eligible[np.flatnonzero(ok)[np.argmin(d[ok])]])
@@ -311,25 +298,66 @@ class FollowTracker:
         owner[pick] = 1
         return pick
 
+    def _weigh_identity(self, obs: Observation, rb: np.ndarray, chosen: int, owner: np.ndarray, t: float,
+                        dt: float) -> int:
+        """Add this frame's colour evidence (:mod:`~worldtrack.follow.identity`); another track seen now
+        that fits the target's templates clearly better than the followed one exchanges roles with it.
+        Changes ``owner`` in place; returns the target's candidate."""
+        cfg = self.config
+        self.identity.keep(self.others.ids)
+        if cfg.identity_margin <= 0 or self._alpha >= cfg.alpha_th:
+            return chosen
+        seen = np.flatnonzero(owner > 1)
+        self.identity.observe(dt, float(rb[chosen]) if chosen >= 0 else None, owner[seen], rb[seen])
+        better = self.identity.better(cfg.identity_margin)
+        if better is None or better not in owner:
+            return chosen
+        new = int(np.flatnonzero(owner == better)[0])
+        hist = obs.hists[chosen] if chosen >= 0 else None
+        self.x, self.P, self.last_seen = self.others.exchange(better, self.x, self.P, self.last_seen, hist)
+        if chosen >= 0:
+            owner[chosen] = better
+        owner[new] = 1
+        self.identity.exchange(better)
+        self.probation_until = t + cfg.probation
+        if self.templates.short is not None:     # it may have learnt the wrong person: restart it
+            self.templates.short, self.templates.short_wb = self.templates.long.copy(), self.templates.long_wb
+        return new
+
+    def _within_reach(self, xy: np.ndarray, t: float) -> np.ndarray:
+        """(N,) positions (N, 2) the lost target could have reached: no farther from its constant-velocity
+        prediction than ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
+        cfg, unseen = self.config, t - self.last_seen
+        reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
+        return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
+
     def _hiding(self, obs: Observation) -> np.ndarray:
         """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
         than its prediction and covering at least ``HIDE_SHARE`` of the image box where it should
         stand. Such a person appears just as the target vanishes, where it vanishes; they are not
-        taken for it (``occluders``; the paper has no such rule)."""
+        taken for it (``occluders``; the paper has no such rule). Except one standing on the target's
+        way from where it was last measured to its prediction (within ``STOPPED_RADIUS``): that is
+        the target, stopped while its constant-velocity prediction walked on."""
         n = len(obs.candidates)
         if not self.config.occluders or obs.camera is None or n == 0:
             return np.zeros(n, dtype=bool)
         cover = covering(obs.silhouettes, n, person_box(obs.camera, self.x[:2]))
         centre = obs.camera.centre[:2]
         nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
-        return nearer & (cover >= HIDE_SHARE)
+        way = self.x[:2] - self.last_xy
+        along = np.clip((obs.candidates.xy - self.last_xy) @ way / max(way @ way, 1e-12), 0.0, 1.0)
+        stopped = np.hypot(*(obs.candidates.xy - self.last_xy - along[:, None] * way).T) <= STOPPED_RADIUS
+        return nearer & (cover >= HIDE_SHARE) & ~stopped
 
-    def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, alpha: float, dt: float) -> None:
+    def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, rb: np.ndarray, alpha: float,
+                          dt: float) -> None:
         cfg = self.config
         hist = obs.hists[chosen] if chosen >= 0 else None
         d = float(D[chosen]) if chosen >= 0 else np.inf
+        if self.t < self.probation_until:        # identity on probation: nothing learnt yet
+            hist = None
         self.templates.paper_update(hist, obs.wb, alpha, d, cfg.alpha_th, cfg.update_max_d, cfg.update_every)
-        if chosen < 0 or self.templates.short is None:
+        if hist is None or self.templates.short is None:
             return
         # Learn when position alone is sure: close to the prediction and nobody else near. Not D:
         # after a change of light the target's D stays high until the template has learnt it.
