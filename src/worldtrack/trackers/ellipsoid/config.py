@@ -203,6 +203,29 @@ class HeightConfig(Section):
         return self
 
 
+class FeetConfig(Section):
+    """Depth from the feet: after matching, a person seen whole and alone moves along the line of
+    sight towards their feet (:mod:`worldtrack.trackers.ellipsoid.feet`)."""
+
+    path: ClassVar[str] = "ellipsoid.feet"
+
+    anchor: bool = Field(True, description="move people towards the feet a camera shows (off: the ellipse alone)")
+    sigma_m: float = Field(
+        0.1, gt=0, description="uncertainty of the feet's place along the line of sight, m (the feet's pixel "
+        "scatter, a shoe's length)")
+    ellipse_sigma_m: float = Field(
+        0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
+    height_match_m: float = Field(
+        0.3, ge=0, description="the feet count only where the head's ray above them is this close to the person's "
+        "height, m (legs the floor's colour end the silhouette at the waist)")
+    height_sigma_m: float = Field(
+        0.1, gt=0, description="where the feet are not to be trusted, the top of the head places the person at their "
+        "height, uncertain by this much while it is not measured, m (people's heights scatter by 0.1 m)")
+    measured_height_sigma_m: float = Field(
+        0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter)")
+    min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
+
+
 class WarmStartConfig(Section):
     """Starting on the first frame with the people already in view."""
 
@@ -227,6 +250,7 @@ class EllipsoidConfig(Section):
     end: EndConfig = Field(EndConfig(), description="when tracks end")
     height: HeightConfig = Field(HeightConfig(), description="measuring people's heights")
     warm_start: WarmStartConfig = Field(WarmStartConfig(), description="starting with the people in view")
+    feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -236,8 +260,9 @@ class EllipsoidConfig(Section):
             "score.kind": "paper", "score.target_pixels": 0, "score.ring_fraction": 0.0,
             "match.adaptive_step": False, "match.predict": False,
             "births.search_m": 0.0, "rescue.search_m": 0.0, "height.measure": False, "warm_start.frames": 0,
+            "feet.anchor": False,
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "HeightConfig", "MatchConfig",
+__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "MatchConfig",
            "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

@@ -29,6 +29,7 @@ from worldtrack.foreground.background import Foreground
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import Frame, Overlay, Person, PositionMap, Track, TrackerBase, frame_image
 from worldtrack.trackers.ellipsoid.args import DrawArgs, People, Scoring, StepArgs, Walkable
+from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.births import Births
 from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
@@ -82,7 +83,7 @@ class EllipsoidTracker(TrackerBase):
         self.steps = StepArgs(float(m.step_m), float(m.min_step_m), float(m.max_step_m), int(m.iterations),
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
-        self.births = Births(self.views, scene, self.walkable, cfg.births)
+        self.births = Births(self.views, scene, self.walkable, cfg.births, cfg.height.range_m)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
@@ -136,6 +137,8 @@ class EllipsoidTracker(TrackerBase):
         born = self._births(real, t)
         if born:
             scores += self._match(born, real, t, judged + bystanders)
+        anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet,
+                       self.config.height)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
         self._last_t = t
         self.frames_stepped += 1
@@ -227,9 +230,13 @@ class EllipsoidTracker(TrackerBase):
         proposals = self.births.propose(masks, _people(list(self.position_map)), self.frames_stepped == 0)
         h0, w0 = self.scene.people.height, self.scene.people.width
         born = []
-        for xy, cid in proposals:
-            p = self.position_map.add(xy[0], xy[1], h0, w0, mode="capture", time=t, tentative=True)
+        for xy, cid, shown in proposals:
+            # The height the blob shows (feet and head in view) is the person's first measurement.
+            height = shown if shown is not None and self.config.height.measure else h0
+            p = self.position_map.add(xy[0], xy[1], height, w0, mode="capture", time=t, tentative=True)
             p.birth_camera = cid
+            if height != h0:
+                p.height_samples.append(height)
             born.append(p)
         return born
 
@@ -258,7 +265,9 @@ class EllipsoidTracker(TrackerBase):
         if p.id > 0:
             return
         new = self.position_map.promote(p.id)
-        p.height, p.width = self.scene.people.size_of(new)
+        height, p.width = self.scene.people.size_of(new)
+        if not p.height_samples:  # else keep what was measured (at birth, or since)
+            p.height = height
 
 
 def _people(people: Sequence[Person]) -> People:
