@@ -15,7 +15,7 @@ looks. Every seed deals:
 >>> sc = make_scenario("line-of-sight", size=(160, 120), frames=3, seed=0)
 >>> sc.camera_ids, len(sc.people) >= 5
 (['cam'], True)
->>> 2.5 <= sc.scene.cameras["cam"].centre[2] <= 3.0
+>>> bool(2.5 <= sc.scene.cameras["cam"].centre[2] <= 3.0)
 True
 """
 

@@ -29,10 +29,10 @@ from worldtrack.foreground.background import Foreground
 from worldtrack.scene.model import Scene
 from worldtrack.trackers.base import Frame, Overlay, Person, PositionMap, Track, TrackerBase, frame_image
 from worldtrack.trackers.ellipsoid.args import DrawArgs, People, Scoring, StepArgs, Walkable
-from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.births import Births
 from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
+from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.height import heights_due, update_heights
 from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.life import LifeCycle
