@@ -231,7 +231,10 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     shown, share = None, 1.0
     if not feet_hidden:
         p = cam.backproject(foot[None], 0.0)[0]
-        shown = head_height(cam, head, p) if head_seen and np.isfinite(p).all() else None
+        # Only oblique views tell the height (as in height.py): from above, the ends of the blob
+        # are the head and the shoulders, not the head and the feet.
+        oblique = np.isfinite(p).all() and np.hypot(*(p[:2] - cam.centre[:2])) >= cam.centre[2] - 0.5 * height
+        shown = head_height(cam, head, p) if head_seen and oblique else None
         if shown is not None and shown < height_range[0]:
             p, shown = cam.backproject(head[None], height)[0], None
             ends = cam.project(np.array([[p[0], p[1], 0.0], [p[0], p[1], height]]))
