@@ -98,11 +98,12 @@ class Births:
     scene : Scene — its walkable floor, entry regions and default person size
     walkable : callable — (M, 2) floor points → (M,) bool
     config : BirthConfig
-    height_range : (min, max) plausible heights, m (``ellipsoid.height.range_m``)
+    height_range : (min, max) plausible heights, m (``ellipsoid.height.range_m``), or None when
+        heights are not measured (blobs then place people by their lower end, as before issue 37)
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
-                 config: BirthConfig, height_range: tuple[float, float] = (1.3, 2.1)):
+                 config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1)):
         self.views = views
         self.scene = scene
         self.walkable = walkable
@@ -191,7 +192,7 @@ class Births:
 
 
 def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
-                  height: float, height_range: tuple[float, float] = (1.3, 2.1)
+                  height: float, height_range: tuple[float, float] | None = (1.3, 2.1)
                   ) -> BlobPlace | None:
     """Floor position (3,) of a person seen as ``blob``, the height (m) the blob shows and the share
     of the person it shows, or None.
@@ -211,6 +212,7 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     end would put the person too far along the line of sight: the head places them instead (at
     the default ``height``), no height is given, and the share is the blob's length over the
     length of a person of that height standing there. Above the maximum, no height is given either.
+    ``height_range=None`` (heights not measured, as in the paper's preset): the lower end always.
     """
     cam = view.camera
     down = view.down_direction(centroid)
@@ -234,7 +236,7 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
         # Only oblique views tell the height (as in height.py): from above, the ends of the blob
         # are the head and the shoulders, not the head and the feet.
         oblique = np.isfinite(p).all() and np.hypot(*(p[:2] - cam.centre[:2])) >= cam.centre[2] - 0.5 * height
-        shown = head_height(cam, head, p) if head_seen and oblique else None
+        shown = head_height(cam, head, p) if head_seen and oblique and height_range is not None else None
         if shown is not None and shown < height_range[0]:
             p, shown = cam.backproject(head[None], height)[0], None
             ends = cam.project(np.array([[p[0], p[1], 0.0], [p[0], p[1], height]]))

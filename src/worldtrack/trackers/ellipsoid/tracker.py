@@ -83,7 +83,8 @@ class EllipsoidTracker(TrackerBase):
         self.steps = StepArgs(float(m.step_m), float(m.min_step_m), float(m.max_step_m), int(m.iterations),
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
-        self.births = Births(self.views, scene, self.walkable, cfg.births, cfg.height.range_m)
+        self.births = Births(self.views, scene, self.walkable, cfg.births,
+                             cfg.height.range_m if cfg.height.measure else None)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
