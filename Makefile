@@ -4,19 +4,35 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench clean services
 
-$(STAMP): pyproject.toml
+# TrackEval (HOTA) without its declared dependencies: see the comment in pyproject.toml.
+TRACKEVAL := trackeval==1.3.0
+
+$(STAMP): pyproject.toml Makefile
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,baseline]'
+	$(PY) -m pip install --quiet -e '.[test,baseline,redis,serve,browser]'
+	$(PY) -m pip install --quiet --no-deps '$(TRACKEVAL)'
+	@echo "compiling the trackers' kernels once (cached in src/**/__pycache__; a few minutes on a small machine)"
+	$(PY) -m worldtrack.warmup
 	touch $(STAMP)
 
 demo: $(STAMP)
 	$(VENV)/bin/worldtrack demo
 
-test: $(STAMP)
+test: $(STAMP) services
 	$(PY) -m pytest
+
+# The shared-map and live-stream tests start their own redis-server and ffmpeg (Debian packages); the
+# tests of worldtrack serve drive Debian's chromium through Playwright (no browser download).
+services:
+	@command -v redis-server >/dev/null && command -v ffmpeg >/dev/null || \
+	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq redis-server ffmpeg >/dev/null; } || \
+	  echo "redis-server/ffmpeg could not be installed: the shared-map and live-stream tests will be skipped"
+	@command -v chromium >/dev/null || \
+	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; } || \
+	  echo "chromium could not be installed: the browser tests of worldtrack serve will be skipped"
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

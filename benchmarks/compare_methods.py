@@ -42,9 +42,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, render_images, save_result  # noqa: E402
 
-from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, synthetic_tracker  # noqa: E402
+from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, synthetic_threshold, synthetic_tracker  # noqa: E402
 from worldtrack.trackers.base import Frame  # noqa: E402
-from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
 
@@ -75,7 +75,7 @@ def peak_memory_mb(scenario, bundles, method: str) -> float:
     # published figures (the blobs baseline does not keep the foreground models; dropping them lowers its peak).
     cams = scenario.camera_ids
     fgs = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, FOREGROUND,
-                           SYNTHETIC_COLOUR_THRESHOLD if FOREGROUND == "colour" else None)
+                           synthetic_threshold(method, FOREGROUND))
     tracker = make_tracker(method, scenario.scene, fgs)
     for b in bundles:
         tracker.step({c: Frame(b.views[c].image, b.time, b.frame) for c in cams}, b.time)
@@ -102,7 +102,7 @@ def compare(label: str, name: str, params: dict, occlusion: bool, frames: int | 
         r = run_scenario(sc, method, foreground=FOREGROUND, gate=GATE_M, bundles=bundles)
         mem = peak_memory_mb(sc, bundles, method)
         m = r.metrics
-        rows.append([label, "yes" if occlusion else "no", method, m["mota"], m["idf1"], m["num_switches"],
+        rows.append([label, "yes" if occlusion else "no", method, m["mota"], m["idf1"], m["hota"], m["num_switches"],
                      r.errors.mean_m, r.fps, mem])
         print(f"  {method:9s} MOTA {m['mota']:6.3f} IDF1 {m['idf1']:.3f} switches {m['num_switches']:3d} "
               f"error {r.errors.mean_m:.3f} m  {r.fps:6.1f} frames/s  {mem:.1f} MB", file=sys.stderr)
@@ -130,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         rows += compare(label, name, params, occlusion, 60 if args.quick else None)
     elapsed = time.perf_counter() - t_start
-    table = markdown_table(["scenario", "occlusion", "method", "MOTA", "IDF1", "ID switches", "mean error m",
+    table = markdown_table(["scenario", "occlusion", "method", "MOTA", "IDF1", "HOTA", "ID switches", "mean error m",
                             "frames/s", "peak memory MB (tracemalloc)"], rows)
     summary = verdict(rows)
     text = (f"{SIZE[0]}×{SIZE[1]}, seed {SEED}, default presets, foreground `{FOREGROUND}` (blobs: its own MOG2), "

@@ -61,7 +61,7 @@ def run_seed(seed: int, frames: int, people: int, options: dict, texture_ncc: fl
     pairs = evaluate_detailed(r.gt, r.pred, gate=GATE_M).pairs
     causes = error_causes(r.gt, r.pred, pairs, near=1.0)
     views = errors_by_views(r.gt, r.pred, pairs, sc.scene.cameras.values())
-    return {"seed": seed, "mota": m["mota"], "idf1": m["idf1"], "fp": m["num_false_positives"],
+    return {"seed": seed, "mota": m["mota"], "idf1": m["idf1"], "hota": m["hota"], "fp": m["num_false_positives"],
             "miss": m["num_misses"], "switches": m["num_switches"], "error": r.errors.mean_m,
             "causes": causes, "views": views, "fps": r.frames / max(r.seconds, 1e-9), "render_s": render_s}
 
@@ -120,12 +120,12 @@ def main(argv: list[str] | None = None) -> int:
         total += r["causes"]
         for v, counts in r["views"].items():
             by_views.setdefault(v, Counter()).update(counts)
-        rows.append([seed, r["mota"], r["idf1"], r["fp"], r["miss"], r["switches"], r["error"]]
+        rows.append([seed, r["mota"], r["idf1"], r["hota"], r["fp"], r["miss"], r["switches"], r["error"]]
                     + [r["causes"][c] for c in CAUSES] + [r["fps"]])
         print(f"seed {seed}: MOTA {r['mota']:.3f} (fp {r['fp']}, miss {r['miss']}, switches {r['switches']}); "
               f"rendered in {r['render_s']:.0f} s", file=sys.stderr, flush=True)
     motas = np.array([row[1] for row in rows])
-    headers = (["seed", "MOTA", "IDF1", "false positives", "misses", "ID switches", "mean error m"]
+    headers = (["seed", "MOTA", "IDF1", "HOTA", "false positives", "misses", "ID switches", "mean error m"]
                + list(CAUSES) + ["frames/s (step)"])
     summary = (f"MOTA over {len(motas)} seeds: mean **{motas.mean():.3f}**, median {np.median(motas):.3f}, "
                f"min {motas.min():.3f}, max {motas.max():.3f}; {int((motas >= TARGET_MOTA).sum())} of "

@@ -59,8 +59,8 @@ from common import markdown_table, render_images, write_result  # noqa: E402
 
 from worldtrack.config import parse_assignment, with_overrides  # noqa: E402
 from worldtrack.eval import evaluate_detailed  # noqa: E402
-from worldtrack.experiment import gt_table  # noqa: E402
-from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds  # noqa: E402
+from worldtrack.experiment import gt_table, synthetic_threshold  # noqa: E402
+from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
@@ -107,14 +107,16 @@ def render(seed: int, size: tuple[int, int], **overrides) -> Sequence:
     return Sequence(seed, sc, render_images(sc), sc.background("cam"))
 
 
-#: The foreground's colour threshold (the particle tracker's γ): the synthetic world's, as every
-#: synthetic benchmark uses (``--threshold``).
-THRESHOLD = [SYNTHETIC_COLOUR_THRESHOLD]
+#: The foreground's threshold (the particle tracker's γ; ``--threshold``): None, the tracker's own 25.
+THRESHOLD: list[float | None] = [None]
+#: The foreground model's kind (``--foreground``), as ``worldtrack track``'s default.
+KIND = ["colour"]
 
 
 def foreground(seq: Sequence) -> dict:
     """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart)."""
-    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, "colour", THRESHOLD[0])
+    threshold = synthetic_threshold("particle", KIND[0]) if THRESHOLD[0] is None else THRESHOLD[0]
+    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], threshold)
 
 
 def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
@@ -406,10 +408,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", default=None, metavar="PATH", help="also write every run's figures as JSON")
     p.add_argument("--name", default="particle_entry", help="result file benchmarks/results/NAME.md")
     p.add_argument("--no-write", action="store_true")
-    p.add_argument("--threshold", type=float, default=SYNTHETIC_COLOUR_THRESHOLD,
-                   help=f"the foreground's colour threshold, the particle tracker's γ (default {SYNTHETIC_COLOUR_THRESHOLD:g})")
+    p.add_argument("--foreground", default="colour", choices=("grey", "colour"),
+                   help="the foreground model (default colour, as worldtrack track)")
+    p.add_argument("--threshold", type=float, default=None,
+                   help="the foreground's threshold, the particle tracker's γ (default: its own 25)")
     args = p.parse_args(argv)
     THRESHOLD[0] = args.threshold
+    KIND[0] = args.foreground
     w, h = (int(v) for v in args.size.lower().split("x"))
     options = dict(parse_assignment(s) for s in args.set)
     for name in args.configs:

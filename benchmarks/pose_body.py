@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shlex
 import statistics
 import sys
 import time
@@ -23,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, mog2_apply_time, save_result  # noqa: E402
+from common import markdown_table, mog2_apply_time, save_result, write_result  # noqa: E402
 
 from worldtrack.pose import FailureRule, axis_angle_deg  # noqa: E402
 from worldtrack.pose.body import limb_axes  # noqa: E402
@@ -67,6 +68,7 @@ def main() -> None:
     ap.add_argument("--seeds", default="0-2")
     ap.add_argument("--frames", type=int, default=60)
     ap.add_argument("--configs", default="PF1LM0,PF1LM15,PF2LM0,PF2LM50")
+    ap.add_argument("--tag", default="", help="suffix of the results file name (parallel runs)")
     ap.add_argument("--quick", action="store_true")
     a = ap.parse_args()
     rng = lambda s: list(range(int(s.split("-")[0]), int(s.split("-")[1]) + 1)) if "-" in s else [int(s)]
@@ -105,8 +107,14 @@ def main() -> None:
     out += ["## Tables 7 and 8 — limb-axis error (deg)\n", markdown_table(head, rows), "", "## Summary\n", *summary]
     text = "\n".join(out)
     print(text)
-    save_result("pose_body", "Seed 003: 14-DoF upper-body tracking (Tables 7 and 8)", text, a.quick,
-                time.time() - t_start)
+    title = "Seed 003: 14-DoF upper-body tracking (Tables 7 and 8)"
+    if not a.tag:
+        save_result("pose_body", title, text, a.quick, time.time() - t_start)
+    elif not a.quick:                                   # a tagged run: its own file, the real command line
+        args = " ".join(shlex.quote(x) for x in sys.argv[1:])
+        path = write_result(f"pose_body{a.tag}", title, f"Command: `.venv/bin/python benchmarks/pose_body.py {args}` "
+                            f"({time.time() - t_start:.0f} s)\n\n{text}")
+        print(f"wrote {path}", file=sys.stderr)
 
 
 if __name__ == "__main__":

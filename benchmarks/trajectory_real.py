@@ -22,7 +22,8 @@ middle of the range, for the MAP's e_v and for the baseline's back-projection):
 - the MAP without the barrier, and Kalman + RTS on the back-projected head pixels.
 
 (The MAPs run every start to convergence, to tell which start wins; the default race is run too and
-whether it picked a winning start is counted.)
+whether it picked a winning start is counted, and its CPU time beside that of the estimate without
+the environment.)
 
 Scores: horizontal RMSE between views and in view (the truth at the grid times, interpolated where
 an annotation is missing), steps whose segment crosses a wall line (the truth's own crossings are
@@ -165,7 +166,12 @@ def run_sequence(name: str, root: Path, seed: int, totals: dict, starts: Counter
         opts = TrajectoryOptions(dt=0.4, height=1.70, race_iterations=None)     # every start converges
         est = estimate_trajectory(obs, field, opts)
         learnt = estimate_trajectory(obs, free.field_without(pid), opts)
+        c0 = time.process_time()
         race = estimate_trajectory(obs, field, TrajectoryOptions(dt=0.4, height=1.70))
+        c1 = time.process_time()
+        estimate_trajectory(obs, None, TrajectoryOptions(dt=0.4, height=1.70, environment=False))
+        starts[(name, "cpu", "walls")] += c1 - c0
+        starts[(name, "cpu", "none")] += time.process_time() - c1
         truth = np.column_stack([np.interp(est.times, t, xy[:, k]) for k in range(2)] + [np.full(len(est.times), heights[pid])])
         seen = est.observed > 0
         kf = baseline(obs, est.times, opts.motion.q_horizontal, 1.70)
@@ -219,9 +225,13 @@ def report(seed: int, root: Path, missing: list[str], quick: bool, keep: dict, t
                     if any(k[0] == seq and k[1] == env for k in starts))
     race = ", ".join(f"{seq} {starts[(seq, 'race', True)]} of {starts[(seq, 'race', True)] + starts[(seq, 'race', False)]}"
                      for seq in SEQUENCES if (seq, "race", True) in starts or (seq, "race", False) in starts)
+    cpu = ", ".join(f"{seq} {starts[(seq, 'cpu', 'walls')]:.2f} / {starts[(seq, 'cpu', 'none')]:.2f} s "
+                    f"({starts[(seq, 'cpu', 'walls')] / max(starts[(seq, 'cpu', 'none')], 1e-9):.2f}×)"
+                    for seq in SEQUENCES if (seq, "cpu", "none") in starts)
     return (f"## Camera seed {seed}\n\n{table}\n\nStart that won (every start run to convergence; '+' joins starts "
             f"whose optima agree within 1e-6): {won}.\n\nThe default race (5 iterations each, then only the leader) "
-            f"picked a winning start for: {race}.\n")
+            f"picked a winning start for: {race}.\n\nCPU seconds of the default estimate (walls) / without the "
+            f"environment, all people: {cpu}.\n")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,4 +1,4 @@
-"""Make the calibration examples: the 1999 paper's procedure on the kato-lab cameras (seed 000, §6.2).
+"""Make the calibration examples: the 1999 paper's procedure on the kato-lab cameras (paper 000, §6.2).
 
 The paper builds a 0.3 × 0.3 × 1.1 m box with markers, puts it at known places on the floor, clicks
 the markers in the image and fits the camera to 30 pairs. This script does the same with the

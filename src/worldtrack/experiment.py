@@ -23,7 +23,7 @@ from worldtrack.eval.tables import PositionErrors, position_errors
 from worldtrack.trackers.base import Frame
 from worldtrack.io.tracks import TrackTable
 from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
-from worldtrack.trackers import make_tracker
+from worldtrack.trackers import make_tracker, method_threshold
 from worldtrack.trackers.base import warm_started
 
 
@@ -75,6 +75,19 @@ def visibility(gt: TrackTable) -> np.ndarray:
     return np.max(np.vstack(vis), axis=0) if vis else np.ones(len(gt))
 
 
+def synthetic_threshold(method: str, foreground: str = "colour") -> float | None:
+    """The foreground threshold of ``method`` on the synthetic world: the method's own, else for colour
+    the synthetic world's 20 (noise σ ≈ 3), else None (the kind's default).
+
+    >>> synthetic_threshold("ellipsoid"), synthetic_threshold("particle"), synthetic_threshold("ellipsoid", "grey")
+    (20.0, 25.0, None)
+    """
+    own = method_threshold(method)
+    if own is not None:
+        return own
+    return SYNTHETIC_COLOUR_THRESHOLD if foreground == "colour" else None
+
+
 def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
                       threshold: float | None = None, cameras: list[str] | None = None,
                       shadow_texture_ncc: float | None = None, **options):
@@ -84,14 +97,15 @@ def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "defaul
     ----------
     scenario : worldtrack.synth.Scenario
     method, preset, options : passed to :func:`worldtrack.trackers.make_tracker`
-    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
-        the colour threshold defaults to the synthetic world's 20
+    foreground, threshold : the foreground model (see :func:`worldtrack.foreground.make_foregrounds`);
+        the threshold defaults to the method's own (:func:`worldtrack.trackers.method_threshold`),
+        else, for colour, to the synthetic world's 20
     cameras : the cameras to track with (default: all)
     shadow_texture_ncc : the foreground's texture test of shadow-like pixels (default off; see
-        :func:`worldtrack.pipeline.make_foregrounds`)
+        :func:`worldtrack.foreground.make_foregrounds`)
     """
-    if threshold is None and foreground == "colour":
-        threshold = SYNTHETIC_COLOUR_THRESHOLD
+    if threshold is None:
+        threshold = synthetic_threshold(method, foreground)
     cams = list(cameras or scenario.camera_ids)
     foregrounds = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, foreground, threshold,
                                    shadow_texture_ncc=shadow_texture_ncc)
@@ -151,8 +165,9 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
     ----------
     scenario : worldtrack.synth.Scenario
     method, preset, options : passed to :func:`worldtrack.trackers.make_tracker`
-    foreground, threshold : the foreground model (see :func:`worldtrack.pipeline.make_foregrounds`);
-        the colour threshold defaults to the synthetic world's 20
+    foreground, threshold : the foreground model (see :func:`worldtrack.foreground.make_foregrounds`);
+        the threshold defaults to the method's own (:func:`worldtrack.trackers.method_threshold`),
+        else, for colour, to the synthetic world's 20
     min_visibility : ground truth less visible than this in every camera is not scored
     gate : metres
     score_rows : optional ``gt -> (N,) bool`` choosing the ground-truth rows to score (e.g. only

@@ -18,7 +18,7 @@ worldtrack.errors.InputError: blobs.filter.gat: unknown setting (expected one of
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
 import yaml
@@ -29,6 +29,8 @@ from worldtrack.foreground.config import ForegroundConfig
 
 METHODS = ("ellipsoid", "particle", "blobs")
 PRESETS = ("default", "paper")
+#: Settings of stages besides the tracker, by top-level name: ``module:Section`` (imported when used).
+STAGES = {"map": "worldtrack.map.config:MapConfig"}
 
 
 @dataclass(frozen=True)
@@ -41,12 +43,14 @@ class RunConfig:
     preset : str — "default" or "paper"
     foreground : ForegroundConfig
     methods : {method: its configuration section} — every method's, so a file can hold all three
+    stages : {name: section} — the other stages' settings (:data:`STAGES`: ``map``, the shared map)
     """
 
     method: str
     preset: str
     foreground: ForegroundConfig
     methods: Mapping[str, Section]
+    stages: Mapping[str, Section] = field(default_factory=dict)
 
     def section(self, method: str | None = None) -> Section:
         """The configuration of ``method`` (default: the one that runs)."""
@@ -55,12 +59,28 @@ class RunConfig:
     def to_mapping(self) -> dict[str, Any]:
         """Plain nested values, in the layout of a configuration file."""
         return {"method": self.method, "preset": self.preset, "foreground": to_mapping(self.foreground),
-                **{m: to_mapping(s) for m, s in self.methods.items()}}
+                **{m: to_mapping(s) for m, s in self.methods.items()},
+                **{n: to_mapping(s) for n, s in self.stages.items()}}
+
+    def stage(self, name: str) -> Section:
+        """The settings of stage ``name`` (e.g. ``"map"``)."""
+        return self.stages[name]
+
+
+def _stage_class(name: str) -> type[Section]:
+    import importlib
+    module, _, cls = STAGES[name].partition(":")
+    return getattr(importlib.import_module(module), cls)
 
 
 def _method_config_class(method: str) -> type[Section]:
     from worldtrack.trackers import CONFIGS
     return CONFIGS[method]
+
+
+def _method_threshold(method: str) -> float | None:
+    from worldtrack.trackers import method_threshold
+    return method_threshold(method)
 
 
 def _base(method: str, preset: str) -> Section:
@@ -89,7 +109,8 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
         method), or None
     method, preset : the command line's ``--method`` / ``--preset`` (None: the file's, else
         ellipsoid / default)
-    flags : the command line's named settings: ``foreground`` (kind), ``threshold``, ``births``
+    flags : the command line's named settings: ``foreground`` (kind), ``threshold`` (default the
+        method's own, e.g. 25 for the particle tracker, else the kind's), ``births``
         (where new people may appear; set on the method that runs)
     sets : ``--set`` pairs (dotted path from the top, value), applied last in order
 
@@ -98,10 +119,10 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
     InputError — one line naming the setting at fault.
     """
     data = dict(data or {})
-    unknown = [k for k in data if k not in ("method", "preset", "foreground", *METHODS)]
+    unknown = [k for k in data if k not in ("method", "preset", "foreground", *METHODS, *STAGES)]
     if unknown:
         raise InputError(f"{unknown[0]}: unknown setting (expected one of: method, preset, foreground, "
-                         f"{', '.join(METHODS)})")
+                         f"{', '.join(METHODS + tuple(STAGES))})")
     top_sets = {path: value for path, value in sets if path in ("method", "preset")}
     method = _choice(top_sets.get("method", method or data.get("method", "ellipsoid")), METHODS, "method")
     preset = _choice(top_sets.get("preset", preset or data.get("preset", "default")), PRESETS, "preset")
@@ -115,6 +136,7 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
             base = from_mapping(type(base), _deep_merge(to_mapping(base), given), root=m)
         methods[m] = base
     foreground = from_mapping(ForegroundConfig, data.get("foreground"), root="foreground")
+    stages = {n: from_mapping(_stage_class(n), data.get(n), root=n) for n in STAGES}
     flags = dict(flags or {})
     fg_changes = {k: v for k, v in (("kind", flags.get("foreground")), ("threshold", flags.get("threshold")))
                   if v is not None}
@@ -139,10 +161,17 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
             if not rest:
                 raise InputError(f"{head}: is a section (set one of its fields)")
             methods[head] = with_overrides(methods[head], {rest: value}, root=head)
+        elif head in STAGES:
+            if not rest:
+                raise InputError(f"{head}: is a section (set one of its fields)")
+            stages[head] = with_overrides(stages[head], {rest: value}, root=head)
         else:
             raise InputError(f"{head}: unknown setting (expected one of: method, preset, foreground, "
-                             f"{', '.join(METHODS)})")
-    return RunConfig(method, preset, foreground, methods)
+                             f"{', '.join(METHODS + tuple(STAGES))})")
+    if foreground.threshold is None and foreground.kind in ("grey", "colour") and \
+            _method_threshold(method) is not None:        # the method's own threshold (the particle's γ)
+        foreground = with_overrides(foreground, {"threshold": _method_threshold(method)}, root="foreground")
+    return RunConfig(method, preset, foreground, methods, stages)
 
 
 def _deep_merge(base: dict[str, Any], given: Mapping[str, Any]) -> dict[str, Any]:
@@ -175,6 +204,8 @@ def dump_run_config(cfg: RunConfig, described: bool = True) -> str:
     parts = [head.rstrip(), "foreground:", _indent(dump_yaml(cfg.foreground, described))]
     for m, section in cfg.methods.items():
         parts += [f"{m}:", _indent(dump_yaml(section, described))]
+    for n, section in cfg.stages.items():
+        parts += [f"{n}:", _indent(dump_yaml(section, described))]
     return "\n".join(p.rstrip("\n") for p in parts) + "\n"
 
 
@@ -182,4 +213,4 @@ def _indent(text: str) -> str:
     return "\n".join("  " + line if line else line for line in text.splitlines())
 
 
-__all__ = ["METHODS", "PRESETS", "RunConfig", "dump_run_config", "resolve_run_config"]
+__all__ = ["METHODS", "PRESETS", "STAGES", "RunConfig", "dump_run_config", "resolve_run_config"]

@@ -23,7 +23,7 @@ def _json(capsys, argv):
 def test_ground_truth_against_itself_json(capsys):
     m = _json(capsys, ["eval", GT, GT, "--json"])
     assert m["mota"] == 1.0 and m["motp_m"] == 0.0 and m["idf1"] == 1.0
-    assert m["num_switches"] == 0 and m["hota"] is None
+    assert m["num_switches"] == 0 and m["hota"] == pytest.approx(1.0) and m["hota_assa"] == pytest.approx(1.0)
     assert m["mean_error_m"] == 0.0 and m["num_position_pairs"] == 10
 
 
@@ -37,6 +37,10 @@ def test_table_shows_metrics_and_paper_errors(capsys):
     assert lines["ID switches"] == "1"
     assert lines["mean error"] == f"{2.5 / 9:.3f} m"         # (5·0.3 + 2·0.4 + 2·0.1) / 9
     assert lines["mean |dX|"] == f"{1.5 / 9:.3f} m" and lines["mean |dY|"] == f"{1.0 / 9:.3f} m"
+    m = _json(capsys, ["eval", GT, PRED, "--json"])            # HOTA and its parts, as computed
+    assert lines["HOTA (DetA / AssA / LocA)"] == (f"{m['hota']:.3f} ({m['hota_deta']:.3f} / {m['hota_assa']:.3f} / "
+                                                   f"{m['hota_loca']:.3f})")
+    assert 0.2 < m["hota"] < 0.8 and m["hota"] == pytest.approx((m["hota_deta"] * m["hota_assa"]) ** 0.5, abs=0.05)
 
 
 def test_swapped_copy_per_frame_csv_and_mot_input(tmp_path, capsys):
@@ -100,7 +104,7 @@ def test_non_numeric_value_is_one_line_exit_2(tmp_path, capsys):
 @pytest.mark.parametrize("extra, fragment", [
     (["--gate", "-1"], "--gate: expected a positive distance"),
     (["--gate", "wide"], "--gate: expected a distance in metres, got 'wide'"),
-    (["--area", "0,0,1,1"], "--area: expected x1,y1,x2,y2,... with at least 3"),
+    (["--area", "0,0,1,1"], "--area: expected x1,y1,x2,y2,... with 3 to 1000 finite (x, y) points, got 4"),
     (["--area", "0,0,1,x,1,1"], "no such file, and not numbers x1,y1,x2,y2"),
 ])
 def test_bad_options_are_one_line_exit_2(capsys, extra, fragment):

@@ -13,7 +13,7 @@ def test_print_config_prints_every_setting_and_round_trips(tmp_path, capsys):
     text = capsys.readouterr().out
     data = yaml.safe_load(text)
     assert data["method"] == "ellipsoid" and data["preset"] == "default"
-    assert set(data) == {"method", "preset", "foreground", "ellipsoid", "particle", "blobs"}
+    assert set(data) == {"method", "preset", "foreground", "ellipsoid", "particle", "blobs", "map"}
     assert "# " in text                                        # each field carries its description
     (tmp_path / "all.yaml").write_text(text)
     assert main(["track", "--config", str(tmp_path / "all.yaml"), "--print-config"]) == 0
@@ -30,6 +30,15 @@ def test_config_file_flags_and_set_in_that_order(tmp_path, capsys):
     assert data["blobs"]["filter"]["gate"] == 5.0
     cfg = resolve_run_config({"preset": "paper"})
     assert cfg.preset == "paper" and cfg.section("ellipsoid") == resolve_run_config(preset="paper").section("ellipsoid")
+
+
+def test_the_particle_tracker_keeps_its_own_threshold_unless_one_is_given():
+    assert resolve_run_config(method="ellipsoid").foreground.threshold is None          # the kind's: 30 colour
+    assert resolve_run_config(method="particle").foreground.threshold == 25.0            # its γ
+    assert resolve_run_config(method="particle", flags={"threshold": 12}).foreground.threshold == 12
+    assert resolve_run_config({"method": "particle", "foreground": {"threshold": 9}}).foreground.threshold == 9
+    assert resolve_run_config(method="particle", sets=[("foreground.threshold", 40)]).foreground.threshold == 40
+    assert resolve_run_config(method="particle", flags={"foreground": "mog2"}).foreground.threshold is None
 
 
 @pytest.mark.parametrize("args, message", [

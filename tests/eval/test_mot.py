@@ -29,7 +29,7 @@ def test_ground_truth_against_itself_is_perfect():
     assert m["mota"] == 1.0 and m["motp_m"] == 0.0 and m["idf1"] == 1.0
     assert m["num_switches"] == 0 and m["num_false_positives"] == 0 and m["num_misses"] == 0
     assert m["num_objects"] == 10 and m["num_frames"] == 5 and m["mostly_tracked"] == 2
-    assert m["hota"] is None
+    assert m["hota"] == pytest.approx(1.0) and m["hota_deta"] == pytest.approx(1.0)
 
 
 def test_two_ids_swapped_from_mid_way_give_exactly_two_switches():

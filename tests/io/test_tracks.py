@@ -60,6 +60,29 @@ def test_time_is_optional_and_unknown_text_columns_are_kept(tmp_path):
     assert t.extra["note"].tolist() == ["", "hello"]
 
 
+@pytest.mark.parametrize("ending", ["\r", "\r\n", "\n"])
+def test_every_line_ending_reads_the_same_rows(tmp_path, ending):
+    p = tmp_path / "t.csv"
+    p.write_bytes(ending.join(["frame,id,x,y", "0,1,1.0,2.0", "", "1,1,1.5,2.5", ""]).encode())
+    t = read_tracks(p)
+    assert t.frame.tolist() == [0, 1] and t.xy.tolist() == [[1.0, 2.0], [1.5, 2.5]]
+
+
+def test_the_fast_and_the_cell_by_cell_readers_give_the_same_table(tmp_path):
+    from worldtrack.io.track_reader import _read_csv_cells, _read_csv_fast
+
+    rng = np.random.default_rng(3)
+    rows = [f"{f},{f / 7:.6f},{i},{x:.4f},{y:.4f},1.7,,{s:.3f},tracking,,note{i}"
+            for f in range(40) for i, x, y, s in zip(range(1, 4), *rng.normal(size=(3, 3)))]
+    text = "frame,time,id,x,y,height,width,score,mode,flags,note\n" + "\n".join(rows) + "\n"
+    fast, cells = _read_csv_fast(text, "t.csv"), _read_csv_cells(text, "t.csv")
+    assert fast.columns == cells.columns
+    for c in fast.columns:
+        a, b = fast.column(c), cells.column(c)
+        assert a.dtype.kind == b.dtype.kind and (np.array_equal(a, b, equal_nan=True) if a.dtype.kind == "f"
+                                                 else a.tolist() == b.tolist()), c
+
+
 def test_excel_byte_order_mark_is_ignored(tmp_path):
     p = tmp_path / "bom.csv"
     p.write_bytes("\ufeffframe,id,x,y\n0,1,1.0,2.0\n".encode("utf-8"))
@@ -71,9 +94,15 @@ def test_excel_byte_order_mark_is_ignored(tmp_path):
     ("frame,id,x,y\n0,1,1.0,2.0\n1,1,abc,2.0\n", "line 3, column x: expected a number, got 'abc'"),
     ("frame,id,x,y\n0,1,1.0,\n", "line 2, column y: expected a number, got ''"),
     ("frame,id,x,y\n0,1,nan,2.0\n", "line 2, column x: expected a finite number, got 'nan'"),
-    ("frame,id,x,y\n0.5,1,1.0,2.0\n", "line 2, column frame: expected an integer, got '0.5'"),
-    ("frame,id,x,y\n0,0,1.0,2.0\n", "line 2, column id: expected an integer >= 1, got '0'"),
-    ("frame,id,x,y\n-1,1,1.0,2.0\n", "line 2, column frame: expected an integer >= 0, got '-1'"),
+    ("frame,id,x,y\n0.5,1,1.0,2.0\n", "line 2, column frame: expected a whole number from 0 to 1000000000, got '0.5'"),
+    ("frame,id,x,y\n0,0,1.0,2.0\n", "line 2, column id: expected a whole number from 1 to 1000000000, got '0'"),
+    ("frame,id,x,y\n-1,1,1.0,2.0\n", "line 2, column frame: expected a whole number from 0 to 1000000000, got '-1'"),
+    # Numbers that used to wrap or overflow: frame 1e30 and 2**63, id 1e19, x = 1e308.
+    ("frame,id,x,y\n1e30,1,1.0,2.0\n", "line 2, column frame: expected a whole number from 0 to 1000000000, got '1e30'"),
+    ("frame,id,x,y\n9223372036854775808,1,1.0,2.0\n", "line 2, column frame: expected a whole number from 0"),
+    ("frame,id,x,y\n0,1e19,1.0,2.0\n", "line 2, column id: expected a whole number from 1 to 1000000000, got '1e19'"),
+    ("frame,id,x,y\n0,1,1e308,2.0\n", "line 2, column x: expected metres within ±1e+06, got '1e308'"),
+    ("frame,id,x,y\n0,1,1.0,2.0\x00\n", "holds NUL bytes"),
     ("frame,id,x,y\n0,1,1.0\n", "line 2: expected 4 fields (frame,id,x,y), got 3"),
     ("frame,id,x,y\n0,1,1.0,2.0\n0,2,1.0,2.0\n\n0,1,3.0,4.0\n",
      "line 5: duplicate row for frame 0, id 1 (first at line 2)"),
@@ -163,10 +192,10 @@ def test_writer_writes_header_at_once_and_flushes_every_frame(tmp_path):
                             flags=(), sx=0.4, sy=0.3)])
     # Still open: the row is already on disk.
     lines = p.read_text().splitlines()
-    assert lines[1] == "0,0.0,1,1.0,2.0,1.7,0.4,0.9,capture,,0.4,0.3"
+    assert lines[1] == "0,0.0,1,1.0,2.0,1.7,0.4,0.9,capture,,,,,0.4,0.3"   # no vx, vy, speed given: empty
     w.write(1, 0.1, [{"id": 2, "xy": (3.0, 4.0), "mode": "tracking",
                       "flags": ["unmeasurable", "occluded"]}])
-    assert p.read_text().splitlines()[2] == "1,0.1,2,3.0,4.0,,,,tracking,unmeasurable;occluded,,"
+    assert p.read_text().splitlines()[2] == "1,0.1,2,3.0,4.0,,,,tracking,unmeasurable;occluded,,,,,"
     w.close()
     with pytest.raises(ValueError, match="after close"):
         w.write(2, 0.2, [])

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from worldtrack.pose.cost import (BILINEAR, NEAREST_POSITIVE, EigenTemplateCost, SparseTemplate,
+from worldtrack.pose.cost import (BILINEAR, DEPTH_BILINEAR, NEAREST_POSITIVE, EigenTemplateCost, SparseTemplate,
                                   _eigen_epsilon_kernel, project_sample, project_sample_reference)
 from worldtrack.pose.render import Intrinsics, splat, splat_reference
 
@@ -27,7 +27,7 @@ def test_splat_keeps_nearest_point():
     assert r.index[24, 32] == 1 and r.depth[24, 32] == 1.0   # (cx, cy) rounds to pixel (32, 24)
 
 
-@pytest.mark.parametrize("mode", [BILINEAR, NEAREST_POSITIVE])
+@pytest.mark.parametrize("mode", [BILINEAR, NEAREST_POSITIVE, DEPTH_BILINEAR])
 def test_project_sample_matches_reference(mode):
     rng = np.random.default_rng(2)
     images = rng.uniform(0, 255, (2, 48, 64)).astype(np.float32)
@@ -38,12 +38,31 @@ def test_project_sample_matches_reference(mode):
     T[..., 2, 3] = rng.uniform(0.4, 1.0, (7, 2))
     T[..., :2, 3] = rng.normal(0, 0.05, (7, 2, 2))
     T[0, :, 2, 3] = -0.5                                     # candidate behind the camera
-    v1, z1 = project_sample(images, INTR, T, tpl, mode)
-    v2, z2 = project_sample_reference(images, INTR, T, tpl, mode)
+    v1, z1 = project_sample(images, INTR, T, tpl, mode, max_step=60.0)       # some quads smooth, some edges
+    v2, z2 = project_sample_reference(images, INTR, T, tpl, mode, max_step=60.0)
     np.testing.assert_allclose(z1, z2)
     assert np.array_equal(np.isnan(v1), np.isnan(v2))
     np.testing.assert_allclose(np.nan_to_num(v1), np.nan_to_num(v2), rtol=1e-5, atol=1e-3)
     assert np.isnan(v1[0]).all() and np.isfinite(v1[1:]).any()
+
+
+def test_depth_bilinear_is_exact_on_a_plane_and_does_not_mix_across_an_edge():
+    # A slanted plane (depth linear in u) with a step edge to a wall at 3 m: on the plane the
+    # reading is the plane's depth at the sub-pixel position; next to the edge it is the nearest
+    # pixel's, never a mixture of person and wall (which nearest-pixel reading of a 5 mm staircase
+    # and plain bilinear reading across the edge both get wrong).
+    u = np.arange(64, dtype=np.float32)
+    depth = np.broadcast_to(1.0 + 0.002 * u, (48, 64)).copy()
+    depth[:, 40:] = 3.0
+    uv = np.array([[10.3, 20.6], [25.75, 5.25], [39.4, 12.0], [39.6, 12.0]])
+    pts = np.column_stack([(uv[:, 0] - INTR.cx) / INTR.fx, (uv[:, 1] - INTR.cy) / INTR.fy, np.ones(4)])
+    T = np.zeros((1, 1, 3, 4))
+    T[0, 0, :3, :3] = np.eye(3)
+    tpl = SparseTemplate(pts, np.zeros(4, int), np.zeros(4))
+    v = project_sample(depth, INTR, T, tpl, DEPTH_BILINEAR)[0][0, 0]
+    np.testing.assert_allclose(v[:2], 1.0 + 0.002 * uv[:2, 0], rtol=1e-6)
+    np.testing.assert_allclose(v[2:], [1.0 + 0.002 * 39, 3.0], rtol=1e-6)
+    np.testing.assert_array_equal(project_sample_reference(depth, INTR, T, tpl, DEPTH_BILINEAR)[0][0, 0], v)
 
 
 def test_eigen_epsilon_kernel_matches_residuals():
@@ -75,3 +94,25 @@ def test_colour_depth_epsilon_kernel_matches_residuals():
         cost = ColourDepthCost(col, dep, grey, d_img, INTR, lam=lam)
         r = cost.residuals(T)
         np.testing.assert_allclose(cost.epsilon(T), (r * r).sum(1), rtol=1e-9)
+
+
+def test_equal_shares_of_the_template():
+    # The water-filling once let the remainder go negative on the last groups: with 128 points over
+    # the body's 5 parts the right arm (parts 3, 4) got no colour point at all.
+    from worldtrack.pose.render import _by_group, equal_shares
+
+    np.testing.assert_array_equal(equal_shares([99, 77, 47, 58, 35], 128), [26, 26, 26, 25, 25])
+    np.testing.assert_array_equal(equal_shares([3, 77, 10, 58, 2], 128), [3, 57, 10, 56, 2])
+    np.testing.assert_array_equal(equal_shares([3, 4], 128), [3, 4])
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        counts, n = rng.integers(0, 60, rng.integers(1, 7)), int(rng.integers(0, 200))
+        q = equal_shares(counts, n)
+        assert q.sum() == min(n, counts.sum()) and (q >= 0).all() and (q <= counts).all()
+        full = q < counts                                     # groups not exhausted get equal shares ±1
+        assert not full.any() or q[full].max() - q[full].min() <= 1
+        assert not full.any() or q[full].min() >= q[~full].max(initial=0) - 1
+    group = np.repeat(np.arange(5), [99, 77, 47, 58, 35])
+    rc = np.column_stack([np.arange(len(group))] * 2)
+    picked = group[_by_group(rc, rng.random(len(group)), group, 128)[:, 0]]
+    np.testing.assert_array_equal(np.bincount(picked), [26, 26, 26, 25, 25])

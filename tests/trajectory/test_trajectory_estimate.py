@@ -154,3 +154,28 @@ def test_shortest_start_equals_straight_where_nothing_is_in_the_way():
     open_floor = FloorGrid(np.array([-5.0, -5.0]), 0.1, np.full((120, 120), 5.0))
     b = shortest_path_start(case.problem.observations, case.problem.grid, 1.7, open_floor, 0.2)
     np.testing.assert_array_equal(a, b)
+
+
+def test_without_a_wall_near_the_map_there_is_no_race_and_the_same_optimum():
+    """A wall 1.5 m beside the walk: the MAP without the barrier keeps clear of it, so the default
+    estimate only polishes that start, and lands where running every start to convergence does."""
+    from worldtrack.trajectory.environment import field_from_walkable
+    walkable = np.ones((80, 120), dtype=bool)        # x −1…4.95 m, y −2…1.95 m
+    walkable[70:, :] = False                         # a wall from y = 1.5 m
+    case = observed_walk(T=81, noise_px=2.0)
+    field = field_from_walkable(walkable, (-1.0, -2.0), 0.05)
+    raced = estimate_trajectory(case.obs, field, TrajectoryOptions(dt=0.1))
+    every = estimate_trajectory(case.obs, field, TrajectoryOptions(dt=0.1, race_iterations=None))
+    assert set(raced.results) == {"map"} and set(every.results) == {"straight", "map", "shortest"}
+    assert raced.costs["total"] <= min(every.start_objectives.values()) * (1 + 1e-5)
+    np.testing.assert_allclose(raced.positions, every.positions, atol=5e-3)
+    walkable[46:, :] = False                         # the wall at y = 0.3 m: within the barrier's reach
+    near = estimate_trajectory(case.obs, field_from_walkable(walkable, (-1.0, -2.0), 0.05), TrajectoryOptions(dt=0.1))
+    assert set(near.results) == {"straight", "map", "shortest"}
+
+
+def test_without_environment_the_map_is_solved_once_and_is_the_estimate():
+    case = observed_walk(T=81, noise_px=2.0)
+    est = estimate_trajectory(case.obs, None, TrajectoryOptions(dt=0.1))
+    assert est.results["straight"] is est.results["map"]
+    np.testing.assert_array_equal(est.X, est.without_barrier)

@@ -39,3 +39,18 @@ def positive(text: str, flag: str, example: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise InputError(f"{flag}: expected a positive number such as {example}, got {text!r}")
     return value
+
+
+def positive_int(text: str, flag: str, example: str) -> int:
+    """A whole number > 0.
+
+    >>> positive_int("25", "--max-bad-frames", "25")
+    25
+    """
+    try:
+        value = int(text)
+    except (TypeError, ValueError):
+        value = 0
+    if value <= 0:
+        raise InputError(f"{flag}: expected a whole number > 0 such as {example}, got {text!r}")
+    return value

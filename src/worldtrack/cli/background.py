@@ -11,11 +11,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from worldtrack.cli._args import parse_size
 from worldtrack.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 DESCRIPTION = """\
 Estimate the background (the scene without people) from a video in which people walk, when
@@ -37,8 +39,8 @@ methods:
 """
 
 EPILOG = """\
-example (PETS 2009 S2.L1):
-  worldtrack background /work/shared/data/pets2009_s2l1/video/View_001_480x360.avi --out bg.png
+example (PETS 2009 S2.L1, with PETS=path/to/pets2009_s2l1 as in examples/pets2009/README.md):
+  worldtrack background $PETS/video/View_001_480x360.avi --out bg.png
 """
 
 
@@ -80,6 +82,9 @@ def sample_frames(path: str | Path, samples: int, progress: bool = True) -> tupl
     InputError
         No such file, not a video, or no frame can be decoded.
     """
+
+
+    import numpy as np
     import cv2
 
     path = Path(path)

@@ -18,17 +18,24 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
-import yaml
+from typing import TYPE_CHECKING
 
 from worldtrack.cli._args import parse_size, positive
 from worldtrack.errors import InputError
-from worldtrack.geometry.calibrate import ADVISED_POINTS, CalibrationResult, calibrate
-from worldtrack.geometry.camera import Camera
-from worldtrack.io.calibration_formats import UNITS, ImportedCamera, import_camera, read_calibration
 from worldtrack.io.text import is_number, read_text
-from worldtrack.scene.load import camera_to_dict
+
+if TYPE_CHECKING:   # NumPy, and the fitting and import modules load SciPy: imported where they run
+    import numpy as np
+
+    from worldtrack.geometry.calibrate import CalibrationResult
+    from worldtrack.geometry.camera import Camera
+    from worldtrack.io.calibration_formats import ImportedCamera
+
+#: worldtrack.geometry.calibrate.ADVISED_POINTS, repeated here so ``--help`` need not load SciPy
+#: (tests/cli check that the two agree).
+ADVISED_POINTS = 20
+#: Largest points file read (bytes; 100 000 points take about 4 MB).
+MAX_POINTS_FILE_BYTES = 20_000_000
 
 _HEADER = ("X", "Y", "Z", "x", "y")
 _SIZE_COMMENT = re.compile(r"^#\s*image[_ ]?size\s*[:=]\s*(.*)$", re.IGNORECASE)
@@ -112,7 +119,15 @@ def read_points(path: str | Path) -> PointsFile:
     InputError
         Naming the file, the line and what was expected.
     """
+    import numpy as np
+
     label = str(path)
+    try:
+        size = Path(path).stat().st_size
+    except OSError:
+        size = 0                                # read_text names the problem
+    if size > MAX_POINTS_FILE_BYTES:
+        raise InputError(f"{label}: {size:,} bytes; a points file may have at most {MAX_POINTS_FILE_BYTES:,}")
     text = read_text(path, "CSV with header X,Y,Z,x,y", directory="a CSV file")
 
     header_seen = False
@@ -128,7 +143,10 @@ def read_points(path: str | Path) -> PointsFile:
             if m:
                 image_size = parse_size(m.group(1).strip(), f"{label}: line {n}: image_size", "640x480")
             continue
-        cells = _cells(line)
+        try:
+            cells = _cells(line)
+        except csv.Error as e:
+            raise InputError(f"{label}: line {n}: not valid CSV ({e})") from None
         if not header_seen:
             names = [c.lower() for c in cells]
             expected = [h.lower() for h in _HEADER]
@@ -191,6 +209,9 @@ def _m(x: float, nd: int = 3) -> str:
 
 def format_report(result: CalibrationResult, points: PointsFile, label: str) -> str:
     """Everything ``worldtrack calibrate`` prints to standard output."""
+
+
+    import numpy as np
     cam = result.camera
     out = [f"calibrated {cam.id!r} from {result.n_points} points in {label} ({cam.width}x{cam.height} px)", "",
            "camera block (paste under 'cameras:' in a scene file):", camera_block(result).rstrip("\n"), ""]
@@ -234,6 +255,8 @@ def format_report(result: CalibrationResult, points: PointsFile, label: str) -> 
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     if args.import_file is not None:
         if args.points is not None:
             raise InputError(f"give either POINTS.csv ({args.points}) or --import FILE, not both")
@@ -263,12 +286,16 @@ def run(args: argparse.Namespace) -> int:
     intrinsics = _parse_intrinsics(args.intrinsics) if args.intrinsics is not None else None
     radial_terms = _parse_radial_terms(args.radial_terms)
     distortion: bool | int = bool(args.distortion) if radial_terms is None else radial_terms
+    from worldtrack.geometry.calibrate import calibrate
     try:
         result = calibrate(points.world, points.image, size[0], size[1], camera_id=args.id,
                            distortion=distortion, intrinsics=intrinsics,
                            point_names=[f"line {n}" for n in points.lines])
     except InputError as e:
         raise InputError(f"{label}: {e}") from None
+    except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:   # degenerate beyond the checks
+        raise InputError(f"{label}: these points do not determine a camera (the fit failed numerically: "
+                         f"{e}); check for repeated or mistyped points") from None
     result.warnings.extend(extra_warnings)
     print(format_report(result, points, label), end="")
     if not result.success:
@@ -313,6 +340,9 @@ class CheckPoint:
 
 def parse_check(text: str) -> CheckPoint:
     """``X,Y,Z`` or ``X,Y,Z,u,v`` → :class:`CheckPoint`."""
+
+
+    import numpy as np
     parts = [p.strip() for p in text.split(",")]
     try:
         values = [float(p) for p in parts]
@@ -328,6 +358,9 @@ def _parse_scale(text: str | None) -> float | None:
 
 
 def _fmt_uv(uv: np.ndarray) -> str:
+
+
+    import numpy as np
     return "outside the lens model" if not np.all(np.isfinite(uv)) else f"({uv[0]:.2f}, {uv[1]:.2f}) px"
 
 
@@ -347,6 +380,9 @@ def import_command(args: argparse.Namespace) -> str:
 
 def format_import_report(imp: ImportedCamera, checks: list[CheckPoint]) -> str:
     """Everything ``worldtrack calibrate --import`` prints to standard output."""
+
+
+    import numpy as np
     cal, cam, native = imp.source, imp.camera, imp.native
     which = f" camera {cal.camera!r}" if len(cal.cameras) > 1 else ""
     out = [f"imported{which} from {cal.path}: {cal.format_name}, calibrated for "
@@ -397,11 +433,15 @@ def format_import_report(imp: ImportedCamera, checks: list[CheckPoint]) -> str:
 
 def _block(camera: Camera) -> str:
     """A camera as YAML, a one-item list indented to paste under ``cameras:``."""
+    import yaml
+
+    from worldtrack.scene.load import camera_to_dict
     text = yaml.safe_dump([camera_to_dict(camera)], sort_keys=False, default_flow_style=None)
     return "".join("  " + line for line in text.splitlines(keepends=True))
 
 
 def run_import(args: argparse.Namespace) -> int:
+    from worldtrack.io.calibration_formats import UNITS, import_camera, read_calibration
     if args.distortion or args.intrinsics is not None:
         raise InputError("--distortion and --intrinsics fit points; they do not apply with --import")
     radial_terms = _parse_radial_terms(args.radial_terms)
@@ -439,10 +479,12 @@ def run_import(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("calibrate", help="fit a camera to point pairs (CSV) or import a calibration file",
+                              usage="worldtrack calibrate POINTS.csv [options]\n"
+                                    "       worldtrack calibrate --import FILE [options]",
                               description=DESCRIPTION, epilog=EPILOG,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("points", metavar="POINTS.csv", nargs="?",
-                   help="CSV with header X,Y,Z,x,y (metres, pixels)")
+                   help="CSV with header X,Y,Z,x,y (metres, pixels); required unless --import")
     p.add_argument("--image-size", metavar="WxH",
                    help="image size in pixels, e.g. 640x480 (default: the file's '# image_size:' comment); "
                         "with --import: the size of the images you track on (the camera is rescaled)")

@@ -1,7 +1,7 @@
 """``worldtrack eval GT PRED``: score tracks against ground truth on the floor, in metres.
 
 Prints CLEAR-MOT and identity metrics (motmetrics, Euclidean distance on the floor with a gate
-in metres) and the papers' mean position error, |ΔX| and |ΔY|; optionally per-frame counts
+in metres), HOTA (TrackEval, similarity 1 − distance / gate) and the papers' mean position error, |ΔX| and |ΔY|; optionally per-frame counts
 (CSV), a plot (PNG) or the metrics as JSON.
 """
 
@@ -14,20 +14,26 @@ import math
 import re
 import sys
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from worldtrack.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+
+#: Most vertices of an --area polygon.
+MAX_AREA_POINTS = 1000
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "eval", help="score tracks against ground truth (MOTA, MOTP in metres, IDF1, errors)",
+        "eval", help="score tracks against ground truth (MOTA, MOTP in metres, IDF1, HOTA, errors)",
         description="Compare predicted tracks with ground truth frame by frame on the floor. "
                     "GT and PRED are tracks.csv / gt.csv files or MOTChallenge text with world "
                     "x,y,z (columns 8-10). Frames evaluated: every GT frame, plus predicted "
-                    "frames inside the GT frame range (their predictions are false positives).")
+                    "frames inside the GT frame range (their predictions are false positives). "
+                    "HOTA is TrackEval's, with similarity max(0, 1 - distance/gate).")
     p.add_argument("gt", metavar="GT", help="ground-truth tracks (gt.csv, tracks.csv or MOT txt)")
     p.add_argument("pred", metavar="PRED", help="predicted tracks (tracks.csv or MOT txt)")
     p.add_argument("--gate", default="0.5", metavar="METRES",
@@ -58,6 +64,9 @@ def parse_gate(text: str) -> float:
 
 def read_area(text: str) -> np.ndarray:
     """``--area``: a polygon file (numbers x1,y1,x2,y2,…, '#' comments) or the numbers, → (M, 2) m."""
+
+
+    import numpy as np
     path = Path(text)
     if path.is_file():
         try:
@@ -77,13 +86,16 @@ def read_area(text: str) -> np.ndarray:
 
 def parse_area(text: str) -> np.ndarray:
     """``--area x1,y1,x2,y2,…`` → (M, 2) polygon in metres, M ≥ 3."""
+
+
+    import numpy as np
     parts = [s.strip() for s in text.split(",")]
     try:
         values = [float(s) for s in parts]
     except ValueError:
         raise InputError(f"--area: expected numbers x1,y1,x2,y2,... in metres, got {text!r}") from None
-    if len(values) % 2 or len(values) < 6 or not all(math.isfinite(v) for v in values):
-        raise InputError(f"--area: expected x1,y1,x2,y2,... with at least 3 (x, y) points, "
+    if len(values) % 2 or not 6 <= len(values) <= 2 * MAX_AREA_POINTS or not all(math.isfinite(v) for v in values):
+        raise InputError(f"--area: expected x1,y1,x2,y2,... with 3 to {MAX_AREA_POINTS} finite (x, y) points, "
                          f"got {len(values)} numbers")
     return np.asarray(values, dtype=float).reshape(-1, 2)
 
@@ -111,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from worldtrack.viz.eval_plots import plot_evaluation
         plot_evaluation(args.plot, gt_in, pred_in, result.pairs, gate=gate, area=area,
-                        title=f"{args.pred} vs {args.gt}")
+                        title=plot_title(args.pred, args.gt, metrics))
 
     if args.json:
         print(json.dumps({k: _json_value(v) for k, v in metrics.items()}, sort_keys=False))
@@ -132,8 +144,26 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def plot_title(pred: str, gt: str, m: dict[str, Any]) -> str:
+    """A short title: the predictions by folder and name, the ground truth by name, and the scores.
+
+    >>> plot_title("/data/run3/tracks.csv", "/data/gt.csv", {"mota": 0.91, "idf1": 0.85, "gate_m": 0.5})
+    'run3/tracks.csv vs gt.csv: MOTA 0.910, IDF1 0.850 (0.5 m gate)'
+    """
+    def name(path: str) -> str:
+        p = Path(path)
+        return f"{p.parent.name}/{p.name}" if p.parent.name else p.name
+
+    def f3(v: Any) -> str:
+        return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3f}"
+
+    return f"{name(pred)} vs {Path(gt).name}: MOTA {f3(m['mota'])}, IDF1 {f3(m['idf1'])} ({m['gate_m']:g} m gate)"
+
+
 def format_table(m: dict[str, Any]) -> str:
     """The metrics as an aligned two-column table."""
+    from worldtrack.eval.hota import INSTALL_HINT
+
     def f3(v: Any) -> str:
         return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3f}"
 
@@ -155,8 +185,8 @@ def format_table(m: dict[str, Any]) -> str:
         ("misses", str(m["num_misses"])),
         ("matches / GT objects / predictions",
          f"{m['num_matches']} / {m['num_objects']} / {m['num_predictions']}"),
-        ("HOTA", "n/a (not available, see worldtrack.eval.mot)" if m["hota"] is None
-         else f3(m["hota"])),
+        ("HOTA (DetA / AssA / LocA)", f"n/a (TrackEval not installed: {INSTALL_HINT})" if m["hota"] is None
+         else f"{f3(m['hota'])} ({f3(m['hota_deta'])} / {f3(m['hota_assa'])} / {f3(m['hota_loca'])})"),
         ("mean error", metres(m["mean_error_m"])),
         ("mean |dX|", metres(m["mean_abs_dx_m"])),
         ("mean |dY|", metres(m["mean_abs_dy_m"])),
@@ -166,6 +196,9 @@ def format_table(m: dict[str, Any]) -> str:
 
 
 def _within(frames: np.ndarray, gt_frames: np.ndarray) -> np.ndarray:
+
+
+    import numpy as np
     return (frames >= gt_frames.min()) & (frames <= gt_frames.max())
 
 
@@ -188,6 +221,9 @@ def _write_per_frame(path: str, per_frame: dict[str, np.ndarray]) -> None:
 
 
 def _json_value(v: Any) -> Any:
+
+
+    import numpy as np
     if v is None or isinstance(v, (bool, str)):
         return v
     if isinstance(v, (int, np.integer)):

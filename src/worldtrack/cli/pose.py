@@ -1,4 +1,4 @@
-"""``worldtrack pose track``: track the 6-DoF pose of a face or a rigid object (seed 003).
+"""``worldtrack pose track``: track the 6-DoF pose of a face or a rigid object (paper 003).
 
     worldtrack pose track --model face|upper-body|MODEL.obj --rgb DIR [--depth DIR] \\
         --camera K.yaml --init POSE --out DIR
@@ -34,8 +34,8 @@ COLUMNS = ["frame", "time", "id", "tx", "ty", "tz", "qw", "qx", "qy", "qz", "rz_
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("pose", help="track the pose of a face, an upper body or a rigid object (seed 003)",
-                       description="Pose tracking by particle filter + Levenberg-Marquardt (seed 003).")
+    p = sub.add_parser("pose", help="track the pose of a face, an upper body or a rigid object (paper 003)",
+                       description="Pose tracking by particle filter + Levenberg-Marquardt (paper 003).")
     verbs = p.add_subparsers(dest="pose_command", metavar="<verb>")
     t = verbs.add_parser("track", help="track a model through a folder of frames",
                          description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "))

@@ -3,11 +3,7 @@
 from __future__ import annotations
 
 import argparse
-
-import numpy as np
-
-from worldtrack.scene import load_scene
-from worldtrack.scene.model import Box
+import sys
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,7 +20,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run_check(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from worldtrack.scene import load_scene
+    from worldtrack.scene.model import Box
+
     scene = load_scene(args.scene)
+    for line in scene.warnings:
+        print(f"warning: {line}", file=sys.stderr)
     print(f"scene {scene.name!r} ({args.scene}): valid")
     print(f"cameras: {len(scene.cameras)}")
     bounds = scene.walkable.bounds
@@ -57,7 +60,12 @@ def run_check(args: argparse.Namespace) -> int:
 
 def _seen_floor_area(scene, cam, resolution: float = 0.05) -> float:
     """Area (m²) of walkable floor whose Z = 0 point falls inside the camera's image."""
+    import numpy as np
+
+    from worldtrack.scene.floor import grid_resolution
+
     x0, x1, y0, y1 = scene.walkable.bounds
+    resolution = grid_resolution(scene.walkable.bounds, resolution, max_cells=1_000_000)
     xs = np.arange(x0, x1, resolution) + resolution / 2
     ys = np.arange(y0, y1, resolution) + resolution / 2
     gx, gy = np.meshgrid(xs, ys)

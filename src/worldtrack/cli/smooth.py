@@ -1,5 +1,5 @@
 """``worldtrack smooth SCENE OBSERVATIONS… --out DIR``: head trajectories across cameras that do not
-share views, by MAP estimation with the scene as environment model (seed 002)."""
+share views, by MAP estimation with the scene as environment model (paper 002)."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from worldtrack.trajectory.starts import START_NAMES
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "smooth", help="estimate head trajectories across cameras that do not share views (seed 002)",
+        "smooth", help="estimate head trajectories across cameras that do not share views (paper 002)",
         description="MAP estimate of each person's head trajectory from head pixels in cameras that need not "
                     "share views: a constant-velocity motion prior, the scene's walls and obstacles (people keep "
                     "clear of them) and the person's head height. Writes DIR/trajectory.csv (id,t,x,y,z,vx,vy,vz,"

@@ -12,20 +12,22 @@ from worldtrack.errors import InputError
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "synth", help="render a synthetic multi-camera sequence with exact ground truth",
+        usage="worldtrack synth SCENARIO --out DIR [options]\n       worldtrack synth --list",
         description="Render a built-in scenario (people walking in a calibrated room) to video or PNG "
                     "frames, with depth/disparity where the sensor has them, gt.csv, frames.csv and "
                     "scene.yaml. Same seed, same files. `worldtrack synth --list` shows the scenarios.")
-    p.add_argument("scenario", nargs="?", help="scenario name (see --list)")
-    p.add_argument("--out", help="output folder (created)")
+    p.add_argument("scenario", nargs="?", metavar="SCENARIO", help="scenario name (see --list; required unless --list)")
+    p.add_argument("--out", metavar="DIR", help="output folder, created (required unless --list)")
     p.add_argument("--frames", type=int, help="number of frames (default: the scenario's length)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--size", help="image size WIDTHxHEIGHT, e.g. 640x480 (default: the scenario's)")
+    p.add_argument("--size", metavar="WxH", help="image size in pixels, e.g. 640x480 (default: the scenario's)")
     p.add_argument("--png", action="store_true", help="write lossless PNG frames instead of MP4 video")
     p.add_argument("--instances", action="store_true", help="also write 16-bit person-id images")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
                    help="scenario parameter, e.g. --set people=20 --set camera=both (repeatable)")
     p.add_argument("--list", action="store_true", help="list the scenarios and their parameters, then exit")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-progress", action="store_true", dest="quiet", help=argparse.SUPPRESS)  # the former name
     p.set_defaults(func=run)
 
 
@@ -65,6 +67,6 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--out: expected an output folder")
     scenario = make_scenario(args.scenario, size=args.size, frames=args.frames, seed=args.seed,
                              **_parse_overrides(args.overrides))
-    out = write_sequence(scenario, args.out, png=args.png, progress=not args.no_progress, instances=args.instances)
+    out = write_sequence(scenario, args.out, png=args.png, progress=not args.quiet, instances=args.instances)
     print(f"wrote {scenario.n_frames} frames of {scenario.name!r} from {len(scenario.camera_ids)} camera(s) to {out}")
     return 0

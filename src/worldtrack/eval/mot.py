@@ -22,10 +22,9 @@ before this filter, so a frame whose people are all outside still counts as a fr
 
 HOTA
 ----
-Not computed (``hota`` is ``None``): motmetrics 1.4.0 has no HOTA, and ``trackeval`` 1.3.0
-from PyPI, although it runs with NumPy 2, requires ``opencv-python`` (a second OpenCV next to
-our ``opencv-python-headless``; both own the ``cv2`` package) and ``pycocotools``. HOTA is not
-re-implemented here.
+``hota`` (and its parts ``hota_deta``, ``hota_assa``, ``hota_loca``) is TrackEval's HOTA on the
+same rows and frames, with the similarity ``max(0, 1 − d / gate)`` (:mod:`worldtrack.eval.hota`);
+None when TrackEval is not installed. MOTA and IDF1 do not depend on it.
 
 Note: ``motmetrics.distances.norm2squared_matrix`` returns *squared* distances (its ``max_d2``
 is a squared gate) and, in motmetrics 1.4.0, calls ``np.asfarray``, which NumPy 2 removed; we
@@ -42,11 +41,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
+from worldtrack.eval.hota import evaluate_hota
 from worldtrack.io.tracks import TrackTable
 from worldtrack.scene.floor import points_in_polygon
 
 #: The default gate: a prediction more than this many metres from a person cannot match them.
 DEFAULT_GATE_M = 0.5
+#: Most rows (people) one frame of either table may hold: the frame's distance matrix and its
+#: assignment grow with the square and the cube of it.
+MAX_PER_FRAME = 2000
 
 #: motmetrics metric names computed by :func:`summarize`.
 MOTMETRICS_NAMES: tuple[str, ...] = (
@@ -207,6 +210,8 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         raise InputError(f"{gt.source or 'ground truth'}: no rows to evaluate against")
     gt, pred = gt.sorted(), pred.sorted()
     frames = evaluated_frames(gt, pred)
+    for table in (gt, pred):
+        _check_per_frame(table)
     if area is not None:
         ring = _check_area(area)
         gt = gt.select(inside_area(gt, ring))
@@ -228,9 +233,9 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         "num_matches": m["num_detections"],  # matches including those with an id switch
         "num_unique_objects": m["num_unique_objects"],
         "num_frames": m["num_frames"],
-        "hota": None,  # see the module docstring
         "gate_m": float(gate),
     }
+    metrics.update(hota_metrics(gt, pred, gate, frames))
 
     ev = acc.mot_events
     ev_frame = ev.index.get_level_values("FrameId").to_numpy(dtype=np.int64)
@@ -284,8 +289,9 @@ def evaluate(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GATE_M,
         ``num_switches, num_fragmentations``; ``precision, recall``; ``mostly_tracked,
         partially_tracked, mostly_lost``; ``num_false_positives, num_misses, num_objects``
         (ground-truth rows), ``num_predictions``, ``num_matches`` (switches included),
-        ``num_unique_objects``, ``num_frames``; ``hota`` (always ``None``, see the module
-        docstring) and ``gate_m``. Ratios are NaN where undefined (e.g. no ground truth
+        ``num_unique_objects``, ``num_frames``; ``gate_m``; ``hota, hota_deta, hota_assa,
+        hota_loca`` (TrackEval's HOTA, similarity ``1 − d / gate``; None without TrackEval).
+        Ratios are NaN where undefined (e.g. no ground truth
         inside ``area``).
 
     Raises
@@ -302,10 +308,30 @@ def evaluate(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GATE_M,
     return evaluate_detailed(gt, pred, gate=gate, area=area).metrics
 
 
+def hota_metrics(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray) -> dict[str, float | None]:
+    """``hota, hota_deta, hota_assa, hota_loca`` of the compared rows (None without TrackEval)."""
+    h = evaluate_hota(gt, pred, gate, frames)
+    if h is None:
+        return dict.fromkeys(("hota", "hota_deta", "hota_assa", "hota_loca"))
+    return {"hota": h.hota, "hota_deta": h.deta, "hota_assa": h.assa, "hota_loca": h.loca}
+
+
 def _count_per_frame(row_frames: np.ndarray, frames: np.ndarray) -> np.ndarray:
     """How many of the sorted ``row_frames`` fall on each of ``frames``."""
     lo, hi = _frame_bounds(row_frames, frames)
     return (hi - lo).astype(np.int64)
+
+
+def _check_per_frame(table: TrackTable) -> None:
+    """:class:`InputError` if a frame of the sorted ``table`` holds more than :data:`MAX_PER_FRAME` rows."""
+    if len(table) <= MAX_PER_FRAME:
+        return
+    starts = np.flatnonzero(np.r_[True, np.diff(table.frame) != 0])
+    counts = np.diff(np.r_[starts, len(table)])
+    k = int(np.argmax(counts))
+    if counts[k] > MAX_PER_FRAME:
+        raise InputError(f"{table.source or 'tracks'}: frame {table.frame[starts[k]]} has {counts[k]:,} rows; "
+                         f"at most {MAX_PER_FRAME:,} people per frame are evaluated")
 
 
 def _check_area(area: ArrayLike) -> np.ndarray:

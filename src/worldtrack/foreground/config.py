@@ -28,7 +28,7 @@ class ForegroundConfig(Section):
         "colour", description="grey difference (paper 000), colour difference, or OpenCV's adaptive mog2/knn")
     threshold: float | None = Field(
         None, gt=0, allow_inf_nan=False,
-        description="difference threshold of grey/colour: grey levels or RGB distance (null: 25 grey, 30 colour)")
+        description="difference threshold of grey/colour: grey levels or RGB distance (null: the method's own, 25 for the particle tracker, else 25 grey, 30 colour)")
     shadows: bool | None = Field(
         None, description="set cast shadows apart as unsure (null: on except for grey, the paper's)")
     shadow_texture_ncc: float | None = Field(

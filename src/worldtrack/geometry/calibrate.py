@@ -37,6 +37,14 @@ MIN_POINTS = 6
 """A 3×4 camera has 11 degrees of freedom and each point gives 2 equations."""
 
 ADVISED_POINTS = 20
+#: Most point pairs a calibration takes (its refinement's Jacobian grows with the count).
+MAX_POINTS = 100_000
+#: World coordinates beyond ± this many metres are refused; a point cloud wider than
+#: MM_SUSPECT_M is warned about (millimetres given as metres).
+MAX_WORLD_M = 10_000.0
+MM_SUSPECT_M = 100.0
+#: Pixel coordinates beyond ± this are refused.
+MAX_PIXEL = 1_000_000.0
 """The paper (§2.1.4) asks for at least 20 points."""
 
 PLANE_TOLERANCE = 1e-3
@@ -129,6 +137,15 @@ def _check_pairs(world: ArrayLike, image: ArrayLike,
         i = int(np.flatnonzero(bad.any(axis=1))[0])
         cols = ", ".join(f"{c} = {pairs[i, k]}" for k, c in enumerate(_COLUMNS) if bad[i, k])
         raise InputError(f"{label[i]}: expected finite numbers, got {cols}")
+    for what, A, limit, unit in (("world", W, MAX_WORLD_M, "m"), ("image", I, MAX_PIXEL, "px")):
+        far = np.abs(A) > limit
+        if far.any():
+            i = int(np.flatnonzero(far.any(axis=1))[0])
+            hint = " (world coordinates are metres: were they millimetres?)" if what == "world" else ""
+            raise InputError(f"{label[i]}: expected {what} coordinates within ±{limit:g} {unit}, got "
+                             f"{np.abs(A[i]).max():.4g}{hint}")
+    if len(W) > MAX_POINTS:
+        raise InputError(f"expected at most {MAX_POINTS:,} points, got {len(W):,}")
     if len(W) < MIN_POINTS:
         raise InputError(f"expected at least {MIN_POINTS} points (the paper advises ≥ {ADVISED_POINTS}), "
                          f"got {len(W)}")
@@ -152,7 +169,7 @@ def _spread(points: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray]:
     """Centroid, largest distance from the best-fit line and plane, and the principal axes (rows)."""
     c = points.mean(axis=0)
     d = points - c
-    _, _, Vt = np.linalg.svd(d, full_matrices=True)
+    _, _, Vt = np.linalg.svd(d, full_matrices=False)     # (k, k) axes; U is (N, k): memory linear in N
     along = d @ Vt[0]
     off_line = float(np.max(np.linalg.norm(d - along[:, None] * Vt[0], axis=1)))
     off_plane = float(np.max(np.abs(d @ Vt[-1]))) if points.shape[1] == 3 else 0.0
@@ -286,7 +303,7 @@ def _normalised_dlt(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
     A[0::2, 2 * k:] = d[:, 1:2] * s
     A[1::2, :k] = d[:, 2:3] * s
     A[1::2, 2 * k:] = -d[:, 0:1] * s
-    _, _, Vt = np.linalg.svd(A)
+    _, _, Vt = np.linalg.svd(A, full_matrices=False)      # U (2N, k), not (2N, 2N): memory linear in N
     return np.linalg.solve(Td, Vt[-1].reshape(3, k) @ Ts)
 
 
@@ -522,6 +539,10 @@ def calibrate(world: ArrayLike, image: ArrayLike, width: int, height: int, *, ca
     floor = floor_backprojection_errors(camera, W[on_floor], I[on_floor])
     in_centre, centre, edge = _centre_edge(camera, I[on_floor], floor)
 
+    extent = float(np.ptp(W, axis=0).max())
+    if extent > MM_SUSPECT_M:
+        warnings.append(f"the world points span {extent:.0f} m: worldtrack expects metres; if they are "
+                        "millimetres, divide them by 1000 (a fit in millimetres gives floor errors in millimetres)")
     if camera.centre[2] <= 0:
         warnings.append(f"the camera centre is at Z = {camera.centre[2]:.3f} m, not above the floor: "
                         "expected world Z up with the floor at Z = 0")

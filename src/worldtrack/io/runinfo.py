@@ -12,7 +12,7 @@ import shlex
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import yaml
 
@@ -38,6 +38,34 @@ def file_digest(path: str | Path) -> str | None:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
     except OSError:
         return None
+
+
+#: Files a run writes into its output folder (patterns): what ``--overwrite`` replaces.
+RUN_OUTPUTS = ("run.yaml", "tracks.csv", "floorplan.png", "*_annotated.mp4")
+
+
+def prepare_output(out_dir: Path, overwrite: bool, extra: Sequence[str | Path] = ()) -> list[Path]:
+    """Make sure ``out_dir`` may take a new run's outputs; returns the files removed.
+
+    A folder holding a previous run's outputs (:data:`RUN_OUTPUTS`) is refused with an
+    :class:`InputError` unless ``overwrite``, which removes those files (and ``extra`` ones, e.g.
+    the ``--mot`` file), so no stale video or plan is left beside the new tracks. Other files in
+    the folder (the user's own) are never touched.
+    """
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"--out {out_dir}: is a file, expected a folder")
+    old = sorted({p for pattern in RUN_OUTPUTS for p in out_dir.glob(pattern)}) if out_dir.is_dir() else []
+    old += [Path(e) for e in extra if Path(e).is_file()]
+    if old and not overwrite:
+        names = ", ".join(p.name for p in old[:4]) + (", …" if len(old) > 4 else "")
+        raise InputError(f"--out {out_dir}: holds the outputs of a previous run ({names}); give a new "
+                         "folder, or --overwrite to replace them")
+    for p in old:
+        try:
+            p.unlink()
+        except OSError as e:
+            raise InputError(f"{p}: cannot remove ({e.strerror})") from None
+    return old
 
 
 def write_run_info(out_dir: Path, config: Mapping[str, Any], inputs: Mapping[str, Any],
@@ -81,4 +109,4 @@ def _plain(value: Any) -> Any:
     return value
 
 
-__all__ = ["file_digest", "source_commit", "write_run_info"]
+__all__ = ["RUN_OUTPUTS", "file_digest", "prepare_output", "source_commit", "write_run_info"]

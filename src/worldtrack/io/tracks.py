@@ -4,12 +4,13 @@ Two headered CSV formats that open in a spreadsheet, plus MOTChallenge text for 
 
 ``tracks.csv`` (tracker output), one row per person per frame::
 
-    frame,time,id,x,y,height,width,score,mode,flags[,extra…]
+    frame,time,id,x,y,height,width,score,mode,flags,vx,vy,speed[,extra…]
 
-``frame`` counts from 0, ``time`` is seconds, ``id`` is an integer from 1, ``x, y, height,
-width`` are metres, ``mode`` is a word (``capture``, ``tracking``…) and ``flags`` is a
-``;``-separated list of words (``unmeasurable``), possibly empty. Trackers may append columns
-(``sx,sy,sz`` box sizes…); readers keep them.
+``frame`` counts from 0, ``time`` is seconds (to the microsecond), ``id`` is an integer from 1,
+``x, y, height, width`` are metres, ``vx, vy, speed`` metres per second, ``mode`` is a word
+(``capture``, ``tracking``…) and ``flags`` is a ``;``-separated list of words
+(``unmeasurable``), possibly empty. Trackers may append columns (``sigma``, the 1-σ position
+uncertainty in metres; ``sx,sy,sz`` box sizes…); readers keep them.
 
 ``gt.csv`` (ground truth from the synthetic-world renderer)::
 
@@ -31,9 +32,7 @@ from __future__ import annotations
 
 import csv
 import enum
-import io
 import math
-import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,23 +42,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
-from worldtrack.io.text import is_number
 
 #: Columns of ``tracks.csv``, in order; trackers may append more.
 TRACK_COLUMNS: tuple[str, ...] = ("frame", "time", "id", "x", "y", "height", "width", "score",
-                                  "mode", "flags")
+                                  "mode", "flags", "vx", "vy", "speed")
 #: Columns of a MOTChallenge text file (1-based frames and ids, ``-1`` = unknown).
 MOT_COLUMNS: tuple[str, ...] = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height",
                                 "conf", "x", "y", "z")
 
 _CORE = ("frame", "time", "id", "x", "y")
-_REQUIRED = ("frame", "id", "x", "y")
-# Extra columns that must be numbers (empty cells read as NaN) and ones that are always text.
-_FLOAT_COLUMNS = frozenset({"height", "width", "score", "z_head", "speed", "sx", "sy", "sz",
-                            "bb_left", "bb_top", "bb_width", "bb_height", "conf", "z"})
-_FLOAT_PREFIXES = ("vis_", "head_", "feet_")
-_TEXT_COLUMNS = frozenset({"mode", "flags"})
-_SPLIT_MOT = re.compile(r"[,\s]+")
 
 
 # --------------------------------------------------------------------------------------------
@@ -164,213 +155,6 @@ class TrackTable:
 
 
 # --------------------------------------------------------------------------------------------
-# Reading
-# --------------------------------------------------------------------------------------------
-
-def read_tracks(path: str | Path) -> TrackTable:
-    """Read ``tracks.csv``, ``gt.csv`` or MOTChallenge text into a :class:`TrackTable`.
-
-    A headered CSV needs at least ``frame, id, x, y``; ``time`` is optional (NaN if absent) and
-    every other column is kept in ``extra``. A file without a header whose first line has at
-    least ten numbers is read as MOTChallenge (frames made 0-based; world ``x, y`` from columns
-    8–9, ``z`` and the box kept as extras).
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    TrackTable
-        Sorted by frame, then id.
-
-    Raises
-    ------
-    InputError
-        One line naming the file and, where it applies, the line and column: a missing file,
-        an empty file, missing columns, a cell that is not a number, a row with the wrong number
-        of fields, a negative frame, an id below 1, or two rows for the same (frame, id).
-    """
-    name = str(path)
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as f:
-            text = f.read()
-    except FileNotFoundError:
-        raise InputError(f"{name}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{name}: is a directory, expected a track file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{name}: not a text file (expected UTF-8 CSV)") from None
-    except OSError as e:
-        raise InputError(f"{name}: cannot read: {e.strerror or e}") from None
-
-    first = next((line for line in text.splitlines() if line.strip()), None)
-    if first is None:
-        raise InputError(f"{name}: empty file")
-    tokens = [t for t in _SPLIT_MOT.split(first.strip()) if t]
-    if all(is_number(t) for t in tokens):
-        if len(tokens) < len(MOT_COLUMNS):
-            raise InputError(f"{name}: line 1: no header and only {len(tokens)} numeric columns; "
-                             f"expected a CSV header (frame,id,x,y,…) or MOTChallenge text with "
-                             f"{len(MOT_COLUMNS)} columns")
-        return _read_mot(text, name)
-    return _read_csv(text, name)
-
-
-def _read_csv(text: str, name: str) -> TrackTable:
-    reader = csv.reader(io.StringIO(text))
-    header: list[str] | None = None
-    cells: list[list[str]] = []
-    lines: list[int] = []
-    for record in reader:
-        if not any(c.strip() for c in record):
-            continue
-        if header is None:
-            header = [c.strip() for c in record]
-            if "" in header:
-                raise InputError(f"{name}: line {reader.line_num}: empty column name in header")
-            dup = sorted({c for c in header if header.count(c) > 1})
-            if dup:
-                raise InputError(f"{name}: line {reader.line_num}: repeated columns: {', '.join(dup)}")
-            missing = [c for c in _REQUIRED if c not in header]
-            if missing:
-                hint = ""
-                if len(header) == 1 and any(sep in header[0] for sep in ";\t"):
-                    hint = " (the header is one column: columns must be separated by commas)"
-                raise InputError(f"{name}: missing columns: {', '.join(missing)}{hint}")
-            continue
-        if len(record) != len(header):
-            raise InputError(f"{name}: line {reader.line_num}: expected {len(header)} fields "
-                             f"({','.join(header)}), got {len(record)}")
-        cells.append([c.strip() for c in record])
-        lines.append(reader.line_num)
-    assert header is not None  # the caller saw a non-blank first line
-    line_no = np.asarray(lines, dtype=np.int64)
-    cols = list(zip(*cells)) if cells else [() for _ in header]
-    raw = {h: np.asarray(c, dtype=str) for h, c in zip(header, cols)}
-
-    frame = _integers(raw["frame"], "frame", line_no, name, minimum=0)
-    ids = _integers(raw["id"], "id", line_no, name, minimum=1)
-    x = _floats(raw["x"], "x", line_no, name, allow_empty=False)
-    y = _floats(raw["y"], "y", line_no, name, allow_empty=False)
-    if "time" in raw:
-        time = _floats(raw["time"], "time", line_no, name, allow_empty=True, finite=False)
-    else:
-        time = np.full(len(cells), np.nan)
-    extra: dict[str, np.ndarray] = {}
-    for h in header:
-        if h in _CORE:
-            continue
-        if h in _TEXT_COLUMNS:
-            extra[h] = raw[h]
-        elif h in _FLOAT_COLUMNS or h.startswith(_FLOAT_PREFIXES):
-            extra[h] = _floats(raw[h], h, line_no, name, allow_empty=True, finite=False)
-        else:
-            extra[h] = _guess(raw[h])
-    return _finish(TrackTable(frame=frame, time=time, id=ids, x=x, y=y, extra=extra, source=name),
-                   line_no)
-
-
-def _read_mot(text: str, name: str) -> TrackTable:
-    rows: list[list[str]] = []
-    lines: list[int] = []
-    width = None
-    for i, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        tokens = [t for t in _SPLIT_MOT.split(line.strip()) if t]
-        if width is None:
-            width = len(tokens)
-        elif len(tokens) != width:
-            raise InputError(f"{name}: line {i}: expected {width} fields (MOTChallenge), "
-                             f"got {len(tokens)}")
-        rows.append(tokens)
-        lines.append(i)
-    assert width is not None
-    line_no = np.asarray(lines, dtype=np.int64)
-    names = list(MOT_COLUMNS) + [f"col_{k + 1}" for k in range(len(MOT_COLUMNS), width)]
-    raw = np.asarray(rows, dtype=str)
-    col = {n: raw[:, k] for k, n in enumerate(names)}
-
-    frame = _integers(col["frame"], "frame", line_no, name, minimum=1) - 1
-    ids = _integers(col["id"], "id", line_no, name, minimum=1)
-    x = _floats(col["x"], "x", line_no, name, allow_empty=False)
-    y = _floats(col["y"], "y", line_no, name, allow_empty=False)
-    extra = {n: _floats(col[n], n, line_no, name, allow_empty=False, finite=False)
-             for n in names if n not in ("frame", "id", "x", "y")}
-    if np.all(x == -1) and np.all(y == -1) and np.all(extra["z"] == -1):
-        raise InputError(f"{name}: MOTChallenge file without world coordinates (columns 8-10, "
-                         f"x,y,z, are all -1); worldtrack evaluates positions in metres")
-    return _finish(TrackTable(frame=frame, time=np.full(len(rows), np.nan), id=ids, x=x, y=y,
-                              extra=extra, source=name), line_no)
-
-
-def _finish(table: TrackTable, line_no: np.ndarray) -> TrackTable:
-    """Sort by (frame, id) and reject duplicate rows, naming both lines."""
-    order = np.lexsort((table.id, table.frame))
-    table = table.select(order)
-    line_no = line_no[order]
-    same = (np.diff(table.frame) == 0) & (np.diff(table.id) == 0)
-    if np.any(same):
-        k = int(np.flatnonzero(same)[0])
-        a, b = sorted((int(line_no[k]), int(line_no[k + 1])))
-        raise InputError(f"{table.source}: line {b}: duplicate row for frame {table.frame[k]}, "
-                         f"id {table.id[k]} (first at line {a})")
-    return table
-
-
-def _floats(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
-            allow_empty: bool, finite: bool = True) -> np.ndarray:
-    """Parse a column of strings to float64; the first bad cell raises with its line number."""
-    vals = np.where(values == "", "nan", values) if allow_empty else values
-    try:
-        out = vals.astype(float) if vals.size else np.zeros(0)
-    except ValueError:
-        out = None
-    bad = np.zeros(values.shape, bool)
-    if out is None:
-        bad = np.array([not is_number(v) for v in vals], dtype=bool)
-        if not np.any(bad):  # text NumPy refuses but Python's float() accepts ("1_000")
-            out = np.array([float(v) for v in vals])
-    if finite and out is not None:
-        bad = ~np.isfinite(out)
-    if np.any(bad):
-        k = int(np.flatnonzero(bad)[0])
-        what = "a number" if out is None else "a finite number"
-        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected {what}, "
-                         f"got {str(values[k])!r}")
-    assert out is not None
-    return out
-
-
-def _integers(values: np.ndarray, column: str, line_no: np.ndarray, name: str, *,
-              minimum: int) -> np.ndarray:
-    out = _floats(values, column, line_no, name, allow_empty=False)
-    bad = out != np.round(out)
-    if np.any(bad):
-        k = int(np.flatnonzero(bad)[0])
-        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected an integer, "
-                         f"got {str(values[k])!r}")
-    low = out < minimum
-    if np.any(low):
-        k = int(np.flatnonzero(low)[0])
-        raise InputError(f"{name}: line {line_no[k]}, column {column}: expected an integer "
-                         f">= {minimum}, got {str(values[k])!r}")
-    return out.astype(np.int64)
-
-
-def _guess(values: np.ndarray) -> np.ndarray:
-    """An unknown extra column: float64 if every non-empty cell is a number, else text."""
-    filled = values != ""
-    if not np.any(filled):
-        return values
-    try:
-        return np.where(filled, values, "nan").astype(float)
-    except ValueError:
-        return values
-
-
-# --------------------------------------------------------------------------------------------
 # Writing
 # --------------------------------------------------------------------------------------------
 
@@ -455,11 +239,11 @@ class TracksWriter:
         ----------
         frame : int
             Frame index from 0.
-        time : float, seconds
+        time : float, seconds (written rounded to the microsecond)
         tracks : iterable of objects or mappings
             Each has ``id`` (int ≥ 1) and ``x, y`` (metres) — or ``xy``/``position`` (2+,) —
             and optionally ``height, width`` (metres), ``score``, ``mode`` (str or Enum),
-            ``flags`` (str or iterable of str) and the extra columns.
+            ``flags`` (str or iterable of str), ``vx, vy, speed`` (m/s) and the extra columns.
         """
         if self._file is None:
             raise ValueError(f"TracksWriter({self.path}): write after close")
@@ -478,10 +262,11 @@ class TracksWriter:
                     xy = _get(t, "position")
                 x, y = xy[0], xy[1]
             flags = _get(t, "flags", "")
-            row = [str(frame), _fmt_float(time), str(tid), _fmt_float(x), _fmt_float(y),
+            row = [str(frame), _fmt_float(round(float(time), 6)), str(tid), _fmt_float(x), _fmt_float(y),
                    _fmt_float(_get(t, "height")), _fmt_float(_get(t, "width")),
                    _fmt_float(_get(t, "score")), _fmt_cell(_get(t, "mode", "")),
-                   flags if isinstance(flags, str) else ";".join(map(str, flags))]
+                   flags if isinstance(flags, str) else ";".join(map(str, flags)),
+                   _fmt_float(_get(t, "vx")), _fmt_float(_get(t, "vy")), _fmt_float(_get(t, "speed"))]
             row += [_fmt_cell(_get(t, c)) for c in self.extra_columns]
             rows.append(row)
         self._csv.writerows(rows)
@@ -538,3 +323,50 @@ def write_mot(path: str | Path, table: TrackTable) -> None:
         for k in range(n):
             f.write(",".join([str(int(t.frame[k]) + 1), str(int(t.id[k]))]
                              + [_fmt_float(c[k]) for c in cols]) + "\n")
+
+
+class MotWriter:
+    """Stream MOTChallenge rows as a tracker runs: ``frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z``.
+
+    Frames are written 1-based, the box in pixels with the MOTChallenge convention of 1-based
+    pixel coordinates (``bb_left = u_min + 1``), ``-1`` when the person is not in front of the
+    camera; ``x, y, z`` are world metres. Every :meth:`write` is flushed.
+
+    Examples
+    --------
+    >>> with MotWriter("tracks_mot.txt") as out:                     # doctest: +SKIP
+    ...     out.write(0, [(1, (100.0, 50.0, 40.0, 120.0), 0.9, 1.2, 0.4, 0.0)])
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self._file: TextIO | None = _open_for_writing(self.path)
+
+    def write(self, frame: int, rows: Iterable[tuple[int, Sequence[float] | None, float, float, float, float]]) -> None:
+        """Append this frame's rows: ``(id, box, conf, x, y, z)`` with ``box = (u_min, v_min, width,
+        height)`` in 0-based pixels or None."""
+        if self._file is None:
+            raise ValueError(f"MotWriter({self.path}): write after close")
+        lines = []
+        for tid, box, conf, x, y, z in rows:
+            b = ["-1"] * 4 if box is None else [_fmt_float(round(box[0] + 1, 2)), _fmt_float(round(box[1] + 1, 2)),
+                                                _fmt_float(round(box[2], 2)), _fmt_float(round(box[3], 2))]
+            lines.append(",".join([str(int(frame) + 1), str(int(tid)), *b, _fmt_float(round(float(conf), 4)),
+                                   _fmt_float(round(x, 4)), _fmt_float(round(y, 4)), _fmt_float(round(z, 4))]))
+        self._file.write("".join(line + "\n" for line in lines))
+        self._file.flush()
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> "MotWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# Reading lives in worldtrack.io.track_reader (imported here, after TrackTable, for the old name).
+from worldtrack.io.track_reader import read_tracks  # noqa: E402

@@ -27,7 +27,7 @@ import numpy as np
 
 from worldtrack.geometry.rotation import euler_zyx, rot_y, rot_z
 from worldtrack.pose.body import LEFT_ARM, RIGHT_ARM, TORSO, BodyModel, BodySpace, SubSpace, stacked_points
-from worldtrack.pose.cost import ColourDepthCost, SparseTemplate
+from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, SparseTemplate
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics, sparse_template_pixels
@@ -40,7 +40,8 @@ class BodyConfig:
 
     sigma_mm : first-stage σ of the torso's tx, ty, tz (mm); sigma_deg : of θ, φ, ψ, then each
     arm's shoulder (θs, φs) and elbow (θe, φe), degrees; pf : "cascade" (torso → right arm → left
-    arm, the paper's) or "joint" (all 14 at once)
+    arm, the paper's) or "joint" (all 14 at once); depth_sampling : "bilinear" (on one surface) or
+    "nearest" pixel (see :class:`~worldtrack.pose.cost.ColourDepthCost`)
     """
 
     stages: int = 1
@@ -57,6 +58,7 @@ class BodyConfig:
     camera_blur_px: float = 0.6
     pf: str = "cascade"
     elbow_limit_deg: float | None = 150.0
+    depth_sampling: str = "bilinear"
     seed: int = 0
 
 
@@ -135,7 +137,8 @@ class BodyTracker:
         order = np.argsort(self.part[tp.colour], kind="stable")
         colour = SparseTemplate(self.local[ci], self.part[ci], tp.value[order])
         dtemp = SparseTemplate(self.local[di], self.part[di], xyz[di, 2])
-        return ColourDepthCost(colour, dtemp, grey, depth, self.intr, None, cfg.c_depth_mm / 1000, cfg.lam)
+        return ColourDepthCost(colour, dtemp, grey, depth, self.intr, None, cfg.c_depth_mm / 1000, cfg.lam,
+                               DEPTH_SAMPLING[cfg.depth_sampling])
 
     def _pf(self, eps, start: np.ndarray):
         cfg = self.config

@@ -23,7 +23,9 @@ from numba import njit
 
 from worldtrack.pose.render import Intrinsics
 
-BILINEAR, NEAREST_POSITIVE = 0, 1
+BILINEAR, NEAREST_POSITIVE, DEPTH_BILINEAR = 0, 1, 2
+DEPTH_SAMPLING = {"bilinear": 2, "nearest": 1}     # configuration names of the depth readings
+DEPTH_EDGE = 0.03      # m: four depth pixels further apart than this straddle an edge (DEPTH_BILINEAR)
 
 
 def geman_mcclure(d: np.ndarray, c: float) -> np.ndarray:
@@ -48,11 +50,14 @@ class SparseTemplate(NamedTuple):
 
 
 @njit(cache=True, fastmath=True)
-def _project_sample_kernel(images, fx, fy, cx, cy, T, X, part, mode, vals, zout):  # pragma: no cover
-    # One pass over candidates × points: transform, project, read (bilinear or nearest-positive).
-    # The part's 3×4 transform is held in locals while consecutive points share a part.
-    # fastmath is safe here: NaN only comes in through the image (depth holes are tested as > 0).
+def _project_sample_kernel(images, intr4, T, X, part, mode, max_step, vals, zout):  # pragma: no cover
+    # One pass over candidates × points: transform, project, read (bilinear, nearest-positive, or
+    # bilinear depth: bilinear where the four pixels all hold depth within max_step of each other,
+    # else the nearest positive pixel). The part's 3×4 transform is held in locals while
+    # consecutive points share a part. fastmath is safe here: NaN only comes in through the image
+    # (depth holes are tested as > 0).
     n_ch, h, w = images.shape
+    fx, fy, cx, cy = intr4[0], intr4[1], intr4[2], intr4[3]
     for k in range(T.shape[0]):
         p_prev = -1
         r00 = r01 = r02 = t0 = r10 = r11 = r12 = t1 = r20 = r21 = r22 = t2 = 0.0
@@ -71,7 +76,7 @@ def _project_sample_kernel(images, fx, fy, cx, cy, T, X, part, mode, vals, zout)
             inv = 1.0 / max(z, 1e-6)
             u = fx * (r00 * a0 + r01 * a1 + r02 * a2 + t0) * inv + cx
             v = fy * (r10 * a0 + r11 * a1 + r12 * a2 + t1) * inv + cy
-            if mode == 0:
+            if mode != 1:
                 if z <= 1e-6 or not (u >= 0.0 and v >= 0.0 and u <= w - 1.0 and v <= h - 1.0):
                     for ch in range(n_ch):
                         vals[k, ch, i] = np.nan
@@ -81,8 +86,17 @@ def _project_sample_kernel(images, fx, fy, cx, cy, T, X, part, mode, vals, zout)
                 a = u - u0
                 b = v - v0
                 for ch in range(n_ch):
-                    top = images[ch, v0, u0] + a * (images[ch, v0, u0 + 1] - images[ch, v0, u0])
-                    bot = images[ch, v0 + 1, u0] + a * (images[ch, v0 + 1, u0 + 1] - images[ch, v0 + 1, u0])
+                    q00, q01 = images[ch, v0, u0], images[ch, v0, u0 + 1]
+                    q10, q11 = images[ch, v0 + 1, u0], images[ch, v0 + 1, u0 + 1]
+                    if mode == 2:
+                        lo = min(min(q00, q01), min(q10, q11))
+                        hi = max(max(q00, q01), max(q10, q11))
+                        if not (lo > 0.0 and hi - lo <= max_step):             # a hole or an edge:
+                            q = images[ch, v0 + int(b >= 0.5), u0 + int(a >= 0.5)]    # the nearest pixel
+                            vals[k, ch, i] = q if q > 0.0 else np.nan
+                            continue
+                    top = q00 + a * (q01 - q00)
+                    bot = q10 + a * (q11 - q10)
                     vals[k, ch, i] = top + b * (bot - top)
             else:
                 uu = int(np.floor(u + 0.5))
@@ -166,13 +180,15 @@ def _colour_depth_epsilon_kernel(vals, I, alpha, c, zhat, z, c_depth, lam):  # p
 
 
 def project_sample(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template: SparseTemplate,
-                   mode: int = BILINEAR) -> tuple[np.ndarray, np.ndarray]:
+                   mode: int = BILINEAR, max_step: float = DEPTH_EDGE) -> tuple[np.ndarray, np.ndarray]:
     """Project template points under K candidate poses and read the images there.
 
     Parameters
     ----------
     images : (C, H, W) float32 — e.g. grey level and its gradients; or depth (m) with ``mode``
-        ``NEAREST_POSITIVE`` (nearest pixel; 0 = no measurement → NaN)
+        ``NEAREST_POSITIVE`` (nearest pixel; 0 = no measurement → NaN) or ``DEPTH_BILINEAR``
+        (bilinear where the four pixels hold depth within ``max_step`` m of each other — on one
+        surface — else the nearest pixel: no depth invented across an edge or a hole)
     T : (K, P, 3, 4) float — part → camera transform of each of the P parts, per candidate
     template : SparseTemplate
 
@@ -188,9 +204,9 @@ def project_sample(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template
     K, N = T.shape[0], len(template.points)
     vals = np.empty((K, images.shape[0], N), np.float32)
     z = np.empty((K, N))
-    _project_sample_kernel(images, intr.fx, intr.fy, intr.cx, intr.cy, T,
+    _project_sample_kernel(images, np.array([intr.fx, intr.fy, intr.cx, intr.cy]), T,
                            np.ascontiguousarray(template.points, np.float64),
-                           np.ascontiguousarray(template.part, np.int64), int(mode), vals, z)
+                           np.ascontiguousarray(template.part, np.int64), int(mode), float(max_step), vals, z)
     return vals, z
 
 
@@ -201,7 +217,7 @@ def camera_points(T: np.ndarray, template: SparseTemplate) -> np.ndarray:
 
 
 def project_sample_reference(images: np.ndarray, intr: Intrinsics, T: np.ndarray, template: SparseTemplate,
-                             mode: int = BILINEAR) -> tuple[np.ndarray, np.ndarray]:
+                             mode: int = BILINEAR, max_step: float = DEPTH_EDGE) -> tuple[np.ndarray, np.ndarray]:
     """:func:`project_sample` in NumPy (cv2-free bilinear interpolation)."""
     images = np.asarray(images, np.float32)
     if images.ndim == 2:
@@ -213,13 +229,18 @@ def project_sample_reference(images: np.ndarray, intr: Intrinsics, T: np.ndarray
         u = intr.fx * P[..., 0] / z + intr.cx
         v = intr.fy * P[..., 1] / z + intr.cy
     front = z > 1e-6
-    if mode == BILINEAR:
+    if mode in (BILINEAR, DEPTH_BILINEAR):
         ok = front & (u >= 0) & (v >= 0) & (u <= W - 1) & (v <= H - 1)
         u0 = np.minimum(np.where(ok, u, 0).astype(int), W - 2)
         v0 = np.minimum(np.where(ok, v, 0).astype(int), H - 2)
         a, b = np.where(ok, u - u0, 0), np.where(ok, v - v0, 0)
-        vals = ((1 - a) * (1 - b) * images[:, v0, u0] + a * (1 - b) * images[:, v0, u0 + 1]
-                + (1 - a) * b * images[:, v0 + 1, u0] + a * b * images[:, v0 + 1, u0 + 1])
+        q = images[:, v0, u0], images[:, v0, u0 + 1], images[:, v0 + 1, u0], images[:, v0 + 1, u0 + 1]
+        vals = (1 - a) * (1 - b) * q[0] + a * (1 - b) * q[1] + (1 - a) * b * q[2] + a * b * q[3]
+        if mode == DEPTH_BILINEAR:
+            lo, hi = np.minimum.reduce(q), np.maximum.reduce(q)
+            near = images[:, v0 + (b >= 0.5), u0 + (a >= 0.5)]
+            vals = np.where((lo > 0) & (hi - lo <= max_step), vals, near)
+            ok = ok[None] & (vals > 0)
     else:
         uu, vv = np.floor(np.nan_to_num(u) + 0.5).astype(int), np.floor(np.nan_to_num(v) + 0.5).astype(int)
         ok = front & (uu >= 0) & (vv >= 0) & (uu < W) & (vv < H)
@@ -286,12 +307,15 @@ class ColourDepthCost:
     grey : (H, W) float32; depth_image : (H, W) float32 metres, 0 = no measurement (or None)
     c : float or None — colour scale on the normalised differences; None = 0.5 / N (the paper's)
     c_depth : float, metres (5 mm); lam : λ, the depth share (0.9)
+    depth_sampling : ``DEPTH_BILINEAR`` (default: the depth image read bilinearly on a surface, so
+        the cost changes smoothly with the pose and LM's central differences see a slope) or
+        ``NEAREST_POSITIVE`` (the nearest pixel: piecewise constant in the pose, flat within a pixel)
     """
 
     def __init__(self, colour: SparseTemplate, depth: SparseTemplate | None, grey: np.ndarray,
                  depth_image: np.ndarray | None, intr: Intrinsics, c: float | None = None,
-                 c_depth: float = 0.005, lam: float = 0.9):
-        self.colour, self.depth = colour, depth
+                 c_depth: float = 0.005, lam: float = 0.9, depth_sampling: int = DEPTH_BILINEAR):
+        self.colour, self.depth, self.depth_sampling = colour, depth, int(depth_sampling)
         self.images = np.ascontiguousarray(grey, np.float32)[None]
         self.depth_image = None if depth_image is None else np.ascontiguousarray(depth_image, np.float32)[None]
         if self.depth_image is None or depth is None or len(depth.points) == 0:
@@ -321,7 +345,7 @@ class ColourDepthCost:
         r = np.sqrt(1.0 - self.lam) * robust_residual(self.colour_differences(vals[:, 0].astype(float)), self.c)
         if self.depth is None:
             return r
-        zhat, z = project_sample(self.depth_image, self.intr, T, self.depth, NEAREST_POSITIVE)
+        zhat, z = project_sample(self.depth_image, self.intr, T, self.depth, self.depth_sampling)
         rd = np.sqrt(self.lam) * robust_residual(zhat[:, 0] - z, self.c_depth)   # d′ = Ẑ − Z
         return np.concatenate([r, rd], 1)
 
@@ -331,7 +355,7 @@ class ColourDepthCost:
         if self.depth is None:
             zhat, z = np.zeros((0, 0), np.float32), np.zeros((0, 0))
         else:
-            zhat, z = project_sample(self.depth_image, self.intr, T, self.depth, NEAREST_POSITIVE)
+            zhat, z = project_sample(self.depth_image, self.intr, T, self.depth, self.depth_sampling)
             zhat = zhat[:, 0]
         return _colour_depth_epsilon_kernel(vals[:, 0], np.asarray(self.colour.value, float), self.alpha, self.c,
                                             zhat, z, self.c_depth, self.lam)
@@ -342,5 +366,6 @@ class ColourDepthCost:
         sub = ColourDepthCost(SparseTemplate(c.points[:n], c.part[:n], c.value[:n]),
                               None if d is None else SparseTemplate(d.points[:n], d.part[:n], d.value[:n]),
                               self.images[0], None if self.depth_image is None else self.depth_image[0], self.intr,
-                              self.c * len(c.points) / max(min(n, len(c.points)), 1), self.c_depth, self.lam)
+                              self.c * len(c.points) / max(min(n, len(c.points)), 1), self.c_depth, self.lam,
+                              self.depth_sampling)
         return sub

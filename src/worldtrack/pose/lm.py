@@ -85,8 +85,13 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
     taken = np.zeros(len(X), int)
     history = [cost.copy()]
     M = space.dim
+    jac = jacobian if jacobian is not None else lambda X_, r_: central_difference_jacobian(space, residuals, X_)
+    J, moved = None, np.ones(len(X), bool)
     for _ in range(int(iterations)):
-        J = jacobian(X, r) if jacobian is not None else central_difference_jacobian(space, residuals, X)
+        if J is None:
+            J = jac(X, r)
+        elif moved.any():                   # a rejected step leaves X, hence J, as it was: recompute the rest
+            J[moved] = jac(X[moved], r[moved])
         Jt = np.swapaxes(J, 1, 2)
         A = Jt @ J + C[:, None, None] * np.eye(M)                          # JᵀJ + C·I
         g = (Jt @ r[..., None])[..., 0]                                    # Jᵀr
@@ -98,6 +103,7 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
         X[better], r[better], cost[better] = X_try[better], r_try[better], cost_try[better]
         C = np.where(better, C / 10.0, C * 10.0)
         taken += better
+        moved = better
         history.append(cost.copy())
     return LMResult(X, cost, C, taken, np.array(history))
 

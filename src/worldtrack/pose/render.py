@@ -287,30 +287,38 @@ def _bilinear(image: np.ndarray, xyz: np.ndarray, intr: Intrinsics) -> np.ndarra
                      cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[0].astype(float)
 
 
+def equal_shares(counts: np.ndarray, n: int) -> np.ndarray:
+    """Quotas (G,) summing to ``min(n, Σ counts)``: every group the same share of ``n``, a share a
+    group cannot fill passed on to the others (water-filling); a remainder smaller than the number
+    of open groups goes one each to the first of them."""
+    counts = np.asarray(counts, int)
+    quota = np.zeros(len(counts), int)
+    left = int(n)
+    while left > 0:
+        open_ = np.flatnonzero(quota < counts)
+        if len(open_) == 0:
+            break
+        share = left // len(open_)
+        if share == 0:
+            quota[open_[:left]] += 1
+            break
+        add = np.minimum(counts[open_] - quota[open_], share)
+        quota[open_] += add
+        left -= int(add.sum())
+    return quota
+
+
 def _by_group(rc: np.ndarray, strength: np.ndarray, group: np.ndarray, n: int) -> np.ndarray:
     """Up to ``n`` pixels, strongest first within each group, the groups sharing ``n`` equally."""
     if len(rc) == 0:
         return rc
     order = np.argsort(-strength, kind="stable")
     rc, group = rc[order], group[order]
-    names = np.unique(group)
+    names, slot, counts = np.unique(group, return_inverse=True, return_counts=True)
     rank = np.zeros(len(rc), int)
-    for g in names:
-        rank[group == g] = np.arange((group == g).sum())
-    counts = np.array([(group == g).sum() for g in names])
-    quota = np.zeros(len(names), int)
-    left = n
-    while left > 0 and (quota < counts).any():                      # water-filling: equal shares
-        open_ = quota < counts
-        share = max(left // open_.sum(), 1)
-        add = np.minimum(counts - quota, share) * open_
-        add = np.minimum(add, left - np.concatenate([[0], np.cumsum(add)[:-1]]).clip(0))
-        quota += add
-        left -= add.sum()
-        if add.sum() == 0:
-            break
-    q = quota[np.searchsorted(names, group)]
-    return rc[rank < q]
+    for g in range(len(names)):
+        rank[slot == g] = np.arange(counts[g])
+    return rc[rank < equal_shares(counts, n)[slot]]
 
 
 def _nearest_point(index: np.ndarray, drawn: np.ndarray, rc: np.ndarray) -> np.ndarray:

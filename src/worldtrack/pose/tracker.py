@@ -29,7 +29,7 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.pose.cost import ColourDepthCost, EigenTemplateCost, SparseTemplate
+from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, EigenTemplateCost, SparseTemplate
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
 from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
@@ -54,6 +54,7 @@ class TrackerConfig:
     camera_blur_px : the camera's own blur (σ, pixels), added to the drawn template's smoothing
         (not for appearance read from an image, which holds it already)
     shading_vectors : eigenvectors Φ of the eigen-template besides the mean v̄
+    depth_sampling : "bilinear" (on one surface) or "nearest" pixel, for ``colour-depth``
     """
 
     stages: int = 1
@@ -73,6 +74,7 @@ class TrackerConfig:
     shading_vectors: int = 9
     motion: str = "velocity"
     pf_points: int | None = 256
+    depth_sampling: str = "bilinear"
     seed: int = 0
 
 
@@ -172,7 +174,7 @@ class RigidTracker:
         if depth is not None and self.depth_offset:
             depth = np.where(depth > 0, depth - np.float32(self.depth_offset), 0).astype(np.float32)
         return ColourDepthCost(colour, dt, grey, depth, self.intr, self.config.c, self.config.c_depth_mm / 1000,
-                               self.config.lam)
+                               self.config.lam, DEPTH_SAMPLING[self.config.depth_sampling])
 
     def _lm(self, cost, states: np.ndarray, iterations: int):
         """Batched LM of the kept candidates on one cost (compiled normal equations for the face)."""

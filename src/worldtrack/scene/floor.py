@@ -14,6 +14,28 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 
+#: Point-edge pairs tested at once by :func:`points_in_polygon` (bounds its temporary arrays).
+_PAIRS_PER_CHUNK = 2_000_000
+#: Most cells of a floor raster or distance field; a finer grid over a large floor is coarsened.
+MAX_GRID_CELLS = 16_000_000
+
+
+def grid_resolution(bounds: tuple[float, float, float, float], resolution: float,
+                    max_cells: int = MAX_GRID_CELLS) -> float:
+    """``resolution`` (m), or the finest coarser one whose grid over ``bounds`` has at most ``max_cells``.
+
+    >>> grid_resolution((0.0, 10.0, 0.0, 10.0), 0.01)
+    0.01
+    >>> round(grid_resolution((0.0, 1000.0, 0.0, 1000.0), 0.01), 4)
+    0.25
+    """
+    x0, x1, y0, y1 = bounds
+    cells = ((x1 - x0) / resolution + 2) * ((y1 - y0) / resolution + 2)
+    if cells <= max_cells:
+        return resolution
+    return float(np.sqrt((x1 - x0 + 2 * resolution) * (y1 - y0 + 2 * resolution) / max_cells)) * 1.0001
+
+
 def points_in_polygon(points: ArrayLike, ring: ArrayLike) -> np.ndarray:
     """Even-odd (crossing number) test of many points against one polygon ring.
 
@@ -30,12 +52,15 @@ def points_in_polygon(points: ArrayLike, ring: ArrayLike) -> np.ndarray:
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     a = np.asarray(ring, dtype=float)
     b = np.roll(a, -1, axis=0)
-    x, y = p[:, 0:1], p[:, 1:2]                       # (N, 1) against (M,) edges
-    straddles = (a[:, 1] > y) != (b[:, 1] > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x_cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    crossings = np.count_nonzero(straddles & (x < x_cross), axis=1)
-    return crossings % 2 == 1
+    out = np.empty(len(p), dtype=bool)
+    chunk = max(1, _PAIRS_PER_CHUNK // max(len(a), 1))  # bounded memory: (chunk, M) temporaries
+    for start in range(0, len(p), chunk):
+        x, y = p[start:start + chunk, 0:1], p[start:start + chunk, 1:2]   # (n, 1) against (M,) edges
+        straddles = (a[:, 1] > y) != (b[:, 1] > y)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            x_cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+        out[start:start + chunk] = np.count_nonzero(straddles & (x < x_cross), axis=1) % 2 == 1
+    return out
 
 
 def polygon_area(ring: ArrayLike) -> float:
@@ -123,15 +148,20 @@ class WalkableArea:
         return inside
 
     def raster(self, resolution: float = 0.01) -> "WalkableRaster":
-        """The walkable area sampled on a grid, for O(1) look-ups in hot loops (cached)."""
+        """The walkable area sampled on a grid, for O(1) look-ups in hot loops (cached).
+
+        The grid has at most :data:`MAX_GRID_CELLS` cells: over a large floor it is coarser than
+        ``resolution`` (read :attr:`WalkableRaster.resolution`)."""
         cache = self.__dict__.setdefault("_rasters", {})
         if resolution not in cache:
+            asked, resolution = resolution, grid_resolution(self.bounds, resolution)
             x0, x1, y0, y1 = self.bounds
             xs = np.arange(x0, x1 + resolution, resolution)
             ys = np.arange(y0, y1 + resolution, resolution)
             gx, gy = np.meshgrid(xs + resolution / 2, ys + resolution / 2)
             inside = self.contains(np.column_stack([gx.ravel(), gy.ravel()])).reshape(gx.shape)
-            cache[resolution] = WalkableRaster(np.array([x0, y0]), resolution, inside)
+            cache[asked] = WalkableRaster(np.array([x0, y0]), resolution, inside)
+            resolution = asked
         return cache[resolution]
 
     @property
@@ -152,9 +182,12 @@ class WalkableArea:
         Positive inside the walkable area (distance to the nearest non-walkable cell), negative
         outside (minus the distance to the nearest walkable cell). Thin obstacles (vertical
         partitions, whose footprint is a segment) are rasterised as lines so they still count.
-        Seed 002's environment model ``e_h(d_h)`` reads this field.
+        Paper 002's environment model ``e_h(d_h)`` reads this field. Over a large floor the grid is
+        coarser than ``resolution`` (at most :data:`MAX_GRID_CELLS` cells; read
+        :attr:`FloorGrid.resolution`).
         """
         x0, x1, y0, y1 = self.bounds
+        resolution = grid_resolution((x0 - margin, x1 + margin, y0 - margin, y1 + margin), resolution)
         xs = np.arange(x0 - margin, x1 + margin + resolution / 2, resolution)
         ys = np.arange(y0 - margin, y1 + margin + resolution / 2, resolution)
         gx, gy = np.meshgrid(xs, ys)

@@ -26,259 +26,34 @@ Format (every key optional unless stated; unknown keys are errors)::
       - {name: door, polygon: [[x, y], ...]}
     people: {height: 1.65, width: 0.40, overrides: {3: {height: 1.80}}}
 
-Every problem is reported as ``file: field.path: what was expected``.
+Every problem is reported as ``file: field.path: what was expected``, quoting at most a short
+excerpt of the input. The file is read by :func:`worldtrack.io.safe_yaml.read_yaml` (bounded size,
+nesting and aliases; numbers as YAML 1.2 reads them; duplicate keys refused), its fields validated
+by :mod:`worldtrack.scene.spec`, and the whole checked by :mod:`worldtrack.scene.checks` (cameras
+that cannot see the floor are errors; one that sees none of the walkable floor is a warning, kept
+in :attr:`Scene.warnings`).
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Any
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import ValidationError
 
-from worldtrack.errors import SceneError
+from worldtrack.errors import InputError, SceneError
 from worldtrack.geometry.camera import Camera, intrinsics_from_fov, look_at_rotation, normalise_projection
 from worldtrack.geometry.rotation import rodrigues
-from worldtrack.scene.floor import EntryRegion, FloorPolygon, WalkableArea, polygon_area
+from worldtrack.io.safe_yaml import read_yaml, short
+from worldtrack.scene import checks
+from worldtrack.scene.floor import EntryRegion, FloorPolygon, WalkableArea
 from worldtrack.scene.model import Box, Patch, PersonDefaults, Scene
-
-Number = float
-Point2 = list[Number]
-Point3 = list[Number]
-
-
-def _shape_of(value: Any) -> str:
-    a = np.asarray(value, dtype=object)
-    if a.ndim == 0:
-        return "a scalar"
-    if a.ndim == 1:
-        return f"{a.shape[0]} values"
-    return "x".join(str(s) for s in a.shape)
-
-
-def _matrix(value: list[list[float]], rows: int, cols: int) -> list[list[float]]:
-    if len(value) != rows or any(len(r) != cols for r in value):
-        lens = sorted({len(r) for r in value})
-        got = f"{len(value)}x{lens[0]}" if len(lens) == 1 else f"{len(value)} rows of lengths {lens}"
-        raise ValueError(f"expected {rows}x{cols} matrix, got {got}")
-    if not all(math.isfinite(x) for r in value for x in r):
-        raise ValueError("expected finite numbers, got NaN or infinity")
-    return value
-
-
-def _vector(value: list[float], n: int, what: str = "values") -> list[float]:
-    if len(value) != n:
-        raise ValueError(f"expected {n} {what}, got {len(value)}")
-    if not all(math.isfinite(x) for x in value):
-        raise ValueError("expected finite numbers, got NaN or infinity")
-    return value
-
-
-def _ring(value: list[list[float]]) -> list[list[float]]:
-    if any(len(p) != 2 for p in value):
-        raise ValueError("expected [x, y] points")
-    if len(value) < 3:
-        raise ValueError(f"expected a polygon of at least 3 points, got {len(value)}")
-    if polygon_area(value) < 1e-6:
-        raise ValueError("expected a polygon with non-zero area")
-    return value
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=False)
-
-
-class CameraSpec(_Strict):
-    id: str
-    image_size: list[int]
-    P: list[list[float]] | None = None
-    K: list[list[float]] | None = None
-    R: list[list[float]] | None = None
-    rvec: list[float] | None = None
-    t: list[float] | None = None
-    position: list[float] | None = None
-    look_at: list[float] | None = None
-    hfov_deg: float | None = None
-    distortion: list[float] | None = None
-
-    @field_validator("image_size")
-    @classmethod
-    def _size(cls, v: list[int]) -> list[int]:
-        if len(v) != 2 or min(v) <= 0:
-            raise ValueError(f"expected [width, height] in pixels, got {v}")
-        return v
-
-    @field_validator("P")
-    @classmethod
-    def _p(cls, v):
-        return None if v is None else _matrix(v, 3, 4)
-
-    @field_validator("K", "R")
-    @classmethod
-    def _k(cls, v):
-        return None if v is None else _matrix(v, 3, 3)
-
-    @field_validator("t", "rvec", "position", "look_at")
-    @classmethod
-    def _v3(cls, v):
-        return None if v is None else _vector(v, 3)
-
-    @field_validator("distortion")
-    @classmethod
-    def _dist(cls, v):
-        if v is not None and not 1 <= len(v) <= 5:
-            raise ValueError(f"expected 1 to 5 coefficients (k1, k2, p1, p2, k3), got {len(v)}")
-        return v
-
-    @field_validator("hfov_deg")
-    @classmethod
-    def _fov(cls, v):
-        if v is not None and not 0 < v < 180:
-            raise ValueError(f"expected degrees in (0, 180), got {v}")
-        return v
-
-    @model_validator(mode="after")
-    def _one_pose(self) -> "CameraSpec":
-        forms = {
-            "P": self.P is not None,
-            "K/R/t": self.t is not None or self.R is not None or self.rvec is not None,
-            "position/look_at": self.position is not None or self.look_at is not None,
-        }
-        given = [k for k, v in forms.items() if v]
-        if len(given) != 1:
-            raise ValueError("expected exactly one pose: P, or K + R (or rvec) + t, or position + look_at"
-                             + (f"; got {' and '.join(given)}" if given else "; got none"))
-        if given[0] == "K/R/t":
-            if self.t is None or (self.R is None) == (self.rvec is None):
-                raise ValueError("expected t and one of R or rvec")
-            if self.K is None and self.hfov_deg is None:
-                raise ValueError("expected K or hfov_deg with R/t")
-        if given[0] == "position/look_at":
-            if self.position is None or self.look_at is None:
-                raise ValueError("expected both position and look_at")
-            if self.K is None and self.hfov_deg is None:
-                raise ValueError("expected K or hfov_deg with position/look_at")
-        if given[0] == "P" and (self.K is not None or self.hfov_deg is not None):
-            raise ValueError("P already holds the intrinsics: give P alone, not with K or hfov_deg")
-        return self
-
-
-class FloorPolygonSpec(_Strict):
-    outer: list[list[float]]
-    holes: list[list[list[float]]] = Field(default_factory=list)
-
-    @field_validator("outer")
-    @classmethod
-    def _outer(cls, v):
-        return _ring(v)
-
-    @field_validator("holes")
-    @classmethod
-    def _holes(cls, v):
-        return [_ring(h) for h in v]
-
-
-class FloorSpec(_Strict):
-    walkable: list[FloorPolygonSpec]
-
-    @field_validator("walkable")
-    @classmethod
-    def _nonempty(cls, v):
-        if not v:
-            raise ValueError("expected at least one polygon")
-        return v
-
-
-class BoxSpec(_Strict):
-    name: str
-    type: Literal["box"]
-    centre: list[float]
-    size: list[float]
-    yaw_deg: float = 0.0
-    blocks_walking: bool = True
-
-    @field_validator("centre")
-    @classmethod
-    def _c(cls, v):
-        return _vector(v, 3)
-
-    @field_validator("size")
-    @classmethod
-    def _s(cls, v):
-        _vector(v, 3)
-        if min(v) <= 0:
-            raise ValueError(f"expected positive sizes in metres, got {v}")
-        return v
-
-
-class PatchSpec(_Strict):
-    name: str
-    type: Literal["patch"]
-    corners: list[list[float]]
-    blocks_walking: bool = True
-
-    @field_validator("corners")
-    @classmethod
-    def _corners(cls, v):
-        _matrix(v, 4, 3)
-        q = np.asarray(v, dtype=float)
-        n = np.cross(q[1] - q[0], q[2] - q[0])
-        if np.linalg.norm(n) < 1e-9:
-            raise ValueError("expected 4 corners spanning a rectangle, got collinear points")
-        n /= np.linalg.norm(n)
-        if abs((q[3] - q[0]) @ n) > 0.01:
-            raise ValueError("expected 4 coplanar corners (within 1 cm)")
-        return v
-
-
-ObstacleSpec = Annotated[Union[BoxSpec, PatchSpec], Field(discriminator="type")]
-
-
-class EntryRegionSpec(_Strict):
-    name: str
-    polygon: list[list[float]]
-
-    @field_validator("polygon")
-    @classmethod
-    def _poly(cls, v):
-        return _ring(v)
-
-
-class PersonSizeSpec(_Strict):
-    height: float | None = None
-    width: float | None = None
-
-
-class PeopleSpec(_Strict):
-    height: float = 1.65
-    width: float = 0.40
-    overrides: dict[int, PersonSizeSpec] = Field(default_factory=dict)
-
-    @field_validator("height", "width")
-    @classmethod
-    def _pos(cls, v):
-        if not 0 < v < 3:
-            raise ValueError(f"expected metres in (0, 3), got {v}")
-        return v
-
-
-class SceneSpec(_Strict):
-    name: str = "scene"
-    cameras: list[CameraSpec]
-    floor: FloorSpec
-    obstacles: list[ObstacleSpec] = Field(default_factory=list)
-    entry_regions: list[EntryRegionSpec] = Field(default_factory=list)
-    people: PeopleSpec = Field(default_factory=PeopleSpec)
-
-    @field_validator("cameras")
-    @classmethod
-    def _cams(cls, v):
-        if not v:
-            raise ValueError("expected at least one camera")
-        return v
+# The field models, under the names this module has always had.
+from worldtrack.scene.spec import (BoxSpec, CameraSpec, EntryRegionSpec, FloorPolygonSpec,  # noqa: F401
+                                   FloorSpec, PatchSpec, PeopleSpec, PersonSizeSpec, SceneSpec)
 
 
 # ---------------------------------------------------------------------------- loading
@@ -304,12 +79,23 @@ def _message(err: dict) -> str:
         return "unknown key (not part of the scene format)"
     if err["type"] == "missing":
         return "required field is missing"
-    if err["type"] in ("float_parsing", "float_type", "int_parsing", "int_type"):
-        return f"expected a number, got {err.get('input')!r}"
+    if err["type"] in ("float_parsing", "float_type"):
+        return f"expected a number, got {short(err.get('input'))}"
+    if err["type"] in ("int_parsing", "int_type", "int_from_float"):
+        return f"expected a whole number, got {short(err.get('input'))}"
+    if err["type"] in ("string_type",):
+        return f"expected text, got {short(err.get('input'))}"
+    if err["type"] in ("bool_type", "bool_parsing"):
+        return f"expected true or false, got {short(err.get('input'))}"
     if err["type"] in ("list_type",):
-        return f"expected a list, got {err.get('input')!r}"
+        return f"expected a list, got {short(err.get('input'))}"
+    if err["type"] in ("dict_type", "model_type", "model_attributes_type"):
+        return f"expected a mapping (key: value), got {short(err.get('input'))}"
     if err["type"] == "union_tag_invalid":
-        return f"expected type 'box' or 'patch', got {err.get('input', {}).get('type')!r}"
+        tag = err.get("input", {}).get("type") if isinstance(err.get("input"), dict) else None
+        return f"expected type 'box' or 'patch', got {short(tag)}"
+    if err["type"] == "literal_error":
+        return f"expected {err.get('ctx', {}).get('expected', 'one of the allowed values')}, got {short(err.get('input'))}"
     if err["type"] == "union_tag_not_found":
         return "expected a 'type' of 'box' or 'patch'"
     return msg
@@ -324,20 +110,11 @@ def load_scene(path: str | Path) -> Scene:
         Listing every problem as ``file: field.path: what was expected``.
     """
     path = Path(path)
-    label = path.name
     try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise SceneError([f"{path}: no such file"]) from None
-    except OSError as e:
-        raise SceneError([f"{path}: cannot read ({e.strerror})"]) from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f"line {mark.line + 1}: " if mark is not None else ""
-        raise SceneError([f"{label}: {where}not valid YAML ({getattr(e, 'problem', e)})"]) from None
-    return scene_from_dict(data, label=label, source=path)
+        data = read_yaml(path, "scene", label=path.name, max_bytes=checks.MAX_FILE_BYTES)
+    except InputError as e:
+        raise SceneError([str(e)]) from None
+    return scene_from_dict(data, label=path.name, source=path)
 
 
 def scene_from_dict(data: Any, label: str = "scene", source: Path | None = None) -> Scene:
@@ -347,7 +124,11 @@ def scene_from_dict(data: Any, label: str = "scene", source: Path | None = None)
     try:
         spec = SceneSpec.model_validate(data)
     except ValidationError as e:
-        raise SceneError([f"{label}: {_loc(err['loc'])}: {_message(err)}" for err in e.errors()]) from None
+        errors = e.errors()
+        problems = [f"{label}: {_loc(err['loc'])}: {_message(err)}" for err in errors[:10]]
+        if len(errors) > 10:
+            problems.append(f"{label}: … and {len(errors) - 10} more problems")
+        raise SceneError(problems) from None
     problems: list[str] = []
     cameras: dict[str, Camera] = {}
     for i, cs in enumerate(spec.cameras):
@@ -360,9 +141,17 @@ def scene_from_dict(data: Any, label: str = "scene", source: Path | None = None)
         except ValueError as e:
             problems.append(f"{where}: {e}")
             continue
+        if not (np.all(np.isfinite(cam.centre)) and np.all(np.abs(cam.centre) <= checks.MAX_COORDINATE_M)):
+            problems.append(f"{where}: camera centre {short(cam.centre.tolist())} is not within "
+                            f"±{checks.MAX_COORDINATE_M:g} m (check t or P)")
+            continue
         if cam.centre[2] <= 0:
             problems.append(f"{where}: camera centre at Z = {cam.centre[2]:.3f} m is at or below the floor "
                             "(expected a camera above the floor; check the sign of Z or of P)")
+            continue
+        problem = checks.camera_problem(cam)
+        if problem:
+            problems.append(f"{where}: {problem}")
             continue
         cameras[cs.id] = cam
     polys = tuple(FloorPolygon(np.asarray(p.outer, float), tuple(np.asarray(h, float) for h in p.holes))
@@ -378,14 +167,19 @@ def scene_from_dict(data: Any, label: str = "scene", source: Path | None = None)
     for i, n in enumerate(names):
         if names.index(n) != i:
             problems.append(f"{label}: obstacles[{i}].name: expected a unique name, {n!r} is used twice")
+    walkable = WalkableArea(polys, tuple(o.footprint for o in obstacles if o.blocks_walking))
+    problem = checks.floor_extent_problem(walkable)
+    if problem:
+        problems.append(f"{label}: floor.walkable: {problem}")
     if problems:
         raise SceneError(problems)
-    walkable = WalkableArea(polys, tuple(o.footprint for o in obstacles if o.blocks_walking))
     regions = [EntryRegion(r.name, np.asarray(r.polygon, float)) for r in spec.entry_regions]
     ppl = spec.people
     overrides = {k: (v.height or ppl.height, v.width or ppl.width) for k, v in ppl.overrides.items()}
-    return Scene(spec.name, cameras, walkable, obstacles, regions,
-                 PersonDefaults(ppl.height, ppl.width, overrides), source)
+    scene = Scene(spec.name, cameras, walkable, obstacles, regions,
+                  PersonDefaults(ppl.height, ppl.width, overrides), source)
+    scene.warnings.extend(f"{label}: {w}" for w in checks.scene_warnings(list(cameras.values()), walkable))
+    return scene
 
 
 def _build_camera(cs: CameraSpec) -> Camera:

@@ -115,6 +115,8 @@ class Scene:
     entry_regions : list of EntryRegion
     people : PersonDefaults
     source : Path or None — the file it was loaded from (for messages)
+    warnings : list of str — odd but valid things the loader noticed (a camera that sees none of
+        the walkable floor), one line each, for the command line to print
     """
 
     name: str
@@ -124,6 +126,7 @@ class Scene:
     entry_regions: list[EntryRegion] = field(default_factory=list)
     people: PersonDefaults = field(default_factory=PersonDefaults)
     source: Path | None = None
+    warnings: list[str] = field(default_factory=list)
     _occlusion: dict = field(default_factory=dict, repr=False)
     _distance: dict = field(default_factory=dict, repr=False)
 

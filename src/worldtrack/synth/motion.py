@@ -192,6 +192,7 @@ class WalkerSettings:
     min_goal_distance: float = 1.5
     substeps: int = 2
     accel: float = 1.5
+    dwell_yields: bool = False   # a walker standing still steps aside for people coming at them
 
 
 def _segment_clear(df, a: np.ndarray, b: np.ndarray, clearance: float) -> bool:
@@ -293,7 +294,7 @@ def random_walkers(scene: Scene, n: int, fps: float, n_frames: int, rng: np.rand
             w = np.clip((reach - d) / (reach - s.min_separation + 1e-9), 0.0, 1.0) ** 2
             unit = diff / np.maximum(d, 1e-9)[:, :, None]
             side = np.stack([unit[..., 1], -unit[..., 0]], axis=-1)
-            moving = (dwell <= 0)[:, None, None]
+            moving = ((dwell <= 0) | s.dwell_yields)[:, None, None]
             push += np.sum(w[:, :, None] * (1.2 * unit + 0.6 * side * moving), axis=1)
             # Push from walls and obstacles.
             val = df.sample(pos, outside=-1.0)
@@ -301,7 +302,7 @@ def random_walkers(scene: Scene, n: int, fps: float, n_frames: int, rng: np.rand
             gn = np.linalg.norm(grad, axis=1, keepdims=True)
             wo = np.clip((0.75 - val) / 0.45, 0.0, 1.0)[:, None]
             push += wo * 0.8 * grad / np.maximum(gn, 1e-9)
-            v_cmd = v_des + push * (dwell <= 0)[:, None]
+            v_cmd = v_des + push * ((dwell <= 0) | s.dwell_yields)[:, None]
             sp = np.linalg.norm(v_cmd, axis=1, keepdims=True)
             v_cmd *= np.minimum(1.0, 1.3 * pref[:, None] / np.maximum(sp, 1e-9))
             dv = v_cmd - vel
@@ -317,7 +318,11 @@ def random_walkers(scene: Scene, n: int, fps: float, n_frames: int, rng: np.rand
                 np.fill_diagonal(dd, np.inf)
                 close = np.any(dd < s.min_separation, axis=1)
                 if len(obs):
-                    close |= np.any(np.linalg.norm(cand[:, None, :] - obs[None, :, :], axis=2) < other_radius, axis=1)
+                    near_new = np.linalg.norm(cand[:, None, :] - obs[None, :, :], axis=2).min(axis=1)
+                    hit = near_new < other_radius
+                    if s.dwell_yields:   # stepping away from someone already too close is allowed
+                        hit &= near_new < np.linalg.norm(pos[:, None, :] - obs[None, :, :], axis=2).min(axis=1)
+                    close |= hit
                 moved = np.any(cand != pos, axis=1)
                 revert = close & moved
                 if not revert.any():
@@ -367,8 +372,13 @@ class RobotPath:
 
 def follow_target(scene: Scene, target: Track, fps: float, distance: float = 1.8, start_xy: ArrayLike | None = None,
                   start_yaw: float | None = None, max_speed: float = 1.6, max_turn_rate: float = 1.5,
-                  gain: float = 1.2, accel: float = 1.0, clearance: float = 0.35) -> RobotPath:
-    """A robot that turns towards the target and drives to stay ``distance`` metres from it (P control)."""
+                  gain: float = 1.2, accel: float = 1.0, clearance: float = 0.35, avoid: bool = False) -> RobotPath:
+    """A robot that turns towards the target and drives to stay ``distance`` metres from it (P control).
+
+    Without ``avoid`` it stops where driving on would bring it within ``clearance`` of a wall or an
+    obstacle (and may stay stuck there); with ``avoid`` it steers round them: it heads for the
+    direction nearest the target's whose point 0.5 m ahead keeps the clearance (15° steps, up to 90°).
+    """
     T = len(target)
     dt = 1.0 / fps
     df = scene.distance_field(0.05)
@@ -385,16 +395,34 @@ def follow_target(scene: Scene, target: Track, fps: float, distance: float = 1.8
         to = target.xy[min(k + 1, T - 1)] - pos
         dist = float(np.linalg.norm(to))
         want = float(np.arctan2(to[1], to[0]))
+        if avoid:
+            want = _free_heading(df, pos, want, clearance + 0.05)
         diff = (want - yaw + np.pi) % (2 * np.pi) - np.pi
         yaw += float(np.clip(diff, -max_turn_rate * dt, max_turn_rate * dt))
         v_cmd = float(np.clip(gain * (dist - distance), 0.0, max_speed)) * max(0.0, np.cos(diff))
         v += float(np.clip(v_cmd - v, -accel * dt, accel * dt))
         new = pos + v * dt * np.array([np.cos(yaw), np.sin(yaw)])
-        if df.sample(new[None], outside=-1.0)[0] >= clearance:
+        need = clearance
+        if avoid:   # inside the clearance zone, any step that gets out of it is allowed
+            need = min(clearance, float(df.sample(pos[None], outside=-1.0)[0]) + 1e-3)
+        if df.sample(new[None], outside=-1.0)[0] >= need:
             pos = new
         else:
             v = 0.0
     return RobotPath(xy, yaws)
+
+
+def _free_heading(df, pos: np.ndarray, want: float, clearance: float, lookahead: float = 0.5) -> float:
+    """The heading nearest ``want`` (rad) whose point ``lookahead`` m ahead keeps ``clearance`` m free
+    and whose first 0.1 m does not come nearer an obstacle than the robot already is (if inside)."""
+    offsets = np.radians([0, 15, -15, 30, -30, 45, -45, 60, -60, 75, -75, 90, -90])
+    heads = want + offsets
+    unit = np.column_stack([np.cos(heads), np.sin(heads)])
+    here = float(df.sample(pos[None], outside=-1.0)[0])
+    far = df.sample(pos[None] + lookahead * unit, outside=-1.0) >= clearance
+    near = df.sample(pos[None] + 0.1 * unit, outside=-1.0) >= min(clearance, here)
+    free = np.flatnonzero(far & near)
+    return float(heads[free[0]]) if len(free) else want
 
 
 def track_from_robot(robot: RobotPath, fps: float) -> Track:

@@ -122,6 +122,9 @@ class WhiteBalance:
     r, b : int — gains at the start (auto mode sets them from the first frame)
     threshold : int — auto mode jumps to the grey-world gains when either differs by more
     schedule : dict frame → (r, b) — set-points applied at exactly those frames (both modes)
+    offsets : dict frame → (dr, db) — from that frame on, these steps are added to the gains the
+        camera reports and applies (until the next entry): a white balance that wanders off by
+        itself, as seed 001's camera did. The automatic white balance keeps its own state.
     """
 
     mode: str = "auto"
@@ -129,6 +132,7 @@ class WhiteBalance:
     b: int = WB_UNITY
     threshold: int = 40
     schedule: dict = field(default_factory=dict)
+    offsets: dict = field(default_factory=dict)
     _started: bool = False
 
     def update(self, frame: int, raw_mean_bgr: np.ndarray) -> tuple[int, int]:
@@ -143,7 +147,15 @@ class WhiteBalance:
         if frame in self.schedule:
             r, b = self.schedule[frame]
             self.r, self.b = int(np.clip(r, 0, WB_MAX)), int(np.clip(b, 0, WB_MAX))
-        return self.r, self.b
+        if not self.offsets:
+            return self.r, self.b
+        dr, db = self.offset_at(frame)
+        return int(np.clip(self.r + dr, 0, WB_MAX)), int(np.clip(self.b + db, 0, WB_MAX))
+
+    def offset_at(self, frame: int) -> tuple[int, int]:
+        """The (dr, db) steps of :attr:`offsets` in force at ``frame`` ((0, 0) before the first)."""
+        starts = [f for f in self.offsets if f <= frame]
+        return tuple(int(v) for v in self.offsets[max(starts)]) if starts else (0, 0)
 
 
 def grey_world_mean(raw: np.ndarray) -> np.ndarray:

@@ -151,7 +151,7 @@ def parse_size(size) -> tuple[int, int]:
         try:
             w, h = (int(x) for x in size.lower().split("x"))
         except ValueError:
-            raise InputError(f"size: expected WIDTHxHEIGHT in pixels (e.g. 320x240), got {size!r}") from None
+            raise InputError(f"size: expected WxH in pixels (e.g. 320x240), got {size!r}") from None
     else:
         try:
             w, h = (int(x) for x in size)
@@ -293,7 +293,7 @@ def _serpentine(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return out
 
 
-@_register("static-grid", "seed 000 Table 1: one person standing still at the measurement grid points")
+@_register("static-grid", "paper 000 Table 1: one person standing still at the measurement grid points")
 def static_grid(seed: int, common: Common, *, size=None, frames=None, camera: str = "cam1", dwell: float = 1.5,
                 height: float | None = 1.66, width: float | None = 0.42, speed: float = 0.6) -> Scenario:
     """One person walks slowly between the paper's grid points and stands still ``dwell`` seconds at each.
@@ -320,7 +320,7 @@ def static_grid(seed: int, common: Common, *, size=None, frames=None, camera: st
     people = [Person(1, shape, _trim(_pad(track, n), n))]
     return Scenario("static-grid", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
                     _options(common, 0.1), _rigs(scene, common), seed,
-                    description="seed 000 Table 1: a person standing still at grid points (speed 0 while standing)")
+                    description="paper 000 Table 1: a person standing still at grid points (speed 0 while standing)")
 
 
 def _pad(track: Track, n: int) -> Track:
@@ -339,7 +339,7 @@ def _pad(track: Track, n: int) -> Track:
 DESK_ROWS = (0.0, 1.0, 2.0, 3.0)
 
 
-@_register("desk-occlusion", "seed 000 Table 2: a 0.73 m desk hides the feet (and the image border the head)")
+@_register("desk-occlusion", "paper 000 Table 2: a 0.73 m desk hides the feet (and the image border the head)")
 def desk_occlusion(seed: int, common: Common, *, size=None, frames=None, hide: str = "feet", dwell: float = 1.5,
                    height: float | None = 1.66, width: float | None = 0.42, speed: float = 0.6,
                    camera: str = "cam1") -> Scenario:
@@ -375,10 +375,10 @@ def desk_occlusion(seed: int, common: Common, *, size=None, frames=None, hide: s
     people = [Person(1, shape, _trim(_pad(track, n), n))]
     return Scenario("desk-occlusion", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
                     _options(common, 0.1), _rigs(scene, common), seed,
-                    description=f"seed 000 Table 2: desks hide the feet ({hide})")
+                    description=f"paper 000 Table 2: desks hide the feet ({hide})")
 
 
-@_register("two-crossing", "seed 000 Fig. 9-10: two people crossing in camera 1's image (and passing close by)")
+@_register("two-crossing", "paper 000 Fig. 9-10: two people crossing in camera 1's image (and passing close by)")
 def two_crossing(seed: int, common: Common, *, size=None, frames=None, passing: str = "image",
                  speed: float = 0.9, heights: tuple | None = (1.73, 1.66),
                  widths: tuple | None = (0.48, 0.42)) -> Scenario:
@@ -417,7 +417,7 @@ def two_crossing(seed: int, common: Common, *, size=None, frames=None, passing: 
     people = [Person(i + 1, shapes[i], _trim(_pad(tracks[i], n), n)) for i in range(2)]
     return Scenario("two-crossing", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
                     _options(common, 0.12), _rigs(scene, common), seed,
-                    description=f"seed 000 Fig. 9-10: two people crossing ({passing})")
+                    description=f"paper 000 Fig. 9-10: two people crossing ({passing})")
 
 
 def _synchronise_last_leg(routes, tracks, shapes, fps):
@@ -436,7 +436,7 @@ def _synchronise_last_leg(routes, tracks, shapes, fps):
     return out
 
 
-@_register("sit-down", "seed 000's posture change: a person walks to a stool, sits down, stands up, walks on")
+@_register("sit-down", "paper 000's posture change: a person walks to a stool, sits down, stands up, walks on")
 def sit_down(seed: int, common: Common, *, size=None, frames=None, sit_seconds: float = 5.0,
              height: float | None = None, width: float | None = None) -> Scenario:
     """The kato lab with a stool at (−1.8, 1.0): a person comes in by the door, sits facing camera 1
@@ -456,7 +456,7 @@ def sit_down(seed: int, common: Common, *, size=None, frames=None, sit_seconds: 
     n = frames or _route_length([track], 1.0, common.fps, _MAX_FRAMES)
     people = [Person(1, shape, _trim(_pad(track, n), n))]
     return Scenario("sit-down", scene, common.fps, n, people, env, _lighting(common, rng, _kato_light()),
-                    _options(common, 0.1), _rigs(scene, common), seed, description="seed 000: sitting down")
+                    _options(common, 0.1), _rigs(scene, common), seed, description="paper 000: sitting down")
 
 
 # ------------------------------------------------------------------------------------ crowd
@@ -486,9 +486,44 @@ def crowd(seed: int, common: Common, *, size=None, frames=None, people: int = 10
                     _rigs(scene, common), seed, description=f"{people} random walkers")
 
 
+# ------------------------------------------------------------------------------------ two rooms
+
+@_register("two-rooms", "two rooms joined by a door, one camera each: people walk from one view into the other")
+def two_rooms(seed: int, common: Common, *, size=None, frames=None, people: int = 2, stagger: float = 3.0,
+              speed: tuple = (0.9, 1.3)) -> Scenario:
+    """Two 6 × 5 m rooms joined by a 1.2 m door at x = 6 m, a camera on each end wall looking at the
+    door. Person k starts in one room (alternating west, east), waits ``stagger`` · k seconds, walks
+    through the door into the other room to a random point and stops there; the door is seen by
+    both cameras. 320×240 by default."""
+    if not 1 <= int(people) <= 6:
+        raise InputError(f"people: expected 1 to 6, got {people}")
+    rng = np.random.default_rng(seed)
+    scene = _scene(scenes.scene_dict("two_rooms"), size or (320, 240))
+    env = Environment(wall_height=3.2, floor_style="tiles", floor_colour=(140, 150, 160), wall_colour=(195, 200, 190),
+                      obstacle_colours={"wall_south": (195, 200, 190), "wall_north": (195, 200, 190),
+                                        "table_west": (70, 100, 140), "cabinet_east": (120, 120, 125)},
+                      posters=4, seed=23)
+    shapes, routes = [], []
+    for k in range(int(people)):
+        side = 1.0 if k % 2 == 0 else -1.0           # +1: starts west
+        lane = float(rng.uniform(2.1, 2.9))
+        start = (6.0 - side * rng.uniform(3.5, 4.8), float(rng.uniform(1.2, 3.6)))
+        goal = (6.0 + side * rng.uniform(2.5, 4.5), float(rng.uniform(1.5, 3.5)))
+        v = float(rng.uniform(*speed))
+        routes.append([Waypoint(*start, dwell=stagger * k + 0.5), Waypoint(6.0 - side * 1.2, lane, speed=v),
+                       Waypoint(6.0 + side * 1.2, lane, speed=v), Waypoint(*goal, speed=v, dwell=1.0)])
+        shapes.append(_shape(rng, env))
+    tracks = [scripted_track(r, common.fps, _route_frames(r, common.fps), s.height) for r, s in zip(routes, shapes)]
+    n = frames or _route_length(tracks, 1.0, common.fps, _MAX_FRAMES)
+    persons = [Person(k + 1, shapes[k], _trim(_pad(tracks[k], n), n)) for k in range(int(people))]
+    light = Light(ambient=0.6, direct=0.45, direction=light_direction(200.0, 60.0))
+    return Scenario("two-rooms", scene, common.fps, n, persons, env, _lighting(common, rng, light), _options(common),
+                    _rigs(scene, common), seed, description=f"{people} people walking between two rooms")
+
+
 # ------------------------------------------------------------------------------------ seed 004
 
-@_register("entry", "seed 004: people enter side by side through a door region, then split up and leave")
+@_register("entry", "paper 004: people enter side by side through a door region, then split up and leave")
 def entry(seed: int, common: Common, *, size=None, frames=None, pairs: int = 2, singles: int = 1,
           spacing: float = 0.5, split_after: float = 2.0, interval: float = 6.0, speed: float = 1.0,
           backlight: bool = True) -> Scenario:
@@ -539,7 +574,7 @@ def entry(seed: int, common: Common, *, size=None, frames=None, pairs: int = 2, 
     persons = [Person(i + 1, shapes[i], _trim(_pad(tracks[i], n), n)) for i in range(len(tracks))]
     light = Light(ambient=0.6, direct=0.5, direction=light_direction(250.0, 60.0))
     return Scenario("entry", scene, common.fps, n, persons, env, _lighting(common, rng, light), _options(common),
-                    _rigs(scene, common), seed, description="seed 004: pairs entering side by side, then splitting")
+                    _rigs(scene, common), seed, description="paper 004: pairs entering side by side, then splitting")
 
 
 # ------------------------------------------------------------------------------------ seed 001
@@ -548,11 +583,14 @@ SUN_WARM = (0.86, 0.97, 1.08)      # BGR tint of sunlight
 SHADE_BLUE = (1.15, 1.0, 0.86)     # BGR tint of skylight in shade
 
 
-@_register("follow-target", "seed 001: a robot's stereo camera follows a target among 3 others; "
+@_register("follow-target", "paper 001: a robot's stereo camera follows a target among 3 others; "
                             "front light, backlight, shade; white-balance jumps")
 def follow_target(seed: int, common: Common, *, size=None, frames=None, others: int = 3, baseline: float = 0.12,
                   distance: float = 1.8, camera_height: float = 1.1, wb_jumps: tuple = (),
-                  segments: tuple = ("front", "backlight", "shade-front", "shade-back")) -> Scenario:
+                  segments: tuple = ("front", "backlight", "shade-front", "shade-back"),
+                  wb_jump_steps: float = 0.0, wb_jump_every: tuple = (1.0, 2.0), crossers: int = 1,
+                  crossings: int = 2, cross_speed: tuple = (1.3, 1.3), lookalike: int = 0,
+                  clear_route: bool = False, cross_pause: tuple = (0.0, 0.0)) -> Scenario:
     """A target walks a loop in a courtyard; a robot (never drawn) follows at ``distance`` m with a
     stereo camera (``baseline`` m) at ``camera_height``. Of the ``others``, one crosses between
     robot and target twice (short occlusions), the rest walk at random. The sequence is cut into
@@ -560,13 +598,28 @@ def follow_target(seed: int, common: Common, *, size=None, frames=None, others: 
     shade with bluish skylight lit from the front or back); the automatic white balance jumps when
     the light's colour changes, and ``wb_jumps`` (frames) add scheduled jumps. 320×240 by default.
     Per-frame robot poses go to frames.csv / camera_poses.csv.
+
+    Harder variants (issue 35): ``wb_jump_steps`` > 0 makes the white balance wander off by
+    itself every ``wb_jump_every`` seconds (uniform range) by a jump of |ΔR| + |ΔB| uniform in
+    0…``wb_jump_steps`` gain steps, on top of its automatic setting (the gains in frames.csv are
+    what the camera applied); ``crossers`` of the others cross the robot–target line, ``crossings``
+    times in all, at ``cross_speed`` m/s (uniform range; slower crossings hide the target longer),
+    stopping ``cross_pause`` seconds (uniform range) in the line of sight;
+    ``lookalike`` of the others wear the target's clothes (colours within ±8 %). The original loop
+    cuts through the kiosk's corner, and the robot, which drives straight at the target, then
+    sticks at the kiosk or the bench for the rest of a long sequence; ``clear_route`` moves every
+    waypoint and leg of the loop 0.8 m clear of walls and obstacles, makes the robot steer round
+    obstacles, keeps crossers 0.7 m clear of the target and the robot, and makes the others step
+    aside when the target walks at them while they stand. The defaults keep the original sequence.
     """
     known = {"front", "backlight", "shade-front", "shade-back"}
     if not segments or any(s not in known for s in segments):
         raise InputError(f"segments: expected a list from {sorted(known)}, got {segments!r}")
     if not 0 <= int(others) <= 10:
         raise InputError(f"others: expected 0 to 10, got {others}")
+    _check_follow_extras(crossers, crossings, cross_speed, lookalike, wb_jump_steps, wb_jump_every)
     rng = np.random.default_rng(seed)
+    extra = np.random.default_rng([seed, 35])   # draws of the issue-35 options (the defaults draw nothing)
     base_scene = _scene(scenes.scene_dict("courtyard"), size or (320, 240))
     env = Environment(wall_height=6.0, ceiling=False, floor_style="paving", floor_colour=(140, 150, 160),
                       wall_colour=(160, 175, 190), obstacle_colours={"bench": (50, 70, 90), "kiosk": (120, 90, 80)},
@@ -580,21 +633,33 @@ def follow_target(seed: int, common: Common, *, size=None, frames=None, others: 
         for k, (x, y) in enumerate(loop[1:] + loop[:1]):
             wps.append(Waypoint(x + rng.uniform(-0.5, 0.5), y + rng.uniform(-0.5, 0.5), speed=rng.uniform(0.9, 1.2),
                                 dwell=float(rng.choice([0.0, 0.0, 1.5]))))
+    if clear_route:
+        wps = _clear_of_obstacles(wps, base_scene.distance_field(0.05), 0.8)
     target = scripted_track(wps, fps, n, target_shape.height, initial_yaw=0.0)
-    robot = robot_follow(base_scene, target, fps, distance=distance)
-    # Crossers: one person crossing the robot–target line at 30 % and 70 % of the sequence.
+    robot = robot_follow(base_scene, target, fps, distance=distance, avoid=bool(clear_route))
+    # Crossers: people crossing the robot–target line, by default one at 30 % and 70 % of the sequence.
     shapes = [target_shape]
     tracks = [target]
-    if int(others) >= 1:
-        cross_shape = _shape(rng, env)
-        tracks.append(_crosser(base_scene, robot, target, fps, n, cross_shape.height, (0.3, 0.7)))
+    n_cross = min(int(crossers), int(others))
+    at = np.round(0.1 + 0.8 * (np.arange(int(crossings)) + 0.5) / max(int(crossings), 1), 12)  # 2: 0.3, 0.7
+    speeds = (np.full(len(at), float(cross_speed[0])) if cross_speed[0] == cross_speed[1]
+              else extra.uniform(*cross_speed, len(at)))
+    pauses = np.zeros(len(at)) if max(cross_pause) <= 0 else extra.uniform(*cross_pause, len(at))
+    for c in range(n_cross):
+        cross_shape = _shape(rng if c == 0 else extra, env)
+        tracks.append(_crosser(base_scene, robot, target, fps, n, cross_shape.height, tuple(at[c::n_cross]),
+                               speeds[c::n_cross], keep_clear=0.7 if clear_route else 0.0,
+                               pauses=pauses[c::n_cross]))
         shapes.append(cross_shape)
-    n_random = max(0, int(others) - 1)
+    n_random = max(0, int(others) - n_cross)
     if n_random:
         rshapes = [_shape(rng, env) for _ in range(n_random)]
         tracks += random_walkers(base_scene, n_random, fps, n, rng, [s.height for s in rshapes],
+                                 WalkerSettings(dwell_yields=bool(clear_route)),
                                  others=[track_from_robot(robot, fps)] + tracks, other_radius=0.7)
         shapes += rshapes
+    for i in range(1, 1 + min(int(lookalike), len(shapes) - 1)):
+        shapes[i] = _dressed_like(shapes[i], target_shape, extra)
     persons = [Person(i + 1, shapes[i], tracks[i]) for i in range(len(tracks))]
     # Camera poses: on the robot, looking along its heading, tilted 4° down.
     poses = []
@@ -631,43 +696,170 @@ def follow_target(seed: int, common: Common, *, size=None, frames=None, others: 
     rigs = _rigs(scene, common, sensors, schedule)
     rigs["robot"].poses = poses
     rigs["robot"].white_balance.threshold = 30
+    if wb_jump_steps > 0:
+        rigs["robot"].white_balance.offsets = _wb_wander(extra, n, fps, float(wb_jump_steps), wb_jump_every)
     return Scenario("follow-target", scene, fps, n, persons, env,
                     _lighting(common, rng, Light(tint=SUN_WARM), tuple(segs)), _options(common), rigs, seed,
-                    description="seed 001: robot stereo camera following person 1 (the target)")
+                    description="paper 001: robot stereo camera following person 1 (the target)")
 
 
-def _crosser(scene: Scene, robot, target: Track, fps: float, n: int, height: float, at: tuple) -> Track:
+def _clear_of_obstacles(wps: list[Waypoint], df, clearance: float, step: float = 0.2) -> list[Waypoint]:
+    """The route with every waypoint pushed out to ``clearance`` metres from walls and obstacles
+    (along the distance field's gradient), and pushed-out waypoints inserted in any leg that
+    passes closer (recursively, up to 16 per leg)."""
+
+    def push(xy: np.ndarray) -> np.ndarray:
+        for _ in range(80):
+            if df.sample(xy[None], outside=-1.0)[0] >= clearance:
+                break
+            g = df.gradient(xy[None])[0]
+            xy = xy + 0.05 * g / max(np.linalg.norm(g), 1e-9)
+        return xy
+
+    def leg(a: np.ndarray, b: np.ndarray, depth: int) -> list[np.ndarray]:
+        m = max(2, int(np.ceil(np.linalg.norm(b - a) / step)))
+        pts = a + np.linspace(0, 1, m)[:, None] * (b - a)
+        d = df.sample(pts, outside=-1.0)
+        if d.min() >= clearance - 0.05 or depth == 0:
+            return []
+        mid = push(pts[int(np.argmin(d))])
+        return leg(a, mid, depth - 1) + [mid] + leg(mid, b, depth - 1)
+
+    first = push(np.array([wps[0].x, wps[0].y]))
+    out = [replace(wps[0], x=float(first[0]), y=float(first[1]))]
+    for wp in wps[1:]:
+        a, b = np.array([out[-1].x, out[-1].y]), push(np.array([wp.x, wp.y]))
+        out += [Waypoint(float(p[0]), float(p[1]), speed=wp.speed) for p in leg(a, b, 4)]
+        out.append(replace(wp, x=float(b[0]), y=float(b[1])))
+    return out
+
+
+def _check_follow_extras(crossers, crossings, cross_speed, lookalike, wb_jump_steps, wb_jump_every) -> None:
+    if not 0 <= int(crossers) <= 10:
+        raise InputError(f"crossers: expected 0 to 10 (at most ``others`` cross), got {crossers}")
+    if not 0 <= int(crossings) <= 40:
+        raise InputError(f"crossings: expected 0 to 40, got {crossings}")
+    if len(cross_speed) != 2 or not 0.2 <= float(cross_speed[0]) <= float(cross_speed[1]) <= 3.0:
+        raise InputError(f"cross_speed: expected (low, high) m/s within 0.2–3, got {cross_speed!r}")
+    if not 0 <= int(lookalike) <= 10:
+        raise InputError(f"lookalike: expected 0 to 10 (at most ``others`` dress alike), got {lookalike}")
+    if not 0 <= wb_jump_steps <= 1023:
+        raise InputError(f"wb_jump_steps: expected 0–1023 gain steps, got {wb_jump_steps}")
+    if len(wb_jump_every) != 2 or not 0.05 <= float(wb_jump_every[0]) <= float(wb_jump_every[1]):
+        raise InputError(f"wb_jump_every: expected (low, high) seconds ≥ 0.05, got {wb_jump_every!r}")
+
+
+def _dressed_like(shape, model, rng: np.random.Generator):
+    """``shape`` (its own build, skin and hair) in ``model``'s clothes, each colour within ±8 %."""
+    jitter = lambda c: tuple(float(v) for v in np.clip(np.asarray(c) * rng.uniform(0.92, 1.08, 3), 5, 250))
+    return replace(shape, top=jitter(model.top), bottom=jitter(model.bottom), shoes=jitter(model.shoes),
+                   short_sleeves=model.short_sleeves, shorts=model.shorts, stripes=model.stripes)
+
+
+WB_WANDER_LIMIT = 300   # steps: the wandering offset stays within ±this on each gain
+
+
+def _wb_wander(rng: np.random.Generator, n: int, fps: float, max_jump: float, every: tuple) -> dict:
+    """frame → (dr, db): a jump of |dr − dr'| + |db − db'| uniform in 0…``max_jump`` every
+    ``every`` seconds (uniform range), split at random between the gains, random signs, each
+    offset kept within ±WB_WANDER_LIMIT (a component that would leave it is mirrored back, then clipped)."""
+    out, cur, t = {}, np.zeros(2), 0.0
+    while True:
+        t += rng.uniform(*every)
+        k = int(round(t * fps))
+        if k >= n:
+            return out
+        size = rng.uniform(0.0, max_jump)
+        share = rng.uniform(0.0, 1.0)
+        step = size * np.array([share, 1.0 - share]) * rng.choice([-1.0, 1.0], 2)
+        new = cur + step
+        new = np.where(np.abs(new) > WB_WANDER_LIMIT, cur - step, new)
+        cur = np.clip(np.rint(new), -WB_WANDER_LIMIT, WB_WANDER_LIMIT)
+        out[k] = (int(cur[0]), int(cur[1]))
+
+
+def _crosser(scene: Scene, robot, target: Track, fps: float, n: int, height: float, at: tuple,
+             speeds=None, keep_clear: float = 0.0, pauses=None) -> Track:
     """A person who walks across the robot–target line at the given fractions of the sequence,
-    appearing 3 m to one side and vanishing 3 m to the other."""
+    appearing 3 m to one side and vanishing 3 m to the other (``speeds``: m/s per crossing, 1.3).
+
+    With ``keep_clear`` > 0 a crossing that would come nearer than that to the target or the robot
+    (it walks a straight line while they move on) is moved along the line (40–70 % of the way to the
+    target) or in time (±1, ±2 s), and left out if nothing works. ``pauses`` (s per crossing): the
+    crosser stands that long on the line of sight, halfway.
+    """
     df = scene.distance_field(0.05)
     out = Track(np.zeros((n, 2)), np.zeros(n), np.zeros(n), np.zeros(n, bool), np.zeros(n), np.zeros(n), np.zeros(n))
-    speed, half = 1.3, 3.0
-    for frac in at:
-        kc = int(frac * (n - 1))
-        mid = (robot.xy[kc] + target.xy[kc]) / 2
-        line = target.xy[kc] - robot.xy[kc]
-        perp = np.array([-line[1], line[0]]) / max(np.linalg.norm(line), 1e-9)
+    speeds = np.full(len(at), 1.3) if speeds is None else np.asarray(speeds, dtype=float)
+    pauses = np.zeros(len(at)) if pauses is None else np.asarray(pauses, dtype=float)
+    tries = [(0.5, 0)] if keep_clear <= 0 else [(f, s) for s in (0, 1, -1, 2, -2) for f in (0.5, 0.4, 0.6, 0.7)]
+    for frac, speed, pause in zip(at, speeds, pauses):
+        for along, shift in tries:
+            kc = int(np.clip(int(frac * (n - 1)) + round(shift * fps), 0, n - 1))
+            ks, xy = _crossing(df, robot, target, kc, along, speed, fps, n, pause)
+            if ks is None:
+                break
+            near = min(np.hypot(*(xy - target.xy[ks]).T).min(), np.hypot(*(xy - robot.xy[ks]).T).min())
+            if keep_clear <= 0 or near >= keep_clear:
+                seg = finish_track(xy, fps, height)
+                for f in ("xy", "yaw", "speed", "phase", "amplitude"):
+                    getattr(out, f)[ks] = getattr(seg, f)
+                out.present[ks] = True
+                break
+    return out
+
+
+def _crossing(df, robot, target: Track, kc: int, along: float, speed: float, fps: float, n: int,
+              pause: float = 0.0, half: float = 3.0):
+    """Frames and positions of one crossing through the point ``along`` of the robot–target line at
+    frame ``kc``, perpendicular to it, from ``half`` m to one side to ``half`` m to the other;
+    (None, None) if too short. With ``pause`` > 0 the crosser, on reaching the line of sight, walks
+    along with it (staying ``along`` of the way from the robot to the target) for ``pause``
+    seconds before going on across: someone cutting in between them for a moment."""
+    line_at = lambda k: robot.xy[k] + along * (target.xy[k] - robot.xy[k])  # noqa: E731
+
+    def perp_at(k):
+        line = target.xy[k] - robot.xy[k]
+        return np.array([-line[1], line[0]]) / max(np.linalg.norm(line), 1e-9)
+
+    steps = int(round(2 * half / speed * fps))
+    hold = int(round(pause * fps))
+    if hold == 0:
+        mid, perp = line_at(kc), perp_at(kc)
         a, b = mid - half * perp, mid + half * perp
-        ends_ok = df.sample(np.array([a, b]), outside=-1.0).min() > 0.35
-        if not ends_ok:
+        if not df.sample(np.array([a, b]), outside=-1.0).min() > 0.35:
             a, b = b, a
-        steps = int(round(2 * half / speed * fps))
         k0 = kc - steps // 2
         ks = np.arange(max(k0, 0), min(k0 + steps + 1, n))
         if len(ks) < 3:
-            continue
+            return None, None
         s_ = (ks - k0) / steps
-        xy = a + s_[:, None] * (b - a)
-        seg = finish_track(xy, fps, height)
-        for f in ("xy", "yaw", "speed", "phase", "amplitude"):
-            getattr(out, f)[ks] = getattr(seg, f)
-        out.present[ks] = True
-    return out
+        return ks, a + s_[:, None] * (b - a)
+    k1 = kc - hold // 2                      # reaches the line
+    k2 = min(k1 + hold, n - 1)               # leaves it
+    k0, k3 = k1 - steps // 2, k2 + steps // 2
+    if k1 < 0 or k0 + 3 > n:
+        return None, None
+    side = 1.0
+    ends = np.array([line_at(k1) - half * perp_at(k1), line_at(k2) + half * perp_at(k2)])
+    if not df.sample(ends, outside=-1.0).min() > 0.35:
+        side = -1.0
+    a = line_at(k1) - side * half * perp_at(k1)
+    ks = np.arange(max(k0, 0), min(k3 + 1, n))
+    xy = np.empty((len(ks), 2))
+    for i, k in enumerate(ks):
+        if k < k1:
+            xy[i] = a + (k - k0) / max(k1 - k0, 1) * (line_at(k1) - a)
+        elif k <= k2:
+            xy[i] = line_at(k)
+        else:
+            xy[i] = line_at(k2) + side * (k - k2) / max(k3 - k2, 1) * half * perp_at(k2)
+    return ks, xy
 
 
 # ------------------------------------------------------------------------------------ seed 002
 
-@_register("non-overlapping", "seed 002: an office with walls and desks seen by 4 cameras whose views do not overlap")
+@_register("non-overlapping", "paper 002: an office with walls and desks seen by 4 cameras whose views do not overlap")
 def non_overlapping(seed: int, common: Common, *, size=None, frames=None, people: int = 2, legs: int = 14,
                     speed: tuple = (1.0, 1.3), layout: str = "open") -> Scenario:
     """A 16 × 8 m office: a corridor along y = 4 m with desks and partitions on both sides and four
@@ -704,7 +896,7 @@ def non_overlapping(seed: int, common: Common, *, size=None, frames=None, people
     light = Light(ambient=0.6, direct=0.45, direction=light_direction(70.0, 70.0))
     return Scenario("non-overlapping", scene, common.fps, n, persons, env, _lighting(common, rng, light),
                     _options(common), _rigs(scene, common), seed,
-                    description="seed 002: four non-overlapping cameras in an office")
+                    description="paper 002: four non-overlapping cameras in an office")
 
 
 def _office_graph(layout: str = "open"):
@@ -774,7 +966,7 @@ def _quat(R: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q)
 
 
-@_register("face-pose", "seed 003: RGB-D close-up of a face with small or large 6-DoF head motion")
+@_register("face-pose", "paper 003: RGB-D close-up of a face with small or large 6-DoF head motion")
 def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str = "small", distance: float = 0.8,
               depth_step_mm: float = 5.0, height: float = 1.72) -> Scenario:
     """A person stands facing a Kinect-like camera ``distance`` m in front of the head and moves the
@@ -813,10 +1005,10 @@ def face_pose(seed: int, common: Common, *, size=None, frames=None, motion: str 
     light = Light(ambient=0.55, direct=0.6, direction=light_direction(-60.0, 35.0))
     return Scenario("face-pose", scene, fps, n, [person], env, _lighting(common, rng, light), _options(common),
                     _rigs(scene, common, sensors), seed, pose_rows=rows,
-                    description=f"seed 003: face pose, {motion} motion")
+                    description=f"paper 003: face pose, {motion} motion")
 
 
-@_register("upper-body", "seed 003: RGB-D view of an upper body with 14-DoF motion "
+@_register("upper-body", "paper 003: RGB-D view of an upper body with 14-DoF motion "
                           "(torso 6, shoulders 2+2, elbows 2+2)")
 def upper_body(seed: int, common: Common, *, size=None, frames=None, distance: float = 1.9,
                depth_step_mm: float = 5.0, height: float = 1.72) -> Scenario:
@@ -872,7 +1064,7 @@ def upper_body(seed: int, common: Common, *, size=None, frames=None, distance: f
     light = Light(ambient=0.55, direct=0.6, direction=light_direction(-60.0, 40.0))
     return Scenario("upper-body", scene, fps, n, [person], env, _lighting(common, rng, light), _options(common),
                     _rigs(scene, common, sensors), seed, pose_rows=rows,
-                    description="seed 003: upper-body pose, 14 DoF")
+                    description="paper 003: upper-body pose, 14 DoF")
 
 
 SCENARIOS = tuple(_REGISTRY)

@@ -137,8 +137,31 @@ BOOTH = {
     "people": {"height": 1.72, "width": 0.45},
 }
 
+# Two 6 x 5 m rooms side by side, joined by a 1.2 m door in the wall at x = 6 m; one camera high on
+# each end wall looking at the door, so the door and a little of the room beyond it are in both
+# views (a person walking from one room to the other is handed from one camera to the other).
+TWO_ROOMS = {
+    "name": "two-rooms",
+    "cameras": [
+        {"id": "west", "image_size": [640, 480], "position": [0.3, 2.5, 3.0], "look_at": [4.6, 2.5, 0.4],
+         "hfov_deg": 78},
+        {"id": "east", "image_size": [640, 480], "position": [11.7, 2.5, 3.0], "look_at": [7.4, 2.5, 0.4],
+         "hfov_deg": 78},
+    ],
+    "floor": {"walkable": [{"outer": [[0.0, 0.0], [12.0, 0.0], [12.0, 5.0], [0.0, 5.0]]}]},
+    "obstacles": [
+        {"name": "wall_south", "type": "box", "centre": [6.0, 0.95, 1.3], "size": [0.15, 1.9, 2.6]},
+        {"name": "wall_north", "type": "box", "centre": [6.0, 4.05, 1.3], "size": [0.15, 1.9, 2.6]},
+        {"name": "table_west", "type": "box", "centre": [2.5, 4.2, 0.375], "size": [1.4, 0.7, 0.75]},
+        {"name": "cabinet_east", "type": "box", "centre": [10.0, 0.45, 0.9], "size": [1.2, 0.5, 1.8]},
+    ],
+    "entry_regions": [],
+    "people": {"height": 1.70, "width": 0.45},
+}
+
 BUILTIN = {"kato_lab": KATO_LAB, "hall": HALL, "lobby": LOBBY, "office_4cams": OFFICE_4CAMS,
-           "office_4cams_detours": OFFICE_4CAMS_DETOURS, "courtyard": COURTYARD, "booth": BOOTH}
+           "office_4cams_detours": OFFICE_4CAMS_DETOURS, "courtyard": COURTYARD, "booth": BOOTH,
+           "two_rooms": TWO_ROOMS}
 
 
 def scene_dict(name: str) -> dict:

@@ -4,7 +4,9 @@ A person's upper body (:func:`worldtrack.pose.body.body_geometry`: torso with he
 arms, two forearms) with textured clothes — a printed shirt (checks, stripes and blobs, drawn per
 person), sleeves or skin, a head with hair and face marks — moves in front of a Kinect-like
 camera 2 m away: torso translation (±3 cm) and ``Rz·Ry·Rx`` rotation (±8°, ±6°, ±5°), shoulders
-(±35° about their mean pose) and elbows (±30°), smooth random sinusoids. Frames are drawn like the
+(±35° about their mean pose) and elbows (±30° sideways, flexed forward 15° ± 25°), smooth random
+sinusoids; ``mirror=True`` gives the left–right mirror image of the same motion (the arms swap
+their motions), to tell a side-specific tracker fault from a hard motion. Frames are drawn like the
 faces (:mod:`worldtrack.synth.faces`): z-buffered points at twice the resolution, Lambert shading
 with a moving light, area averaging, blur and noise; depth is quantised to 5 mm as in the paper.
 
@@ -71,11 +73,22 @@ def _albedo(part: int, p: np.ndarray, rng: np.random.Generator, seed: int, shirt
     return np.where(marks[:, None], skin * 0.7, skin)
 
 
+def mirror_params(P: np.ndarray) -> np.ndarray:
+    """Pose parameters (..., 14) of the left–right mirror image (x → −x in the torso frame): torso
+    tx, θ (about z) and φ (about y) change sign, and the arms swap, their Rz angles changing sign."""
+    P = np.asarray(P, float)
+    Q = P.copy()
+    Q[..., [0, 3, 4]] = -P[..., [0, 3, 4]]
+    flip = np.array([-1.0, 1.0, -1.0, 1.0])
+    Q[..., 6:10], Q[..., 10:14] = P[..., 10:14] * flip, P[..., 6:10] * flip
+    return Q
+
+
 class BodySequence:
     """Sequence ``number`` (1–7 are the benchmark's no1–no7): a person moving in front of the camera."""
 
     def __init__(self, number: int, n_frames: int = 100, size=(640, 480), fps: float = 30.0, distance: float = 2.0,
-                 noise: float = 2.0, depth_step: float = 0.005):
+                 noise: float = 2.0, depth_step: float = 0.005, mirror: bool = False):
         rng = np.random.default_rng([number, 3014])
         w, h = size
         f = 525.0 * w / 640                                          # Kinect-like field of view
@@ -102,8 +115,10 @@ class BodySequence:
             P[:, base] = sign * (deg(55) + s(deg(35)))                  # shoulder: arm lowered ±35°
             P[:, base + 1] = -deg(10) + s(deg(25))                      # shoulder: forward / back
             P[:, base + 2] = sign * s(deg(30))                          # elbow in the arm's plane
-            P[:, base + 3] = -deg(15) + s(deg(25))                      # elbow: forearm bent forward
-        self.params = P
+            # elbow flexion: Ry(φ) with φ > 0 turns the forearm towards −z, the front (the torso's z
+            # points into the back), so the forearm bends forward by 15° ± 25° (at most 10° over-straight)
+            P[:, base + 3] = deg(15) + s(deg(25))
+        self.params = mirror_params(P) if mirror else P
         az = np.radians(-40 + 80 * tt / max(tt[-1], 1e-9))
         self.light_dir = np.column_stack([np.sin(az) * 0.8, -np.full_like(az, 0.5), -np.cos(az) * 0.8])
         self.light_dir /= np.linalg.norm(self.light_dir, axis=1, keepdims=True)
@@ -134,9 +149,9 @@ class BodySequence:
         return BodyFrame(np.clip(img, 0, 255).astype(np.uint8), depth, p.copy(), axes, k / self.fps)
 
 
-def body_sequence(number: int, n_frames: int = 100, size=(640, 480)) -> BodySequence:
-    """Upper-body sequence ``number`` (no1–no7 are 1–7)."""
-    return BodySequence(number, n_frames, size)
+def body_sequence(number: int, n_frames: int = 100, size=(640, 480), mirror: bool = False) -> BodySequence:
+    """Upper-body sequence ``number`` (no1–no7 are 1–7), or its mirror image."""
+    return BodySequence(number, n_frames, size, mirror=mirror)
 
 
 _ = BodyModel  # re-exported type for callers

@@ -54,17 +54,18 @@ def method_config(method: str, preset: str = "default", overrides: Mapping[str, 
     return config
 
 
-def _override(config: Any, overrides: Mapping[str, Any], method: str) -> Any:
-    if isinstance(config, Section):
-        return with_overrides(config, overrides, root=method)
-    # A configuration not yet moved to sections: flat fields (``dataclasses.replace``).
-    from dataclasses import replace
-    try:
-        return replace(config, **dict(overrides))
-    except TypeError as e:
-        raise InputError(f"{method} tracker: {e}") from None
-    except ValueError as e:
-        raise InputError(f"{method} tracker: {e}") from None
+def _override(config: Section, overrides: Mapping[str, Any], method: str) -> Section:
+    return with_overrides(config, overrides, root=method)
+
+
+def method_threshold(method: str) -> float | None:
+    """The foreground threshold ``method`` runs with when none is given (None: the foreground kind's
+    default, :data:`worldtrack.foreground.DEFAULT_THRESHOLDS`).
+
+    >>> method_threshold("ellipsoid"), method_threshold("particle")
+    (None, 25.0)
+    """
+    return CONFIGS[method].foreground_threshold
 
 
 def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *, preset: str = "default",
@@ -95,4 +96,4 @@ def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *
 
 
 __all__ = ["CONFIGS", "METHODS", "PRESETS", "TRACKERS", "Frame", "Person", "PositionMap", "Track", "Tracker",
-           "TrackerBase", "make_tracker", "method_config", "warm_started"]
+           "TrackerBase", "method_threshold", "make_tracker", "method_config", "warm_started"]

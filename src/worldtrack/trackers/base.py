@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Iterable, Iterator, Mapping, Protocol, Sequence
 
 import numpy as np
@@ -102,7 +103,7 @@ class TrackerBase:
 
     extra_columns: tuple[str, ...] = ("sigma",)
     position_map: PositionMap
-    last_masks: dict[str, np.ndarray]
+    last_masks: Mapping[str, np.ndarray] = MappingProxyType({})   # a tracker sets its own dict
 
     @property
     def warm_start_frames(self) -> int:
@@ -116,7 +117,7 @@ class TrackerBase:
         raise InputError(f"--init: the {type(self).__name__} starts tracks by itself")
 
     def overlay(self, camera_id: str) -> Overlay:
-        return Overlay(mask=getattr(self, "last_masks", {}).get(camera_id))
+        return Overlay(mask=self.last_masks.get(camera_id))
 
 
 def warm_started(tracker: Tracker, items: Iterable[tuple[int, float, Mapping[str, Frame]]]

@@ -40,7 +40,10 @@ class TrajectoryOptions:
     starts : tuple of str — a subset of ``("straight", "map", "shortest")``
     environment : bool — False: no barrier at all (the paper's comparison without e_h)
     race_iterations : int or None — every start gets this many iterations; only the one with the
-        lowest objective then goes on to convergence (None: every start converges, as the paper)
+        lowest objective then goes on to convergence (None: every start converges, as the paper).
+        With a race, when the MAP without the barrier keeps so clear of every obstacle that its
+        barrier cost is below the solver's tolerance, it is the optimum within that tolerance and
+        is the only start run
     solver : SolverOptions
     """
 
@@ -79,11 +82,12 @@ class TrajectoryEstimate:
     covariance : (n, 6, 6) — diagonal blocks of the inverse Gauss–Newton matrix at X
     costs : dict — each term of the objective at X, and the total
     start : str — the start whose optimum won
-    start_objectives : dict str → float — every start's final objective
+    start_objectives : dict str → float — the final objective of every start that was run
     observed : (n,) int — observations at each step
     barrier_active : (n,) bool — steps where the barrier pushes (a sample inside the clearance)
     without_barrier : (n, 6) — the MAP without the barrier (start ``map``), for comparison
-    results : dict str → SolveResult — per start
+    results : dict str → SolveResult — per start that was run (without a barrier ``straight`` and
+        ``map`` are one solve)
     """
 
     times: np.ndarray
@@ -167,25 +171,11 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
     problem = Problem.build(obs, grid, options.motion, env, options.robust)
     free = problem.with_environment(env.without_barrier())
     straight = straight_start(problem.observations, grid, options.height)
-    results: dict[str, SolveResult] = {}
     without = levenberg_marquardt(free, straight, options.solver)
-    starts = {"straight": straight, "map": without.X}
-    if env.barrier is not None and "shortest" in options.starts:
-        starts["shortest"] = shortest_path_start(problem.observations, grid, options.height, env.barrier.field,
-                                                 options.clearance, max(env.barrier.field.resolution, 0.1))
-    runs = {}
-    for name in options.starts:
-        if name not in starts:
-            continue
-        if env.barrier is None and name == "map":
-            results[name] = without
-            continue
-        runs[name] = LevenbergMarquardt(problem, starts[name], options.solver)
-        runs[name].run(options.race_iterations)
-    if runs:                        # the race: only the leader goes on to convergence
-        leader = min(runs, key=lambda k: runs[k].lin.costs.total)
-        runs[leader].run()
-        results.update({name: run.result for name, run in runs.items()})
+    if env.barrier is None:          # "straight" and "map": the same problem from the same start
+        results = {name: without for name in options.starts if name != "shortest"} or {"map": without}
+    else:
+        results = _barrier_starts(problem, straight, without, options)
     objectives = {name: r.costs.total for name, r in results.items()}
     best = min(objectives, key=objectives.get)
     win = results[best]
@@ -193,6 +183,30 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
     covariance = marginal_covariances(win.linearisation.D, win.linearisation.B)
     return TrajectoryEstimate(grid.times, win.X, covariance, win.costs.as_dict(), best, objectives, observed,
                               win.linearisation.barrier_steps, without.X, results)
+
+
+def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult,
+                    options: TrajectoryOptions) -> dict[str, SolveResult]:
+    """Levenberg–Marquardt with the barrier from each start: the race (every start
+    ``options.race_iterations``, then only the leader to convergence) or every start to convergence."""
+    if options.race_iterations is not None and "map" in options.starts:
+        polish = LevenbergMarquardt(problem, without.X, options.solver)
+        if polish.lin.costs.barrier <= options.solver.barrier_relative_decrease * polish.lin.costs.total:
+            # F(X) ≥ F_free(X) ≥ F_free(X_free) = F(X_free) − barrier(X_free) for every X: no start
+            # beats the MAP without the barrier by more than its barrier cost, here below the
+            # tolerance the solver stops at, so there is no race (walls far from the path)
+            return {"map": polish.run()}
+    starts = {"straight": straight, "map": without.X}
+    if "shortest" in options.starts:
+        barrier = problem.environment.barrier
+        starts["shortest"] = shortest_path_start(problem.observations, problem.grid, options.height, barrier.field,
+                                                 options.clearance, max(barrier.field.resolution, 0.1))
+    runs = {name: LevenbergMarquardt(problem, starts[name], options.solver) for name in options.starts}
+    for run in runs.values():
+        run.run(options.race_iterations)
+    if options.race_iterations is not None:      # only the leader goes on to convergence
+        min(runs.values(), key=lambda run: run.lin.costs.total).run()
+    return {name: run.result for name, run in runs.items()}
 
 
 def with_height(options: TrajectoryOptions, height: float) -> TrajectoryOptions:

@@ -112,6 +112,10 @@ def plot_evaluation(path: str | Path, gt: TrackTable, pred: TrackTable,
             t = np.insert(t, gap, np.nan)
             d = np.insert(d, gap, np.nan)
             ax_err.plot(t, d, "-", color=colour[int(g)], lw=1.2, label=f"GT {g}")
+            if len(gt_ids) > 12:            # too many for a legend: name each line where it ends
+                last = np.flatnonzero(np.isfinite(d))[-1]
+                ax_err.annotate(f"{g}", (t[last], d[last]), xytext=(2, 0), textcoords="offset points",
+                                fontsize=6, color=colour[int(g)], va="center")
     if gate is not None:
         ax_err.axhline(gate, color="k", ls=":", lw=0.8, label=f"gate {gate:g} m")
     ax_err.set_ylabel("position error [m]")
@@ -119,6 +123,9 @@ def plot_evaluation(path: str | Path, gt: TrackTable, pred: TrackTable,
     ax_err.set_title("error of matched pairs")
     ax_err.grid(alpha=0.3)
     if len(gt_ids) <= 12:
+        ax_err.legend(fontsize="small", loc="upper right", title="ground-truth id")
+    else:
+        ax_err.plot([], [], "-", color="0.3", label="one line per ground-truth id (named at its end)")
         ax_err.legend(fontsize="small", loc="upper right")
 
     if area is not None:
@@ -130,13 +137,16 @@ def plot_evaluation(path: str | Path, gt: TrackTable, pred: TrackTable,
         rows = gt.id == g
         ax_map.plot(gt.x[rows], gt.y[rows], "-", color=colour[int(g)], lw=1.6)
         ax_map.plot(gt.x[rows][:1], gt.y[rows][:1], "o", color=colour[int(g)], ms=4)
+        ax_map.annotate(f"{g}", (gt.x[rows][0], gt.y[rows][0]), xytext=(3, 3), textcoords="offset points",
+                        fontsize=7, color=colour[int(g)])
     owner = assign_pred_to_gt(pairs, pred.ids())
     for pid, g in owner.items():
         rows = pred.id == pid
         c = colour.get(g, _UNMATCHED) if g is not None else _UNMATCHED
         ax_map.plot(pred.x[rows], pred.y[rows], "--", color=c, lw=1.1)
-    ax_map.plot([], [], "-", color="k", label="ground truth")
-    ax_map.plot([], [], "--", color="k", label="predicted")
+    ax_map.plot([], [], "-", color="k", label="ground truth (id at start)")
+    ax_map.plot([], [], "--", color="k", label="predicted, in the colour of its person")
+    ax_map.plot([], [], "--", color=_UNMATCHED, label="predicted, matched nobody")
     ax_map.set_aspect("equal", adjustable="datalim")
     ax_map.set_xlabel("x [m]")
     ax_map.set_ylabel("y [m]")
@@ -144,7 +154,7 @@ def plot_evaluation(path: str | Path, gt: TrackTable, pred: TrackTable,
     ax_map.grid(alpha=0.3)
     ax_map.legend(fontsize="small", loc="best")
     if title:
-        fig.suptitle(title)
+        fig.suptitle(title, fontsize="medium")
     try:
         fig.savefig(path, dpi=100)
     except OSError as e:

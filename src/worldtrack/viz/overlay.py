@@ -42,6 +42,33 @@ def ellipse_outline(camera: Camera, x: float, y: float, height: float, width: fl
     return camera.distort_pixels(pts)
 
 
+def projected_box(camera: Camera, track) -> tuple[float, float, float, float] | None:
+    """The image box ``(u_min, v_min, width, height)`` (pixels, 0-based, not clipped to the image)
+    around a person's ellipsoid as ``camera`` sees it (lens distortion included), or None when the
+    person is not in front of the camera.
+
+    Parameters
+    ----------
+    track : an object with ``x, y, height, width`` (metres)
+    """
+    outline = ellipse_outline(camera, track.x, track.y, track.height, track.width)
+    if outline is None or not np.isfinite(outline).all():
+        return None
+    lo, hi = outline.min(axis=0), outline.max(axis=0)
+    return float(lo[0]), float(lo[1]), float(hi[0] - lo[0]), float(hi[1] - lo[1])
+
+
+def draw_label(image: np.ndarray, text: str, scale: float) -> None:
+    """White text on a dark band in the top-left corner, readable on any background (in place)."""
+    size = 0.45 * scale * 1.3
+    thick = max(1, int(round(scale)))
+    (w, h), base = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, size, thick)
+    pad = max(2, int(3 * scale))
+    band = image[: h + base + 2 * pad, : w + 2 * pad]
+    band[:] = (band * 0.35).astype(np.uint8)
+    cv2.putText(image, text, (pad, pad + h), cv2.FONT_HERSHEY_SIMPLEX, size, (255, 255, 255), thick, cv2.LINE_AA)
+
+
 def draw_tracks(image: np.ndarray, camera: Camera, tracks: Iterable, ring_px: float | None = None,
                 mask: np.ndarray | None = None, label: str | None = None) -> np.ndarray:
     """A copy of ``image`` with each track's ellipse, id and score drawn.
@@ -82,8 +109,7 @@ def draw_tracks(image: np.ndarray, camera: Camera, tracks: Iterable, ring_px: fl
         cv2.putText(out, text, org, cv2.FONT_HERSHEY_SIMPLEX, 0.5 * scale * 1.4, (0, 0, 0), thick + 2, cv2.LINE_AA)
         cv2.putText(out, text, org, cv2.FONT_HERSHEY_SIMPLEX, 0.5 * scale * 1.4, colour, thick, cv2.LINE_AA)
     if label:
-        cv2.putText(out, label, (4, int(14 * scale * 1.3)), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * scale * 1.3,
-                    (255, 255, 255), max(1, thick - 1), cv2.LINE_AA)
+        draw_label(out, label, scale)
     return out
 
 

@@ -7,7 +7,7 @@ import numpy as np
 from _ellipsoid_scenes import ellipsoid_frames, noise_backgrounds, two_camera_scene
 
 from worldtrack.geometry import quadric as q
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.ellipsoid.real import ternary_real
 

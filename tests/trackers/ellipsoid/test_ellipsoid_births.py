@@ -5,7 +5,7 @@ import pytest
 from _ellipsoid_seen import one_person_seen
 
 from worldtrack.errors import InputError
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.ellipsoid.args import People
 from worldtrack.trackers.ellipsoid.births import BIRTH_PLACES, Anywhere, InEntryRegions, Nowhere

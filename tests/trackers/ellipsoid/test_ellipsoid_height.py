@@ -7,7 +7,7 @@ from _ellipsoid_scenes import drawn_frame, ellipsoid_frames, noise_backgrounds, 
 
 import worldtrack.trackers.ellipsoid.height as height_module
 from worldtrack.geometry import quadric as q
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.synth import make_scenario
 from worldtrack.trackers.base import Frame
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker

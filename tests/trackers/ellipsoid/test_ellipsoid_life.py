@@ -6,7 +6,7 @@ from _ellipsoid_scenes import ellipsoid_frames, noise_backgrounds, two_camera_sc
 
 from worldtrack.errors import InputError
 from worldtrack.geometry import quadric as q
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.ellipsoid.life import EVIDENCE, PaperEvidence, SupportEvidence
 from worldtrack.trackers.ellipsoid.support import Support

@@ -6,7 +6,7 @@ from _ellipsoid_scenes import ellipsoid_frames, noise_backgrounds
 
 from worldtrack.errors import InputError
 from worldtrack.geometry import quadric as q
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.scene import scene_from_dict
 from worldtrack.synth import make_scenario
 from worldtrack.trackers import make_tracker

@@ -11,7 +11,7 @@ import pytest
 from _ellipsoid_scenes import ellipsoid_frames, noise_backgrounds
 
 from worldtrack.geometry import quadric as q
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.scene import scene_from_dict
 from worldtrack.trackers.base import PositionMap
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker

@@ -11,7 +11,7 @@ from _ellipsoid_scenes import drawn_frame, noise_backgrounds, one_camera_scene
 from worldtrack.config import with_overrides
 from worldtrack.errors import InputError
 from worldtrack.experiment import run_scenario, standing_with_head_and_feet
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.synth import make_scenario
 from worldtrack.trackers import make_tracker
 from worldtrack.trackers.base import Frame, Overlay

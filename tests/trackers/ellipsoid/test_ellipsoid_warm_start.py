@@ -7,7 +7,7 @@ from _ellipsoid_scenes import ellipsoid_frames, noise_backgrounds, two_camera_sc
 from worldtrack.errors import InputError
 from worldtrack.experiment import run_scenario, step_tracker
 from worldtrack.geometry import quadric as q
-from worldtrack.pipeline import make_foregrounds
+from worldtrack.foreground import make_foregrounds
 from worldtrack.synth import make_scenario
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 

@@ -332,3 +332,18 @@ def test_feet_below_the_image_cost_the_true_column_less():
         gap[unknown] = ratio.max() - ratio[0]
     assert gap[False] > 5.0
     assert gap[True] < 0.5 * gap[False]
+
+
+def test_the_foreground_threshold_decides_what_the_tracker_sees():
+    # Issue 33: the tracker read its own γ and ignored the run's foreground (--threshold 10 and 60
+    # gave identical tracks). A threshold above every colour change (the RGB distance is at most
+    # 255·√3 ≈ 442) leaves it nothing to detect; the same frames at 25 give the walker.
+    scene = make_scene()
+    bgs = {cid: texture(i) for i, cid in enumerate(scene.cameras)}
+    found = {}
+    for threshold in (25.0, 450.0):
+        fgs = {cid: StaticBackground(bg, threshold, "colour", shadows=True) for cid, bg in bgs.items()}
+        tracker = ParticleTracker(scene, fgs, config(column__surface_offset_m=0.0))
+        out = run(tracker, scene, bgs, walker, 15)
+        found[threshold] = {tr.id for _, _, tracks in out for tr in tracks}
+    assert found[25.0] == {1} and found[450.0] == set()

@@ -80,6 +80,9 @@ class BlobConfig(Section):
     """The blobs baseline (MOG2 blobs + Stone Soup), by step."""
 
     path: ClassVar[str] = "blobs"
+    #: The foreground threshold a run of this method gets when none is given (None: the kind's default;
+    #: it detects with its own MOG2).
+    foreground_threshold: ClassVar[float | None] = None
     foreground: BlobForeground = Field(BlobForeground(), description="MOG2 foreground and morphology")
     detection: BlobDetection = Field(BlobDetection(), description="blobs to floor points")
     filter: BlobFilter = Field(BlobFilter(), description="Kalman filter and assignment")

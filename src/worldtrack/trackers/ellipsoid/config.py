@@ -243,6 +243,8 @@ class EllipsoidConfig(Section):
     """Parameters of the ellipsoid tracker, by step of the method; defaults are worldtrack's."""
 
     path: ClassVar[str] = "ellipsoid"
+    #: The foreground threshold a run of this method gets when none is given (None: the kind's default).
+    foreground_threshold: ClassVar[float | None] = None
 
     score: ScoreConfig = Field(ScoreConfig(), description="eq. 5 and the simulated image")
     match: MatchConfig = Field(MatchConfig(), description="the matching rounds and the motion between frames")

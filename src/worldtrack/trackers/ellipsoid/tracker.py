@@ -147,8 +147,13 @@ class EllipsoidTracker(TrackerBase):
 
     # ------------------------------------------------------------------ steps
     def _read(self, frames: Mapping[str, Frame]) -> dict[str, np.ndarray]:
-        """The ternary real image of each camera of this tracker in ``frames``."""
+        """The ternary real image of each camera of this tracker in ``frames``. A camera missing
+        from the bundle (a skipped frame, a video that ended) has no labels this step, so support
+        and heights are not measured on its last, stale image."""
         real: dict[str, np.ndarray] = {}
+        for cid in [c for c in self.last_labels if c not in frames]:
+            del self.last_labels[cid]
+            self.last_masks.pop(cid, None)
         for cid, frame in frames.items():
             if cid not in self.views:
                 continue

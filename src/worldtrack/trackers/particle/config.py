@@ -245,6 +245,9 @@ class ParticleConfig(Section):
     """Parameters of :class:`~worldtrack.trackers.particle.ParticleTracker`, by step of the method."""
 
     path: ClassVar[str] = "particle"
+    #: The foreground threshold γ a run of this method gets when none is given: paper 004's F > γ on the
+    #: RGB distance, at the 25 this tracker always used (``benchmarks/results/tuning_foreground.md``).
+    foreground_threshold: ClassVar[float | None] = 25.0
     seed: StrictInt = Field(0, description="seed of the tracker's random generator: same seed and input, same "
                             "tracks")
     motion: MotionConfig = Field(MotionConfig(), description="prediction (eqs. 1–2)")

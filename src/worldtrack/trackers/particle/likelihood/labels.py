@@ -74,7 +74,7 @@ class FrameLabels:
             else:
                 background = fg.background_image()
                 if background is None:                      # an adaptive model before its first frame
-                    hit = np.where(labels == 2, 2, labels).astype(np.uint8)
+                    hit = labels.astype(np.uint8)
                 else:
                     hit = read_shadows(labels, image, background, self.floor[cid], self.shadow_as,
                                        self._grey_of(cid, background))

@@ -1,0 +1,170 @@
+"""Parameters of the follower (seed 001): :class:`FollowConfig`, the published preset and the ablations.
+
+The paper gives k = 1.0 m⁻¹ (eq. 2), p = 0.25 and α_th = 0.8 (eq. 3) and the method of every step,
+but no detection thresholds, histogram sizes, Kalman noises, decision threshold or update
+interval. Each default below says whether it is the paper's number or ours, and why.
+
+Presets (:meth:`FollowConfig.preset`):
+
+* ``paper`` — the method as published: HS histogram of the white-balanced image, α = p·|W| from
+  the camera's gain change, D of eq. 3, the smallest D under the threshold, the template refreshed
+  every N frames when α ≥ α_th and D is small; nobody else is tracked.
+* ``default`` — worldtrack's: the known gains undone before the histogram (von Kries) and the
+  remaining change of the light's colour measured instead (grey world on the background), a floor
+  on the position weight, a gate that grows while the target is hidden, a short-term template
+  beside the long-term one, and every other person tracked so that a crossing cannot swap the
+  target (one assignment of all candidates to all people).
+* ablations: ``colour-only`` (D = RBhat, the paper's previous system), ``position-only`` (D = E),
+  ``paper+undo`` (the paper's D on gain-corrected colour), ``paper+undo+others`` (and the others
+  tracked).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+from worldtrack.errors import InputError
+
+NORMALISATIONS = ("none", "gains", "gains+greyworld")
+WEIGHTINGS = ("illumination", "colour", "position")
+PRESETS = ("default", "paper", "colour-only", "position-only", "paper+undo", "paper+undo+others")
+
+
+@dataclass(frozen=True)
+class FollowConfig:
+    """Parameters of :class:`~worldtrack.follow.tracker.FollowTracker`; lengths in metres, times in seconds.
+
+    Plan-view detection (§2.3; no numbers in the paper — ours)
+        cell : plan-view grid cell (0.05 m). smooth : Gaussian σ of the occupancy map (0.06 m).
+        min_point_height, max_point_height : points between these heights count as occupancy
+        (0.25–2.3 m: above the floor's noise, below a doorway). structure_height : a cell holding
+        points above this (2.4 m) is a wall or a building, never a person. person_top : the
+        highest point of a person (1.1–2.2 m). min_area : measured surface (m²) a candidate needs
+        (0.03 m²: stereo measures 0.15–0.3 m² of a whole standing person — textureless clothing
+        leaves holes — so this keeps people half hidden; noise specks measure under 0.015 m²).
+        min_points : and at least this many measured points (15). max_extent : a candidate's floor extent (1.0 m).
+        peak_separation : nearest two people can stand, centre to centre (0.4 m).
+        person_radius : points within this of a peak belong to it (0.35 m). max_range : depth
+        beyond which stereo is too noisy to use (8 m). stride : pixel step of the depth image read
+        (0: about 160 columns whatever the resolution). wall_margin : points closer than this to
+        a wall of the scene's walkable area are dropped (0.3 m: stereo noise at 6 m). surface_offset : the camera sees
+        a person's near surface; its mean lies π/4·r ≈ 0.10 m nearer than the body axis for a
+        body of radius r ≈ 0.13 m, so each candidate is pushed back by this along the view ray.
+    Colour (eq. 1)
+        hue_bins, sat_bins : HS histogram size (16 × 8, ours). grey_bins : extra bins by value for
+        achromatic pixels (saturation below ``achromatic_sat`` or value below ``achromatic_val``),
+        whose hue is noise (4; 0 = the paper's pure HS histogram). normalise : "none" (the paper),
+        "gains" (undo the camera's white-balance gains: von Kries) or "gains+greyworld" (then
+        balance the light's colour by the grey world of the background).
+    Position (eq. 2, Kalman filter)
+        k : 1.0 m⁻¹ (paper). accel_sigma : white-noise acceleration of the constant-velocity model
+        (2.0 m/s², a walker turning). measurement_sigma : candidate position noise (0.08 m).
+    Illumination weight and decision (eq. 3)
+        weighting : "illumination" (α = p·|W|, the paper), "colour" (α ≡ 0) or "position" (α ≡ 1).
+        p : 0.25 (paper). alpha_th : 0.8 (paper). wb_unit : gain steps per unit of |W| (70,
+        measured: see :mod:`worldtrack.follow.dissimilarity`). alpha_floor :
+        α never falls below this (0 in the paper; 0.5: colour and position weigh the same when
+        the light is steady). threshold : largest D accepted (0.5, ours). gate : largest distance
+        from the prediction accepted (inf in the paper; 1.0 m), growing by gate_growth m/s while
+        the target is unseen, up to max_gate.
+    Templates (§2.4)
+        update_every : the paper's "every fixed number of frames" N (10). update_max_d : "D is
+        small" (0.3). short_term_tau : time constant of the short-term template (2 s; 0 = none).
+    Others
+        track_others : track every candidate and assign all at once (True; False in the paper).
+        others_max_coast : an unseen other is dropped after this (1.5 s). reid_rbhat : a person who
+        appeared while the target was lost is taken for it when their RBhat is under this (0.3).
+        reid_speed : and no farther from its prediction than ``gate + reid_speed·unseen`` (1.5 m/s).
+        occluders : a person nearer the camera who covers the image box where the target should
+        stand may be hiding it, and is never taken for it (True; False in the paper).
+    """
+
+    cell: float = 0.05
+    smooth: float = 0.06
+    min_point_height: float = 0.25
+    max_point_height: float = 2.3
+    structure_height: float = 2.4
+    person_top: tuple = (1.1, 2.2)
+    min_area: float = 0.03
+    min_points: int = 15
+    max_extent: float = 1.0
+    peak_separation: float = 0.4
+    person_radius: float = 0.35
+    max_range: float = 8.0
+    stride: int = 0
+    wall_margin: float = 0.3
+    surface_offset: float = 0.10
+    hue_bins: int = 16
+    sat_bins: int = 8
+    grey_bins: int = 4
+    achromatic_sat: int = 40
+    achromatic_val: int = 40
+    normalise: str = "gains+greyworld"
+    k: float = 1.0
+    accel_sigma: float = 2.0
+    measurement_sigma: float = 0.08
+    weighting: str = "illumination"
+    p: float = 0.25
+    alpha_th: float = 0.8
+    wb_unit: float = 70.0
+    alpha_floor: float = 0.5
+    threshold: float = 0.5
+    gate: float = 1.0
+    gate_growth: float = 1.0
+    max_gate: float = 3.0
+    update_every: int = 10
+    update_max_d: float = 0.3
+    short_term_tau: float = 2.0
+    track_others: bool = True
+    others_max_coast: float = 1.5
+    reid_rbhat: float = 0.3
+    reid_speed: float = 1.5
+    occluders: bool = True
+
+    def __post_init__(self) -> None:
+        if self.normalise not in NORMALISATIONS:
+            raise InputError(f"normalise: expected one of {', '.join(NORMALISATIONS)}, got {self.normalise!r}")
+        if self.weighting not in WEIGHTINGS:
+            raise InputError(f"weighting: expected one of {', '.join(WEIGHTINGS)}, got {self.weighting!r}")
+        positive = ("cell", "min_area", "max_extent", "peak_separation", "person_radius", "max_range", "k",
+                    "accel_sigma", "measurement_sigma", "wb_unit", "threshold", "gate", "max_gate")
+        for name in positive:
+            if not getattr(self, name) > 0:
+                raise InputError(f"{name}: expected a positive value, got {getattr(self, name)!r}")
+        for name in ("alpha_th", "alpha_floor"):
+            if not 0 <= getattr(self, name) <= 1:
+                raise InputError(f"{name}: expected a value in [0, 1], got {getattr(self, name)!r}")
+        if self.p < 0:
+            raise InputError(f"p: expected a value ≥ 0, got {self.p!r}")
+        if self.hue_bins < 2 or self.sat_bins < 1 or self.grey_bins < 0:
+            raise InputError("hue_bins ≥ 2, sat_bins ≥ 1, grey_bins ≥ 0 expected")
+        if not self.person_top[0] < self.person_top[1]:
+            raise InputError(f"person_top: expected (lowest, highest) metres, got {self.person_top!r}")
+        if self.stride < 0 or self.update_every < 1:
+            raise InputError("stride ≥ 0 and update_every ≥ 1 expected")
+
+    @classmethod
+    def preset(cls, name: str, **overrides) -> "FollowConfig":
+        """The configuration called ``name`` (see :data:`PRESETS`), with ``overrides`` applied.
+
+        >>> FollowConfig.preset("paper").normalise, FollowConfig.preset("default").track_others
+        ('none', True)
+        """
+        paper = dict(normalise="none", grey_bins=0, alpha_floor=0.0, gate=1e6, max_gate=1e6, gate_growth=0.0,
+                     short_term_tau=0.0, track_others=False, occluders=False)
+        undo = dict(paper, normalise="gains+greyworld")
+        table = {
+            "default": {},
+            "paper": paper,
+            "colour-only": dict(paper, weighting="colour"),
+            "position-only": dict(paper, weighting="position"),
+            "paper+undo": undo,
+            "paper+undo+others": dict(undo, track_others=True),
+        }
+        if name not in table:
+            raise InputError(f"preset: expected one of {', '.join(PRESETS)}, got {name!r}")
+        known = {f.name for f in fields(cls)}
+        bad = sorted(set(overrides) - known)
+        if bad:
+            raise InputError(f"follow: unknown parameter(s) {', '.join(bad)}")
+        return replace(cls(), **{**table[name], **overrides})

@@ -1,0 +1,164 @@
+"""The closed loop in the synthetic world: the robot's camera moves by the commands it gets.
+
+Each frame of a ``follow-target`` scenario is rendered from where the simulated robot stands *now*:
+the robot's pose becomes the camera pose of that frame before the frame is drawn (the scenario
+renders lazily, frame by frame), the follower sees the frame, the PID turns what it saw into
+(v, ω), and the robot drives by them for one frame time — a unicycle with limited speed, turn rate
+and acceleration that stops rather than drive into a wall or an obstacle (a bumper, counted).
+
+The camera sits on the robot as in the scenario: ``camera_height`` m up, 0.1 m ahead of the
+robot's centre, looking along its heading, tilted 4° down.
+
+>>> from worldtrack.synth import make_scenario
+>>> sc = make_scenario("follow-target", size=(160, 120), frames=20, seed=3, others=0)
+>>> result = run_closed_loop(sc)
+>>> bool(abs(result.distance[-1] - 1.8) < 0.4), result.collisions
+(True, 0)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from worldtrack.follow.pid import PIDFollower
+from worldtrack.follow.tracker import FollowStep, FollowTracker, frame_from_synth
+from worldtrack.geometry.camera import look_at_rotation
+
+CAMERA_FORWARD = 0.1       # m, camera ahead of the robot's centre
+CAMERA_TILT_DEG = 4.0
+
+
+@dataclass
+class Robot:
+    """A unicycle robot: pose (m, rad), speeds (m/s, rad/s) and their limits."""
+
+    x: float
+    y: float
+    yaw: float
+    v: float = 0.0
+    w: float = 0.0
+    max_speed: float = 1.6
+    max_turn_rate: float = 1.5
+    accel: float = 1.5
+    turn_accel: float = 4.0
+    radius: float = 0.3
+
+    def drive(self, v_cmd: float, w_cmd: float, dt: float, clearance_at) -> bool:
+        """Move for ``dt`` s towards the commanded speeds; False when the bumper stopped it.
+
+        ``clearance_at(xy (1, 2)) -> (1,)`` is the distance (m) to walls and obstacles.
+        """
+        v_cmd = float(np.clip(v_cmd, -self.max_speed, self.max_speed))
+        w_cmd = float(np.clip(w_cmd, -self.max_turn_rate, self.max_turn_rate))
+        self.v += float(np.clip(v_cmd - self.v, -self.accel * dt, self.accel * dt))
+        self.w += float(np.clip(w_cmd - self.w, -self.turn_accel * dt, self.turn_accel * dt))
+        self.yaw = float((self.yaw + self.w * dt + np.pi) % (2 * np.pi) - np.pi)
+        new = np.array([self.x, self.y]) + self.v * dt * np.array([np.cos(self.yaw), np.sin(self.yaw)])
+        if clearance_at(new[None])[0] < self.radius:
+            self.v = 0.0
+            return False
+        self.x, self.y = float(new[0]), float(new[1])
+        return True
+
+    @classmethod
+    def from_camera(cls, camera, **limits) -> "Robot":
+        """The robot that carries ``camera`` (its centre 0.1 m behind the camera, same heading)."""
+        fwd = camera.floor_direction
+        x, y = camera.centre[:2] - CAMERA_FORWARD * fwd
+        return cls(float(x), float(y), float(np.arctan2(fwd[1], fwd[0])), **limits)
+
+
+def camera_pose(robot: Robot, camera_height: float) -> tuple[np.ndarray, np.ndarray]:
+    """(R, t) world → camera of the robot's camera."""
+    fwd = np.array([np.cos(robot.yaw), np.sin(robot.yaw), 0.0])
+    pos = np.array([robot.x, robot.y, camera_height]) + CAMERA_FORWARD * fwd
+    R = look_at_rotation(pos, pos + fwd + np.array([0.0, 0.0, -np.tan(np.radians(CAMERA_TILT_DEG))]))
+    return R, -R @ pos
+
+
+@dataclass
+class LoopResult:
+    """What happened in a closed-loop run (T frames).
+
+    times (T,) s; robot_xy (T, 2) m; camera_xy (T, 2) m; target_xy (T, 2) the true target, m;
+    distance (T,) camera to true target, m; commands (T, 2) (v m/s, ω rad/s);
+    nearest_person (T,) distance from the robot's centre to the nearest person, m;
+    clearance (T,) robot centre to the nearest wall or obstacle, m; found (T,) bool;
+    bumps : frames the bumper stopped the robot; contacts : frames with a person within
+    ``robot.radius + 0.2`` m of the robot's centre; collisions : of those, frames where the robot
+    was driving towards that person (faster than 0.05 m/s) — the robot's doing, not a person
+    walking into it standing; steps : the FollowSteps (if kept)
+    """
+
+    times: np.ndarray
+    robot_xy: np.ndarray
+    camera_xy: np.ndarray
+    target_xy: np.ndarray
+    distance: np.ndarray
+    commands: np.ndarray
+    nearest_person: np.ndarray
+    clearance: np.ndarray
+    found: np.ndarray
+    bumps: int
+    contacts: int
+    collisions: int
+    steps: list = field(default_factory=list)
+
+
+def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PIDFollower | None = None,
+                    camera_id: str = "robot", camera_height: float | None = None, keep_steps: bool = False,
+                    on_frame=None, **robot_limits) -> LoopResult:
+    """Render ``scenario`` frame by frame from the robot that follows its person 1 (see the module docstring).
+
+    ``on_frame(bundle, step, (v, ω))`` is called after every frame (e.g. to write a video).
+    """
+    tracker = tracker or FollowTracker(scene=scenario.scene)
+    follower = follower or PIDFollower(distance=float(scenario.params.get("distance", 1.8)))
+    poses = scenario.rigs[camera_id].poses
+    if poses is None:
+        raise ValueError(f"camera {camera_id!r} of scenario {scenario.name!r} does not move")
+    first = scenario.camera_at(camera_id, 0)
+    height = float(first.centre[2]) if camera_height is None else camera_height
+    robot = Robot.from_camera(first, **robot_limits)
+    df = scenario.scene.distance_field(0.05)
+    clearance_at = lambda xy: df.sample(xy, outside=-1.0)  # noqa: E731
+    n = scenario.n_frames
+    rec = {k: np.zeros((n, 2)) for k in ("robot", "camera", "target", "cmd")}
+    near, clear, found = np.full(n, np.inf), np.zeros(n), np.zeros(n, bool)
+    bumps = contacts = collisions = 0
+    steps: list[FollowStep] = []
+    frames = scenario.frames()
+    for k in range(n):
+        poses[k] = camera_pose(robot, height)     # frame k is drawn from where the robot is now
+        bundle = next(frames)
+        cam = bundle.views[camera_id].camera
+        people = {r["id"]: np.array([r["x"], r["y"]]) for r in bundle.gt}
+        start = people.get(1) if k == 0 else None
+        step = tracker.follow(frame_from_synth(bundle, camera_id), cam, start_xy=start)
+        v, w = follower.command(step, cam, bundle.time)
+        rec["robot"][k] = (robot.x, robot.y)
+        rec["camera"][k] = cam.centre[:2]
+        rec["target"][k] = people.get(1, np.full(2, np.nan))
+        rec["cmd"][k] = (v, w)
+        found[k] = step.found
+        heading = np.array([np.cos(robot.yaw), np.sin(robot.yaw)])
+        if people:
+            rel = np.array(list(people.values())) - rec["robot"][k]
+            dist = np.hypot(rel[:, 0], rel[:, 1])
+            near[k] = dist.min()
+            touching = dist < robot.radius + 0.2
+            contacts += int(touching.any())
+            towards = robot.v * (rel @ heading) / np.maximum(dist, 1e-9) > 0.05
+            collisions += int(np.any(touching & towards))
+        clear[k] = clearance_at(rec["robot"][k][None])[0]
+        if keep_steps:
+            steps.append(step)
+        if on_frame is not None:
+            on_frame(bundle, step, (v, w))
+        dt = 1.0 / scenario.fps
+        bumps += int(not robot.drive(v, w, dt, clearance_at))
+    distance = np.hypot(*(rec["target"] - rec["camera"]).T)
+    return LoopResult(np.arange(n) / scenario.fps, rec["robot"], rec["camera"], rec["target"], distance, rec["cmd"],
+                      near, clear, found, bumps, contacts, collisions, steps)

@@ -1,0 +1,126 @@
+"""The follower (seed 001 §3.2): PID control on the distance and bearing to the target → (v, ω).
+
+The robot's pose is its camera's: the camera centre on the floor and its viewing direction. With
+``e_d = d − distance`` (m) and ``e_β = β`` (rad, left positive)::
+
+    v = v_ff + Kp_d·e_d + Ki_d·∫e_d dt + Kd_d·de_d/dt
+    ω = ω_ff + Kp_β·e_β + Ki_β·∫e_β dt + Kd_β·de_β/dt
+
+with the real time step. ``v_ff`` (the target's speed along the line of sight) and ``ω_ff`` (its
+angular rate about the robot), both from the Kalman filter's velocity, are worldtrack's
+feed-forward terms (``feed_forward=False`` is the paper's plain PID): without them a PID lags a
+walking target by ``v/Kp``. Derivatives are of the errors computed from the filtered state, so a
+noisy detection does not kick the output. Limits: ``−max_reverse ≤ v ≤ max_speed`` (the robot backs
+off when the target walks at it), ``|ω| ≤ max_turn_rate``; the integrals are clamped (anti-windup)
+and reset when the target is lost.
+
+Safety: the robot does not drive forward while anybody (target or other) is in its path — ahead
+of it, within ``stop_distance`` metres and ``corridor`` metres to either side — and stops driving
+when the target has not been seen for ``lost_timeout`` seconds; then it only turns (at most
+``search_turn_rate``) towards where the target should be, to look for it.
+
+>>> import numpy as np
+>>> from types import SimpleNamespace
+>>> from worldtrack.geometry.camera import Camera
+>>> cam = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1), hfov_deg=66)
+>>> step = SimpleNamespace(found=True, xy=np.array([3.0, 0.5]), velocity=np.zeros(2), t=0.0,
+...                        candidates=SimpleNamespace(xy=np.array([[3.0, 0.5]])), others_xy=np.zeros((0, 2)))
+>>> v, w = PIDFollower().command(step, cam, 0.0)
+>>> bool(v > 0 and w > 0)                  # too far and to the left: forward, turning left
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from worldtrack.geometry.camera import Camera
+
+
+@dataclass
+class PIDFollower:
+    """PID on distance (m) and bearing (rad) to the target; see the module docstring.
+
+    distance_gains, bearing_gains : (Kp, Ki, Kd) in 1/s, 1/s², 1 (distance) and 1/s, 1/s², 1 (bearing)
+    """
+
+    distance: float = 1.8
+    distance_gains: tuple = (1.2, 0.1, 0.1)
+    bearing_gains: tuple = (2.5, 0.1, 0.1)
+    max_speed: float = 1.6
+    max_reverse: float = 0.5
+    max_turn_rate: float = 1.5
+    feed_forward: bool = True
+    stop_distance: float = 0.8
+    corridor: float = 0.6
+    lost_timeout: float = 1.0
+    search_turn_rate: float = 0.5
+    integral_limit: float = 0.5
+    _state: dict = field(default_factory=dict, repr=False)
+
+    def reset(self) -> None:
+        self._state.clear()
+
+    def command(self, step, camera: Camera, t: float) -> tuple[float, float]:
+        """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep`."""
+        s = self._state
+        if step.found:
+            s["seen"] = t
+        pos = camera.centre[:2]
+        fwd = camera.floor_direction
+        left = np.array([-fwd[1], fwd[0]])
+        rel = np.asarray(step.xy, float) - pos
+        d = float(np.hypot(*rel))
+        bearing = float(np.arctan2(rel @ left, rel @ fwd))
+        if t - s.get("seen", -np.inf) > self.lost_timeout:
+            seen = s.get("seen", -np.inf)
+            self.reset()
+            s["seen"] = seen
+            # Lost: stand, and turn slowly towards where the target should be, to look for it.
+            return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
+        e_d = d - self.distance
+        dt = t - s["t"] if "t" in s else 0.0
+        v_ff = w_ff = 0.0
+        if self.feed_forward:
+            vel = np.asarray(step.velocity, float)
+            v_ff = float(vel @ rel) / max(d, 1e-6)
+            w_ff = float(rel[0] * vel[1] - rel[1] * vel[0]) / max(d * d, 1e-6)
+        v = v_ff + self._pid("d", e_d, dt, self.distance_gains)
+        w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
+        s["t"] = t
+        v = float(np.clip(v, -self.max_reverse, self.max_speed))
+        w = float(np.clip(w, -self.max_turn_rate, self.max_turn_rate))
+        s["blocked"] = self._blocked(step, pos, fwd)
+        if s["blocked"]:
+            v = min(v, 0.0)
+        return v, w
+
+    @property
+    def blocked(self) -> bool:
+        """Whether the last command was held back because somebody was in the robot's path."""
+        return bool(self._state.get("blocked", False))
+
+    def _pid(self, name: str, error: float, dt: float, gains: tuple) -> float:
+        kp, ki, kd = gains
+        s = self._state
+        integral = s.get(name + "_i", 0.0)
+        deriv = 0.0
+        if dt > 0 and name + "_e" in s:
+            integral = float(np.clip(integral + error * dt, -self.integral_limit, self.integral_limit))
+            deriv = (error - s[name + "_e"]) / dt
+        s[name + "_i"], s[name + "_e"] = integral, error
+        return kp * error + ki * integral + kd * deriv
+
+    def _blocked(self, step, pos: np.ndarray, fwd: np.ndarray) -> bool:
+        """Somebody in the robot's path: ahead, within ``stop_distance`` and ``corridor`` to the side."""
+        people = [np.asarray(step.xy, float)[None]]
+        if len(step.candidates.xy):
+            people.append(step.candidates.xy)
+        if len(step.others_xy):
+            people.append(step.others_xy)
+        rel = np.vstack(people) - pos
+        ahead = rel @ fwd
+        side = np.abs(rel @ np.array([-fwd[1], fwd[0]]))
+        return bool(np.any((ahead > -0.1) & (ahead < self.stop_distance) & (side < self.corridor)))

@@ -1,0 +1,349 @@
+"""Following one target person with a moving stereo / RGB-D camera (seed 001), one frame at a time.
+
+Per frame (:meth:`FollowTracker.step`):
+
+1. predict the target (and every other tracked person) with the constant-velocity Kalman filter
+   over the real time step;
+2. plan-view detection from depth (:mod:`~worldtrack.follow.planview`), silhouettes
+   (:mod:`~worldtrack.follow.silhouette`), colour normalisation and HS histograms
+   (:mod:`~worldtrack.follow.colour`);
+3. for every candidate RBhat (eq. 1) against the target's templates, E (eq. 2) against its
+   prediction, the illumination weight α and D (eq. 3) (:mod:`~worldtrack.follow.dissimilarity`);
+4. the decision: the paper's smallest D under the threshold, or (``track_others``) one assignment
+   of all candidates to the target and the others (:mod:`~worldtrack.follow.others`);
+5. the Kalman update with the chosen candidate, the template rules
+   (:mod:`~worldtrack.follow.templates`), new and ended tracks of the others.
+
+>>> import numpy as np
+>>> from worldtrack.synth import make_scenario
+>>> from worldtrack.follow import FollowTracker, frame_from_synth
+>>> sc = make_scenario("follow-target", size=(160, 120), frames=12, seed=1, others=0)
+>>> tracker = FollowTracker(scene=sc.scene)
+>>> for b in sc.frames():
+...     truth = (b.gt[0]["x"], b.gt[0]["y"])
+...     step = tracker.follow(frame_from_synth(b), b.views["robot"].camera, start_xy=truth if b.frame == 0 else None)
+>>> bool(step.found), bool(np.hypot(*(step.xy - truth)) < 0.15)
+(True, True)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.follow import kalman
+from worldtrack.follow.colour import bhattacharyya, histograms, n_bins, normalise_colour
+from worldtrack.follow.config import FollowConfig
+from worldtrack.follow.dissimilarity import (decide, dissimilarity, illumination_weight, position_error,
+                                             wb_change)
+from worldtrack.follow.others import Others, assign
+from worldtrack.follow.planview import Candidates, detect
+from worldtrack.follow.silhouette import box_silhouettes, covering, person_box, silhouettes
+from worldtrack.follow.templates import Templates
+from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Frame
+from worldtrack.scene.model import Scene
+
+#: Others are tracked mostly by position: their α is at least this (their templates are recent).
+OTHERS_MIN_ALPHA = 0.5
+#: A person within this distance (m) of the target makes its silhouette unsafe to learn from.
+CLEAR_RADIUS = 1.0
+#: A person this much nearer the camera (m) covering this share of the target's expected image box
+#: may be hiding it.
+HIDE_MARGIN = 0.25
+HIDE_SHARE = 0.3
+#: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
+COAST_S = 1.5
+
+
+@dataclass
+class Observation:
+    """What one frame shows: candidates, silhouettes (H, W) int32, histograms (N, B), the white
+    balance α reads (r, b) and the camera."""
+
+    candidates: Candidates
+    silhouettes: np.ndarray
+    hists: np.ndarray
+    wb: tuple[float, float]
+    camera: Camera
+
+
+@dataclass
+class FollowStep:
+    """The result of one frame.
+
+    Attributes
+    ----------
+    t : float, seconds; found : bool — the target was identified in this frame
+    xy, velocity : (2,) filtered position (m) and velocity (m/s), world (predicted when not found)
+    measured : (2,) the chosen candidate's position, NaN when not found
+    chosen : int — index of the target's candidate, −1 if none
+    candidates : Candidates; silhouettes : (H, W) int32 (0 background, i + 1 candidate i)
+    D, RBhat, E : (N,) each candidate against the target (eqs. 3, 1, 2)
+    alpha : float (eq. 3); w_steps : float — |W| in gain steps; gate : float, metres
+    owner : (N,) int — who each candidate was given to: 1 the target, ≥ 2 another person, 0 nobody
+    others_ids : (K,) int; others_xy : (K, 2) — the other people tracked (predicted when unseen)
+    """
+
+    t: float
+    found: bool
+    xy: np.ndarray
+    velocity: np.ndarray
+    measured: np.ndarray
+    chosen: int
+    candidates: Candidates
+    silhouettes: np.ndarray
+    D: np.ndarray
+    RBhat: np.ndarray
+    E: np.ndarray
+    alpha: float
+    w_steps: float
+    gate: float
+    owner: np.ndarray
+    others_ids: np.ndarray
+    others_xy: np.ndarray
+
+
+def observation_from_boxes(image: np.ndarray, boxes: np.ndarray, xy: np.ndarray, gains_rb, config: FollowConfig,
+                           camera: Camera | None = None) -> Observation:
+    """An :class:`Observation` whose candidates are given: floor positions ``xy`` (N, 2) metres and
+    image boxes (N, 4) ``(left, top, width, height)`` pixels (e.g. ground truth, or another detector).
+    ``gains_rb``: the frame's white balance (r, b) or None."""
+    sil = box_silhouettes(image.shape[:2], boxes)
+    n = len(xy)
+    b = np.asarray(boxes, float).reshape(-1, 4)
+    cands = Candidates(np.asarray(xy, float).reshape(-1, 2), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n),
+                       -(b[:, 1] + b[:, 3]), sil, 1)
+    normalised, wb = normalise_colour(image, gains_rb, config.normalise, sil > 0)
+    return Observation(cands, sil, histograms(normalised, sil, n, config), wb, camera)
+
+
+def frame_from_synth(bundle, camera_id: str = "robot") -> Frame:
+    """A :class:`~worldtrack.io.sources.Frame` (image, measured depth, gains) from a synthetic bundle."""
+    v = bundle.views[camera_id]
+    return Frame(v.image, float(bundle.time), int(bundle.frame), v.sensor_depth,
+                 meta={"wb_gains": tuple(v.wb_gains)})
+
+
+class FollowTracker:
+    """Follows one target person (id 1) among others; see the module docstring.
+
+    Parameters
+    ----------
+    config : FollowConfig, optional (the ``default`` preset)
+    scene : Scene, optional — its walkable area removes walls and obstacles from the plan view
+    """
+
+    def __init__(self, config: FollowConfig | None = None, scene: Scene | None = None):
+        self.config = config or FollowConfig()
+        self.walkable = scene.distance_field(0.05) if scene is not None else None
+        self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
+                             self.config.others_max_coast)
+        self.templates: Templates | None = None
+        self.x = np.zeros(4)
+        self.P = np.eye(4)
+        self.t = 0.0
+        self.last_seen = 0.0
+        self._alpha = 0.0
+
+    # ------------------------------------------------------------------ observation
+    def observe(self, frame: Frame, camera: Camera) -> Observation:
+        """Candidates, silhouettes and histograms of one frame (no state changes)."""
+        if frame.depth is None:
+            raise InputError(f"frame {frame.index}: no depth (give a depth or disparity image per frame)")
+        if frame.depth.shape != frame.image.shape[:2]:
+            raise InputError(f"frame {frame.index}: depth is {frame.depth.shape[1]}x{frame.depth.shape[0]} "
+                             f"but the colour image is {frame.image.shape[1]}x{frame.image.shape[0]}")
+        cfg = self.config
+        cands = detect(frame.depth, camera, cfg, self.walkable)
+        sil = silhouettes(cands.labels, cands.stride, frame.depth, cands.depth)
+        gains = frame.meta.get("wb_gains")
+        image, wb = normalise_colour(frame.image, gains, cfg.normalise, sil > 0)
+        return Observation(cands, sil, histograms(image, sil, len(cands), cfg), wb, camera)
+
+    # ------------------------------------------------------------------ start and step
+    def start(self, frame: Frame, camera: Camera, target_xy, max_distance: float = 1.0) -> FollowStep:
+        """Register the candidate nearest ``target_xy`` (m, world) as the target; InputError if none is
+        within ``max_distance``. Everyone else seen becomes another tracked person."""
+        return self.start_with(self.observe(frame, camera), frame.t, target_xy, max_distance, frame.index)
+
+    def start_with(self, obs: Observation, t: float, target_xy, max_distance: float = 1.0,
+                   index: int = 0) -> FollowStep:
+        """:meth:`start` on an observation made elsewhere (e.g. candidates from ground truth)."""
+        c = obs.candidates
+        d = np.hypot(*(c.xy - np.asarray(target_xy, float)).T) if len(c) else np.zeros(0)
+        if len(d) == 0 or d.min() > max_distance:
+            raise InputError(f"target: nobody found within {max_distance:g} m of ({target_xy[0]:.2f}, "
+                             f"{target_xy[1]:.2f}) in frame {index}")
+        i = int(np.argmin(d))
+        self.templates = Templates(obs.hists[i], obs.wb, self.config.short_term_tau)
+        x, P = kalman.initial_state(c.xy[i:i + 1], self.config.measurement_sigma)
+        self.x, self.P = x[0], P[0]
+        self.t = self.last_seen = t
+        self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
+                             self.config.others_max_coast)
+        rest = np.arange(len(c)) != i
+        owner = np.zeros(len(c), dtype=np.int64)
+        owner[i] = 1
+        if self.config.track_others:
+            owner[rest] = self.others.add(c.xy[rest], obs.hists[rest], t)
+        zeros = np.zeros(len(c))
+        return self._result(t, obs, i, zeros, zeros, d * self.config.k, 0.0, 0.0, owner)
+
+    def follow(self, frame: Frame, camera: Camera, start_xy=None) -> FollowStep:
+        """:meth:`start` when ``start_xy`` is given (or nothing is followed yet), else :meth:`step`."""
+        if start_xy is not None or self.templates is None:
+            if start_xy is None:
+                raise InputError("follow: give the target's position on the first frame (start_xy)")
+            return self.start(frame, camera, start_xy)
+        return self.step(frame, camera)
+
+    def step(self, frame: Frame, camera: Camera) -> FollowStep:
+        """Follow the target into ``frame`` (taken by ``camera``, the camera's pose at that frame)."""
+        if self.templates is None:
+            raise InputError("follow: call start() with the target's position first")
+        if frame.t < self.t:
+            raise InputError(f"frame {frame.index}: time stamp {frame.t:.3f} s is before the previous frame's")
+        return self.step_with(self.observe(frame, camera), frame.t)
+
+    def step_with(self, obs: Observation, t: float) -> FollowStep:
+        """:meth:`step` on an observation made elsewhere, at time ``t`` (s)."""
+        cfg = self.config
+        dt = t - self.t
+        if dt > 0:
+            x, P = kalman.predict(self.x[None], self.P[None], dt, cfg.accel_sigma)
+            self.x, self.P = x[0], P[0]
+            if t - self.last_seen > COAST_S:      # long unseen: the walk slows down (not off the map)
+                self.x[2:] *= np.exp(-dt / COAST_S)
+            self.others.predict(dt)
+        self.t = t
+        c = obs.candidates
+        E = position_error(c.xy, self.x[None, :2], cfg.k)[:, 0]
+        rb = self.templates.rbhat(obs.hists)
+        w = wb_change(obs.wb, self.templates.registered_wb)
+        alpha = float(illumination_weight(w, cfg.p, cfg.wb_unit, cfg.alpha_floor, cfg.weighting))
+        D = dissimilarity(rb, E, alpha, cfg.alpha_th)
+        self._alpha = alpha
+        gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
+        hiding = self._hiding(obs)
+        allowed = (E / cfg.k <= gate) & ~hiding
+        if cfg.track_others:
+            chosen, owner = self._assign_all(obs, D, allowed, hiding, t, dt)
+        else:
+            chosen = decide(D, cfg.threshold, allowed)
+            owner = np.zeros(len(c), dtype=np.int64)
+            if chosen >= 0:
+                owner[chosen] = 1
+        if chosen >= 0:
+            x, P = kalman.update(self.x[None], self.P[None], c.xy[chosen][None], cfg.measurement_sigma)
+            self.x, self.P = x[0], P[0]
+            self.last_seen = t
+        self._update_templates(obs, chosen, D, alpha, dt)
+        return self._result(t, obs, chosen, D, rb, E, alpha, w, owner, gate)
+
+    # ------------------------------------------------------------------ internals
+    def _assign_all(self, obs: Observation, D: np.ndarray, allowed: np.ndarray, hiding: np.ndarray, t: float,
+                    dt: float) -> tuple[int, np.ndarray]:
+        """One assignment of all candidates to the target (row 0) and the others; new tracks for the rest."""
+        cfg = self.config
+        c = obs.candidates
+        others = self.others
+        cost = np.where(allowed, D, np.inf)[None]
+        if len(others):
+            E_o = position_error(c.xy, others.x[:, :2], cfg.k)
+            rb_o = bhattacharyya(obs.hists, others.hist)
+            alpha_o = max(self._alpha, OTHERS_MIN_ALPHA)
+            D_o = dissimilarity(rb_o, E_o, alpha_o, cfg.alpha_th)
+            gate_o = others.gate(t, cfg.gate, cfg.gate_growth, cfg.max_gate)
+            D_o = np.where(E_o / cfg.k <= gate_o[None], D_o, np.inf)
+            cost = np.vstack([cost, D_o.T])
+        rows = assign(cost, cfg.threshold)
+        chosen = int(rows[0])
+        owner = np.zeros(len(c), dtype=np.int64)
+        if chosen >= 0:
+            owner[chosen] = 1
+        matched = np.flatnonzero(rows[1:] >= 0)
+        if len(matched):
+            cand = rows[1:][matched]
+            others.update(matched, c.xy[cand], obs.hists[cand], t, dt)
+            owner[cand] = others.ids[matched]
+        others.expire(t)
+        if chosen < 0:
+            chosen = self._reidentify(obs, owner, D, hiding, t)
+        free = np.flatnonzero(owner == 0)
+        owner[free] = others.add(c.xy[free], obs.hists[free], t)
+        return chosen, owner
+
+    def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, hiding: np.ndarray, t: float) -> int:
+        """Re-identify the lost target among the people who appeared since it was last seen.
+
+        Somebody seen at the same time as the target cannot be the target, so only candidates
+        nobody owns and those of tracks born after the target's last sighting qualify (a person
+        who reappears half hidden is often first taken for somebody new), and not one who may be
+        hiding the target. They must look like it (RBhat < ``reid_rbhat``) or score like it (D <
+        ``threshold``, E counting only the distance beyond half of what a walker could have strayed
+        from the prediction while unseen), and be no farther from it than a walker could have gone
+        (``gate + reid_speed·unseen``); the smallest D wins. A track taken over ends. Changes
+        ``owner`` in place; returns the candidate's index or −1.
+        """
+        cfg = self.config
+        others = self.others
+        young_ids = others.ids[others.born > self.last_seen]
+        eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
+        eligible = np.flatnonzero(eligible)
+        if len(eligible) == 0:
+            return -1
+        c = obs.candidates
+        rb = self.templates.rbhat(obs.hists[eligible])
+        dist = np.hypot(*(c.xy[eligible] - self.x[:2]).T)
+        unseen = t - self.last_seen
+        # Position counts only beyond half of what a walker could have strayed from the prediction.
+        e = cfg.k * np.maximum(0.0, dist - 0.5 * cfg.reid_speed * unseen)
+        d = dissimilarity(rb, e, self._alpha, cfg.alpha_th)
+        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & (dist <= cfg.gate + cfg.reid_speed * unseen)
+        if not ok.any():
+            return -1
+        pick = int(eligible[np.flatnonzero(ok)[np.argmin(d[ok])]])
+        if owner[pick] > 1:
+            others.remove(others.ids != owner[pick])
+        owner[pick] = 1
+        return pick
+
+    def _hiding(self, obs: Observation) -> np.ndarray:
+        """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
+        than its prediction and covering at least ``HIDE_SHARE`` of the image box where it should
+        stand. Such a person appears just as the target vanishes, where it vanishes; they are not
+        taken for it (``occluders``; the paper has no such rule)."""
+        n = len(obs.candidates)
+        if not self.config.occluders or obs.camera is None or n == 0:
+            return np.zeros(n, dtype=bool)
+        cover = covering(obs.silhouettes, n, person_box(obs.camera, self.x[:2]))
+        centre = obs.camera.centre[:2]
+        nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
+        return nearer & (cover >= HIDE_SHARE)
+
+    def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, alpha: float, dt: float) -> None:
+        cfg = self.config
+        hist = obs.hists[chosen] if chosen >= 0 else None
+        d = float(D[chosen]) if chosen >= 0 else np.inf
+        self.templates.paper_update(hist, obs.wb, alpha, d, cfg.alpha_th, cfg.update_max_d, cfg.update_every)
+        if chosen < 0 or self.templates.short is None:
+            return
+        # Learn when position alone is sure: close to the prediction and nobody else near. Not D:
+        # after a change of light the target's D stays high until the template has learnt it.
+        c = obs.candidates
+        near = np.hypot(*(c.xy - c.xy[chosen]).T) < CLEAR_RADIUS
+        close = np.hypot(*(c.xy[chosen] - self.x[:2])) * cfg.k < cfg.update_max_d
+        if near.sum() == 1 and close:
+            self.templates.learn(hist, obs.wb, dt)
+
+    def _result(self, t: float, obs: Observation, chosen: int, D, rb, E, alpha: float, w: float,
+                owner: np.ndarray, gate: float = 0.0) -> FollowStep:
+        c = obs.candidates
+        measured = c.xy[chosen].copy() if chosen >= 0 else np.full(2, np.nan)
+        return FollowStep(t, chosen >= 0, self.x[:2].copy(), self.x[2:].copy(), measured, int(chosen), c,
+                          obs.silhouettes, np.asarray(D, float), np.asarray(rb, float), np.asarray(E, float),
+                          float(alpha), float(w), float(gate), owner, self.others.ids.copy(),
+                          self.others.x[:, :2].copy())

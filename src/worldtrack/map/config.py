@@ -1,0 +1,79 @@
+"""Settings of the shared map: time buckets, leases, retention, how people are merged and forgotten.
+
+Set them like any other setting: ``map:`` in a ``--config`` file or ``--set map.bucket_s=0.1``.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from pydantic import Field, model_validator
+
+from worldtrack.config import Section, from_mapping, load_yaml, parse_assignment, with_overrides
+from worldtrack.errors import InputError
+
+
+class MapConfig(Section):
+    """How workers, the fusion role and the streams on Redis behave (times in seconds)."""
+
+    path: ClassVar[str] = "map"
+    prefix: str = Field("worldtrack", min_length=1, pattern=r"^[A-Za-z0-9_.:-]+$",
+                        description="key prefix: several maps can share one Redis database")
+    bucket_s: float = Field(0.1, gt=0, le=5, description="fusion time bucket: observations whose capture times "
+                                                          "fall in one bucket are merged into one map state")
+    max_wait_s: float = Field(0.5, gt=0, le=60, description="a bucket is written once every live camera has "
+                                                              "reported it, or this long after its first observation")
+    lease_s: float = Field(1.0, gt=0.1, le=60, description="camera and fusion leases expire this long after "
+                                                            "their last renewal (a dead worker's cameras are "
+                                                            "free again after it)")
+    renew_s: float = Field(0.25, gt=0.01, le=20, description="leases are renewed (and standbys try to take "
+                                                              "them) this often")
+    retention_s: float = Field(3600.0, gt=0, description="streams keep this much capture time (older entries "
+                                                         "are trimmed with MINID)")
+    merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
+                                                           "for merge_after_s are one person (the younger id "
+                                                           "is folded into the elder)")
+    merge_after_s: float = Field(0.2, ge=0, description="see merge_distance_m")
+    forget_after_s: float = Field(3.0, gt=0, description="a person no worker reports for this long leaves the "
+                                                         "map (their id may be reclaimed until then)")
+    claim_radius_m: float = Field(1.0, gt=0, description="a worker's new person within this distance of a "
+                                                         "person the map lost takes that person's id "
+                                                         "(plus 1.5 m/s times the time since they were lost)")
+    handover_margin_m: float = Field(1.0, ge=0, description="a worker puts the map's people on its own map "
+                                                            "when they come this close to its cameras' views")
+    pace_files: bool = Field(True, description="play video files as live cameras (in real time from the map's "
+                                               "epoch); false: as fast as the worker can (batch runs)")
+    fusion_in_worker: bool = Field(True, description="each worker contends for the fusion role in a thread; false: "
+                                                     "leave it to `worldtrack map fuse` processes (a fusion thread "
+                                                     "shares the worker's interpreter lock with its tracker)")
+    wait_for_start: bool = Field(False, description="video files wait for `worldtrack map start` (which sets "
+                                                    "the epoch for all at once) instead of the first worker's start")
+
+    @model_validator(mode="after")
+    def _renew_within_lease(self) -> "MapConfig":
+        if self.renew_s * 2 > self.lease_s:
+            raise ValueError(f"renew_s: expected at most half of lease_s ({self.lease_s}), got {self.renew_s}")
+        return self
+
+
+def map_settings(config: str | None = None, sets: list[str] | tuple[str, ...] = ()) -> MapConfig:
+    """The map settings of a ``--config`` file's ``map:`` section and ``--set map.NAME=VALUE``.
+
+    >>> map_settings(sets=["map.bucket_s=0.05"]).bucket_s
+    0.05
+    """
+    data = load_yaml(config).get("map") if config else None
+    try:
+        cfg = from_mapping(MapConfig, data, root="map")
+    except InputError as e:
+        raise InputError(f"{config}: {e}") from None
+    overrides = {}
+    for text in sets:
+        path, value = parse_assignment(text)
+        if not path.startswith("map."):
+            raise InputError(f"--set {path}: only the map's settings (map.NAME=VALUE) can be set here")
+        overrides[path[4:]] = value
+    return with_overrides(cfg, overrides, root="map") if overrides else cfg
+
+
+__all__ = ["MapConfig", "map_settings"]

@@ -1,0 +1,385 @@
+"""A worker on the shared map: owns some cameras (leases), runs a tracker on them, publishes what it
+sees and takes from the map the people it does not see.
+
+The worker's tracker needs no Redis code: it steps on its own :class:`SharedPositionMap`, and the
+worker, around each step (:class:`MapTracker`):
+
+* **before** — puts on that map the people the shared map holds near its cameras' views (a person
+  walking in from a neighbour's view is on it under their id before this worker's cameras show
+  them: no new birth) and moves the people its cameras did not show at the previous step to where
+  the shared map has them. People its cameras show are left to its tracker.
+* **after** — publishes, per camera, the people its tracker holds in that camera's view with its
+  estimate, their support, and whether the cameras show them now (a person it holds but cannot see,
+  hidden behind a desk, is published as not seen); and the ids its tracker ended there.
+
+New ids come from the map (:class:`SharedPositionMap`): a person the tracker confirms where the
+map has just lost somebody takes that person's id (a camera taken over after a worker died finds
+its people again), anyone else the next id of the map's counter, so ids never clash between workers.
+See :mod:`worldtrack.map.fusion` for how the estimates of a person two workers see are merged.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from worldtrack.errors import InputError
+from worldtrack.geometry.camera import Camera
+from worldtrack.map.config import MapConfig
+from worldtrack.map.connection import MapKeys
+from worldtrack.map.fusion import LEAD_SHARE, floor_information, visible_share
+from worldtrack.map.lease import FENCED_XADD, Lease
+from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
+                                     encode_observation, stream_id_ms)
+from worldtrack.trackers.base import Frame, Person, PositionMap, Track, Tracker
+
+
+class SharedPositionMap(PositionMap):
+    """A :class:`PositionMap` whose new ids come from ``new_id(x, y)`` (the shared map's) instead of
+    a local counter, so that trackers in different processes never give two people one id.
+
+    >>> ids = iter([41, 42])
+    >>> m = SharedPositionMap(lambda x, y: next(ids))
+    >>> m.add(1.0, 1.0).id, m.promote(m.add(2.0, 2.0, tentative=True).id)
+    (41, 42)
+    """
+
+    def __init__(self, new_id: Callable[[float, float], int]):
+        super().__init__()
+        self.new_id = new_id
+        #: While a tracker's warm start copies people from its private passes (local ids), their
+        #: ids are replaced by the shared map's: ``{local id: map id}``; None otherwise.
+        self.remap: dict[int, int] | None = None
+
+    def add(self, x: float, y: float, height: float = 1.65, width: float = 0.40, mode: str = "capture",
+            time: float = 0.0, track_id: int | None = None, tentative: bool = False,
+            confirmed: bool | None = None) -> Person:
+        if not tentative and (track_id is None or self.remap is not None):
+            new = self._free(self.new_id(x, y))
+            if self.remap is not None and track_id is not None:
+                self.remap[track_id] = new
+            track_id = new
+        return super().add(x, y, height, width, mode, time, track_id, tentative, confirmed)
+
+    def promote(self, person_id: int) -> int:
+        p = self[person_id]
+        self._next_id = self._free(self.new_id(p.x, p.y))    # the base class gives out _next_id
+        return super().promote(person_id)
+
+    def _free(self, pid: int) -> int:
+        """Make room for ``pid``: a copy of that person taken from the shared map gives way."""
+        if pid in self:
+            self.remove(pid)
+        return pid
+
+
+def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
+    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
+    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
+    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
+    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
+    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
+    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
+
+
+class MapLink:
+    """A worker's side of the shared map: its camera leases, ids, the map it reads, what it publishes.
+
+    Parameters
+    ----------
+    client : redis.Redis
+    keys : MapKeys
+    cfg : MapConfig
+    name : this worker's name (lease value)
+    cameras : {camera_id: Camera} — the cameras this worker owns
+    fps : the cameras' frame rate (for the fusion's wait)
+    clock : wall clock, seconds
+    occlusion : {camera_id: (H, W) floor distance of the obstacles} — the scene's occlusion maps
+        (:func:`~worldtrack.map.fusion.floor_information` leaves hidden body points out)
+    """
+
+    def __init__(self, client: Any, keys: MapKeys, cfg: MapConfig, name: str, cameras: Mapping[str, Camera],
+                 fps: float = 10.0, clock: Callable[[], float] = time.time,
+                 occlusion: Mapping[str, np.ndarray] | None = None):
+        self.client, self.keys, self.cfg, self.name, self.clock = client, keys, cfg, name, clock
+        self.cameras = dict(cameras)
+        self.occlusion = dict(occlusion or {})
+        self.fps = fps
+        self.leases = {c: Lease(client, keys.camera_lease(c), name, cfg.lease_s) for c in self.cameras}
+        self._xadd = client.register_script(FENCED_XADD)
+        self.state: MapState | None = None
+        self._state_t: float | None = None
+        self.mine_seen: set[int] = set()      # people this worker's cameras have shown (its own)
+        self.ever_seen: set[int] = set()
+        self.placed: set[int] = set()         # people put on the local map from the shared one
+        self.handed_over = 0                  # how many times (hand-overs from a neighbour's view)
+        self.claimed = 0                      # new people that took the id of a person the map had
+        self._reported: dict[int, tuple[str, ...]] = {}
+        self.published = 0
+        self.last_capture: float | None = None
+        #: Batch runs (files not played in real time): before each step wait (at most
+        #: ``lockstep_wait_s``) until the map holds the previous frame, so that workers going at
+        #: different speeds stay in step and none reads a map from its own future.
+        self.lockstep = False
+        self.lockstep_wait_s = 2.0
+        self._first_t: float | None = None
+
+    # ------------------------------------------------------------------ set-up
+    def register(self) -> None:
+        """Tell the fusion about this worker's cameras (and their frame rate)."""
+        self.client.hset(self.keys.cameras, mapping={c: json.dumps({"fps": self.fps, "worker": self.name})
+                                                    for c in self.cameras})
+
+    def epoch(self, lead_s: float = 0.5, wait: bool = False, poll_s: float = 0.05) -> float:
+        """The map's epoch: when video files played as cameras have their frame 0. Set by the first
+        worker to ask (``lead_s`` from now), or with ``wait`` by ``worldtrack map start``."""
+        if not wait:
+            set_epoch(self.client, self.keys, lead_s, self.cfg.bucket_s, self.clock, only_if_unset=True)
+        while True:
+            value = self.client.get(self.keys.epoch)
+            if value is not None:
+                return float(value)
+            time.sleep(poll_s)
+
+    def new_id(self, x: float, y: float) -> int:
+        """An id for a person the tracker confirms at (x, y): a lost person's of the map nearby, else
+        the next of the map's counter."""
+        claimed = self._claim(x, y)
+        if claimed is not None:
+            self.claimed += 1
+            return claimed
+        return int(self.client.incr(self.keys.ids))
+
+    def _claim(self, x: float, y: float) -> int | None:
+        if self.state is None:
+            return None
+        best, best_d = None, math.inf
+        now = self._state_t if self._state_t is not None else self.state.t
+        for p in self.state.people:
+            d = math.hypot(p.x - x, p.y - y)
+            if p.mode == "lost":
+                reach = self.cfg.claim_radius_m + 1.5 * max(0.0, now - p.last_seen)
+            elif p.id not in self.mine_seen:
+                reach = self.cfg.merge_distance_m
+            else:
+                continue
+            if d < reach and d < best_d:
+                best, best_d = p.id, d
+        return best
+
+    # ------------------------------------------------------------------ each frame
+    def read_map(self) -> MapState | None:
+        """The latest map state (None before the first)."""
+        raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports"])
+        if raw[0] is None:
+            return None
+        if self.state is None or float(raw[2]) != self.state.t:
+            fields = {"v": FORMAT_VERSION, "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}",
+                      "written": raw[3] or "0",
+                      "reports": raw[4] or "[]"}
+            self.state = decode_map_state(fields)
+        return self.state
+
+    def _wait_for_map(self, t: float) -> None:
+        if self._first_t is None:
+            self._first_t = t
+        if not self.lockstep or t - self._first_t < 1.5 / self.fps:
+            return
+        deadline = time.monotonic() + self.lockstep_wait_s
+        while time.monotonic() < deadline:
+            state = self.read_map()
+            if state is not None and state.captured >= t - 1.5 / self.fps:
+                return
+            time.sleep(0.002)
+
+    def sync(self, tracker: Tracker, t: float) -> None:
+        """Before the tracker steps at ``t``: take from the shared map what this worker does not see."""
+        self._wait_for_map(t)
+        state = self.read_map()
+        self._state_t = t
+        if state is None:
+            return
+        local = tracker.position_map
+        for young, elder in state.aliases.items():
+            if young in local:
+                local.remove(young)
+                self.mine_seen.discard(young)
+        present = {p.id: p for p in state.present()}
+        cams = list(self.cameras.values())
+        dt = min(max(t - state.captured, 0.0), 0.5)
+        for p in present.values():
+            x, y = p.x + p.vx * dt, p.y + p.vy * dt
+            q = local.get(p.id)
+            if q is None:
+                # Not where this worker already holds somebody under another id: the map merges
+                # those two ids (a copy here would make one worker hold the same person twice).
+                if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)) and \
+                        not self._holds_near(local, x, y):
+                    self._place(tracker, p, x, y, t)
+            elif p.id not in self.mine_seen or p.lead not in ("", self.name):
+                # Not shown by this worker's cameras, or shown better by another worker's: from
+                # where the map has them (this worker's cameras then move them by their evidence).
+                q.x, q.y, q.vx, q.vy = x, y, p.vx, p.vy
+                if math.isfinite(p.height):
+                    q.height = p.height
+        for q in list(local):
+            if q.id > 0 and q.id in self.placed and q.id not in present and q.id not in self.mine_seen:
+                local.remove(q.id)
+                self.placed.discard(q.id)
+
+    def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
+        return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m for q in local)
+
+    def _place(self, tracker: Tracker, p, x: float, y: float, t: float) -> None:
+        local = tracker.position_map
+        try:
+            tracker.init_track(x, y, track_id=p.id, t=t)
+        except (InputError, TypeError):
+            local.add(x, y, p.height, p.width, mode="tracking", time=t, track_id=p.id, confirmed=True)
+        q = local[p.id]
+        q.vx, q.vy, q.born, q.last_seen = p.vx, p.vy, p.born, p.last_seen
+        q.height = p.height if math.isfinite(p.height) else q.height
+        q.width = p.width if math.isfinite(p.width) else q.width
+        self.placed.add(p.id)
+        self.handed_over += 1
+
+    def observations(self, tracker: Tracker, tracks: Sequence[Track], t: float,
+                     frames: Mapping[str, Frame]) -> list[Observation]:
+        """What this worker saw at ``t``, one observation per camera it has a frame of."""
+        local = tracker.position_map
+        sent = self.clock()
+        per_cam: dict[str, list[Estimate]] = {c: [] for c in frames if c in self.cameras}
+        cams = [c for c in per_cam]
+        now_ids = set()
+        self.mine_seen = set()
+        for tr in tracks:
+            person = local.get(tr.id)
+            seen = person is not None and (person.last_seen >= t or person.seen_now(t))
+            views = in_views([self.cameras[c] for c in cams], np.array([tr.x, tr.y]), tr.height)
+            if not any(views) or not (seen or tr.id in self.ever_seen):
+                continue
+            mine = [c for c, ok in zip(cams, views) if ok]
+            where, occ = np.array([tr.x, tr.y]), [self.occlusion.get(c) for c in mine]
+            # This worker's own estimate only where its cameras show most of the body; a person
+            # it glimpses (through a door, at the image's edge) it keeps taking from the map.
+            share = visible_share([self.cameras[c] for c in mine], where, tr.height, occ)
+            if seen and share >= LEAD_SHARE:
+                self.mine_seen.add(tr.id)
+                self.ever_seen.add(tr.id)
+                self.placed.discard(tr.id)
+            now_ids.add(tr.id)
+            support = _support(person, tr)
+            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ)
+            e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info,
+                         share)
+            for c, ok in zip(cams, views):
+                if ok:
+                    per_cam[c].append(e)
+        ended = tuple(sorted(i for i in self._reported if i not in local))
+        self._reported = {i: () for i in now_ids}
+        self.ever_seen &= {p.id for p in local}
+        return [Observation(c, float(frames[c].t), self.name, int(frames[c].index), sent, tuple(per_cam[c]), ended)
+                for c in cams]
+
+    def publish(self, observations: Sequence[Observation]) -> None:
+        """Append the observations to their cameras' streams (only while this worker holds the camera)."""
+        pipe = self.client.pipeline(transaction=False)
+        for o in observations:
+            fields = encode_observation(o)
+            args = [self.name, f"{stream_id_ms(o.t)}-*", str(stream_id_ms(o.t - self.cfg.retention_s))]
+            for k, v in fields.items():
+                args += [k, v]
+            self._xadd(keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)], args=args,
+                       client=pipe)
+        for o, res in zip(observations, pipe.execute()):
+            if res == 0 and not self._retake(o):
+                holder = self.leases[o.camera].holder()[0]
+                raise InputError(f"{o.camera}: this worker lost the camera's lease to {holder}; stopping")
+            self.published += 1
+            self.last_capture = o.t
+
+    def _retake(self, o: Observation) -> bool:
+        """The lease expired while this worker stalled: take it again if nobody else has, and publish."""
+        if not self.leases[o.camera].acquire():
+            return False
+        fields = encode_observation(o)
+        args = [self.name, f"{stream_id_ms(o.t)}-*", str(stream_id_ms(o.t - self.cfg.retention_s))]
+        for k, v in fields.items():
+            args += [k, v]
+        return self._xadd(keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)], args=args) != 0
+
+
+def set_epoch(client: Any, keys: MapKeys, lead_s: float, bucket_s: float, clock: Callable[[], float] = time.time,
+              only_if_unset: bool = False) -> float:
+    """Set the map's epoch ``lead_s`` from now, in the middle of a time bucket (frame ``i`` of every
+    file, at ``epoch + i / fps``, then falls in bucket ``i`` when fps is ``1 / bucket_s``)."""
+    epoch = (math.floor((clock() + lead_s) / bucket_s) + 0.5) * bucket_s
+    client.set(keys.epoch, repr(epoch), nx=only_if_unset)
+    return float(client.get(keys.epoch))
+
+
+def _support(person: Person | None, tr: Track) -> float:
+    for v in (getattr(person, "support", float("nan")), (person.extra if person is not None else {}).get("support"),
+              tr.extra.get("support")):
+        if v is not None and math.isfinite(float(v)):
+            return float(v)
+    return float("nan")
+
+
+class MapTracker:
+    """A tracker stepping on the shared map: :class:`MapLink` ``sync`` before each step and
+    ``publish`` after. Everything else is the inner tracker's (the :class:`Tracker` protocol).
+
+    The inner tracker's warm start (tracking the first frames forwards and backwards, to start on
+    frame 0 with the people in view) runs only when the shared map has nobody near this worker's
+    views (a worker starting with the map, not one taking a camera over), its people taking the
+    map's ids.
+    """
+
+    def __init__(self, inner: Tracker, link: MapLink, on_step: Callable[[float], None] | None = None):
+        self.inner, self.link, self.on_step = inner, link, on_step
+        self.extra_columns = inner.extra_columns
+
+    @property
+    def position_map(self) -> PositionMap:
+        return self.inner.position_map
+
+    @property
+    def warm_start_frames(self) -> int:
+        if not isinstance(self.position_map, SharedPositionMap):
+            return 0
+        state = self.link.read_map()
+        cams = list(self.link.cameras.values())
+        if state is not None and any(any(in_views(cams, np.array([p.x, p.y]), p.height,
+                                                  self.link.cfg.handover_margin_m)) for p in state.present()):
+            return 0
+        return self.inner.warm_start_frames
+
+    def warm_start(self, frames) -> None:
+        pm = self.position_map
+        pm.remap = {}
+        try:
+            self.inner.warm_start(frames)
+        finally:
+            pm.remap = None
+
+    def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0) -> Track:
+        return self.inner.init_track(x, y, track_id=track_id, t=t)
+
+    def overlay(self, camera_id: str):
+        return self.inner.overlay(camera_id)
+
+    def step(self, frames: Mapping[str, Frame], t: float) -> list[Track]:
+        self.link.sync(self.inner, t)
+        tracks = self.inner.step(frames, t)
+        self.link.publish(self.link.observations(self.inner, tracks, t, frames))
+        if self.on_step is not None:
+            self.on_step(t)
+        return tracks
+
+
+__all__ = ["MapLink", "MapTracker", "SharedPositionMap", "in_views", "set_epoch"]

@@ -1,0 +1,80 @@
+"""The PID follower's commands, and the closed loop in the synthetic world."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from worldtrack.follow import PIDFollower
+from worldtrack.follow.loop import Robot, camera_pose, run_closed_loop
+from worldtrack.geometry.camera import Camera
+
+CAM = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1), hfov_deg=66)
+
+
+def step(xy, velocity=(0.0, 0.0), found=True, others=()):
+    return SimpleNamespace(found=found, xy=np.array(xy, float), velocity=np.array(velocity, float),
+                           candidates=SimpleNamespace(xy=np.array([xy], float)),
+                           others_xy=np.array(others, float).reshape(-1, 2))
+
+
+def test_pid_drives_to_the_distance_and_turns_to_the_bearing():
+    pid = PIDFollower(distance=1.8, feed_forward=False)
+    v, w = pid.command(step((2.8, 0.0)), CAM, 0.0)
+    assert v == pytest.approx(1.2 * 1.0) and w == pytest.approx(0.0)      # Kp·e, nothing integrated yet
+    v, w = PIDFollower().command(step((1.8, 0.0)), CAM, 0.0)
+    assert v == pytest.approx(0.0) and w == pytest.approx(0.0)
+    v, w = PIDFollower().command(step((1.8, -0.5)), CAM, 0.0)
+    assert w < 0                                                          # target to the right: turn right
+    v, _ = PIDFollower().command(step((1.0, 0.0)), CAM, 0.0)
+    assert v == pytest.approx(-0.5)                                       # too close: back off, at most 0.5 m/s
+    v, _ = PIDFollower().command(step((30.0, 0.0)), CAM, 0.0)
+    assert v == pytest.approx(1.6)                                        # speed limit
+
+
+def test_feed_forward_matches_a_walking_target_and_the_integral_uses_real_time():
+    v, _ = PIDFollower().command(step((1.8, 0.0), velocity=(1.1, 0.0)), CAM, 0.0)
+    assert v == pytest.approx(1.1)
+    pid = PIDFollower(distance_gains=(0.0, 1.0, 0.0), feed_forward=False)
+    pid.command(step((2.8, 0.0)), CAM, 0.0)
+    v, _ = pid.command(step((2.8, 0.0)), CAM, 0.25)
+    assert v == pytest.approx(0.25)                                       # ∫e dt = 1 m · 0.25 s
+
+
+def test_somebody_in_the_path_stops_the_robot_and_a_lost_target_only_turns_it():
+    pid = PIDFollower()
+    v, _ = pid.command(step((3.5, 0.0), others=[(0.6, 0.1)]), CAM, 0.0)
+    assert v == 0.0 and pid.blocked
+    v, _ = PIDFollower().command(step((3.5, 0.0), others=[(0.6, 1.5)]), CAM, 0.0)
+    assert v > 0                                                          # beside the path: no stop
+    pid = PIDFollower()
+    pid.command(step((3.5, 0.0)), CAM, 0.0)
+    v, w = pid.command(step((3.5, 2.0), found=False), CAM, 1.5)
+    assert v == 0.0 and 0 < w <= 0.5
+
+
+def test_robot_kinematics_limits_and_bumper():
+    r = Robot(0.0, 0.0, 0.0)
+    free = lambda xy: np.full(len(xy), 5.0)                               # noqa: E731
+    for _ in range(10):
+        r.drive(3.0, 0.0, 0.1, free)
+    assert r.v == pytest.approx(1.5) and r.x == pytest.approx(sum(0.15 * k for k in range(1, 11)) * 0.1, abs=1e-9)
+    wall = lambda xy: np.full(len(xy), 0.1)                               # noqa: E731
+    assert not r.drive(1.0, 0.0, 0.1, wall) and r.v == 0.0
+    R, t = camera_pose(Robot(2.0, 1.0, np.pi / 2), 1.1)
+    cam = CAM.moved(R, t)
+    np.testing.assert_allclose(cam.centre, [2.0, 1.1, 1.1], atol=1e-9)
+    np.testing.assert_allclose(cam.floor_direction, [0.0, 1.0], atol=1e-9)
+
+
+@pytest.mark.slow
+def test_closed_loop_keeps_the_distance_without_collisions():
+    from worldtrack.synth import make_scenario
+    sc = make_scenario("follow-target", size=(160, 120), frames=150, seed=5, others=1, clear_route=True)
+    result = run_closed_loop(sc)
+    err = np.abs(result.distance - 1.8)
+    assert result.found.mean() > 0.95
+    assert np.mean(err <= 0.3) > 0.85 and err.max() < 0.8
+    assert result.collisions == 0 and result.bumps == 0
+    # the camera was where the robot put it: the frames were drawn from the closed loop
+    assert np.linalg.norm(result.camera_xy[-1] - result.robot_xy[-1]) == pytest.approx(0.1, abs=1e-6)

@@ -1,0 +1,139 @@
+"""The follower end to end on a short hard sequence: a look-alike cuts in, the white balance jumps."""
+
+import numpy as np
+import pytest
+
+from worldtrack.errors import InputError
+from worldtrack.eval.follow import counts, follow_labels, reacquisitions
+from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth
+from worldtrack.follow.tracker import observation_from_boxes
+from worldtrack.trackers.base import Frame
+
+
+def follow(sc, bundles, preset="default", **overrides):
+    tracker = FollowTracker(FollowConfig.preset(preset, **overrides), sc.scene)
+    n = len(bundles)
+    truth, vis, others = np.full((n, 2), np.nan), np.zeros(n), []
+    reported, filtered, steps = np.full((n, 2), np.nan), np.zeros((n, 2)), []
+    for b in bundles:
+        people = {r["id"]: r for r in b.gt}
+        truth[b.frame] = people[1]["x"], people[1]["y"]
+        vis[b.frame] = people[1]["vis_robot"]
+        others.append(np.array([[r["x"], r["y"]] for i, r in people.items() if i != 1]).reshape(-1, 2))
+        step = tracker.follow(frame_from_synth(b), b.views["robot"].camera, start_xy=truth[0] if b.frame == 0 else None)
+        if step.found:
+            reported[b.frame] = step.measured
+        filtered[b.frame] = step.xy
+        steps.append(step)
+    labels = follow_labels(truth, vis >= 0.5, reported, others)
+    return labels, truth, vis, filtered, steps
+
+
+def test_default_keeps_the_target_through_the_look_alike_and_the_gain_jumps(lookalike_cut_in):
+    sc, bundles = lookalike_cut_in
+    labels, truth, vis, filtered, steps = follow(sc, bundles)
+    c = counts(labels[1:])
+    assert c.b == 0 and c.recall >= 0.98
+    times = np.arange(len(bundles)) / sc.fps
+    occlusions = reacquisitions(labels, vis >= 0.5, np.ones(len(labels), bool), times)
+    assert len(occlusions) == 2 and all(o.duration >= 0.6 and o.delay <= 0.5 for o in occlusions)
+    found = labels == "A"
+    assert np.sqrt(np.mean(np.sum((filtered[found] - truth[found]) ** 2, axis=1))) < 0.1
+    # the white balance did jump, by up to 400 steps, while this went on
+    gains = np.array([b.views["robot"].wb_gains for b in bundles])
+    assert np.abs(np.diff(gains, axis=0)).sum(axis=1).max() > 150
+    # the target's own D stays small, the others' large
+    assert np.mean([s.D[s.chosen] for s in steps[1:] if s.found]) < 0.15
+
+
+def test_colour_alone_loses_the_target_when_the_white_balance_jumps(lookalike_cut_in):
+    sc, bundles = lookalike_cut_in
+    labels = follow(sc, bundles, "colour-only")[0]
+    assert counts(labels[1:]).recall < 0.3
+
+
+def test_without_tracking_the_others_the_target_is_not_found_again_after_the_cut_in(lookalike_cut_in):
+    sc, bundles = lookalike_cut_in
+    labels = follow(sc, bundles, "default", track_others=False)[0]
+    assert counts(labels[1:]).recall < 0.6
+
+
+def test_start_needs_somebody_near_the_given_position_and_depth_of_the_image_size(lookalike_cut_in):
+    sc, bundles = lookalike_cut_in
+    b = bundles[0]
+    tracker = FollowTracker(scene=sc.scene)
+    with pytest.raises(InputError, match="nobody found within 1 m"):
+        tracker.start(frame_from_synth(b), b.views["robot"].camera, (1.0, 11.0))
+    frame = frame_from_synth(b)
+    assert frame.meta["wb_gains"] == tuple(b.views["robot"].wb_gains) and frame.disparity is None
+    bad = Frame(frame.image, frame.t, 0, frame.depth[:, :-2], meta=frame.meta)
+    with pytest.raises(InputError, match="depth is 158x120 but the colour image is 160x120"):
+        tracker.observe(bad, b.views["robot"].camera)
+    with pytest.raises(InputError, match="start"):
+        FollowTracker().step(frame, b.views["robot"].camera)
+
+
+@pytest.mark.parametrize("preset, right", [("default", True), ("colour-only", False)])
+def test_given_candidates_are_followed_through_a_crossing_of_look_alikes(preset, right):
+    """Two people in the same clothes pass each other 0.6 m apart (boxes given, no depth): position
+    keeps them apart, colour alone cannot."""
+    cfg = FollowConfig.preset(preset)
+    img = np.full((120, 200, 3), 120, np.uint8)
+    tracker = FollowTracker(cfg)
+    chosen_x = []
+    for k in range(40):
+        t = k / 10
+        xy = np.array([[2.0 - t, 0.6], [-2.0 + t, 0.0]])            # they pass at t = 2 s; the target is 1
+        u = 100 + 20 * xy[:, 0]
+        boxes = np.column_stack([u - 8, np.full(2, 20.0), np.full(2, 16.0), np.full(2, 80.0)])
+        frame = img.copy()
+        for left in boxes[:, 0]:
+            frame[20:100, int(left):int(left) + 16] = (40, 60, 160)
+        obs = observation_from_boxes(frame, boxes, xy, (512, 512), cfg)
+        step = tracker.start_with(obs, t, xy[1]) if k == 0 else tracker.step_with(obs, t)
+        chosen_x.append(xy[step.chosen, 0] if step.found else np.nan)
+    chosen_x = np.array(chosen_x)
+    seen = np.isfinite(chosen_x)
+    truth = -2.0 + np.arange(40) / 10
+    if right:
+        assert seen.sum() >= 39                   # only at t = 2 s, boxes on top of each other, is it hidden
+        np.testing.assert_allclose(chosen_x[seen], truth[seen], atol=1e-9)   # always the target
+    else:
+        assert np.sum(np.abs(chosen_x[seen] - truth[seen]) > 1e-9) >= 5       # the other one, often
+
+
+def test_a_person_appearing_in_front_of_the_target_as_it_vanishes_is_not_taken_for_it():
+    """An occluder in the target's clothes steps in front of it (nearer the camera) and walks with
+    it for a second: the target is hidden, the newcomer covers where it should be. Nobody is
+    reported until the target is seen again, then the target is."""
+    from worldtrack.follow.silhouette import person_box
+    from worldtrack.geometry.camera import Camera
+
+    cam = Camera.look_at("c", 320, 240, position=(0, -6, 3), target=(0, 0, 0.8), hfov_deg=60)
+    cfg = FollowConfig()
+    tracker = FollowTracker(cfg)
+    rng = np.random.default_rng(0)
+    labels = []
+    for k in range(35):
+        t = k / 10
+        target = np.array([-1.5 + t, 0.0])
+        occluder = target + [0.05, -0.5]
+        people = [target, np.array([2.0, 2.0])]
+        who = ["T", "O"]
+        if 10 <= k < 25:                                  # the occluder in front; the target hidden
+            people[0] = occluder
+            who[0] = "X"
+        boxes = []
+        for xy in people:
+            u0, v0, u1, v1 = person_box(cam, xy)
+            boxes.append([u0, v0, u1 - u0, v1 - v0])
+        boxes = np.array(boxes, float)
+        img = np.full((240, 320, 3), 110, np.uint8)
+        for left, top, w, h in boxes[np.argsort(boxes[:, 1] + boxes[:, 3])]:
+            img[int(top):int(top + h), int(left):int(left + w)] = (40, 60, 160)
+        img = np.clip(img + rng.normal(0, 2, img.shape), 0, 255).astype(np.uint8)
+        obs = observation_from_boxes(img, boxes, np.array(people), (512, 512), cfg, cam)
+        step = tracker.start_with(obs, t, target) if k == 0 else tracker.step_with(obs, t)
+        labels.append(who[step.chosen] if step.found else "-")
+    assert "X" not in labels, "".join(labels)
+    assert labels[:10].count("T") == 10 and labels[25:].count("T") >= 9

@@ -1,0 +1,129 @@
+"""Message formats and the fusion rule, without a server (pure functions)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from worldtrack.errors import InputError
+from worldtrack.map.config import MapConfig, map_settings
+from worldtrack.map.connection import hide_passwords, redacted, with_credentials
+from worldtrack.map.fusion import FusionState, floor_information, fuse_bucket
+from worldtrack.map.messages import (Estimate, MapPerson, MapState, Observation, decode_map_state,
+                                     decode_observation, encode_map_state, encode_observation)
+
+
+def est(pid, x, y, support=0.8, seen=True, info=(1.0, 0.0, 1.0)):
+    return Estimate(pid, x, y, 1.7, 0.45, 0.0, 0.0, 0.5, support, seen, *info)
+
+
+def obs(cam, t, worker, people, ended=()):
+    return Observation(cam, t, worker, int(t * 10), t + 0.01, tuple(people), tuple(ended))
+
+
+def test_observation_and_map_state_round_trip_with_nan():
+    o = obs("cam1", 12.34, "w", [Estimate(3, 1.25, 2.5, 1.7, 0.45, 0.1, -0.2, 0.7, float("nan"), False, 40.0, -3.0, 900.0)],
+            ended=[5])
+    back = decode_observation(encode_observation(o))
+    assert back.people[0].id == 3 and back.people[0].seen is False and math.isnan(back.people[0].support)
+    assert back.people[0][:4] == (3, 1.25, 2.5, 1.7) and back.people[0].iyy == 900.0 and back.ended == (5,)
+    s = MapState(12.3, (MapPerson(3, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "lost", 11.0, 3.0, 1),),
+                 (("cam1", 12.34, 12.35),), {7: 3}, 12.5, 2)
+    assert decode_map_state(encode_map_state(s)) == s
+
+
+@pytest.mark.parametrize("fields, problem", [({"v": "0"}, "format version"), ({"v": "2", "t": "1"}, "KeyError"),
+                                             ({"v": "2", "t": "1", "o": '["c", "w", 1, 1.0, [[1, 2]'}, "JSONDecodeError"),
+                                             ({"v": "2", "t": "1", "o": '["c", "w", 1, 1.0, [[1, 2]], []]'},
+                                              "IndexError")])
+def test_malformed_observations_are_named(fields, problem):
+    with pytest.raises(ValueError, match=problem):
+        decode_observation(fields)
+
+
+def test_support_and_geometry_weigh_two_workers():
+    cfg = MapConfig()
+    # Same resolution: the support decides, 0.9 against 0.3.
+    s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(1, 2.0, 0.0, 0.9)]),
+                                        obs("b", 1.02, "w2", [est(1, 2.4, 0.0, 0.3)])], cfg)
+    assert s.people[0].x == pytest.approx((0.9 * 2.0 + 0.3 * 2.4) / 1.2)
+    # A camera that resolves x ten times finer wins along x only.
+    s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(1, 2.0, 1.0, info=(100.0, 0.0, 1.0))]),
+                                        obs("b", 1.0, "w2", [est(1, 3.0, 2.0, info=(10.0, 0.0, 1.0))])], cfg)
+    assert s.people[0].x == pytest.approx((100 * 2.0 + 10 * 3.0) / 110) and s.people[0].y == pytest.approx(1.5)
+
+
+def test_held_estimates_count_only_when_nobody_sees_the_person():
+    cfg = MapConfig()
+    s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(1, 2.0, 0.0, seen=True)]),
+                                        obs("b", 1.0, "w2", [est(1, 5.0, 0.0, seen=False)])], cfg)
+    assert s.people[0].x == pytest.approx(2.0) and s.people[0].workers == 1
+    s = fuse_bucket(FusionState(), 10, [obs("b", 1.0, "w2", [est(1, 5.0, 0.0, seen=False)])], cfg)
+    assert s.people[0].x == pytest.approx(5.0) and s.people[0].mode == "tracking"
+
+
+def test_lost_forgotten_and_ended():
+    cfg = MapConfig(forget_after_s=1.0)
+    st = FusionState()
+    fuse_bucket(st, 10, [obs("a", 1.0, "w1", [est(1, 2.0, 0.0), est(2, 4.0, 0.0)])], cfg)
+    s = fuse_bucket(st, 11, [obs("a", 1.1, "w1", [est(2, 4.0, 0.0)])], cfg)
+    assert [(p.id, p.mode) for p in s.people] == [(1, "lost"), (2, "tracking")]
+    assert [p.id for p in s.present()] == [2]
+    s = fuse_bucket(st, 12, [obs("a", 1.2, "w1", [], ended=[2])], cfg)       # walked out of the door
+    assert [p.id for p in s.people] == [1]
+    s = fuse_bucket(st, 21, [obs("a", 2.1, "w1", [])], cfg)                   # 1.1 s unseen > forget_after_s
+    assert s.people == ()
+
+
+def test_two_ids_of_one_person_from_two_workers_merge_into_the_elder():
+    cfg = MapConfig(merge_after_s=0.25)
+    st = FusionState()
+    fuse_bucket(st, 10, [obs("a", 1.0, "w1", [est(4, 2.0, 0.0)])], cfg)
+    merged = None
+    for b in range(11, 16):
+        s = fuse_bucket(st, b, [obs("a", b / 10, "w1", [est(4, 2.0, 0.0)]), obs("b", b / 10, "w2", [est(9, 2.2, 0.0)])],
+                        cfg)
+        merged = merged or (s.aliases or None)
+    assert merged == {9: 4} and [p.id for p in s.people] == [4]
+    # Later observations under the merged id land on the elder.
+    s = fuse_bucket(st, 16, [obs("b", 1.6, "w2", [est(9, 2.1, 0.0)])], cfg)
+    assert [p.id for p in s.present()] == [4]
+    # The same worker holding two people close together: two people, never merged.
+    st2 = FusionState()
+    for b in range(10, 20):
+        s = fuse_bucket(st2, b, [obs("a", b / 10, "w1", [est(1, 2.0, 0.0), est(2, 2.2, 0.0)])], cfg)
+    assert [p.id for p in s.people] == [1, 2]
+
+
+def test_fusion_state_survives_json():
+    cfg = MapConfig()
+    st = FusionState()
+    fuse_bucket(st, 10, [obs("a", 1.0, "w1", [est(1, 2.0, 0.0)]), obs("b", 1.0, "w2", [est(2, 2.1, 0.0)])], cfg)
+    back = FusionState.from_json(st.to_json())
+    assert back.people == st.people and back.close_since == st.close_since and back.last_bucket == 10
+
+
+def test_floor_information_is_finer_near_the_camera_and_along_its_image_plane():
+    from worldtrack.geometry.camera import Camera
+    cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
+    near = floor_information([cam], np.array([2.5, 0.0]), 1.7)
+    far = floor_information([cam], np.array([6.0, 0.0]), 1.7)
+    assert near[0] > 4 * far[0] and near[2] > far[2]
+    assert far[2] > far[0]              # across the line of sight resolves better than along it
+    assert all(math.isnan(v) for v in floor_information([cam], np.array([-3.0, 0.0]), 1.7))   # behind it
+
+
+def test_passwords_never_shown_and_taken_from_the_environment():
+    assert redacted("redis://u:pw@h:1/0") == "redis://u:***@h:1/0"
+    assert hide_passwords("x rtsp://a:b@c/d redis://h:1") == "x rtsp://a:***@c/d redis://h:1"
+    env = {"WORLDTRACK_REDIS_USER": "trk", "WORLDTRACK_REDIS_PASSWORD": "s3 cr/et"}
+    assert with_credentials("rediss://h:6380/2", env) == "rediss://trk:s3%20cr%2Fet@h:6380/2"
+    assert with_credentials("redis://me:mine@h/0", env) == "redis://me:mine@h/0"     # the URL's own win
+
+
+def test_map_settings_errors_name_the_field():
+    assert map_settings(sets=["map.lease_s=2", "map.renew_s=0.5"]).renew_s == 0.5
+    with pytest.raises(InputError, match=r"^map.renew_s: expected at most half of lease_s"):
+        map_settings(sets=["map.renew_s=0.9"])
+    with pytest.raises(InputError, match=r"^--set ellipsoid.x: only the map's settings"):
+        map_settings(sets=["ellipsoid.x=1"])
