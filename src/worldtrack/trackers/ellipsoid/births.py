@@ -100,15 +100,18 @@ class Births:
     config : BirthConfig
     height_range : (min, max) plausible heights, m (``ellipsoid.height.range_m``), or None when
         heights are not measured (blobs then place people by their lower end, as before issue 37)
+    min_px : a blob tells a height only when it is at least this long, px (``ellipsoid.height.min_px``,
+        the rule the tracker's own height measurements follow: small, a pixel is centimetres)
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
-                 config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1)):
+                 config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60):
         self.views = views
         self.scene = scene
         self.walkable = walkable
         self.config = config
         self.height_range = height_range
+        self.min_px = min_px
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
@@ -154,7 +157,7 @@ class Births:
         # Components found at ~320 px wide (each blob then read back at full resolution):
         # labelling the whole 640x480 frame was a third of the births' time.
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
-            found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range)
+            found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px)
             if found is None:
                 continue
             p, height, share = found
@@ -192,7 +195,7 @@ class Births:
 
 
 def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
-                  height: float, height_range: tuple[float, float] | None = (1.3, 2.1)
+                  height: float, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: float = 0
                   ) -> BlobPlace | None:
     """Floor position (3,) of a person seen as ``blob``, the height (m) the blob shows and the share
     of the person it shows, or None.
@@ -212,7 +215,8 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     end would put the person too far along the line of sight: the head places them instead (at
     the default ``height``), no height is given, and the share is the blob's length over the
     length of a person of that height standing there. Above the maximum, no height is given either.
-    ``height_range=None`` (heights not measured, as in the paper's preset): the lower end always.
+    ``height_range=None`` (heights not measured, as in the paper's preset), or a blob shorter
+    than ``min_px`` or touching the image border: no height, and the lower end always.
     """
     cam = view.camera
     down = view.down_direction(centroid)
@@ -236,7 +240,10 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
         # Only oblique views tell the height (as in height.py): from above, the ends of the blob
         # are the head and the shoulders, not the head and the feet.
         oblique = np.isfinite(p).all() and np.hypot(*(p[:2] - cam.centre[:2])) >= cam.centre[2] - 0.5 * height
-        shown = head_height(cam, head, p) if head_seen and oblique and height_range is not None else None
+        # Small, a pixel is centimetres of height; at the border, the blob may go on beyond it.
+        inside = bool(pixel_clear(cam, None, np.array([head - 3 * down, foot + 3 * down])).all())
+        readable = height_range is not None and head_seen and oblique and inside and along_max - along_min >= min_px
+        shown = head_height(cam, head, p) if readable else None
         if shown is not None and shown < height_range[0]:
             p, shown = cam.backproject(head[None], height)[0], None
             ends = cam.project(np.array([[p[0], p[1], 0.0], [p[0], p[1], height]]))

@@ -84,7 +84,7 @@ class EllipsoidTracker(TrackerBase):
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
         self.births = Births(self.views, scene, self.walkable, cfg.births,
-                             cfg.height.range_m if cfg.height.measure else None)
+                             cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
@@ -238,11 +238,11 @@ class EllipsoidTracker(TrackerBase):
         born = []
         for xy, cid, shown in proposals:
             # The height the blob shows (feet and head in view) is the person's first measurement.
-            height = shown if shown is not None and self.config.height.measure else h0
+            height = shown if shown is not None and abs(shown - h0) > self.config.height.deadband_m else h0
             p = self.position_map.add(xy[0], xy[1], height, w0, mode="capture", time=t, tentative=True)
             p.birth_camera = cid
-            if height != h0:
-                p.height_samples.append(height)
+            if shown is not None:
+                p.height_samples.append(shown)
             born.append(p)
         return born
 
