@@ -229,6 +229,34 @@ class FeetConfig(Section):
     min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
 
 
+class IdentityConfig(Section):
+    """Identity by colour: per-person colour models that undo swaps and re-identify people who come
+    back (:mod:`worldtrack.trackers.ellipsoid.identity`)."""
+
+    path: ClassVar[str] = "ellipsoid.identity"
+
+    enabled: bool = Field(True, description="keep colour models, undo swaps and re-identify people")
+    min_pixels: int = Field(
+        30, ge=1, description="a body part gives colours only with at least this many foreground pixels it owns")
+    update_rate: float = Field(
+        0.1, gt=0, le=1, description="weight of each new isolated view in a person's colour model")
+    min_updates: int = Field(5, ge=1, description="a model decides a swap only after this many isolated views")
+    swap_window_s: float = Field(
+        3.0, ge=0, description="two people whose ellipses met this recently are checked for a swap, s")
+    swap_margin: float = Field(
+        0.1, ge=0, description="the exchanged places must fit the two models better by this much (Bhattacharyya "
+        "distance summed over the two people)")
+    reid_s: float = Field(5.0, ge=0, description="a lost person can be re-identified this long after the track ended, s")
+    reid_distance: float = Field(
+        0.35, ge=0, le=1, description="largest colour distance (Bhattacharyya, mean of the body parts) of a "
+        "re-identification")
+    reid_margin: float = Field(
+        0.05, ge=0, description="the best lost person must be nearer in colour than the next by this much")
+    reid_near_m: float = Field(1.0, ge=0, description="a lost person may be found this far from where they were lost, m, ...")
+    walk_speed_mps: float = Field(2.0, ge=0, description="... plus this speed times the time since, m/s")
+    min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept for re-identification, s")
+
+
 class WarmStartConfig(Section):
     """Starting on the first frame with the people already in view."""
 
@@ -256,6 +284,7 @@ class EllipsoidConfig(Section):
     height: HeightConfig = Field(HeightConfig(), description="measuring people's heights")
     warm_start: WarmStartConfig = Field(WarmStartConfig(), description="starting with the people in view")
     feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
+    identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -265,8 +294,9 @@ class EllipsoidConfig(Section):
             "score.kind": "paper", "score.target_pixels": 0, "score.ring_fraction": 0.0,
             "match.adaptive_step": False, "match.predict": False,
             "births.search_m": 0.0, "rescue.search_m": 0.0, "height.measure": False, "warm_start.frames": 0,
+            "identity.enabled": False,
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "MatchConfig",
+__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
            "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

@@ -34,6 +34,7 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.height import heights_due, update_heights
+from worldtrack.trackers.ellipsoid.identity import Identities
 from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
@@ -92,6 +93,10 @@ class EllipsoidTracker(TrackerBase):
         self._other_views: dict[str, CameraView] = {}
         self.last_masks: dict[str, np.ndarray] = {}
         self.last_labels: dict[str, np.ndarray] = {}
+        self.last_images: dict[str, np.ndarray] = {}
+        #: The people's colour models (:mod:`.identity`).
+        self.identity = Identities(cfg.identity)
+        self._now = 0.0
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -126,6 +131,7 @@ class EllipsoidTracker(TrackerBase):
         this tracker does not read are ignored) taken at time ``t`` (s); return the confirmed
         people's tracks (everybody on the map, whoever's cameras see them)."""
         self.position_map.advance(t)
+        self._now = t
         dt = 0.0 if self._last_t is None else max(t - self._last_t, 1e-6)
         if dt > 0:
             self.frame_interval = dt
@@ -140,6 +146,9 @@ class EllipsoidTracker(TrackerBase):
             scores += self._match(born, real, t, judged + bystanders)
         anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet,
                        self.config.height)
+        if self.config.identity.enabled:  # before the life cycle: a person confirmed now is re-identified by it
+            self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
+                                 lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
         self._last_t = t
         self.frames_stepped += 1
@@ -154,6 +163,7 @@ class EllipsoidTracker(TrackerBase):
         for cid in [c for c in self.last_labels if c not in frames]:
             del self.last_labels[cid]
             self.last_masks.pop(cid, None)
+            self.last_images.pop(cid, None)
         for cid, frame in frames.items():
             if cid not in self.views:
                 continue
@@ -161,6 +171,7 @@ class EllipsoidTracker(TrackerBase):
             image = frame_image(frame)
             labels = fg.labels(image)
             self.last_labels[cid] = labels
+            self.last_images[cid] = image
             self.last_masks[cid] = (labels == 1).astype(np.uint8)
             real[cid] = ternary_real(labels, self.views[cid].ring_px)
         return real
@@ -270,7 +281,9 @@ class EllipsoidTracker(TrackerBase):
         """A confirmed candidate gets its public id and the scene's size for that id."""
         if p.id > 0:
             return
-        new = self.position_map.promote(p.id)
+        back = self.identity.reidentify(p, self._now, lambda pid: pid in self.position_map) \
+            if self.config.identity.enabled else None
+        new = self.position_map.promote(p.id, back)
         height, p.width = self.scene.people.size_of(new)
         if not p.height_samples:  # else keep what was measured (at birth, or since)
             p.height = height
