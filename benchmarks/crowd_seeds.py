@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, render_images, save_result  # noqa: E402
+from common import markdown_table, render_images, save_result, setting_value  # noqa: E402
 
 from worldtrack.eval import CAUSES, error_causes, errors_by_views, evaluate_detailed  # noqa: E402
 from worldtrack.experiment import run_scenario  # noqa: E402
@@ -78,15 +78,6 @@ def views_table(by_views: dict[int, Counter]) -> str:
                               "false-positive rate"], rows))
 
 
-def _value(text: str):
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return {"true": True, "false": False}.get(text.lower(), text)
-
-
 def _seed_list(text: str) -> list[int]:
     """``"7"`` → [7]; ``"0-79"`` → [0, …, 79]."""
     first, _, last = text.partition("-")
@@ -112,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     args.seeds = ([0, 1] if args.quick else list(range(SEEDS))) if args.seeds is None else sum(args.seeds, [])
     if args.frames is None:
         args.frames = 40 if args.quick else FRAMES
-    options = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
+    options = {k: setting_value(v) for k, v in (s.split("=", 1) for s in args.set)}
     t0 = time.perf_counter()
     rows, total, by_views = [], Counter(), {}
     for seed in args.seeds:

@@ -38,8 +38,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from crowd_seeds import _seed_list, _value  # noqa: E402
+from common import markdown_table, save_result, setting_value  # noqa: E402
+from crowd_seeds import _seed_list  # noqa: E402
 
 from worldtrack.eval import drop_ignored, evaluate, evaluate_detailed  # noqa: E402
 from worldtrack.experiment import (bundle_frames, gt_table, predictions_table, step_tracker,  # noqa: E402
@@ -175,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
     seeds = ([100, 101] if args.quick else HELD_OUT) if args.seeds is None else sum(args.seeds, [])
     frames = args.frames or (60 if args.quick else FRAMES)
     size = (320, 240) if args.quick else SIZE
-    options = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
+    options = {k: setting_value(v) for k, v in (s.split("=", 1) for s in args.set)}
     t0 = time.perf_counter()
     results = []
     for seed in seeds:
