@@ -8,6 +8,7 @@ Exactly the same problem and weights as :class:`worldtrack.trajectory.objective.
 - observations (eq. 7): ``TriangulationFactorCal3DS2`` — projection of a point key through a fixed
   camera with OpenCV's k1, k2, p1, p2 (GTSAM's Cal3DS2 has no k3, so the benchmark's cameras have
   k3 = 0) and isotropic σ in pixels; on-grid time stamps only (τ = 0);
+- the prior on the first velocity: ``PriorFactorVector`` on v_1, N(0, σ₁²·I) (none when σ₁ is None);
 - height (e_v): ``PriorFactorPoint3`` on z alone (precisions 0, 0, λ/σ_v²);
 - barrier (e_h), optional: one ``CustomFactor`` per barrier sample on (p_t, v_t, p_{t+1}, v_{t+1}),
   residual and Jacobian from our own barrier code (a Python callback per factor: GTSAM pays for it).
@@ -70,6 +71,9 @@ def build_graph(problem: Problem, X0: np.ndarray, with_barrier: bool = False):
     for t in range(grid.n - 1):
         graph.add(gtsam.WnoaMotionFactorPoint3(gtsam.StateData(P(t), V(t), float(times[t])),
                                                gtsam.StateData(P(t + 1), V(t + 1), float(times[t + 1])), q))
+    if problem.motion.first_velocity_sigma is not None:
+        noise = gtsam.noiseModel.Isotropic.Sigma(3, float(problem.motion.first_velocity_sigma))
+        graph.add(gtsam.PriorFactorVector(V(0), np.zeros(3), noise))
     cams = [_camera(c) for c in term.obs.cameras]
     for i in range(len(term.obs)):
         noise = gtsam.noiseModel.Isotropic.Sigma(2, float(term.obs.sigma[i]))

@@ -113,3 +113,77 @@ def test_a_person_that_cannot_be_estimated_is_skipped_with_a_line(office_files, 
     assert main(["smooth", str(d / "scene.yaml"), str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
     err = capsys.readouterr().err
     assert "person 7: skipped: cannot tell the time step" in err and "person 1:" in err
+
+
+@pytest.fixture(scope="module")
+def feet_files(office_files):
+    """The same person with feet pixels (unknown height: no height column) and as boxes."""
+    d, sc, tracks = office_files
+    px = head_pixels(sc, noise_px=1.0, rng=2, tracks=tracks, feet=True)
+    n = len(px.time)
+    table = ObservationTable(px.time, px.camera.astype(object), px.uv, np.full(n, 1.0), px.id, np.full(n, np.nan),
+                             np.arange(n) + 2, "obs", px.feet_uv, np.full(n, 1.0))
+    write_observations(d / "feet.csv", table)
+    with open(d / "boxes.csv", "w") as f:
+        f.write("t,camera,left,top,right,bottom,sigma_px\n")
+        for k in range(n):
+            if np.all(np.isfinite(px.feet_uv[k])):
+                u = (px.uv[k, 0] + px.feet_uv[k, 0]) / 2
+                f.write(f"{px.time[k]},{px.camera[k]},{u - 20},{px.uv[k, 1]},{u + 20},{px.feet_uv[k, 1]},1\n")
+    return d, sc, tracks
+
+
+def test_feet_pixels_fit_the_head_height_and_boxes_give_both(feet_files, capsys):
+    d, sc, tracks = feet_files
+    table = read_observations(d / "feet.csv", sc.scene.cameras)
+    assert table.feet_uv is not None and np.isfinite(table.feet_uv).all(axis=1).mean() > 0.5
+    boxes = read_observations(d / "boxes.csv", sc.scene.cameras)
+    with_feet = np.isfinite(table.feet_uv).all(axis=1)             # a box: top centre and bottom centre
+    np.testing.assert_allclose(boxes.uv[:, 1], table.uv[with_feet, 1], atol=1e-3)
+    np.testing.assert_allclose(boxes.feet_uv[:, 1], table.feet_uv[with_feet, 1], atol=1e-3)
+    np.testing.assert_allclose(boxes.uv[:, 0], (table.uv[with_feet, 0] + table.feet_uv[with_feet, 0]) / 2, atol=1e-3)
+    np.testing.assert_array_equal(boxes.uv[:, 0], boxes.feet_uv[:, 0])
+    assert main(["smooth", str(d / "scene.yaml"), str(d / "feet.csv"), "--out", str(d / "feet_out"), "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert "(fitted: feet seen)" in err
+    with open(d / "feet_out" / "trajectory.csv") as f:
+        rows = list(csv.DictReader(f))
+    t = np.array([float(r["t"]) for r in rows])
+    z = np.array([float(r["z"]) for r in rows])
+    seen = np.array([int(r["observed"]) for r in rows]) > 0
+    truth = tracks[1].points[np.rint(t * sc.fps).astype(int)]
+    # 17 steps in view: the fitted height is right on average (the scene's 1.70 m would be 0.16 m low)
+    assert abs(np.mean(z[seen] - truth[seen, 2])) < 0.03 and np.sqrt(np.mean((z[seen] - truth[seen, 2]) ** 2)) < 0.08
+
+
+def _feet_bad(d, name, column, value, row=3):
+    src = list(csv.reader(open(d / "feet.csv")))
+    src[row - 1][src[0].index(column)] = value
+    path = d / name
+    with open(path, "w", newline="") as f:
+        csv.writer(f).writerows(src)
+    return path
+
+
+@pytest.mark.parametrize("name, column, value, message", [
+    ("half.csv", "u_feet", "", "row 3: u_feet and v_feet come together"),
+    ("feet_nan.csv", "v_feet", "nan", "row 3: feet pixel ("),
+    ("feet_text.csv", "u_feet", "left", "row 3: u_feet is not a number ('left')"),
+    ("feet_outside.csv", "v_feet", "900", "row 3: feet pixel ("),
+    ("feet_sigma.csv", "sigma_feet_px", "0", "row 3: sigma_feet_px must be a positive number"),
+])
+def test_bad_feet_give_one_line_naming_the_row(feet_files, capsys, name, column, value, message):
+    d, _, _ = feet_files
+    path = _feet_bad(d, name, column, value)
+    assert main(["smooth", str(d / "scene.yaml"), str(path), "--out", str(d / "bad")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "\n" not in err and message in err and name in err
+
+
+def test_a_feet_column_alone_is_named(feet_files, capsys, tmp_path):
+    d, _, _ = feet_files
+    src = [r[:-2] for r in csv.reader(open(d / "feet.csv"))]     # drop v_feet and sigma_feet_px
+    with open(tmp_path / "one.csv", "w", newline="") as f:
+        csv.writer(f).writerows(src)
+    assert main(["smooth", str(d / "scene.yaml"), str(tmp_path / "one.csv"), "--out", str(tmp_path / "o")]) == 2
+    assert "u_feet and v_feet come together (only u_feet is given)" in capsys.readouterr().err

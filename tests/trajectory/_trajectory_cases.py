@@ -39,16 +39,26 @@ class Case:
 
 
 def observed_walk(T: int = 81, noise_px: float = 2.0, seed: int = 0, barrier_field=None, curve: float = 0.0,
-                  robust: float | None = None) -> Case:
-    """The walk seen by camera a near its start and by camera b near its end, nothing between."""
+                  robust: float | None = None, feet: bool = False, height: float = 1.7) -> Case:
+    """The walk seen by camera a near its start and by camera b near its end, nothing between; with
+    ``feet`` also the pixel of the floor point below the head (every third row left out: unseen)."""
     cams = ceiling_cameras()
-    t, pts = walk(T, curve=curve)
+    t, pts = walk(T, curve=curve, height=height)
     ids = np.where(pts[:, 0] < 2.0, "a", "b")
     centre = np.where(ids == "a", 0.0, 4.0)
     seen = np.abs(pts[:, 0] - centre) < 0.7
     rng = np.random.default_rng(seed)
     obs = Observations.from_points(t[seen], ids[seen], pts[seen], cams)
-    obs = Observations(obs.time, obs.camera, obs.uv + rng.normal(0, noise_px, obs.uv.shape), obs.sigma, obs.cameras)
+    feet_uv = None
+    if feet:
+        floor = pts[seen] * [1.0, 1.0, 0.0]
+        feet_uv = np.empty((len(floor), 2))
+        for k, cam in enumerate(obs.cameras):
+            sel = obs.camera == k
+            feet_uv[sel] = cam.project(floor[sel]) + rng.normal(0, noise_px, (int(sel.sum()), 2))
+        feet_uv[::3] = np.nan
+    obs = Observations(obs.time, obs.camera, obs.uv + rng.normal(0, noise_px, obs.uv.shape), obs.sigma, obs.cameras,
+                       feet_uv, None if feet_uv is None else np.full(len(obs.time), 1.5))
     grid = TimeGrid.covering(obs.time, 0.1)
     barrier = Barrier(barrier_field, clearance=0.2, substeps=2) if barrier_field is not None else None
     env = EnvironmentModel(barrier, HeightPrior(1.7, 0.05), 1.0)

@@ -179,3 +179,36 @@ def test_without_environment_the_map_is_solved_once_and_is_the_estimate():
     est = estimate_trajectory(case.obs, None, TrajectoryOptions(dt=0.1))
     assert est.results["straight"] is est.results["map"]
     np.testing.assert_array_equal(est.X, est.without_barrier)
+
+
+def test_the_first_velocity_prior_is_its_own_term_and_holds_a_person_seen_once():
+    """‖ẋ_1/σ₁‖² is added to the motion cost, exactly; a person seen once and then, 8 s later,
+    walking across the line to them: the paper's flat start lets the first velocity take whatever
+    bends the path most smoothly, a tight prior holds it at rest."""
+    from dataclasses import replace
+    from worldtrack.trajectory.model import MotionPrior
+    from worldtrack.trajectory.objective import evaluate
+    from _trajectory_cases import ceiling_cameras
+    cams = ceiling_cameras()
+    t = np.r_[0.0, np.arange(8.0, 10.01, 0.1)]
+    pts = np.column_stack([np.r_[0.0, np.full(len(t) - 1, 4.0)], np.r_[0.0, (t[1:] - 8.0) * 0.8 - 0.8],
+                           np.full(len(t), 1.7)])
+    obs = Observations.from_points(t, np.r_[["a"], ["b"] * (len(t) - 1)], pts, cams)
+    flat = TrajectoryOptions(dt=0.1, motion=MotionPrior(first_velocity_sigma=None))
+    est_flat = estimate_trajectory(obs, None, flat)
+    est_tight = estimate_trajectory(obs, None, replace(flat, motion=MotionPrior(first_velocity_sigma=0.01)))
+    est = estimate_trajectory(obs, None, TrajectoryOptions(dt=0.1))                # default σ₁ = 2 m/s
+    speed = lambda e: float(np.hypot(*e.velocities[0, :2]))  # noqa: E731
+    assert speed(est_flat) > 0.2 and speed(est_tight) < 0.01
+    assert speed(est_tight) < speed(est) < speed(est_flat)
+    from worldtrack.trajectory.objective import Problem
+    from worldtrack.trajectory.environment import EnvironmentModel, HeightPrior
+    grid = TimeGrid.covering(obs.time, 0.1)
+    env = EnvironmentModel(None, HeightPrior(1.7, 0.05), 1.0)
+    with_prior = Problem.build(obs, grid, MotionPrior(first_velocity_sigma=0.5), env)
+    without = Problem.build(obs, grid, MotionPrior(first_velocity_sigma=None), env)
+    X = est_flat.X
+    difference = evaluate(with_prior, X).motion - evaluate(without, X).motion
+    assert difference == pytest.approx(float(np.sum(X[0, [1, 3, 5]] ** 2)) / 0.25, rel=1e-12)
+    with pytest.raises(InputError, match="first_velocity_sigma"):
+        MotionPrior(first_velocity_sigma=0.0)

@@ -31,19 +31,24 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "±2σ band, obstacles) and DIR/height.png.")
     p.add_argument("scene", help="scene YAML file (cameras, floor, obstacles)")
     p.add_argument("observations", nargs="+", metavar="OBSERVATIONS",
-                   help="observations.csv with columns t,camera,u,v[,sigma_px][,id][,height] (seconds, pixels of "
-                        "the head), or CAM=tracks.csv from 'worldtrack track' on camera CAM (the head point of each "
+                   help="observations.csv with columns t,camera,u,v[,sigma_px][,id][,height][,u_feet,v_feet"
+                        "[,sigma_feet_px]] (seconds, pixels of the head and of the floor below it: the feet make the "
+                        "head height observable), or t,camera,left,top,right,bottom[,…] (a box: its top and bottom "
+                        "centres), or CAM=tracks.csv from 'worldtrack track' on camera CAM (the head point of each "
                         "row is projected into CAM)")
     p.add_argument("--out", default="smooth_out", metavar="DIR", help="output folder (default: smooth_out)")
     p.add_argument("--person", type=int, action="append", default=[], metavar="ID",
                    help="only this person (repeatable; default: every id)")
     p.add_argument("--dt", default=None, metavar="S", help="time step in seconds (default: the cameras' frame interval)")
     p.add_argument("--height", default=None, metavar="M",
-                   help="head height in metres for e_v (default: the observations' height column, else the scene's "
-                        "person height)")
+                   help="head height in metres for e_v (default: the observations' height column; else, with feet "
+                        "pixels, fitted to the person; else the scene's person height)")
     p.add_argument("--sigma-px", default="2", metavar="PX", help="pixel noise where sigma_px is not given (default 2)")
     p.add_argument("--q", default=None, metavar="M2S3",
                    help=f"horizontal acceleration noise, m²/s³ (default {MotionPrior().q_horizontal:g})")
+    p.add_argument("--first-velocity-sigma", default=None, metavar="M/S",
+                   help=f"spread of the prior on the first velocity, per axis (default "
+                        f"{MotionPrior().first_velocity_sigma:g} m/s; 'none': the paper's flat start)")
     p.add_argument("--clearance", default=None, metavar="M",
                    help=f"distance people keep from obstacles and walls (default {TrajectoryOptions().clearance:g} m)")
     p.add_argument("--weight", default=None, metavar="LAMBDA", help="λ, the environment's weight (default 1)")
@@ -64,6 +69,10 @@ def _options(args: argparse.Namespace) -> TrajectoryOptions:
         opts = replace(opts, dt=positive(args.dt, "--dt", "0.1"))
     if args.q is not None:
         opts = replace(opts, motion=replace(opts.motion, q_horizontal=positive(args.q, "--q", "1.0")))
+    if args.first_velocity_sigma is not None:
+        sigma = (None if args.first_velocity_sigma.strip().lower() == "none"
+                 else positive(args.first_velocity_sigma, "--first-velocity-sigma", "2"))
+        opts = replace(opts, motion=replace(opts.motion, first_velocity_sigma=sigma))
     if args.clearance is not None:
         opts = replace(opts, clearance=positive(args.clearance, "--clearance", "0.2"))
     if args.weight is not None:
@@ -109,10 +118,12 @@ def run(args: argparse.Namespace) -> int:
             continue
         given = rows.height[np.isfinite(rows.height)]
         height = height_arg or (float(np.median(given)) if len(given) else scene.people.size_of(pid)[0])
-        obs = Observations.from_rows(rows.time, rows.camera, rows.uv, scene.cameras, rows.sigma)
+        obs = Observations.from_rows(rows.time, rows.camera, rows.uv, scene.cameras, rows.sigma, rows.feet_uv,
+                                     rows.feet_sigma)
+        fit = not (height_arg or len(given)) and bool(obs.has_feet.any())
         t0 = time.perf_counter()
         try:
-            est = estimate_trajectory(obs, field, replace(options, height=height))
+            est = estimate_trajectory(obs, field, replace(options, height=height, fit_height=fit))
         except InputError as e:                       # this person only (e.g. one time stamp): go on
             print(f"person {pid}: skipped: {e}", file=sys.stderr)
             continue
@@ -121,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
         if not args.quiet:
             seen = int(np.count_nonzero(est.observed))
             print(f"person {pid}: {len(est.times)} steps of {est.times[1] - est.times[0]:g} s, {len(obs)} observations "
-                  f"on {seen} steps, head height {height:.2f} m; start '{est.start}' won "
+                  f"on {seen} steps, head height {est.height:.2f} m{' (fitted: feet seen)' if fit else ''}; start '{est.start}' won "
                   f"(objective {est.costs['total']:.1f}: motion {est.costs['motion']:.1f}, observations "
                   f"{est.costs['observation']:.1f}, barrier {est.costs['barrier']:.2f}, height {est.costs['height']:.2f}); "
                   f"barrier active on {int(est.barrier_active.sum())} steps; {time.perf_counter() - t0:.2f} s",

@@ -2,12 +2,17 @@
 
 ``observations.csv``, one row per head seen by one camera at one time::
 
-    t,camera,u,v[,sigma_px][,id][,height]
+    t,camera,u,v[,sigma_px][,id][,height][,u_feet,v_feet[,sigma_feet_px]]
+    t,camera,left,top,right,bottom[,…]          (a box: its top centre and bottom centre)
 
 ``t`` is seconds, ``camera`` a camera id of the scene, ``u, v`` the head's pixel in that camera's
 real (distorted) image — the head's top, or the top centre of a person's box — ``sigma_px`` its
 standard deviation in pixels (default 2), ``id`` the person (default 1), ``height`` the person's
-head height in metres (used for e_v when given). Rows are counted as a spreadsheet counts them
+head height in metres (used for e_v when given). ``u_feet, v_feet`` (optional, both or neither
+in a row; empty cells: not seen) is the pixel of the floor point below the head — the bottom centre
+of the box — with ``sigma_feet_px`` (default ``sigma_px``); with it the head height is observed. A
+box (``left,top,right,bottom`` pixels instead of ``u,v``) gives both — for cameras that see people
+upright (a camera looking straight down sees the head beside the feet: give ``u,v,u_feet,v_feet``). Rows are counted as a spreadsheet counts them
 (the header is row 1); every row of one person must come in time order.
 
 A worldtrack ``tracks.csv`` from one camera's run is read as observations of that camera: each
@@ -34,7 +39,8 @@ from worldtrack.io.text import read_text
 from worldtrack.io.tracks import read_tracks
 
 REQUIRED = ("t", "camera", "u", "v")
-OPTIONAL = ("sigma_px", "id", "height")
+OPTIONAL = ("sigma_px", "id", "height", "u_feet", "v_feet", "sigma_feet_px")
+BOX = ("left", "top", "right", "bottom")
 TRAJECTORY_COLUMNS = ("id", "t", "x", "y", "z", "vx", "vy", "vz", "sigma_x", "sigma_y", "sigma_z", "rho_xy",
                       "observed", "barrier")
 
@@ -42,7 +48,8 @@ TRAJECTORY_COLUMNS = ("id", "t", "x", "y", "z", "vx", "vy", "vz", "sigma_x", "si
 @dataclass(frozen=True, eq=False)
 class ObservationTable:
     """Rows of head observations: time (N,) s, camera (N,) str, uv (N, 2) px, sigma (N,) px,
-    id (N,) int, height (N,) m (NaN: not given), row (N,) int — the row in the file — and source."""
+    id (N,) int, height (N,) m (NaN: not given), row (N,) int — the row in the file — and source;
+    feet_uv (N, 2) px and feet_sigma (N,) px (NaN rows: no feet pixel; None: no feet column)."""
 
     time: np.ndarray
     camera: np.ndarray
@@ -52,6 +59,8 @@ class ObservationTable:
     height: np.ndarray
     row: np.ndarray
     source: str = ""
+    feet_uv: np.ndarray | None = None
+    feet_sigma: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.time)
@@ -60,8 +69,10 @@ class ObservationTable:
         return sorted(int(i) for i in np.unique(self.id))
 
     def select(self, keep: np.ndarray) -> "ObservationTable":
+        pick = lambda a: None if a is None else a[keep]  # noqa: E731
         return ObservationTable(self.time[keep], self.camera[keep], self.uv[keep], self.sigma[keep], self.id[keep],
-                                self.height[keep], self.row[keep], self.source)
+                                self.height[keep], self.row[keep], self.source, pick(self.feet_uv),
+                                pick(self.feet_sigma))
 
     def of(self, person_id: int) -> "ObservationTable":
         """One person's rows, in time order (stable: rows at one time keep the file's order)."""
@@ -73,8 +84,12 @@ class ObservationTable:
         if len(tables) == 1:
             return tables[0]
         cat = lambda name: np.concatenate([getattr(t, name) for t in tables])  # noqa: E731
+        feet = feet_sigma = None
+        if any(t.feet_uv is not None for t in tables):
+            feet = np.concatenate([np.full((len(t), 2), np.nan) if t.feet_uv is None else t.feet_uv for t in tables])
+            feet_sigma = np.concatenate([t.sigma if t.feet_sigma is None else t.feet_sigma for t in tables])
         return ObservationTable(cat("time"), cat("camera"), cat("uv"), cat("sigma"), cat("id"), cat("height"),
-                                cat("row"), ", ".join(t.source for t in tables))
+                                cat("row"), ", ".join(t.source for t in tables), feet, feet_sigma)
 
 
 def read_observations(path: str | Path, cameras: Mapping[str, Camera], sigma_px: float = 2.0) -> ObservationTable:
@@ -85,7 +100,7 @@ def read_observations(path: str | Path, cameras: Mapping[str, Camera], sigma_px:
     InputError
         One line naming the file and the first bad row: a missing column, a cell that is not a
         number, an unknown camera, a pixel that is NaN or outside the camera's image, sigma ≤ 0,
-        an id below 1, or a time earlier than the person's previous row.
+        an id below 1, a time earlier than the person's previous row, a feet pixel half given.
     """
     name = str(path)
     records = list(csv.reader(io.StringIO(read_text(path, "a CSV of observations"))))
@@ -94,10 +109,14 @@ def read_observations(path: str | Path, cameras: Mapping[str, Camera], sigma_px:
         raise InputError(f"{name}: empty file")
     header = [c.strip().lower() for c in records[lines[0] - 1]]
     header = ["t" if h == "time" else h for h in header]
-    missing = [c for c in REQUIRED if c not in header]
+    boxes = all(c in header for c in BOX) and not ("u" in header or "v" in header)
+    missing = [c for c in (REQUIRED[:2] + BOX if boxes else REQUIRED) if c not in header]
     if missing:
         raise InputError(f"{name}: missing columns: {', '.join(missing)} (expected t,camera,u,v[,sigma_px][,id]"
-                         f"[,height])")
+                         f"[,height][,u_feet,v_feet], or t,camera,left,top,right,bottom[,…])")
+    if ("u_feet" in header) != ("v_feet" in header):
+        raise InputError(f"{name}: u_feet and v_feet come together (only {'u_feet' if 'u_feet' in header else 'v_feet'} "
+                         f"is given)")
     rows = np.array(lines[1:], dtype=np.int64)
     cells = []
     for line in rows:
@@ -108,16 +127,38 @@ def read_observations(path: str | Path, cameras: Mapping[str, Camera], sigma_px:
     col = {h: np.array([c[k] for c in cells], dtype=object) for k, h in enumerate(header)}
     n = len(rows)
     t = _numbers(col["t"], "t", rows, name)
-    u = _numbers(col["u"], "u", rows, name)
-    v = _numbers(col["v"], "v", rows, name)
     sigma = _numbers(col["sigma_px"], "sigma_px", rows, name) if "sigma_px" in col else np.full(n, float(sigma_px))
+    uv, feet = _pixels(col, rows, name, boxes)
+    feet_sigma = (_numbers(col["sigma_feet_px"], "sigma_feet_px", rows, name) if "sigma_feet_px" in col
+                  else sigma.copy()) if feet is not None else None
     ids = _numbers(col["id"], "id", rows, name) if "id" in col else np.ones(n)
     height = _numbers(col["height"], "height", rows, name, empty_ok=True) if "height" in col else np.full(n, np.nan)
     camera = np.array([str(c) for c in col["camera"]], dtype=object)
-    table = ObservationTable(t, camera, np.column_stack([u, v]) if n else np.zeros((0, 2)), sigma,
-                             ids.astype(np.int64), height, rows, name)
+    table = ObservationTable(t, camera, uv, sigma, ids.astype(np.int64), height, rows, name, feet, feet_sigma)
     check_observations(table, cameras, ids)
     return table
+
+
+def _pixels(col: dict, rows: np.ndarray, name: str, boxes: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """The head pixels (N, 2) and the feet pixels (N, 2) or None, from u,v[,u_feet,v_feet] or a box."""
+    if boxes:
+        left, top, right, bottom = (_numbers(col[c], c, rows, name) for c in BOX)
+        centre = (left + right) / 2
+        return np.column_stack([centre, top]).reshape(-1, 2), np.column_stack([centre, bottom]).reshape(-1, 2)
+    uv = np.column_stack([_numbers(col["u"], "u", rows, name), _numbers(col["v"], "v", rows, name)]).reshape(-1, 2)
+    if "u_feet" not in col:
+        return uv, None
+    feet = np.column_stack([_numbers(col[c], c, rows, name, empty_ok=True) for c in ("u_feet", "v_feet")])
+    empty = np.column_stack([col[c] == "" for c in ("u_feet", "v_feet")]).reshape(-1, 2)
+    for k in np.flatnonzero(~empty.any(axis=1) & ~np.all(np.isfinite(feet), axis=1))[:1]:
+        raise InputError(f"{name}: row {rows[k]}: feet pixel ({feet[k, 0]}, {feet[k, 1]}) is not a finite number; "
+                         f"leave both cells empty where the feet are not seen")
+    half = np.flatnonzero(empty[:, 0] != empty[:, 1])
+    if len(half):
+        k = half[0]
+        raise InputError(f"{name}: row {rows[k]}: u_feet and v_feet come together (one is empty); leave both empty "
+                         f"where the feet are not seen")
+    return uv, feet.reshape(-1, 2)
 
 
 def _numbers(values: np.ndarray, column: str, rows: np.ndarray, name: str, empty_ok: bool = False) -> np.ndarray:
@@ -141,6 +182,7 @@ def check_observations(table: ObservationTable, cameras: Mapping[str, Camera], r
             inside[sel] = cam.in_image(np.nan_to_num(table.uv[sel], nan=-1e9))
     ids = table.id if raw_ids is None else raw_ids
     finite_uv = np.all(np.isfinite(table.uv), axis=1)
+    feet_bad = _bad_feet(table, cameras, known)
     early = _time_goes_back(table)
     checks = [
         (~np.isfinite(table.time), lambda k: f"t is not a finite time in seconds ({table.time[k]})"),
@@ -154,6 +196,7 @@ def check_observations(table: ObservationTable, cameras: Mapping[str, Camera], r
         ((ids < 1) | (ids != np.round(ids)), lambda k: f"id must be an integer from 1, got {ids[k]:g}"),
         (~(np.isnan(table.height) | ((table.height > 0.3) & (table.height < 2.6))),
          lambda k: f"height must be a head height in metres (0.3–2.6), got {table.height[k]}"),
+        (feet_bad != "", lambda k: feet_bad[k]),
         (early >= 0, lambda k: f"time {table.time[k]:g} s is before the previous row of person {table.id[k]} "
                                f"(row {table.row[early[k]]}, {table.time[early[k]]:g} s); expected rows in time order"),
     ]
@@ -167,6 +210,25 @@ def check_observations(table: ObservationTable, cameras: Mapping[str, Camera], r
         raise InputError(f"{table.source}: row {table.row[k]}: {message(k)}")
     if n == 0:
         raise InputError(f"{table.source}: no observations (only a header)")
+
+
+def _bad_feet(table: ObservationTable, cameras: Mapping[str, Camera], known: np.ndarray) -> np.ndarray:
+    """(N,) str: what is wrong with each row's feet pixel ('' where nothing is or there is none)."""
+    out = np.full(len(table), "", dtype=object)
+    if table.feet_uv is None:
+        return out
+    feet = table.feet_uv
+    given = ~np.all(np.isnan(feet), axis=1)   # empty cells are NaN: not seen
+    for k in np.flatnonzero(given & ~np.all(np.isfinite(feet), axis=1)):
+        out[k] = f"feet pixel ({feet[k, 0]}, {feet[k, 1]}) is not a finite number (leave both cells empty if unseen)"
+    for k in np.flatnonzero(given & ~(table.feet_sigma > 0)):
+        out[k] = f"sigma_feet_px must be a positive number of pixels, got {table.feet_sigma[k]}"
+    for cid, cam in cameras.items():
+        sel = np.flatnonzero((table.camera == cid) & given & known & np.all(np.isfinite(feet), axis=1))
+        outside = sel[~cam.in_image(feet[sel])] if len(sel) else sel
+        for k in outside:
+            out[k] = f"feet pixel ({feet[k, 0]:.1f}, {feet[k, 1]:.1f}) is outside camera {cid}'s {cam.width}x{cam.height} image"
+    return out
 
 
 def _time_goes_back(table: ObservationTable) -> np.ndarray:
@@ -222,14 +284,20 @@ def _fmt(x: float) -> str:
 
 
 def write_observations(path: str | Path, table: ObservationTable) -> Path:
-    """Write an ``observations.csv`` (t,camera,u,v,sigma_px,id[,height])."""
+    """Write an ``observations.csv`` (t,camera,u,v,sigma_px,id[,height][,u_feet,v_feet,sigma_feet_px])."""
     path = Path(path)
     with_height = bool(np.any(np.isfinite(table.height)))
+    with_feet = table.feet_uv is not None
+    header = ["t", "camera", "u", "v", "sigma_px", "id"] + (["height"] if with_height else [])
     with open(path, "w", newline="") as f:
         out = csv.writer(f)
-        out.writerow(["t", "camera", "u", "v", "sigma_px", "id"] + (["height"] if with_height else []))
+        out.writerow(header + (["u_feet", "v_feet", "sigma_feet_px"] if with_feet else []))
         for k in range(len(table)):
             row = [_fmt(table.time[k]), table.camera[k], f"{table.uv[k, 0]:.3f}", f"{table.uv[k, 1]:.3f}",
-                   _fmt(table.sigma[k]), int(table.id[k])]
-            out.writerow(row + ([_fmt(table.height[k])] if with_height else []))
+                   _fmt(table.sigma[k]), int(table.id[k])] + ([_fmt(table.height[k])] if with_height else [])
+            if with_feet:
+                seen = bool(np.all(np.isfinite(table.feet_uv[k])))
+                row += ([f"{table.feet_uv[k, 0]:.3f}", f"{table.feet_uv[k, 1]:.3f}", _fmt(table.feet_sigma[k])]
+                        if seen else ["", "", ""])
+            out.writerow(row)
     return path

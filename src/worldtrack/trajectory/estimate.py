@@ -13,7 +13,7 @@ import numpy as np
 
 from worldtrack.errors import InputError
 from worldtrack.scene.floor import FloorGrid
-from worldtrack.trajectory.environment import Barrier, EnvironmentModel, HeightPrior
+from worldtrack.trajectory.environment import Barrier, EnvironmentModel, HeightPrior, sample_field
 from worldtrack.trajectory.model import POS, VEL, MotionPrior, TimeGrid, frame_interval
 from worldtrack.trajectory.objective import Problem
 from worldtrack.trajectory.observation import Observations
@@ -32,6 +32,13 @@ class TrajectoryOptions:
     motion : MotionPrior — eq. 4's noise (m²/s³)
     height : float, metres — the person's head height for e_v and the starts
     height_sigma : float, metres — e_v's spread
+    fit_height : bool — the head height is not known: with feet pixels (see :class:`~.observation.Observations`)
+        the MAP is first solved with e_v loosened to ``fit_height_sigma`` around ``height``, the person's
+        head height H is taken as the mean estimated head height over the observed steps (weighted by the
+        inverse of each step's height variance: near a camera's nadir the height is barely seen), and the MAP
+        is solved again with H. Without feet pixels the height cannot be seen (one head pixel per camera
+        cannot tell height from distance) and ``height`` is used as given
+    fit_height_sigma : float, metres — e_v's spread in the first of those two solves
     clearance : float, metres — the barrier starts this far from obstacles and walls
     barrier_scale : float, metres — a penetration of this much costs 1 per sample
     substeps : int or None — barrier samples per step; None: enough for 2.5 m/s (:meth:`Barrier.substeps_for`)
@@ -43,7 +50,8 @@ class TrajectoryOptions:
         lowest objective then goes on to convergence (None: every start converges, as the paper).
         With a race, when the MAP without the barrier keeps so clear of every obstacle that its
         barrier cost is below the solver's tolerance, it is the optimum within that tolerance and
-        is the only start run
+        is the only start run; when the leader converges to a path with a step inside an obstacle
+        (a local optimum: five iterations do not always rank the starts), every start converges
     solver : SolverOptions
     """
 
@@ -51,6 +59,8 @@ class TrajectoryOptions:
     motion: MotionPrior = field(default_factory=MotionPrior)
     height: float = 1.70
     height_sigma: float = 0.05
+    fit_height: bool = False
+    fit_height_sigma: float = 1.0
     clearance: float = 0.2
     barrier_scale: float = 0.02
     substeps: int | None = None
@@ -88,6 +98,7 @@ class TrajectoryEstimate:
     without_barrier : (n, 6) — the MAP without the barrier (start ``map``), for comparison
     results : dict str → SolveResult — per start that was run (without a barrier ``straight`` and
         ``map`` are one solve)
+    height : float, metres — the head height H of e_v (fitted with ``fit_height``)
     """
 
     times: np.ndarray
@@ -100,6 +111,7 @@ class TrajectoryEstimate:
     barrier_active: np.ndarray
     without_barrier: np.ndarray
     results: dict[str, SolveResult]
+    height: float = float("nan")
 
     @property
     def positions(self) -> np.ndarray:
@@ -165,6 +177,11 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
     >>> float(np.abs(est.positions[:, 0] - t).max()) < 0.01      # the gap is bridged at 1 m/s
     True
     """
+    if options.fit_height and obs.has_feet.any():
+        loose = estimate_trajectory(obs, field, replace(options, fit_height=False, height_sigma=options.fit_height_sigma))
+        seen = loose.observed > 0
+        height = float(np.average(loose.positions[seen, 2], weights=loose.sigma[seen, 2] ** -2.0))
+        return estimate_trajectory(obs, field, replace(options, fit_height=False, height=height))
     dt = options.dt or frame_interval(obs.time, obs.camera)
     grid = TimeGrid.covering(obs.time, dt)
     env = build_environment(options, field, dt)
@@ -182,7 +199,7 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
     observed = np.bincount(problem.observations.step, minlength=grid.n)
     covariance = marginal_covariances(win.linearisation.D, win.linearisation.B)
     return TrajectoryEstimate(grid.times, win.X, covariance, win.costs.as_dict(), best, objectives, observed,
-                              win.linearisation.barrier_steps, without.X, results)
+                              win.linearisation.barrier_steps, without.X, results, options.height)
 
 
 def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult,
@@ -205,7 +222,11 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
     for run in runs.values():
         run.run(options.race_iterations)
     if options.race_iterations is not None:      # only the leader goes on to convergence
-        min(runs.values(), key=lambda run: run.lin.costs.total).run()
+        leader = min(runs.values(), key=lambda run: run.lin.costs.total)
+        leader.run()
+        if sample_field(problem.environment.barrier.field, leader.X[:, [POS[0], POS[1]]])[0].min() < 0:
+            for run in runs.values():            # the leader ended inside an obstacle: a local optimum the
+                run.run()                        # barrier could not push out of; every start converges
     return {name: run.result for name, run in runs.items()}
 
 

@@ -24,9 +24,19 @@ expands into ½·Xᵀ·Λ_X·X with the block-tridiagonal
            [0,        −Σ⁻¹A,           Σ⁻¹ + AᵀΣ⁻¹A, …], …,  last diagonal block Σ⁻¹]
 
 which is the paper's matrix with its "Σ_υ" read as the *inverse* covariance Σ_υ⁻¹ (otherwise a
-larger motion noise would make the prior stiffer). As the paper, we put no prior on x_1 and drop
-the common factor ½ throughout: the objective is Σ of squared whitened residuals, here
-r_t = W·(x_{t+1} − A·x_t) with W = chol(Σ_υ)⁻¹, so Σ_t ‖r_t‖² = Xᵀ·Λ_X·X.
+larger motion noise would make the prior stiffer). We drop the common factor ½ throughout: the
+objective is Σ of squared whitened residuals, here r_t = W·(x_{t+1} − A·x_t) with
+W = chol(Σ_υ)⁻¹, so Σ_t ‖r_t‖² = Xᵀ·Λ_X·X.
+
+The first velocity (beyond the paper)
+-------------------------------------
+The paper's Λ_X leaves x_1 free. A person seen once (or for a moment) and then unseen for many
+seconds has no velocity at all until the next view, and a flat start lets the path bend off at
+random speed (zara01 has one: seen once, then not for 15 s, 0.4–0.5 m/s off the wrong way). We add
+a prior on the first state's velocity, u̇_1, v̇_1, ẇ_1 ~ N(0, σ₁²) per axis with σ₁ =
+``first_velocity_sigma`` = 2 m/s by default — people walk at 1–1.5 m/s, so it only rules out the
+absurd; it is the prior the Kalman+RTS baseline starts with. ``first_velocity_sigma=None`` is the
+paper's flat start. Its residual x_1[u̇, v̇, ẇ]/σ₁ counts in the motion cost.
 """
 
 from __future__ import annotations
@@ -117,6 +127,9 @@ class MotionPrior:
         Spectral density of the horizontal acceleration noise (a walking person: about 0.5–2).
     q_vertical : float, m²/s³
         The same for the head height, which changes little while walking.
+    first_velocity_sigma : float or None, m/s
+        Spread of the prior N(0, σ₁²) on each axis of the first state's velocity (walking speed;
+        default 2 m/s); None: no prior on x_1, the paper's Λ_X (see the module's docstring).
 
     Examples
     --------
@@ -129,12 +142,21 @@ class MotionPrior:
 
     q_horizontal: float = 1.0
     q_vertical: float = 0.02
+    first_velocity_sigma: float | None = 2.0
 
     def __post_init__(self) -> None:
         for name in ("q_horizontal", "q_vertical"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise InputError(f"{name}: expected a positive spectral density in m²/s³, got {value}")
+        sigma = self.first_velocity_sigma
+        if sigma is not None and not (np.isfinite(sigma) and sigma > 0):
+            raise InputError(f"first_velocity_sigma: expected a positive speed in m/s or None, got {sigma}")
+
+    @property
+    def first_velocity_gain(self) -> float:
+        """1/σ₁ (s/m), 0 without the prior: the residual of the first velocity is gain·x_1[u̇, v̇, ẇ]."""
+        return 0.0 if self.first_velocity_sigma is None else 1.0 / self.first_velocity_sigma
 
     def transition(self, dt: float) -> np.ndarray:
         """A (6, 6): x_{t+1} = A·x_t for the state (u, u̇, v, v̇, w, ẇ)."""
@@ -160,6 +182,11 @@ def motion_residuals(X: np.ndarray, A: np.ndarray, W: np.ndarray) -> np.ndarray:
     return (X[1:] - X[:-1] @ A.T) @ W.T
 
 
+def first_velocity_residuals(X: np.ndarray, gain: float) -> np.ndarray:
+    """(3,) whitened residual gain·(u̇_1, v̇_1, ẇ_1) of the prior on the first velocity (``gain`` = 1/σ₁)."""
+    return gain * X[0, VEL]
+
+
 def motion_blocks(A: np.ndarray, W: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Λ_X of eq. 9 as blocks: diagonal D (n, 6, 6) and upper off-diagonal B (n − 1, 6, 6).
 
@@ -169,7 +196,7 @@ def motion_blocks(A: np.ndarray, W: np.ndarray, n: int) -> tuple[np.ndarray, np.
     AtSA = A.T @ Sinv @ A
     D = np.empty((n, STATE, STATE))
     D[:] = Sinv + AtSA                   # Σ⁻¹ + AᵀΣ⁻¹A
-    D[0] = AtSA                          # no prior on x_1
+    D[0] = AtSA                          # eq. 9: no prior on x_1 (Problem adds the first velocity's)
     D[-1] = Sinv
     B = np.empty((n - 1, STATE, STATE))
     B[:] = -A.T @ Sinv                   # −AᵀΣ⁻¹

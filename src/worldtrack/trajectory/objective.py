@@ -1,8 +1,9 @@
 """The objective of eq. 9 and its Gauss–Newton normal equations in block-tridiagonal form.
 
-    F(X) = Xᵀ·Λ_X·X  +  Σ_(t,i)∈o ρ(‖(π_i(x_t) − y_t^i)/σ‖)  −  λ·Σ_t (e_h + e_v)
+    F(X) = Xᵀ·Λ_X·X + ‖ẋ_1/σ₁‖²  +  Σ_(t,i)∈o ρ(‖(π_i(x_t) − y_t^i)/σ‖)  −  λ·Σ_t (e_h + e_v)
 
-(ρ(e) = e², or Huber's e² / 2ke − k² with ``robust = k``). Every residual touches one state
+(ρ(e) = e², or Huber's e² / 2ke − k² with ``robust = k``; ‖ẋ_1/σ₁‖² is the prior on the first
+velocity of :class:`~.model.MotionPrior`, counted in the motion cost). Every residual touches one state
 (observations, height) or two neighbouring states (motion, barrier samples), so JᵀJ is
 block-tridiagonal with 6 × 6 blocks: ``D[t]`` on the diagonal, ``B[t] = H[t, t+1]`` above it.
 Assembly is vectorised over all steps; no Python loop runs over time.
@@ -17,7 +18,8 @@ import numpy as np
 
 from worldtrack.trajectory.environment import (EnvironmentModel, barrier_residuals, height_residuals)
 from worldtrack.trajectory.kernels import add_motion_terms, add_pair_terms
-from worldtrack.trajectory.model import STATE, MotionPrior, TimeGrid, motion_blocks, motion_residuals
+from worldtrack.trajectory.model import (STATE, VEL, MotionPrior, TimeGrid, first_velocity_residuals, motion_blocks,
+                                        motion_residuals)
 from worldtrack.trajectory.observation import ObservationTerm, Observations
 
 _W = 4  # index of the head height w in the state
@@ -34,6 +36,7 @@ class Problem:
     motion : MotionPrior
     environment : EnvironmentModel
     robust : float or None — Huber threshold in σ (e.g. 3.0); None = plain squares
+    feet : ObservationTerm or None — the feet pixels (floor points below the head), if any
     """
 
     grid: TimeGrid
@@ -41,14 +44,22 @@ class Problem:
     motion: MotionPrior
     environment: EnvironmentModel
     robust: float | None = None
+    feet: ObservationTerm | None = None
 
     @classmethod
     def build(cls, obs: Observations, grid: TimeGrid, motion: MotionPrior, environment: EnvironmentModel,
               robust: float | None = None) -> "Problem":
-        return cls(grid, ObservationTerm.on_grid(obs, grid), motion, environment, robust)
+        feet = obs.feet()
+        return cls(grid, ObservationTerm.on_grid(obs, grid), motion, environment, robust,
+                   None if feet is None else ObservationTerm.on_grid(feet, grid, floor=True))
 
     def with_environment(self, environment: EnvironmentModel) -> "Problem":
-        return Problem(self.grid, self.observations, self.motion, environment, self.robust)
+        return Problem(self.grid, self.observations, self.motion, environment, self.robust, self.feet)
+
+    @property
+    def pixel_terms(self) -> tuple[ObservationTerm, ...]:
+        """The head pixels and, when given, the feet pixels."""
+        return (self.observations,) if self.feet is None else (self.observations, self.feet)
 
     @cached_property
     def A(self) -> np.ndarray:
@@ -60,15 +71,20 @@ class Problem:
 
     @cached_property
     def motion_normal(self) -> tuple[np.ndarray, np.ndarray]:
-        """Λ_X as blocks (D, B) — constant, computed once."""
-        return motion_blocks(self.A, self.W, self.grid.n)
+        """Λ_X as blocks (D, B), with the first velocity's prior on D[0] — constant, computed once."""
+        D, B = motion_blocks(self.A, self.W, self.grid.n)
+        D[0, VEL, VEL] += self.motion.first_velocity_gain ** 2
+        return D, B
 
     @cached_property
-    def observation_groups(self) -> tuple[np.ndarray, np.ndarray]:
-        """(first row of each run of equal steps, that step): observations are in time order."""
-        step = self.observations.step
-        starts = np.flatnonzero(np.r_[True, step[1:] != step[:-1]])
-        return starts, step[starts]
+    def observation_groups(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per pixel term: (first row of each run of equal steps, that step); rows are in time order."""
+        out = []
+        for term in self.pixel_terms:
+            step = term.step
+            starts = np.flatnonzero(np.r_[True, step[1:] != step[:-1]])
+            out.append((starts, step[starts]))
+        return out
 
 
 @dataclass
@@ -113,9 +129,12 @@ def huber(e: np.ndarray, k: float | None) -> tuple[np.ndarray, np.ndarray]:
 def evaluate(problem: Problem, X: np.ndarray) -> Costs:
     """The objective's terms at X (n, 6); ``inf`` observation cost if a head goes behind a camera."""
     rm = motion_residuals(X, problem.A, problem.W)
-    r, _, depth = problem.observations.residuals(X, with_jacobian=False)
-    rho, _ = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
-    obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
+    rv = first_velocity_residuals(X, problem.motion.first_velocity_gain)
+    obs_cost = 0.0
+    for term in problem.pixel_terms:
+        r, _, depth = term.residuals(X, with_jacobian=False)
+        rho, _ = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
+        obs_cost += float(rho.sum()) if np.all(depth > 1e-3) else np.inf
     env = problem.environment
     barrier = height = 0.0
     if env.barrier is not None:
@@ -124,7 +143,20 @@ def evaluate(problem: Problem, X: np.ndarray) -> Costs:
     if env.height is not None:
         rh, _ = height_residuals(X, env.height, env.weight)
         height = float(rh @ rh)
-    return Costs(float(np.sum(rm * rm)), obs_cost, barrier, height)
+    return Costs(float(np.sum(rm * rm) + rv @ rv), obs_cost, barrier, height)
+
+
+def _add_pixel_term(term: ObservationTerm, starts: np.ndarray, steps: np.ndarray, robust: float | None,
+                    X: np.ndarray, D: np.ndarray, g: np.ndarray) -> float:
+    """In place: one pixel term's JᵀWJ into D and JᵀWr into g (each row on one state; rows come in
+    runs of equal steps, time order); returns its cost (inf if a point goes behind a camera)."""
+    r, J, depth = term.residuals(X)
+    rho, w = huber(np.hypot(r[:, 0], r[:, 1]), robust)
+    JtJ = np.einsum("nki,nkj->nij", J, J * w[:, None, None])
+    Jtr = np.einsum("nki,nk->ni", J, r * w[:, None])
+    D[steps] += np.add.reduceat(JtJ, starts, axis=0)
+    g[steps] += np.add.reduceat(Jtr, starts, axis=0)
+    return float(rho.sum()) if np.all(depth > 1e-3) else np.inf
 
 
 def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None) -> Linearisation:
@@ -144,15 +176,13 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None)
     g.fill(0.0)
     barrier_steps.fill(False)
     motion_cost = add_motion_terms(X, problem.A, problem.W, g)
-    # observations, each on one state; rows come in runs of equal steps (time order)
-    r, J, depth = problem.observations.residuals(X)
-    rho, w = huber(np.hypot(r[:, 0], r[:, 1]), problem.robust)
-    starts, steps = problem.observation_groups
-    JtJ = np.einsum("nki,nkj->nij", J, J * w[:, None, None])
-    Jtr = np.einsum("nki,nk->ni", J, r * w[:, None])
-    D[steps] += np.add.reduceat(JtJ, starts, axis=0)
-    g[steps] += np.add.reduceat(Jtr, starts, axis=0)
-    obs_cost = float(rho.sum()) if np.all(depth > 1e-3) else np.inf
+    gain = problem.motion.first_velocity_gain
+    rv = first_velocity_residuals(X, gain)
+    g[0, VEL] += gain * rv
+    motion_cost += float(rv @ rv)
+    obs_cost = 0.0
+    for term, (starts, steps) in zip(problem.pixel_terms, problem.observation_groups):
+        obs_cost += _add_pixel_term(term, starts, steps, problem.robust, X, D, g)
     env = problem.environment
     barrier_cost = height_cost = 0.0
     if env.barrier is not None:

@@ -7,6 +7,12 @@ Only the cameras that see the person at a time contribute; between views there i
 An observation taken at time ``s`` between grid steps is predicted from the nearest step k by the
 motion model itself: the head is at ``p_k + (s − t_k)·ṗ_k``, so off-grid time stamps (cameras
 that are not synchronised) cost no accuracy and still touch one state only.
+
+Feet (beyond the paper). One head pixel per camera cannot tell the head height from the distance:
+a wrong height maps every back-projected point along its ray, a homothety about the camera's nadir.
+A box gives its bottom as well as its top: the optional *feet* pixel of a row is the projection of
+the floor point (u, v, 0) below the head at the same time, with its own σ. It touches the same state
+(not w), so the normal matrix stays block-tridiagonal, and with it the head height is seen.
 """
 
 from __future__ import annotations
@@ -33,6 +39,9 @@ class Observations:
     uv : (N, 2) float, pixels of the real (distorted) image
     sigma : (N,) float, pixels — standard deviation of each pixel coordinate (Σ_ω = σ²·I)
     cameras : tuple of Camera
+    feet_uv : (N, 2) float or None, pixels — the feet (floor point below the head, e.g. a box's
+        bottom centre) seen at the same time by the same camera; NaN rows: not seen
+    feet_sigma : (N,) float or None, pixels — its σ (default: ``sigma``)
 
     Examples
     --------
@@ -48,6 +57,8 @@ class Observations:
     uv: np.ndarray
     sigma: np.ndarray
     cameras: tuple[Camera, ...]
+    feet_uv: np.ndarray | None = None
+    feet_sigma: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.time)
@@ -59,11 +70,35 @@ class Observations:
             raise InputError("observations must be in time order")
         if not (np.all(np.isfinite(self.uv)) and np.all(self.sigma > 0)):
             raise InputError("observations need finite pixels and positive sigma")
+        if self.feet_uv is not None:
+            if self.feet_uv.shape != (n, 2) or (self.feet_sigma is not None and self.feet_sigma.shape != (n,)):
+                raise ValueError("Observations: feet_uv must be (N, 2) and feet_sigma (N,)")
+            if np.any(np.isnan(self.feet_uv).sum(axis=1) == 1) or np.any(np.isinf(self.feet_uv)):
+                raise InputError("feet pixels: give both u_feet and v_feet as finite numbers, or neither")
+            if self.feet_sigma is not None and not np.all(self.feet_sigma[self.has_feet] > 0):
+                raise InputError("feet pixels need a positive sigma")
+
+    @property
+    def has_feet(self) -> np.ndarray:
+        """(N,) bool: rows with a feet pixel."""
+        if self.feet_uv is None:
+            return np.zeros(len(self.time), dtype=bool)
+        return np.all(np.isfinite(self.feet_uv), axis=1)
+
+    def feet(self) -> "Observations | None":
+        """The feet pixels as observations of their own (rows with feet only), or None."""
+        keep = self.has_feet
+        if not keep.any():
+            return None
+        sigma = self.sigma if self.feet_sigma is None else self.feet_sigma
+        return Observations(self.time[keep], self.camera[keep], self.feet_uv[keep], sigma[keep], self.cameras)
 
     @classmethod
     def from_rows(cls, time: ArrayLike, camera_ids: ArrayLike, uv: ArrayLike, cameras: dict[str, Camera],
-                  sigma: ArrayLike | float = 2.0) -> "Observations":
-        """Rows of (time s, camera id, (u, v) px[, sigma px]); ``cameras`` maps ids to cameras."""
+                  sigma: ArrayLike | float = 2.0, feet_uv: ArrayLike | None = None,
+                  feet_sigma: ArrayLike | float | None = None) -> "Observations":
+        """Rows of (time s, camera id, (u, v) px[, sigma px][, feet (u, v) px, NaN: none]);
+        ``cameras`` maps ids to cameras."""
         ids = [str(c) for c in np.asarray(camera_ids).ravel()]
         order = list(cameras)
         unknown = sorted(set(ids) - set(order))
@@ -73,8 +108,11 @@ class Observations:
         index = {c: k for k, c in enumerate(used)}
         t = np.asarray(time, dtype=float).ravel()
         sig = np.broadcast_to(np.asarray(sigma, dtype=float), t.shape).copy()
+        feet = None if feet_uv is None else np.asarray(feet_uv, dtype=float).reshape(-1, 2)
+        feet_sig = (None if feet_sigma is None or feet is None
+                    else np.broadcast_to(np.asarray(feet_sigma, dtype=float), t.shape).copy())
         return cls(t, np.array([index[c] for c in ids], dtype=np.int64), np.asarray(uv, dtype=float).reshape(-1, 2),
-                   sig, tuple(cameras[c] for c in used))
+                   sig, tuple(cameras[c] for c in used), feet, feet_sig)
 
     @classmethod
     def from_points(cls, time: ArrayLike, camera_ids: ArrayLike, points: ArrayLike, cameras: dict[str, Camera],
@@ -97,7 +135,9 @@ class Observations:
 
     def subset(self, keep: np.ndarray) -> "Observations":
         """The rows where ``keep`` (bool (N,)) holds."""
-        return Observations(self.time[keep], self.camera[keep], self.uv[keep], self.sigma[keep], self.cameras)
+        pick = lambda a: None if a is None else a[keep]  # noqa: E731
+        return Observations(self.time[keep], self.camera[keep], self.uv[keep], self.sigma[keep], self.cameras,
+                            pick(self.feet_uv), pick(self.feet_sigma))
 
 
 def project_with_jacobian(camera: Camera, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -149,16 +189,18 @@ class ObservationTerm:
     obs : Observations
     step : (N,) int — grid step of each observation
     tau : (N,) float, seconds — its time minus the step's time
+    floor : bool — the pixels are of the floor point (u, v, 0) below the head (feet), not the head
     """
 
     obs: Observations
     step: np.ndarray
     tau: np.ndarray
+    floor: bool = False
 
     @classmethod
-    def on_grid(cls, obs: Observations, grid: TimeGrid) -> "ObservationTerm":
+    def on_grid(cls, obs: Observations, grid: TimeGrid, floor: bool = False) -> "ObservationTerm":
         step, tau = grid.locate(obs.time)
-        return cls(obs, step, tau)
+        return cls(obs, step, tau, floor)
 
     @cached_property
     def rows_by_camera(self) -> list[np.ndarray]:
@@ -166,8 +208,11 @@ class ObservationTerm:
         return [np.flatnonzero(self.obs.camera == k) for k in range(len(self.obs.cameras))]
 
     def head_points(self, X: np.ndarray) -> np.ndarray:
-        """(N, 3) predicted head points p_k + τ·ṗ_k at the observation times."""
-        return X[self.step][:, POS] + self.tau[:, None] * X[self.step][:, VEL]
+        """(N, 3) predicted head points p_k + τ·ṗ_k at the observation times (z = 0 for feet)."""
+        p = X[self.step][:, POS] + self.tau[:, None] * X[self.step][:, VEL]
+        if self.floor:
+            p[:, 2] = 0.0
+        return p
 
     def residuals(self, X: np.ndarray, with_jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
         """Whitened reprojection residuals (π(x) − y)/σ.
@@ -193,5 +238,7 @@ class ObservationTerm:
                 block = np.zeros((len(sel), 2, STATE))
                 block[:, :, POS] = Jp                              # ∂/∂p_k
                 block[:, :, VEL] = Jp * self.tau[sel][:, None, None]  # ∂/∂ṗ_k (off-grid time)
+                if self.floor:                                     # the feet do not depend on w, ẇ
+                    block[:, :, POS[2]] = block[:, :, VEL[2]] = 0.0
                 J[sel] = block
         return r, J, depth

@@ -22,7 +22,7 @@ import scipy.optimize
 
 from worldtrack.trajectory.environment import barrier_residuals, height_residuals
 from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, block_matvec, fill_banded
-from worldtrack.trajectory.model import STATE, motion_residuals
+from worldtrack.trajectory.model import STATE, VEL, first_velocity_residuals, motion_residuals
 from worldtrack.trajectory.objective import (Costs, Linearisation, Problem, evaluate, huber,
                                              linearise)
 
@@ -219,11 +219,13 @@ def residual_vector(problem: Problem, X: np.ndarray) -> np.ndarray:
     Huber residuals enter as r·√ρ(e)/e, whose squared norm is ρ(e): the same objective, so the same
     optimum (not the same Jacobian as the IRLS weights the fast solver uses).
     """
-    parts = [motion_residuals(X, problem.A, problem.W).ravel()]
-    r, _, _ = problem.observations.residuals(X, with_jacobian=False)
-    e = np.hypot(r[:, 0], r[:, 1])
-    rho, _ = huber(e, problem.robust)
-    parts.append((r * (np.sqrt(rho) / np.where(e > 0, e, 1.0))[:, None]).ravel() if problem.robust else r.ravel())
+    parts = [motion_residuals(X, problem.A, problem.W).ravel(),
+             first_velocity_residuals(X, problem.motion.first_velocity_gain)]
+    for term in problem.pixel_terms:
+        r, _, _ = term.residuals(X, with_jacobian=False)
+        e = np.hypot(r[:, 0], r[:, 1])
+        rho, _ = huber(e, problem.robust)
+        parts.append((r * (np.sqrt(rho) / np.where(e > 0, e, 1.0))[:, None]).ravel() if problem.robust else r.ravel())
     env = problem.environment
     if env.barrier is not None:
         parts.append(barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False).r)
@@ -242,11 +244,15 @@ def jacobian_dense(problem: Problem, X: np.ndarray) -> np.ndarray:
         block[:, STATE * t:STATE * t + STATE] = minus_WA
         block[:, STATE * (t + 1):STATE * (t + 2)] = problem.W
         rows.append(block)
-    _, J, _ = problem.observations.residuals(X)
-    for i, k in enumerate(problem.observations.step):          # observations: one state each
-        block = np.zeros((2, STATE * n))
-        block[:, STATE * k:STATE * k + STATE] = J[i]
-        rows.append(block)
+    first = np.zeros((len(VEL), STATE * n))                  # prior on the first velocity
+    first[np.arange(len(VEL)), VEL] = problem.motion.first_velocity_gain
+    rows.append(first)
+    for term in problem.pixel_terms:                          # observations: one state each
+        _, J, _ = term.residuals(X)
+        for i, k in enumerate(term.step):
+            block = np.zeros((2, STATE * n))
+            block[:, STATE * k:STATE * k + STATE] = J[i]
+            rows.append(block)
     env = problem.environment
     if env.barrier is not None:                               # barrier samples: two states each
         br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
