@@ -125,6 +125,16 @@ def write_result(name: str, title: str, body: str) -> Path:
     return path
 
 
+def setting_value(text: str):
+    """A ``--set KEY=VALUE`` value: an int, a float, true/false, or the text."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(text.lower(), text)
+
+
 def save_result(name: str, title: str, text: str, quick: bool, seconds: float) -> None:
     """Write ``results/<name>.md`` for the script ``benchmarks/<name>.py``; ``--quick`` runs only print."""
     if quick:

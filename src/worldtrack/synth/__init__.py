@@ -38,6 +38,7 @@ from worldtrack.synth.motion import Track, Waypoint, WalkerSettings, random_walk
 from worldtrack.synth.photometry import Light, LightingSchedule, LightSegment, SensorNoise, WhiteBalance
 from worldtrack.synth.render import RenderOptions, Renderer, SynthFrame
 from worldtrack.synth.scenarios import Common, list_scenarios, make_scenario, scenario_parameters
+from worldtrack.synth import unseen as _unseen  # noqa: F401  (registers the line-of-sight scenario)
 from worldtrack.synth.sensors import SensorSpec
 from worldtrack.synth.sequence import CameraRig, Person, Scenario, SynthBundle
 from worldtrack.synth.writer import write_sequence

@@ -239,9 +239,16 @@ class PositionMap:
         self._people[track_id] = p
         return p
 
-    def promote(self, person_id: int) -> int:
-        """Give a tentative person (negative id) the next real id; returns the new id."""
+    def promote(self, person_id: int, known_id: int | None = None) -> int:
+        """Give a tentative person (negative id) the next real id, or ``known_id`` (a person
+        re-identified: their id from before, not on the map); returns the new id."""
+        if known_id is not None and (known_id in self._people or known_id <= 0 or known_id >= self._next_id):
+            raise ValueError(f"track id {known_id} cannot be given back")
         p = self._people.pop(person_id)
+        if known_id is not None:
+            p.id = known_id
+            self._people[p.id] = p
+            return p.id
         p.id = self._next_id
         self._next_id += 1
         self._people[p.id] = p

@@ -21,7 +21,7 @@ def test_a_person_nobody_explains_is_proposed_at_their_feet_by_each_camera_once(
     # Both cameras' blobs point at the same person: the second is within min_separation_m of the
     # first and is dropped. The proposer is recorded.
     assert len(proposals) == 1
-    xy, cid = proposals[0]
+    xy, cid, _ = proposals[0]
     assert cid in scene.cameras and np.hypot(*(xy - person)) < 0.35
     # A person already there explains the blob: nothing proposed.
     assert _proposals(tracker, People(person[None], np.array([1.65]), np.array([0.4]))) == []
@@ -62,3 +62,37 @@ def test_entry_regions_keep_only_proposals_inside_them_after_the_first_frame():
     entry = InEntryRegions()
     assert entry.keep(proposals, Scene, first_frame=True) == proposals
     assert [cid for _, cid in entry.keep(proposals, Scene, first_frame=False)] == ["c1"]
+
+
+def _column_blob(view, xy, z0, z1, half_width=0.2):
+    """A boolean image of a person-like column (floor place ``xy``, from height z0 to z1, m) in
+    ``view``: the crop, its top-left pixel and its centroid, as the births see a blob."""
+    cam = view.camera
+    ray = xy - cam.centre[:2]
+    side = np.array([-ray[1], ray[0]]) / np.hypot(*ray) * half_width
+    corners = [(*(xy + s * side), z) for s, z in ((-1, z0), (1, z0), (1, z1), (-1, z1))]
+    px = cam.project(np.array(corners, float))
+    image = np.zeros((cam.height, cam.width), np.uint8)
+    import cv2
+    cv2.fillConvexPoly(image, np.round(px).astype(np.int32), 1)
+    vs, us = np.nonzero(image)
+    crop = image[vs.min():vs.max() + 1, us.min():us.max() + 1].astype(bool)
+    return crop, (int(us.min()), int(vs.min())), np.array([us.mean(), vs.mean()])
+
+
+def test_a_blob_from_feet_to_head_gives_the_persons_height_and_one_without_legs_is_placed_by_its_head():
+    from worldtrack.trackers.ellipsoid.births import blob_position
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    view = tracker.views[sorted(tracker.views)[0]]
+    whole = blob_position(view, *_column_blob(view, person, 0.0, 1.80), 1.65)
+    assert whole is not None
+    p, shown, share = whole
+    assert share == 1.0
+    assert np.hypot(*(p[:2] - person)) < 0.1 and abs(shown - 1.80) < 0.04
+    # Legs the colour of the floor: the blob starts at the waist. Its lower end would put the
+    # person metres too far along the line of sight; the head puts them within 0.2 m (1.65 m).
+    torso = blob_position(view, *_column_blob(view, person, 0.9, 1.65), 1.65)
+    assert torso is not None
+    p, shown, share = torso
+    assert shown is None and np.hypot(*(p[:2] - person)) < 0.2
+    assert abs(share - (1.65 - 0.9) / 1.65) < 0.1   # the area test asks only for the part shown

@@ -13,7 +13,7 @@ appear is a component chosen by name (``ellipsoid.births.where``, :data:`BIRTH_P
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Callable, Mapping, Protocol, Sequence
+from typing import Callable, Mapping, NamedTuple, Protocol, Sequence
 
 import cv2
 import numpy as np
@@ -25,8 +25,13 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import BirthConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop
 
-#: A proposal: a floor place (2,) m and the camera whose foreground proposed it.
-Proposal = tuple[np.ndarray, str]
+class Proposal(NamedTuple):
+    """A new person: a floor place (2,) m, the camera whose foreground proposed it, and the height
+    (m) its blob shows from the feet to the top of the head (None where the blob shows no both)."""
+
+    xy: np.ndarray
+    camera: str
+    height: float | None = None
 
 
 class BirthPlaces(Protocol):
@@ -62,7 +67,7 @@ class InEntryRegions:
     def keep(self, proposals: list[Proposal], scene, first_frame: bool) -> list[Proposal]:
         if first_frame or not scene.entry_regions:
             return proposals
-        return [(p, cid) for p, cid in proposals if scene.entry_region_index([p])[0] >= 0]
+        return [q for q in proposals if scene.entry_region_index([q[0]])[0] >= 0]
 
 
 @BIRTH_PLACES.register("none")
@@ -75,6 +80,15 @@ class Nowhere:
         return []
 
 
+class BlobPlace(NamedTuple):
+    """Where a blob puts a person: floor point (3,) m, the height it shows (m, or None) and the share
+    of the person's length in the image it covers (1 unless its lower end is not the feet)."""
+
+    xy: np.ndarray
+    height: float | None
+    share: float
+
+
 class Births:
     """Proposes new people in the cameras of one tracker.
 
@@ -84,14 +98,20 @@ class Births:
     scene : Scene — its walkable floor, entry regions and default person size
     walkable : callable — (M, 2) floor points → (M,) bool
     config : BirthConfig
+    height_range : (min, max) plausible heights, m (``ellipsoid.height.range_m``), or None when
+        heights are not measured (blobs then place people by their lower end, as before issue 37)
+    min_px : a blob tells a height only when it is at least this long, px (``ellipsoid.height.min_px``,
+        the rule the tracker's own height measurements follow: small, a pixel is centimetres)
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
-                 config: BirthConfig):
+                 config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60):
         self.views = views
         self.scene = scene
         self.walkable = walkable
         self.config = config
+        self.height_range = height_range
+        self.min_px = min_px
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
@@ -108,9 +128,9 @@ class Births:
         proposals = self.places.keep(proposals, self.scene, first_frame)
         # Each proposal is already clear of the existing people; keep the proposals apart too.
         kept: list[Proposal] = []
-        for p, cid in proposals:
-            if not any(np.hypot(*(q - p)) < self.config.min_separation_m for q, _ in kept):
-                kept.append((p, cid))
+        for q in proposals:
+            if not any(np.hypot(*(k[0] - q[0])) < self.config.min_separation_m for k in kept):
+                kept.append(q)
         return kept
 
     def _in_camera(self, cid: str, mask: np.ndarray, people: People) -> list[Proposal]:
@@ -137,17 +157,18 @@ class Births:
         # Components found at ~320 px wide (each blob then read back at full resolution):
         # labelling the whole 640x480 frame was a third of the births' time.
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
-            p = blob_position(view, blob, (x0, y0), centroid, h0)
-            if p is None:
+            found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px)
+            if found is None:
                 continue
+            p, height, share = found
             pxy = self.nearest_walkable(p[:2], 0.6)
             if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
                 continue  # off the floor, or somebody already there
             # Is the blob big enough to be (the visible part of) a person standing there?
             expected = view.visible_pixels(pxy, h0, w0)
-            if expected <= 0 or area < cfg.min_blob_fraction * expected:
+            if expected <= 0 or area < cfg.min_blob_fraction * expected * share:
                 continue
-            out.append((pxy, cid))
+            out.append(Proposal(pxy, cid, height))
         return out
 
     def walkable_floor(self) -> np.ndarray:
@@ -174,8 +195,10 @@ class Births:
 
 
 def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
-                  height: float) -> np.ndarray | None:
-    """Floor position (3,) of a person seen as ``blob``, or None.
+                  height: float, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: float = 0
+                  ) -> BlobPlace | None:
+    """Floor position (3,) of a person seen as ``blob``, the height (m) the blob shows and the share
+    of the person it shows, or None.
 
     ``blob`` is a boolean crop of the image whose top-left pixel is ``origin`` (u, v);
     ``centroid`` is in full-image pixels.
@@ -185,6 +208,15 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     looks straight down. They are back-projected to the floor, unless the blob ends there at the
     image border or on an obstacle (a desk hides the feet): then its other end, the top of the
     head, is back-projected to the default ``height`` (m).
+
+    Where both ends are in view, the height of the top-of-head ray above the foot point is the
+    person's height. Below ``height_range``'s minimum the blob is too short to be a person standing
+    at its lower end — legs in clothes the colour of the floor, a hole in the mask — and its lower
+    end would put the person too far along the line of sight: the head places them instead (at
+    the default ``height``), no height is given, and the share is the blob's length over the
+    length of a person of that height standing there. Above the maximum, no height is given either.
+    ``height_range=None`` (heights not measured, as in the paper's preset), or a blob shorter
+    than ``min_px`` or touching the image border: no height, and the lower end always.
     """
     cam = view.camera
     down = view.down_direction(centroid)
@@ -201,13 +233,51 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     half = max(1.0, 0.4 * (spread_max - spread_min))  # most of the blob's width
     beyond = foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across
     feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, view.occ, beyond)).mean() > 0.5
+    head_seen = bool(pixel_clear(cam, None, (head - 2 * down)[None]).all())
+    shown, share = None, 1.0
     if not feet_hidden:
         p = cam.backproject(foot[None], 0.0)[0]
-    elif pixel_clear(cam, None, head - 2 * down):  # the head inside the image
+        # Only oblique views tell the height (as in height.py): from above, the ends of the blob
+        # are the head and the shoulders, not the head and the feet.
+        oblique = np.isfinite(p).all() and np.hypot(*(p[:2] - cam.centre[:2])) >= cam.centre[2] - 0.5 * height
+        # Small, a pixel is centimetres of height; at the border, the blob may go on beyond it.
+        inside = bool(pixel_clear(cam, None, np.array([head - 3 * down, foot + 3 * down])).all())
+        readable = height_range is not None and head_seen and oblique and inside and along_max - along_min >= min_px
+        shown = head_height(cam, head, p) if readable else None
+        if shown is not None and shown < height_range[0]:
+            p, shown = cam.backproject(head[None], height)[0], None
+            ends = cam.project(np.array([[p[0], p[1], 0.0], [p[0], p[1], height]]))
+            length = float(np.hypot(*(ends[0] - ends[1])))
+            share = min(1.0, (along_max - along_min + 1.0) / length) if length > 0 else 1.0
+        elif shown is not None and shown > height_range[1]:
+            shown = None
+    elif head_seen:
         p = cam.backproject(head[None], height)[0]
     else:
         return None
-    return p if np.isfinite(p).all() else None
+    return BlobPlace(p, shown, share) if np.isfinite(p).all() else None
+
+
+def head_height(cam, head_px: np.ndarray, foot: np.ndarray) -> float | None:
+    """Height (m) of the viewing ray through pixel ``head_px`` (2,) where it passes over the floor
+    point ``foot`` (2+,), or None for a camera not above it (the ray does not come down to it).
+
+    >>> from worldtrack.geometry import Camera
+    >>> import numpy as np
+    >>> cam = Camera.look_at("c", 640, 480, position=(0, 0, 3.0), target=(0, 5, 0), hfov_deg=60)
+    >>> px = cam.project(np.array([[0.0, 5.0, 1.8]]))[0]
+    >>> round(head_height(cam, px, np.array([0.0, 5.0])), 3)
+    1.8
+    """
+    origin, d = cam.rays(np.asarray(head_px, float)[None])
+    d = d[0]
+    flat = d[:2] @ d[:2]
+    if not np.isfinite(d).all() or flat < 1e-9:
+        return None
+    s = float((np.asarray(foot[:2], float) - origin[:2]) @ d[:2] / flat)
+    if s <= 0:
+        return None
+    return float(origin[2] + s * d[2])
 
 
 @lru_cache(maxsize=8)

@@ -65,6 +65,21 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
         None when the view is not clear: too few pixels, head or feet at the image border or
         hidden by an obstacle, or a result outside the plausible range.
     """
+    found = measure_feet(camera, labels, occ, xy, region, box, max_offset_m, down, max_depth_offset_m)
+    if found is None:
+        return None
+    h = found[1]
+    lo, hi = height_range_m
+    return h if lo <= h <= hi else None
+
+
+def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
+                 region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
+                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None
+                 ) -> tuple[np.ndarray, float] | None:
+    """The feet's floor point (3,) and the height (m) of the top of the head's ray above it, of
+    the person whose foreground lies in ``region`` of ``box``, or None (parameters and the
+    conditions as :func:`measure_height`, which is this without a height range)."""
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
         return None  # the person may extend past the image border
@@ -92,9 +107,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
     if np.dot(dxy, dxy) < 1e-12:
         return None
     s = np.dot(feet[:2] - origin[:2], dxy) / np.dot(dxy, dxy)  # closest approach to the feet's vertical
-    h = float(origin[2] + s * d[2])
-    lo, hi = height_range_m
-    return h if lo <= h <= hi else None
+    return feet, float(origin[2] + s * d[2])
 
 
 def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.ndarray,
@@ -376,4 +389,4 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
 
 
 __all__ = ["MAX_COVERED_FOR_HEIGHT", "extreme_ends", "extreme_ends_reference", "head_ray", "heights_due",
-           "measure_height", "triangulate_height", "update_heights"]
+           "measure_feet", "measure_height", "triangulate_height", "update_heights"]

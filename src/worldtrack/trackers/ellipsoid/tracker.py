@@ -34,7 +34,9 @@ from worldtrack.trackers.ellipsoid.args import DrawArgs, People, Scoring, StepAr
 from worldtrack.trackers.ellipsoid.births import Births
 from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
+from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.height import heights_due, update_heights
+from worldtrack.trackers.ellipsoid.identity import Identities
 from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
@@ -85,7 +87,8 @@ class EllipsoidTracker(TrackerBase):
         self.steps = StepArgs(float(m.step_m), float(m.min_step_m), float(m.max_step_m), int(m.iterations),
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
-        self.births = Births(self.views, scene, self.walkable, cfg.births)
+        self.births = Births(self.views, scene, self.walkable, cfg.births,
+                             cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
@@ -95,6 +98,10 @@ class EllipsoidTracker(TrackerBase):
         self.last_labels: dict[str, np.ndarray] = {}
         #: σ, reported velocity and mode of each person (:mod:`.uncertainty`).
         self.uncertainty = PositionUncertainty()
+        self.last_images: dict[str, np.ndarray] = {}
+        #: The people's colour models (:mod:`.identity`).
+        self.identity = Identities(cfg.identity)
+        self._now = 0.0
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -129,6 +136,7 @@ class EllipsoidTracker(TrackerBase):
         this tracker does not read are ignored) taken at time ``t`` (s); return the confirmed
         people's tracks (everybody on the map, whoever's cameras see them)."""
         self.position_map.advance(t)
+        self._now = t
         dt = 0.0 if self._last_t is None else max(t - self._last_t, 1e-6)
         if dt > 0:
             self.frame_interval = dt
@@ -141,6 +149,11 @@ class EllipsoidTracker(TrackerBase):
         born = self._births(real, t)
         if born:
             scores += self._match(born, real, t, judged + bystanders)
+        anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet,
+                       self.config.height)
+        if self.config.identity.enabled:  # before the life cycle: a person confirmed now is re-identified by it
+            self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
+                                 lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
         self.uncertainty.measure(self, real, t)
         self._last_t = t
@@ -156,6 +169,7 @@ class EllipsoidTracker(TrackerBase):
         for cid in [c for c in self.last_labels if c not in frames]:
             del self.last_labels[cid]
             self.last_masks.pop(cid, None)
+            self.last_images.pop(cid, None)
         for cid, frame in frames.items():
             if cid not in self.views:
                 continue
@@ -163,6 +177,7 @@ class EllipsoidTracker(TrackerBase):
             image = frame_image(frame)
             labels = fg.labels(image)
             self.last_labels[cid] = labels
+            self.last_images[cid] = image
             self.last_masks[cid] = (labels == 1).astype(np.uint8)
             real[cid] = ternary_real(labels, self.views[cid].ring_px)
         return real
@@ -238,9 +253,13 @@ class EllipsoidTracker(TrackerBase):
         proposals = self.births.propose(masks, _people(list(self.position_map)), self.frames_stepped == 0)
         h0, w0 = self.scene.people.height, self.scene.people.width
         born = []
-        for xy, cid in proposals:
-            p = self.position_map.add(xy[0], xy[1], h0, w0, mode="capture", time=t, tentative=True)
+        for xy, cid, shown in proposals:
+            # The height the blob shows (feet and head in view) is the person's first measurement.
+            height = shown if shown is not None and abs(shown - h0) > self.config.height.deadband_m else h0
+            p = self.position_map.add(xy[0], xy[1], height, w0, mode="capture", time=t, tentative=True)
             p.birth_camera = cid
+            if shown is not None:
+                p.height_samples.append(shown)
             born.append(p)
         return born
 
@@ -268,8 +287,12 @@ class EllipsoidTracker(TrackerBase):
         """A confirmed candidate gets its public id and the scene's size for that id."""
         if p.id > 0:
             return
-        new = self.position_map.promote(p.id)
-        p.height, p.width = self.scene.people.size_of(new)
+        back = self.identity.reidentify(p, self._now, lambda pid: pid in self.position_map) \
+            if self.config.identity.enabled else None
+        new = self.position_map.promote(p.id, back)
+        height, p.width = self.scene.people.size_of(new)
+        if not p.height_samples:  # else keep what was measured (at birth, or since)
+            p.height = height
 
 
 def _people(people: Sequence[Person]) -> People:

@@ -55,7 +55,7 @@ def warm_start(tracker: "EllipsoidTracker", frames: Sequence[tuple[float, Mappin
 
 def adopt(tracker: "EllipsoidTracker", other: "EllipsoidTracker", t: float) -> None:
     """Put ``other``'s confirmed people on ``tracker``'s map as tracked, at time ``t``, walking the
-    other way (a pass in mirrored time hands over): same ids, sizes and height measurements; and
+    other way (a pass in mirrored time hands over): same ids, sizes, height measurements and colour models; and
     the frame interval ``other`` has seen (durations on ``tracker``'s first frame count in it)."""
     for p in other.position_map:
         if not p.confirmed:
@@ -64,6 +64,8 @@ def adopt(tracker: "EllipsoidTracker", other: "EllipsoidTracker", t: float) -> N
         new.vx, new.vy = -p.vx, -p.vy
         new.height_samples = list(p.height_samples)
         new.height_tries = p.height_tries
+        if p in other.identity.models:
+            tracker.identity.models[new] = dict(other.identity.models[p])
     tracker.frame_interval = other.frame_interval
 
 
