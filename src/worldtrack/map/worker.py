@@ -47,6 +47,8 @@ class SharedPositionMap(PositionMap):
     >>> m = SharedPositionMap(lambda x, y: next(ids))
     >>> m.add(1.0, 1.0).id, m.promote(m.add(2.0, 2.0, tentative=True).id)
     (41, 42)
+    >>> m.promote(m.add(3.0, 3.0, tentative=True).id, known_id=7)   # re-identified: its id back
+    7
     """
 
     def __init__(self, new_id: Callable[[float, float], int]):
@@ -66,7 +68,12 @@ class SharedPositionMap(PositionMap):
             track_id = new
         return super().add(x, y, height, width, mode, time, track_id, tentative, confirmed)
 
-    def promote(self, person_id: int) -> int:
+    def promote(self, person_id: int, known_id: int | None = None) -> int:
+        """As :meth:`PositionMap.promote`; a re-identified person's ``known_id`` (given by the shared
+        map before) is taken back as it is, every other id comes from the shared map."""
+        if known_id is not None:
+            self._next_id = max(self._next_id, known_id + 1)    # the base class accepts ids it gave
+            return super().promote(person_id, self._free(known_id))
         p = self[person_id]
         self._next_id = self._free(self.new_id(p.x, p.y))    # the base class gives out _next_id
         return super().promote(person_id)
