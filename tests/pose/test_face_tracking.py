@@ -10,7 +10,7 @@ from worldtrack.pose.lm import central_difference_jacobian
 from worldtrack.pose.models import rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, mean_rotation
 from worldtrack.pose.rigid import face_jacobian, face_normal_equations, gradient_images
-from worldtrack.pose.render import local_extrema
+from worldtrack.pose.render import gradient_maxima, local_extrema
 from worldtrack.pose.tracker import to_grey
 from worldtrack.geometry.rotation import rodrigues
 from worldtrack.synth.faces import face_model, face_sequence, make_face
@@ -51,6 +51,41 @@ def test_template_points_are_intensity_extrema(face_setup):
     tp = tr.template(tr.state)
     assert 100 < len(tp.colour) <= tr.config.n_template
     assert len(np.unique(tp.colour)) == len(tp.colour)
+
+
+def test_edge_fill_keeps_the_extrema_first_and_adds_gradient_crests(face_setup):
+    """The template's extrema come first, unchanged; the fill points lie where the drawing's
+    intensity changes to first order with the pose (an extremum's does not)."""
+    face, seq, frames, tr = face_setup
+    plain = RigidTracker(face_model(face), seq.intr, frames[0].R, frames[0].t,
+                         TrackerConfig(n_candidates=300, edge_points=False)).template(tr.state)
+    filled = tr.template(tr.state)
+    n = len(plain.colour)
+    assert n < len(filled.colour) <= tr.config.n_template
+    np.testing.assert_array_equal(filled.colour[:n], plain.colour)
+    assert len(np.unique(filled.colour)) == len(filled.colour)
+    grey = cv2.GaussianBlur(to_grey(frames[0].image), (0, 0), 1.0)
+    grads = gradient_images(grey)
+    R, t = state_pose(tr.state)
+    xyz = tr.model.points[filled.colour] @ R.T + t
+    u = np.round(seq.intr.fx * xyz[:, 0] / xyz[:, 2] + seq.intr.cx).astype(int)
+    v = np.round(seq.intr.fy * xyz[:, 1] / xyz[:, 2] + seq.intr.cy).astype(int)
+    g = np.hypot(grads[1, v, u], grads[2, v, u])
+    assert np.median(g[n:]) > 1.3 * np.median(g[:n])                # crests: steep; extrema: flatter
+
+
+def test_gradient_maxima_are_crests_of_the_gradient_on_valid_pixels():
+    yy, xx = np.mgrid[0:40, 0:60]
+    img = (100 * np.exp(-((xx - 20.3) ** 2 + (yy - 19.6) ** 2) / 18)).astype(np.float32)   # blob, σ = 3 px
+    valid = np.ones_like(img, bool)
+    rc, g = gradient_maxima(img, valid)
+    r = np.hypot(rc[:, 0] - 19.6, rc[:, 1] - 20.3)
+    assert len(rc) >= 4 and np.all(np.abs(r - 3) < 0.8)            # the ring of steepest slope, r = σ
+    np.testing.assert_allclose(g, 100 / 3 * np.exp(-0.5), rtol=0.12)   # |∇I| there: A/σ·e^(−1/2)
+    valid[:, :21] = False                                           # no crest within 2 px of invalid pixels
+    rc2, _ = gradient_maxima(img, valid)
+    assert len(rc2) and rc2[:, 1].min() >= 23
+    assert len(gradient_maxima(np.full((20, 20), 7.0, np.float32), np.ones((20, 20), bool))[0]) == 0   # flat: none
 
 
 def test_local_extrema_finds_peaks_and_pits_only():

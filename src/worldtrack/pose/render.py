@@ -161,6 +161,29 @@ def local_extrema(image: np.ndarray, valid: np.ndarray, radius: int = 1) -> tupl
     return rc, strength
 
 
+def gradient_maxima(image: np.ndarray, valid: np.ndarray, min_gradient: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels where the gradient magnitude ``|∇I|`` (Sobel / 8, grey levels per pixel) is strictly
+    above its eight neighbours and above ``min_gradient``: the crests of texture edges.
+
+    Only pixels whose 5×5 neighbourhood is ``valid`` count. Returns ``(rows, cols)`` stacked (n, 2)
+    and their ``|∇I|`` (n,), like :func:`local_extrema`.
+
+    >>> yy, xx = np.mgrid[0:21, 0:21]
+    >>> blob = (100 * np.exp(-((xx - 10.3) ** 2 + (yy - 9.8) ** 2) / 8)).astype(np.float32)   # σ = 2 px
+    >>> rc, g = gradient_maxima(blob, np.ones((21, 21), bool))
+    >>> len(rc) > 0, bool(np.all(np.abs(np.hypot(rc[:, 0] - 9.8, rc[:, 1] - 10.3) - 2) < 0.5))   # on r = σ
+    (True, True)
+    """
+    img = np.where(valid, image, 0).astype(np.float32)
+    g = np.hypot(cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3, scale=0.125),
+                 cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3, scale=0.125))
+    inner = cv2.erode(valid.astype(np.uint8), np.ones((5, 5), np.uint8), borderValue=0).astype(bool)
+    ring = np.ones((3, 3), np.uint8)
+    ring[1, 1] = 0
+    crest = inner & (g > cv2.dilate(g, ring)) & (g > min_gradient)
+    return np.argwhere(crest), g[crest]
+
+
 def _crop(uv: np.ndarray, intr: Intrinsics, margin: int = 4) -> tuple[Intrinsics, int, int] | None:
     """Intrinsics of the image window around projected points ``uv`` (n, 2); None if off-image."""
     lo = np.floor(uv.min(0)).astype(int) - margin
@@ -209,7 +232,7 @@ class TemplatePixels(NamedTuple):
 def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics, n_colour: int,
                            n_depth: int = 0, radius: int = 1, sigma: float = 1.0,
                            select_sigma: float = 0.5, normals: np.ndarray | None = None,
-                           groups: np.ndarray | None = None) -> TemplatePixels:
+                           groups: np.ndarray | None = None, edge_fill: bool = False) -> TemplatePixels:
     """The sparse template of a model drawn at one pose (§2.2, §4.3).
 
     Parameters
@@ -224,6 +247,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
         so a back surface cannot show through the gaps between a sparse model's points)
     groups : (M,) int part of each point — then every part drawn gets an equal share of
         ``n_colour`` and ``n_depth`` (a share a part cannot fill goes to the others)
+    edge_fill : when the extrema number fewer than ``n_colour``, fill up with the crests of the
+        drawing's gradient magnitude (:func:`gradient_maxima`), strongest first — points whose
+        image value changes to first order with the pose (at an extremum the change is second
+        order); extrema stay first. Not with ``groups``.
     n_depth : this many points where the z-buffer depth is a local max/min, filled up on an even
         grid over the visible surface when there are fewer (planar faces have none)
 
@@ -256,6 +283,9 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     rc, strength = local_extrema(np.nan_to_num(fine), known & np.isfinite(fine), radius)
     if groups is None:
         rc = _strongest(rc, strength, n_colour) if len(rc) else rc
+        if edge_fill and len(rc) < n_colour:
+            rc_e, g_e = gradient_maxima(np.nan_to_num(fine), known & np.isfinite(fine))
+            rc = np.concatenate([rc, _strongest(rc_e, g_e, n_colour - len(rc))]) if len(rc_e) else rc
     else:
         rc = _by_group(rc, strength, groups[np.maximum(r.index[tuple(rc.T)], 0)], n_colour)
     colour = _nearest_point(r.index, drawn, rc)

@@ -55,6 +55,8 @@ class TrackerConfig:
         (not for appearance read from an image, which holds it already)
     shading_vectors : eigenvectors Φ of the eigen-template besides the mean v̄
     depth_sampling : "bilinear" (on one surface) or "nearest" pixel, for ``colour-depth``
+    edge_points : fill the template up to ``n_template`` with crests of the drawing's gradient
+        magnitude after the extrema (worldtrack's addition; False: extrema only, as the paper)
     """
 
     stages: int = 1
@@ -75,6 +77,7 @@ class TrackerConfig:
     motion: str = "velocity"
     pf_points: int | None = 256
     depth_sampling: str = "bilinear"
+    edge_points: bool = True
     seed: int = 0
 
 
@@ -157,7 +160,7 @@ class RigidTracker:
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
         sigma = float(np.hypot(self.config.smooth_px, 0.0 if self.model.from_image else self.config.camera_blur_px))
         return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma,
-                                      normals=self.model.normals @ R.T)
+                                      normals=self.model.normals @ R.T, edge_fill=self.config.edge_points)
 
     def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray, tp=None):
         """The cost object for a (smoothed) grey frame, with the template taken at ``state`` (or ``tp``)."""
