@@ -106,7 +106,7 @@ def table(motion: str, methods: list[str], faces: list[int], seeds: list[int], n
             rs = results[(m, i)]
             mean = float(np.mean([e for r in rs for e in r["err"]]))
             fails = sum(r["fail"] for r in rs)
-            p = paper.get(m, [None] * 9)[i]
+            p = paper[m][i] if i < len(paper.get(m, [])) else None      # faces beyond P9: no paper figure
             ptxt = "" if p is None else (f" ({p})" if p == F else f" ({p:.3f})")
             row.append((f"{F} {fails}, " if fails else "") + f"{mean:.3f}{ptxt}")
         rows.append(row)

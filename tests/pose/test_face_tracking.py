@@ -142,6 +142,20 @@ def test_pf_lm_tracks_a_synthetic_face(face_setup):
     assert np.linalg.norm(last.t - frames[-1].t) < 0.004 and 0 <= last.cost < 0.3
 
 
+def test_cutting_the_frame_to_the_template_window_changes_nothing(face_setup):
+    face, seq, frames, _ = face_setup
+    est = {}
+    for margin in (None, 12):
+        tr = RigidTracker(face_model(face), seq.intr, frames[0].R, frames[0].t,
+                          TrackerConfig(n_candidates=300, lm_iterations=4, window_margin_px=margin, seed=5))
+        est[margin] = [tr.step(f.image) for f in frames[1:4]]
+    intr, rows, cols = tr.window(tr.template(tr.state), tr.state[None])
+    assert intr.width < seq.intr.width / 2 and intr.height < seq.intr.height / 2      # a real cut
+    assert intr.cx == seq.intr.cx - cols.start and intr.height == rows.stop - rows.start
+    for a, b in zip(est[None], est[12]):
+        assert float(rotation_error_deg(a.R, b.R)) < 1e-4 and np.abs(a.t - b.t).max() < 1e-9
+
+
 def test_klt_pnp_baseline_tracks_a_synthetic_face(face_setup):
     face, seq, frames, _ = face_setup
     tr = KltPnpTracker(face_model(face), seq.intr, frames[0].R, frames[0].t, frames[0].image)
