@@ -116,3 +116,21 @@ def test_equal_shares_of_the_template():
     rc = np.column_stack([np.arange(len(group))] * 2)
     picked = group[_by_group(rc, rng.random(len(group)), group, 128)[:, 0]]
     np.testing.assert_array_equal(np.bincount(picked), [26, 26, 26, 25, 25])
+
+
+def test_compiled_retract_and_state_pose_equal_their_numpy_references():
+    from worldtrack.pose.models import quat_matrix, retract, retract_reference, state_pose
+
+    rng = np.random.default_rng(4)
+    X = np.concatenate([rng.normal(size=(40, 3)), rng.normal(size=(40, 4))], 1)
+    X[:, 3:] /= np.linalg.norm(X[:, 3:], axis=1, keepdims=True)
+    X[:, 3:] *= np.sign(X[:, 3:4])
+    D = rng.normal(size=(40, 6)) * 0.3
+    D[0, 3:] = [1.0, 1.0, 1.0]                                   # longer than 1: scaled to unit length
+    np.testing.assert_allclose(retract(X, D, 0.1), retract_reference(X, D, 0.1), atol=1e-7)
+    np.testing.assert_allclose(retract(X[1:], D[1:], 0.1), retract_reference(X[1:], D[1:], 0.1), atol=1e-13)
+    np.testing.assert_allclose(retract(X[3], D[:5], 0.1), retract_reference(X[3], D[:5], 0.1), atol=1e-13)   # broadcast
+    assert retract(X[3], D[5], 0.1).shape == (7,)
+    R, t = state_pose((2 * X).reshape(4, 10, 7))                  # quaternions normalised first
+    np.testing.assert_allclose(R.reshape(-1, 3, 3), quat_matrix(X[:, 3:]), atol=1e-13)
+    np.testing.assert_allclose(t.reshape(-1, 3), 2 * X[:, :3])

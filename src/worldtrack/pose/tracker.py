@@ -59,6 +59,10 @@ class TrackerConfig:
         plus this margin (pixels) before it is smoothed and sampled — the same cost (a point
         beyond it scores as one outside the image), cheaper, and its pixels stay in cache;
         None: the whole frame
+    lm_tol : a kept candidate stops its LM once a step lowers ε by less than this (ε is a negative
+        log-likelihood in the candidates' weights exp(−ε): 1e-3 moves a weight by 0.1 %) or a step
+        with damping above JᵀJ's scale is refused (face cost only; 0: always ``lm_iterations``, as
+        the paper)
     edge_points : fill the template up to ``n_template`` with crests of the drawing's gradient
         magnitude after the extrema (worldtrack's addition; False: extrema only, as the paper)
     """
@@ -83,6 +87,7 @@ class TrackerConfig:
     depth_sampling: str = "bilinear"
     edge_points: bool = True
     window_margin_px: int | None = 48
+    lm_tol: float = 1e-3
     seed: int = 0
 
 
@@ -216,7 +221,8 @@ class RigidTracker:
         if self.cost == "eigen" and self.config.jacobian == "analytic":
             grads = gradient_images(cost.images[0])
             normal = lambda X: face_normal_equations(cost, self.space, grads, X)
-        return levenberg_marquardt(self.space, residuals, states, iterations, normal_equations=normal, epsilon=eps)
+        return levenberg_marquardt(self.space, residuals, states, iterations, normal_equations=normal, epsilon=eps,
+                                   tol=self.config.lm_tol)
 
     def step(self, image: np.ndarray, depth: np.ndarray | None = None) -> PoseEstimate:
         """Track one frame: ``image`` BGR uint8 or grey; ``depth`` (H, W) metres, 0 = none."""
