@@ -186,8 +186,8 @@ def gradient_maxima(image: np.ndarray, valid: np.ndarray, min_gradient: float = 
 
 def _crop(uv: np.ndarray, intr: Intrinsics, margin: int = 4) -> tuple[Intrinsics, int, int] | None:
     """Intrinsics of the image window around projected points ``uv`` (n, 2); None if off-image."""
-    lo = np.floor(uv.min(0)).astype(int) - margin
-    hi = np.ceil(uv.max(0)).astype(int) + margin
+    lo = np.floor([uv[:, 0].min(), uv[:, 1].min()]).astype(int) - margin      # per column: a fast reduction
+    hi = np.ceil([uv[:, 0].max(), uv[:, 1].max()]).astype(int) + margin
     u0, v0 = max(lo[0], 0), max(lo[1], 0)
     u1, v1 = min(hi[0], intr.width - 1), min(hi[1], intr.height - 1)
     if u1 <= u0 or v1 <= v0:
@@ -260,8 +260,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     """
     empty = TemplatePixels(np.zeros(0, int), np.zeros(0), np.zeros(0, int))
     if normals is not None:
-        away = (np.asarray(normals) * xyz).sum(1) > 0
-        xyz = np.where(away[:, None], np.array([0.0, 0.0, -1.0]), xyz)    # behind the camera: not drawn
+        n = np.asarray(normals)
+        away = n[:, 0] * xyz[:, 0] + n[:, 1] * xyz[:, 1] + n[:, 2] * xyz[:, 2] > 0
+        xyz = xyz.copy()
+        xyz[away] = (0.0, 0.0, -1.0)                                      # behind the camera: not drawn
     z = xyz[:, 2]
     front = z > 1e-6
     if not front.any():
