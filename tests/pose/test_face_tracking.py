@@ -150,7 +150,7 @@ def test_cutting_the_frame_to_the_template_window_changes_nothing(face_setup):
                           TrackerConfig(n_candidates=300, lm_iterations=4, window_margin_px=margin, seed=5))
         est[margin] = [tr.step(f.image) for f in frames[1:4]]
     intr, rows, cols = tr.window(tr.template(tr.state), tr.state[None])
-    assert intr.width < seq.intr.width / 2 and intr.height < seq.intr.height / 2      # a real cut
+    assert intr.width < 0.6 * seq.intr.width and intr.height < 0.6 * seq.intr.height  # a real cut
     assert intr.cx == seq.intr.cx - cols.start and intr.height == rows.stop - rows.start
     for a, b in zip(est[None], est[12]):
         assert float(rotation_error_deg(a.R, b.R)) < 1e-4 and np.abs(a.t - b.t).max() < 1e-9
@@ -168,3 +168,31 @@ def test_rigid_state_round_trip():
     R2, t2 = state_pose(rigid_state(R, np.array([1.0, 2.0, 3.0])))
     np.testing.assert_allclose(R2, R, atol=1e-12)
     np.testing.assert_allclose(t2, [1, 2, 3])
+
+
+def test_the_head_hides_face_points_but_is_never_a_template_point():
+    """The face model's skull has unknown appearance: no template point on it, and at 60° of yaw
+    the template keeps no face point the skull covers (the z-buffer draws the nearer surface)."""
+    face = make_face(3)
+    with_head, bare = face_model(face), face_model(face, head_spacing=None)
+    head = np.isnan(with_head.albedo)
+    assert head.sum() > 10000 and not np.isnan(bare.albedo).any()
+    intr = face_sequence(face, "sim1", seed=0, n_frames=1).intr
+    R, t = rodrigues([0.0, np.radians(60), 0.0]), np.array([0.0, 0.0, 0.6])
+    picked = {}
+    for name, model in (("head", with_head), ("bare", bare)):
+        tr = RigidTracker(model, intr, R, t)
+        tp = tr.template(tr.state)
+        assert not np.isnan(model.albedo[tp.colour]).any() and np.isfinite(tr.basis[tp.colour]).all()
+        picked[name] = set(tp.colour.tolist())
+    xyz_head = with_head.points[head] @ R.T + t
+    from worldtrack.pose.render import splat
+    hidden = splat(xyz_head, intr)                                  # what the skull alone covers
+    pts = bare.points @ R.T + t
+    u = np.round(intr.fx * pts[:, 0] / pts[:, 2] + intr.cx).astype(int)
+    v = np.round(intr.fy * pts[:, 1] / pts[:, 2] + intr.cy).astype(int)
+    behind = np.zeros(len(pts), bool)
+    inside = (u >= 0) & (v >= 0) & (u < intr.width) & (v < intr.height)
+    behind[inside] = hidden.depth[v[inside], u[inside]] < pts[inside, 2] - 0.005
+    assert sum(behind[i] for i in picked["bare"]) > 5                # without the skull: hidden points kept
+    assert sum(behind[i] for i in picked["head"]) <= 2

@@ -291,6 +291,8 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     else:
         rc = _by_group(rc, strength, groups[np.maximum(r.index[tuple(rc.T)], 0)], n_colour)
     colour = _nearest_point(r.index, drawn, rc)
+    first = np.sort(np.unique(colour, return_index=True)[1])        # a point reached from two pixels: once
+    colour, rc = colour[first], rc[first]
     value = _bilinear(np.nan_to_num(intensity), xyz[np.maximum(colour, 0)], win[0])   # at the point's projection
     depth_idx = np.zeros(0, int)
     if n_depth > 0:

@@ -134,7 +134,11 @@ class RigidTracker:
             raise InputError(f"cost: expected eigen or colour-depth, got {self.cost!r}")
         self.space = RigidSpace(length=max(self.model.radius, 1e-3))
         self.sigma = self.space.increment_sigma(self.config.sigma_mm, self.config.sigma_deg)
-        self.basis = shading_basis(self.model.normals, n_vectors=self.config.shading_vectors) if self.cost == "eigen" else None
+        self.basis = None
+        if self.cost == "eigen":                               # over the textured points (an occluder's do not count)
+            known = np.isfinite(self.model.albedo)
+            self.basis = np.full((len(known), self.config.shading_vectors + 1), np.nan)
+            self.basis[known] = shading_basis(self.model.normals[known], n_vectors=self.config.shading_vectors)
         self.rng = np.random.default_rng(self.config.seed)
         self.reset(self.R0, self.t0)
 
