@@ -134,3 +134,21 @@ def test_compiled_retract_and_state_pose_equal_their_numpy_references():
     R, t = state_pose((2 * X).reshape(4, 10, 7))                  # quaternions normalised first
     np.testing.assert_allclose(R.reshape(-1, 3, 3), quat_matrix(X[:, 3:]), atol=1e-13)
     np.testing.assert_allclose(t.reshape(-1, 3), 2 * X[:, :3])
+
+
+def test_cull_and_bound_equals_its_numpy_reference():
+    from worldtrack.pose.render import cull_and_bound, cull_and_bound_reference
+
+    rng = np.random.default_rng(8)
+    xyz = rng.normal([0, 0, 1.0], 0.3, (500, 3))
+    xyz[:20, 2] = -0.5                                               # behind the camera
+    nrm = rng.normal(size=(500, 3))
+    intr = Intrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
+    for normals in (nrm, None):
+        a, box_a = cull_and_bound(xyz, normals, intr)
+        b, box_b = cull_and_bound_reference(xyz, normals, intr)
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_allclose(box_a, box_b, rtol=1e-12)
+    culled = (nrm * xyz).sum(1) > 0
+    assert culled.sum() > 100 and (cull_and_bound(xyz, nrm, intr)[0][culled, 2] == -1).all()
+    assert cull_and_bound(np.array([[0.0, 0.0, -1.0]]), None, intr)[1] is None

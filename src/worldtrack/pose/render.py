@@ -184,6 +184,47 @@ def gradient_maxima(image: np.ndarray, valid: np.ndarray, min_gradient: float = 
     return np.argwhere(crest), g[crest]
 
 
+@njit(cache=True)
+def _cull_and_bound_kernel(xyz, normals, cull, fx, fy, cx, cy, out, box):  # pragma: no cover - compiled
+    # cull_and_bound_reference in one pass: copy, move back faces behind the camera, and keep the
+    # image box of the points in front.
+    box[0], box[1], box[2], box[3] = np.inf, np.inf, -np.inf, -np.inf
+    for i in range(xyz.shape[0]):
+        x, y, z = xyz[i, 0], xyz[i, 1], xyz[i, 2]
+        if cull and normals[i, 0] * x + normals[i, 1] * y + normals[i, 2] * z > 0:
+            x, y, z = 0.0, 0.0, -1.0
+        out[i, 0], out[i, 1], out[i, 2] = x, y, z
+        if z > 1e-6:
+            u = fx * x / z + cx
+            v = fy * y / z + cy
+            box[0], box[1] = min(box[0], u), min(box[1], v)
+            box[2], box[3] = max(box[2], u), max(box[3], v)
+
+
+def cull_and_bound(xyz: np.ndarray, normals: np.ndarray | None, intr: Intrinsics) -> tuple[np.ndarray, np.ndarray | None]:
+    """Camera points (M, 3) with back faces (``normals`` (M, 3) facing away) moved behind the
+    camera so they are not drawn, and the image box ``[[u_min, v_min], [u_max, v_max]]`` of the
+    points in front (None if none). Compiled; :func:`cull_and_bound_reference` is the NumPy version."""
+    xyz = np.ascontiguousarray(xyz, np.float64)
+    out, box = np.empty_like(xyz), np.empty(4)
+    nrm = np.ascontiguousarray(normals, np.float64) if normals is not None else np.zeros((1, 3))
+    _cull_and_bound_kernel(xyz, nrm, normals is not None, intr.fx, intr.fy, intr.cx, intr.cy, out, box)
+    return out, (box.reshape(2, 2) if np.isfinite(box[0]) else None)
+
+
+def cull_and_bound_reference(xyz: np.ndarray, normals: np.ndarray | None, intr: Intrinsics):
+    """:func:`cull_and_bound` in NumPy."""
+    xyz = np.array(xyz, float)
+    if normals is not None:
+        xyz[(np.asarray(normals) * xyz).sum(1) > 0] = (0.0, 0.0, -1.0)
+    z = xyz[:, 2]
+    front = z > 1e-6
+    if not front.any():
+        return xyz, None
+    uv = np.column_stack([intr.fx * xyz[front, 0] / z[front] + intr.cx, intr.fy * xyz[front, 1] / z[front] + intr.cy])
+    return xyz, np.array([uv.min(0), uv.max(0)])
+
+
 def _crop(uv: np.ndarray, intr: Intrinsics, margin: int = 4) -> tuple[Intrinsics, int, int] | None:
     """Intrinsics of the image window around projected points ``uv`` (n, 2); None if off-image."""
     lo = np.floor([uv[:, 0].min(), uv[:, 1].min()]).astype(int) - margin      # per column: a fast reduction
@@ -259,17 +300,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     TemplatePixels
     """
     empty = TemplatePixels(np.zeros(0, int), np.zeros(0), np.zeros(0, int))
-    if normals is not None:
-        n = np.asarray(normals)
-        away = n[:, 0] * xyz[:, 0] + n[:, 1] * xyz[:, 1] + n[:, 2] * xyz[:, 2] > 0
-        xyz = xyz.copy()
-        xyz[away] = (0.0, 0.0, -1.0)                                      # behind the camera: not drawn
-    z = xyz[:, 2]
-    front = z > 1e-6
-    if not front.any():
+    xyz, box = cull_and_bound(xyz, normals, intr)
+    if box is None:
         return empty
-    uv = np.column_stack([intr.fx * xyz[front, 0] / z[front] + intr.cx, intr.fy * xyz[front, 1] / z[front] + intr.cy])
-    win = _crop(uv, intr)
+    win = _crop(box, intr)
     if win is None:
         return empty
     r = splat(xyz, win[0])
