@@ -152,3 +152,16 @@ def test_cull_and_bound_equals_its_numpy_reference():
     culled = (nrm * xyz).sum(1) > 0
     assert culled.sum() > 100 and (cull_and_bound(xyz, nrm, intr)[0][culled, 2] == -1).all()
     assert cull_and_bound(np.array([[0.0, 0.0, -1.0]]), None, intr)[1] is None
+
+
+def test_posed_points_transform_and_cull_like_the_reference():
+    from worldtrack.geometry.rotation import rodrigues
+    from worldtrack.pose.render import cull_and_bound_reference, posed_points
+
+    rng = np.random.default_rng(9)
+    pts, nrm = rng.normal(0, 0.1, (400, 3)), rng.normal(size=(400, 3))
+    R, t = rodrigues([0.3, -0.8, 0.2]), np.array([0.05, -0.02, 0.7])
+    intr = Intrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
+    ref = cull_and_bound_reference(pts @ R.T + t, nrm @ R.T, intr)[0]
+    np.testing.assert_allclose(posed_points(pts, nrm, R, t), ref, atol=1e-14)
+    assert 100 < (ref[:, 2] == -1).sum() < 300

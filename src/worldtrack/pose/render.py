@@ -212,6 +212,32 @@ def cull_and_bound(xyz: np.ndarray, normals: np.ndarray | None, intr: Intrinsics
     return out, (box.reshape(2, 2) if np.isfinite(box[0]) else None)
 
 
+@njit(cache=True)
+def _posed_points_kernel(points, normals, R, t, out):  # pragma: no cover - compiled
+    # out_i = R·p_i + t, or (0, 0, −1) (behind the camera, not drawn) where R·n_i faces away.
+    for i in range(points.shape[0]):
+        p0, p1, p2 = points[i, 0], points[i, 1], points[i, 2]
+        x = R[0, 0] * p0 + R[0, 1] * p1 + R[0, 2] * p2 + t[0]
+        y = R[1, 0] * p0 + R[1, 1] * p1 + R[1, 2] * p2 + t[1]
+        z = R[2, 0] * p0 + R[2, 1] * p1 + R[2, 2] * p2 + t[2]
+        n0, n1, n2 = normals[i, 0], normals[i, 1], normals[i, 2]
+        facing = ((R[0, 0] * n0 + R[0, 1] * n1 + R[0, 2] * n2) * x + (R[1, 0] * n0 + R[1, 1] * n1 + R[1, 2] * n2) * y
+                  + (R[2, 0] * n0 + R[2, 1] * n1 + R[2, 2] * n2) * z)
+        if facing > 0:
+            x, y, z = 0.0, 0.0, -1.0
+        out[i, 0], out[i, 1], out[i, 2] = x, y, z
+
+
+def posed_points(points: np.ndarray, normals: np.ndarray, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Object points (M, 3) in the camera at pose ``R, t``, the back faces (normals facing away)
+    moved behind the camera: ready for :func:`sparse_template_pixels` without ``normals``.
+    Compiled; the same as ``cull_and_bound_reference(points @ R.T + t, normals @ R.T, …)[0]``."""
+    out = np.empty((len(points), 3))
+    _posed_points_kernel(np.ascontiguousarray(points, np.float64), np.ascontiguousarray(normals, np.float64),
+                         np.ascontiguousarray(R, np.float64), np.ascontiguousarray(t, np.float64), out)
+    return out
+
+
 def cull_and_bound_reference(xyz: np.ndarray, normals: np.ndarray | None, intr: Intrinsics):
     """:func:`cull_and_bound` in NumPy."""
     xyz = np.array(xyz, float)

@@ -34,7 +34,7 @@ from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
 from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
-from worldtrack.pose.render import Intrinsics, sparse_template_pixels
+from worldtrack.pose.render import Intrinsics, posed_points, sparse_template_pixels
 from worldtrack.pose.rigid import RigidSpace, face_normal_equations, gradient_images, shading_basis
 
 
@@ -169,12 +169,12 @@ class RigidTracker:
     def template(self, state: np.ndarray):
         """The sparse template (:class:`~worldtrack.pose.render.TemplatePixels`) at ``state``."""
         R, t = state_pose(state)
-        xyz = self.model.points @ R.T + t
+        xyz = posed_points(self.model.points, self.model.normals, R, t)        # back faces culled
         albedo = self.model.albedo
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
         sigma = float(np.hypot(self.config.smooth_px, 0.0 if self.model.from_image else self.config.camera_blur_px))
         return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma,
-                                      normals=self.model.normals @ R.T, edge_fill=self.config.edge_points)
+                                      edge_fill=self.config.edge_points)
 
     def window(self, tp, states: np.ndarray) -> tuple[Intrinsics, slice, slice]:
         """The part of the frame the candidates ``states`` can read: the template's box under them
