@@ -367,7 +367,7 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
             score = np.concatenate([s_d + 1.0, np.zeros(len(grid))])          # extrema first, then the grid
             pick = _by_group(cand, score, groups[np.maximum(r.index[tuple(cand.T)], 0)], n_depth)
         depth_idx = r.index[tuple(pick.T)] if len(pick) else depth_idx
-    keep = colour >= 0
+    keep = (colour >= 0) & np.isfinite(albedo[np.maximum(colour, 0)])   # an occluder's point is no template point
     return TemplatePixels(colour[keep], np.asarray(value, float)[keep], np.asarray(depth_idx, int))
 
 
