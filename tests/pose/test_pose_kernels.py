@@ -165,3 +165,22 @@ def test_posed_points_transform_and_cull_like_the_reference():
     ref = cull_and_bound_reference(pts @ R.T + t, nrm @ R.T, intr)[0]
     np.testing.assert_allclose(posed_points(pts, nrm, R, t), ref, atol=1e-14)
     assert 100 < (ref[:, 2] == -1).sum() < 300
+
+
+def test_template_never_picks_a_point_of_unknown_appearance():
+    """Where an occluder (NaN albedo) shows in single pixels among textured ones, the smoothed
+    drawing is defined there; an extremum there must not make a template point of the occluder."""
+    from worldtrack.pose.render import sparse_template_pixels
+
+    rng = np.random.default_rng(10)
+    g = np.arange(-0.05, 0.05, 0.0008)
+    X, Y = np.meshgrid(g, g)
+    pts = np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, 0.5)])
+    albedo = rng.uniform(50, 200, len(pts)).astype(np.float32)
+    albedo[pts[:, 0] > 0.01] = np.nan                                 # the right part: an occluder
+    sliver = rng.random(len(pts)) < 0.1                               # and occluder points scattered in front
+    albedo[sliver] = np.nan
+    pts[sliver, 2] -= 0.002
+    intr = Intrinsics(600.0, 600.0, 80.0, 80.0, 160, 160)
+    tp = sparse_template_pixels(albedo, pts, intr, 1024)
+    assert len(tp.colour) > 100 and np.isfinite(albedo[tp.colour]).all()
