@@ -9,8 +9,9 @@ median ms per frame of the tracker's step (this process pinned to one core), bes
 ``apply`` at the same size measured in the same run; ``trans`` is the mean translation error (mm).
 
 ``PFsLMn`` is the paper's method (random-walk particle filter, s stages, n LM iterations);
-``PF1LM10+v`` is the tracker's default: PF1LM10 with a constant-velocity start and the particle
-filter's candidates ranked on the 256 strongest template points (LM uses all). KLT + solvePnP
+``PF1LM10+v`` is the tracker's default: PF1LM10 with a constant-velocity start, the particle
+filter's candidates ranked on the 256 strongest template points (LM uses all), and the template's
+extrema filled up to N = 1024 with crests of the drawing's gradient magnitude. KLT + solvePnP
 (``worldtrack.pose.baselines``) runs on the same frames as a second baseline.
 
 Seeds: 200–204 are held out (development used seed 100).
@@ -52,12 +53,14 @@ PAPER_SIM2_MS = {"PF1LM0": 30, "PF1LM10": 45, "PF1LM30": 60}
 
 
 def config(name: str, seed: int = 0) -> TrackerConfig:
-    """``PFsLMn`` — the paper's method (random walk, every template point in the particle filter);
-    ``PFsLMn+v`` — worldtrack's defaults (constant-velocity start, candidates ranked on 256 points)."""
+    """``PFsLMn`` — the paper's method (random walk, every template point in the particle filter,
+    a template of intensity extrema only); ``PFsLMn+v`` — worldtrack's defaults (constant-velocity
+    start, candidates ranked on 256 points, the template filled up with gradient crests)."""
     s, l = name[2:].removesuffix("+v").split("LM")
     if name.endswith("+v"):
         return TrackerConfig(stages=int(s), lm_iterations=int(l), seed=seed)
-    return TrackerConfig(stages=int(s), lm_iterations=int(l), motion="none", pf_points=None, seed=seed)
+    return TrackerConfig(stages=int(s), lm_iterations=int(l), motion="none", pf_points=None, edge_points=False,
+                         seed=seed)
 
 
 def run(face, frames, intr, method: str, seed: int) -> dict:
@@ -103,7 +106,7 @@ def table(motion: str, methods: list[str], faces: list[int], seeds: list[int], n
             rs = results[(m, i)]
             mean = float(np.mean([e for r in rs for e in r["err"]]))
             fails = sum(r["fail"] for r in rs)
-            p = paper.get(m, [None] * 9)[i]
+            p = paper[m][i] if i < len(paper.get(m, [])) else None      # faces beyond P9: no paper figure
             ptxt = "" if p is None else (f" ({p})" if p == F else f" ({p:.3f})")
             row.append((f"{F} {fails}, " if fails else "") + f"{mean:.3f}{ptxt}")
         rows.append(row)

@@ -61,9 +61,9 @@ def main() -> None:
     cases = {
         "face PF1LM10 (worldtrack default)": (lambda: RigidTracker(model, fseq.intr, fframes[0].R, fframes[0].t),
                                               fframes, lambda tr, f: tr.step(f.image), 20),
-        "face PF1LM10 (paper: all points, random walk)": (
+        "face PF1LM10 (paper: extrema only, all in the PF, random walk)": (
             lambda: RigidTracker(model, fseq.intr, fframes[0].R, fframes[0].t,
-                                 TrackerConfig(motion="none", pf_points=None)), fframes, lambda tr, f: tr.step(f.image), 20),
+                                 TrackerConfig(motion="none", pf_points=None, edge_points=False)), fframes, lambda tr, f: tr.step(f.image), 20),
         "body PF1LM15 (cascade + joint LM)": (lambda: BodyTracker(bseq.true_model, bseq.intr, bframes[0].params),
                                               bframes, lambda tr, f: tr.step(f.image, f.depth), 80),
     }

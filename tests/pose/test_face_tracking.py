@@ -10,7 +10,7 @@ from worldtrack.pose.lm import central_difference_jacobian
 from worldtrack.pose.models import rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, mean_rotation
 from worldtrack.pose.rigid import face_jacobian, face_normal_equations, gradient_images
-from worldtrack.pose.render import local_extrema
+from worldtrack.pose.render import gradient_maxima, local_extrema
 from worldtrack.pose.tracker import to_grey
 from worldtrack.geometry.rotation import rodrigues
 from worldtrack.synth.faces import face_model, face_sequence, make_face
@@ -51,6 +51,41 @@ def test_template_points_are_intensity_extrema(face_setup):
     tp = tr.template(tr.state)
     assert 100 < len(tp.colour) <= tr.config.n_template
     assert len(np.unique(tp.colour)) == len(tp.colour)
+
+
+def test_edge_fill_keeps_the_extrema_first_and_adds_gradient_crests(face_setup):
+    """The template's extrema come first, unchanged; the fill points lie where the drawing's
+    intensity changes to first order with the pose (an extremum's does not)."""
+    face, seq, frames, tr = face_setup
+    plain = RigidTracker(face_model(face), seq.intr, frames[0].R, frames[0].t,
+                         TrackerConfig(n_candidates=300, edge_points=False)).template(tr.state)
+    filled = tr.template(tr.state)
+    n = len(plain.colour)
+    assert n < len(filled.colour) <= tr.config.n_template
+    np.testing.assert_array_equal(filled.colour[:n], plain.colour)
+    assert len(np.unique(filled.colour)) == len(filled.colour)
+    grey = cv2.GaussianBlur(to_grey(frames[0].image), (0, 0), 1.0)
+    grads = gradient_images(grey)
+    R, t = state_pose(tr.state)
+    xyz = tr.model.points[filled.colour] @ R.T + t
+    u = np.round(seq.intr.fx * xyz[:, 0] / xyz[:, 2] + seq.intr.cx).astype(int)
+    v = np.round(seq.intr.fy * xyz[:, 1] / xyz[:, 2] + seq.intr.cy).astype(int)
+    g = np.hypot(grads[1, v, u], grads[2, v, u])
+    assert np.median(g[n:]) > 1.3 * np.median(g[:n])                # crests: steep; extrema: flatter
+
+
+def test_gradient_maxima_are_crests_of_the_gradient_on_valid_pixels():
+    yy, xx = np.mgrid[0:40, 0:60]
+    img = (100 * np.exp(-((xx - 20.3) ** 2 + (yy - 19.6) ** 2) / 18)).astype(np.float32)   # blob, σ = 3 px
+    valid = np.ones_like(img, bool)
+    rc, g = gradient_maxima(img, valid)
+    r = np.hypot(rc[:, 0] - 19.6, rc[:, 1] - 20.3)
+    assert len(rc) >= 4 and np.all(np.abs(r - 3) < 0.8)            # the ring of steepest slope, r = σ
+    np.testing.assert_allclose(g, 100 / 3 * np.exp(-0.5), rtol=0.12)   # |∇I| there: A/σ·e^(−1/2)
+    valid[:, :21] = False                                           # no crest within 2 px of invalid pixels
+    rc2, _ = gradient_maxima(img, valid)
+    assert len(rc2) and rc2[:, 1].min() >= 23
+    assert len(gradient_maxima(np.full((20, 20), 7.0, np.float32), np.ones((20, 20), bool))[0]) == 0   # flat: none
 
 
 def test_local_extrema_finds_peaks_and_pits_only():
@@ -107,6 +142,20 @@ def test_pf_lm_tracks_a_synthetic_face(face_setup):
     assert np.linalg.norm(last.t - frames[-1].t) < 0.004 and 0 <= last.cost < 0.3
 
 
+def test_cutting_the_frame_to_the_template_window_changes_nothing(face_setup):
+    face, seq, frames, _ = face_setup
+    est = {}
+    for margin in (None, 12):
+        tr = RigidTracker(face_model(face), seq.intr, frames[0].R, frames[0].t,
+                          TrackerConfig(n_candidates=300, lm_iterations=4, window_margin_px=margin, seed=5))
+        est[margin] = [tr.step(f.image) for f in frames[1:4]]
+    intr, rows, cols = tr.window(tr.template(tr.state), tr.state[None])
+    assert intr.width < 0.6 * seq.intr.width and intr.height < 0.6 * seq.intr.height  # a real cut
+    assert intr.cx == seq.intr.cx - cols.start and intr.height == rows.stop - rows.start
+    for a, b in zip(est[None], est[12]):
+        assert float(rotation_error_deg(a.R, b.R)) < 1e-4 and np.abs(a.t - b.t).max() < 1e-9
+
+
 def test_klt_pnp_baseline_tracks_a_synthetic_face(face_setup):
     face, seq, frames, _ = face_setup
     tr = KltPnpTracker(face_model(face), seq.intr, frames[0].R, frames[0].t, frames[0].image)
@@ -119,3 +168,31 @@ def test_rigid_state_round_trip():
     R2, t2 = state_pose(rigid_state(R, np.array([1.0, 2.0, 3.0])))
     np.testing.assert_allclose(R2, R, atol=1e-12)
     np.testing.assert_allclose(t2, [1, 2, 3])
+
+
+def test_the_head_hides_face_points_but_is_never_a_template_point():
+    """The face model's skull has unknown appearance: no template point on it, and at 60° of yaw
+    the template keeps no face point the skull covers (the z-buffer draws the nearer surface)."""
+    face = make_face(3)
+    with_head, bare = face_model(face), face_model(face, head_spacing=None)
+    head = np.isnan(with_head.albedo)
+    assert head.sum() > 10000 and not np.isnan(bare.albedo).any()
+    intr = face_sequence(face, "sim1", seed=0, n_frames=1).intr
+    R, t = rodrigues([0.0, np.radians(60), 0.0]), np.array([0.0, 0.0, 0.6])
+    picked = {}
+    for name, model in (("head", with_head), ("bare", bare)):
+        tr = RigidTracker(model, intr, R, t)
+        tp = tr.template(tr.state)
+        assert not np.isnan(model.albedo[tp.colour]).any() and np.isfinite(tr.basis[tp.colour]).all()
+        picked[name] = set(tp.colour.tolist())
+    xyz_head = with_head.points[head] @ R.T + t
+    from worldtrack.pose.render import splat
+    hidden = splat(xyz_head, intr)                                  # what the skull alone covers
+    pts = bare.points @ R.T + t
+    u = np.round(intr.fx * pts[:, 0] / pts[:, 2] + intr.cx).astype(int)
+    v = np.round(intr.fy * pts[:, 1] / pts[:, 2] + intr.cy).astype(int)
+    behind = np.zeros(len(pts), bool)
+    inside = (u >= 0) & (v >= 0) & (u < intr.width) & (v < intr.height)
+    behind[inside] = hidden.depth[v[inside], u[inside]] < pts[inside, 2] - 0.005
+    assert sum(behind[i] for i in picked["bare"]) > 5                # without the skull: hidden points kept
+    assert sum(behind[i] for i in picked["head"]) <= 2

@@ -116,3 +116,71 @@ def test_equal_shares_of_the_template():
     rc = np.column_stack([np.arange(len(group))] * 2)
     picked = group[_by_group(rc, rng.random(len(group)), group, 128)[:, 0]]
     np.testing.assert_array_equal(np.bincount(picked), [26, 26, 26, 25, 25])
+
+
+def test_compiled_retract_and_state_pose_equal_their_numpy_references():
+    from worldtrack.pose.models import quat_matrix, retract, retract_reference, state_pose
+
+    rng = np.random.default_rng(4)
+    X = np.concatenate([rng.normal(size=(40, 3)), rng.normal(size=(40, 4))], 1)
+    X[:, 3:] /= np.linalg.norm(X[:, 3:], axis=1, keepdims=True)
+    X[:, 3:] *= np.sign(X[:, 3:4])
+    D = rng.normal(size=(40, 6)) * 0.3
+    D[0, 3:] = [1.0, 1.0, 1.0]                                   # longer than 1: scaled to unit length
+    np.testing.assert_allclose(retract(X, D, 0.1), retract_reference(X, D, 0.1), atol=1e-7)
+    np.testing.assert_allclose(retract(X[1:], D[1:], 0.1), retract_reference(X[1:], D[1:], 0.1), atol=1e-13)
+    np.testing.assert_allclose(retract(X[3], D[:5], 0.1), retract_reference(X[3], D[:5], 0.1), atol=1e-13)   # broadcast
+    assert retract(X[3], D[5], 0.1).shape == (7,)
+    R, t = state_pose((2 * X).reshape(4, 10, 7))                  # quaternions normalised first
+    np.testing.assert_allclose(R.reshape(-1, 3, 3), quat_matrix(X[:, 3:]), atol=1e-13)
+    np.testing.assert_allclose(t.reshape(-1, 3), 2 * X[:, :3])
+
+
+def test_cull_and_bound_equals_its_numpy_reference():
+    from worldtrack.pose.render import cull_and_bound, cull_and_bound_reference
+
+    rng = np.random.default_rng(8)
+    xyz = rng.normal([0, 0, 1.0], 0.3, (500, 3))
+    xyz[:20, 2] = -0.5                                               # behind the camera
+    nrm = rng.normal(size=(500, 3))
+    intr = Intrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
+    for normals in (nrm, None):
+        a, box_a = cull_and_bound(xyz, normals, intr)
+        b, box_b = cull_and_bound_reference(xyz, normals, intr)
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_allclose(box_a, box_b, rtol=1e-12)
+    culled = (nrm * xyz).sum(1) > 0
+    assert culled.sum() > 100 and (cull_and_bound(xyz, nrm, intr)[0][culled, 2] == -1).all()
+    assert cull_and_bound(np.array([[0.0, 0.0, -1.0]]), None, intr)[1] is None
+
+
+def test_posed_points_transform_and_cull_like_the_reference():
+    from worldtrack.geometry.rotation import rodrigues
+    from worldtrack.pose.render import cull_and_bound_reference, posed_points
+
+    rng = np.random.default_rng(9)
+    pts, nrm = rng.normal(0, 0.1, (400, 3)), rng.normal(size=(400, 3))
+    R, t = rodrigues([0.3, -0.8, 0.2]), np.array([0.05, -0.02, 0.7])
+    intr = Intrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
+    ref = cull_and_bound_reference(pts @ R.T + t, nrm @ R.T, intr)[0]
+    np.testing.assert_allclose(posed_points(pts, nrm, R, t), ref, atol=1e-14)
+    assert 100 < (ref[:, 2] == -1).sum() < 300
+
+
+def test_template_never_picks_a_point_of_unknown_appearance():
+    """Where an occluder (NaN albedo) shows in single pixels among textured ones, the smoothed
+    drawing is defined there; an extremum there must not make a template point of the occluder."""
+    from worldtrack.pose.render import sparse_template_pixels
+
+    rng = np.random.default_rng(10)
+    g = np.arange(-0.05, 0.05, 0.0008)
+    X, Y = np.meshgrid(g, g)
+    pts = np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, 0.5)])
+    albedo = rng.uniform(50, 200, len(pts)).astype(np.float32)
+    albedo[pts[:, 0] > 0.01] = np.nan                                 # the right part: an occluder
+    sliver = rng.random(len(pts)) < 0.1                               # and occluder points scattered in front
+    albedo[sliver] = np.nan
+    pts[sliver, 2] -= 0.002
+    intr = Intrinsics(600.0, 600.0, 80.0, 80.0, 160, 160)
+    tp = sparse_template_pixels(albedo, pts, intr, 1024)
+    assert len(tp.colour) > 100 and np.isfinite(albedo[tp.colour]).all()

@@ -108,9 +108,10 @@ def _project_sample_kernel(images, intr4, T, X, part, mode, max_step, vals, zout
                         vals[k, ch, i] = images[ch, vv, uu]
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"reassoc", "contract", "nsz", "arcp"})
 def _eigen_epsilon_kernel(V, Q, c):  # pragma: no cover - compiled
     # ε_k = Σ_i ρ_c(d_i), d = (Q·Qᵀ − I)·V per candidate; an unread point (NaN) counts ρ = 1.
+    # Sums may be reordered (vectorised); NaN and inf keep their meaning (no "nnan"/"ninf" flags).
     K, N = V.shape
     B = Q.shape[1]
     eps = np.zeros(K)

@@ -58,7 +58,7 @@ def central_difference_jacobian(space: PoseSpace, residuals: Residuals, X: np.nd
 def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, iterations: int,
                         jacobian: Jacobian | None = None, damping: float = 1e-5,
                         normal_equations: NormalEquations | None = None,
-                        epsilon: Callable[[np.ndarray], np.ndarray] | None = None) -> LMResult:
+                        epsilon: Callable[[np.ndarray], np.ndarray] | None = None, tol: float = 0.0) -> LMResult:
     """Refine K candidate states together.
 
     Parameters
@@ -71,6 +71,10 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
     damping : initial C (1e-5)
     normal_equations, epsilon : optional compiled ``X → (JᵀJ, Jᵀr, ε)`` and ``X → ε``; with them
         no residual matrix is formed (the face's fused kernel)
+    tol : with ``normal_equations``: a candidate whose accepted step lowered ε by less than ``tol``,
+        or whose step is refused at a damping above 10× JᵀJ's largest diagonal element, has
+        converged and is left as it is (0: always
+        ``iterations`` steps, as the paper)
 
     Returns
     -------
@@ -78,7 +82,7 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
     """
     X = np.array(X0, float)
     if normal_equations is not None:
-        return _lm_normal(space, normal_equations, epsilon, X, iterations, damping)
+        return _lm_normal(space, normal_equations, epsilon, X, iterations, damping, tol)
     r = residuals(X)
     cost = (r * r).sum(1)
     C = np.full(len(X), float(damping))
@@ -109,25 +113,40 @@ def levenberg_marquardt(space: PoseSpace, residuals: Residuals, X0: np.ndarray, 
 
 
 def _lm_normal(space: PoseSpace, normal_equations: NormalEquations, epsilon, X: np.ndarray, iterations: int,
-               damping: float) -> LMResult:
-    """:func:`levenberg_marquardt` driven by compiled normal equations."""
+               damping: float, tol: float = 0.0) -> LMResult:
+    """:func:`levenberg_marquardt` driven by compiled normal equations. With ``tol > 0`` a candidate
+    stops (its state and ε kept) once an accepted step lowers ε by less than ``tol``, or a step is
+    refused although the damping ``C`` already exceeds 10× JᵀJ's largest diagonal element (a short
+    gradient step that does not descend) — it has converged; the others go on."""
     C = np.full(len(X), float(damping))
     taken = np.zeros(len(X), int)
+    active = np.ones(len(X), bool)
     A0, g, cost = normal_equations(X)
     history = [cost.copy()]
     eye = np.eye(space.dim)
     for it in range(int(iterations)):
-        delta = -np.linalg.solve(A0 + C[:, None, None] * eye, g[..., None])[..., 0]   # eq. 6
-        X_try = space.retract(X, delta)
+        a = np.flatnonzero(active)
+        if len(a) == 0:
+            history.append(cost.copy())
+            continue
+        delta = -np.linalg.solve(A0[a] + C[a, None, None] * eye, g[a, :, None])[..., 0]   # eq. 6
+        X_try = space.retract(X[a], delta)
         cost_try = epsilon(X_try)
-        better = cost_try < cost
-        X[better], cost[better] = X_try[better], cost_try[better]
-        C = np.where(better, C / 10.0, C * 10.0)
-        taken += better
+        ok = cost_try < cost[a]
+        better = a[ok]
+        gain = cost[better] - cost_try[ok]
+        X[better], cost[better] = X_try[ok], cost_try[ok]
+        C[a] = np.where(ok, C[a] / 10.0, C[a] * 10.0)
+        taken[better] += 1
+        if tol > 0:
+            active[better[gain < tol]] = False
+            stuck = a[~ok]
+            active[stuck[C[stuck] > 10.0 * np.diagonal(A0[stuck], axis1=1, axis2=2).max(1)]] = False
         history.append(cost.copy())
-        if better.any() and it + 1 < iterations:
-            A0n, gn, _ = normal_equations(X[better])
-            A0[better], g[better] = A0n, gn
+        renew = better[active[better]]
+        if len(renew) and it + 1 < iterations:
+            A0n, gn, _ = normal_equations(X[renew])
+            A0[renew], g[renew] = A0n, gn
     return LMResult(X, cost, C, taken, np.array(history))
 
 

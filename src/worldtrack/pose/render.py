@@ -161,10 +161,100 @@ def local_extrema(image: np.ndarray, valid: np.ndarray, radius: int = 1) -> tupl
     return rc, strength
 
 
+def gradient_maxima(image: np.ndarray, valid: np.ndarray, min_gradient: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels where the gradient magnitude ``|∇I|`` (Sobel / 8, grey levels per pixel) is strictly
+    above its eight neighbours and above ``min_gradient``: the crests of texture edges.
+
+    Only pixels whose 5×5 neighbourhood is ``valid`` count. Returns ``(rows, cols)`` stacked (n, 2)
+    and their ``|∇I|`` (n,), like :func:`local_extrema`.
+
+    >>> yy, xx = np.mgrid[0:21, 0:21]
+    >>> blob = (100 * np.exp(-((xx - 10.3) ** 2 + (yy - 9.8) ** 2) / 8)).astype(np.float32)   # σ = 2 px
+    >>> rc, g = gradient_maxima(blob, np.ones((21, 21), bool))
+    >>> len(rc) > 0, bool(np.all(np.abs(np.hypot(rc[:, 0] - 9.8, rc[:, 1] - 10.3) - 2) < 0.5))   # on r = σ
+    (True, True)
+    """
+    img = np.where(valid, image, 0).astype(np.float32)
+    g = np.hypot(cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3, scale=0.125),
+                 cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3, scale=0.125))
+    inner = cv2.erode(valid.astype(np.uint8), np.ones((5, 5), np.uint8), borderValue=0).astype(bool)
+    ring = np.ones((3, 3), np.uint8)
+    ring[1, 1] = 0
+    crest = inner & (g > cv2.dilate(g, ring)) & (g > min_gradient)
+    return np.argwhere(crest), g[crest]
+
+
+@njit(cache=True)
+def _cull_and_bound_kernel(xyz, normals, cull, fx, fy, cx, cy, out, box):  # pragma: no cover - compiled
+    # cull_and_bound_reference in one pass: copy, move back faces behind the camera, and keep the
+    # image box of the points in front.
+    box[0], box[1], box[2], box[3] = np.inf, np.inf, -np.inf, -np.inf
+    for i in range(xyz.shape[0]):
+        x, y, z = xyz[i, 0], xyz[i, 1], xyz[i, 2]
+        if cull and normals[i, 0] * x + normals[i, 1] * y + normals[i, 2] * z > 0:
+            x, y, z = 0.0, 0.0, -1.0
+        out[i, 0], out[i, 1], out[i, 2] = x, y, z
+        if z > 1e-6:
+            u = fx * x / z + cx
+            v = fy * y / z + cy
+            box[0], box[1] = min(box[0], u), min(box[1], v)
+            box[2], box[3] = max(box[2], u), max(box[3], v)
+
+
+def cull_and_bound(xyz: np.ndarray, normals: np.ndarray | None, intr: Intrinsics) -> tuple[np.ndarray, np.ndarray | None]:
+    """Camera points (M, 3) with back faces (``normals`` (M, 3) facing away) moved behind the
+    camera so they are not drawn, and the image box ``[[u_min, v_min], [u_max, v_max]]`` of the
+    points in front (None if none). Compiled; :func:`cull_and_bound_reference` is the NumPy version."""
+    xyz = np.ascontiguousarray(xyz, np.float64)
+    out, box = np.empty_like(xyz), np.empty(4)
+    nrm = np.ascontiguousarray(normals, np.float64) if normals is not None else np.zeros((1, 3))
+    _cull_and_bound_kernel(xyz, nrm, normals is not None, intr.fx, intr.fy, intr.cx, intr.cy, out, box)
+    return out, (box.reshape(2, 2) if np.isfinite(box[0]) else None)
+
+
+@njit(cache=True)
+def _posed_points_kernel(points, normals, R, t, out):  # pragma: no cover - compiled
+    # out_i = R·p_i + t, or (0, 0, −1) (behind the camera, not drawn) where R·n_i faces away.
+    for i in range(points.shape[0]):
+        p0, p1, p2 = points[i, 0], points[i, 1], points[i, 2]
+        x = R[0, 0] * p0 + R[0, 1] * p1 + R[0, 2] * p2 + t[0]
+        y = R[1, 0] * p0 + R[1, 1] * p1 + R[1, 2] * p2 + t[1]
+        z = R[2, 0] * p0 + R[2, 1] * p1 + R[2, 2] * p2 + t[2]
+        n0, n1, n2 = normals[i, 0], normals[i, 1], normals[i, 2]
+        facing = ((R[0, 0] * n0 + R[0, 1] * n1 + R[0, 2] * n2) * x + (R[1, 0] * n0 + R[1, 1] * n1 + R[1, 2] * n2) * y
+                  + (R[2, 0] * n0 + R[2, 1] * n1 + R[2, 2] * n2) * z)
+        if facing > 0:
+            x, y, z = 0.0, 0.0, -1.0
+        out[i, 0], out[i, 1], out[i, 2] = x, y, z
+
+
+def posed_points(points: np.ndarray, normals: np.ndarray, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Object points (M, 3) in the camera at pose ``R, t``, the back faces (normals facing away)
+    moved behind the camera: ready for :func:`sparse_template_pixels` without ``normals``.
+    Compiled; the same as ``cull_and_bound_reference(points @ R.T + t, normals @ R.T, …)[0]``."""
+    out = np.empty((len(points), 3))
+    _posed_points_kernel(np.ascontiguousarray(points, np.float64), np.ascontiguousarray(normals, np.float64),
+                         np.ascontiguousarray(R, np.float64), np.ascontiguousarray(t, np.float64), out)
+    return out
+
+
+def cull_and_bound_reference(xyz: np.ndarray, normals: np.ndarray | None, intr: Intrinsics):
+    """:func:`cull_and_bound` in NumPy."""
+    xyz = np.array(xyz, float)
+    if normals is not None:
+        xyz[(np.asarray(normals) * xyz).sum(1) > 0] = (0.0, 0.0, -1.0)
+    z = xyz[:, 2]
+    front = z > 1e-6
+    if not front.any():
+        return xyz, None
+    uv = np.column_stack([intr.fx * xyz[front, 0] / z[front] + intr.cx, intr.fy * xyz[front, 1] / z[front] + intr.cy])
+    return xyz, np.array([uv.min(0), uv.max(0)])
+
+
 def _crop(uv: np.ndarray, intr: Intrinsics, margin: int = 4) -> tuple[Intrinsics, int, int] | None:
     """Intrinsics of the image window around projected points ``uv`` (n, 2); None if off-image."""
-    lo = np.floor(uv.min(0)).astype(int) - margin
-    hi = np.ceil(uv.max(0)).astype(int) + margin
+    lo = np.floor([uv[:, 0].min(), uv[:, 1].min()]).astype(int) - margin      # per column: a fast reduction
+    hi = np.ceil([uv[:, 0].max(), uv[:, 1].max()]).astype(int) + margin
     u0, v0 = max(lo[0], 0), max(lo[1], 0)
     u1, v1 = min(hi[0], intr.width - 1), min(hi[1], intr.height - 1)
     if u1 <= u0 or v1 <= v0:
@@ -209,7 +299,7 @@ class TemplatePixels(NamedTuple):
 def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics, n_colour: int,
                            n_depth: int = 0, radius: int = 1, sigma: float = 1.0,
                            select_sigma: float = 0.5, normals: np.ndarray | None = None,
-                           groups: np.ndarray | None = None) -> TemplatePixels:
+                           groups: np.ndarray | None = None, edge_fill: bool = False) -> TemplatePixels:
     """The sparse template of a model drawn at one pose (§2.2, §4.3).
 
     Parameters
@@ -224,6 +314,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
         so a back surface cannot show through the gaps between a sparse model's points)
     groups : (M,) int part of each point — then every part drawn gets an equal share of
         ``n_colour`` and ``n_depth`` (a share a part cannot fill goes to the others)
+    edge_fill : when the extrema number fewer than ``n_colour``, fill up with the crests of the
+        drawing's gradient magnitude (:func:`gradient_maxima`), strongest first — points whose
+        image value changes to first order with the pose (at an extremum the change is second
+        order); extrema stay first. Not with ``groups``.
     n_depth : this many points where the z-buffer depth is a local max/min, filled up on an even
         grid over the visible surface when there are fewer (planar faces have none)
 
@@ -232,15 +326,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     TemplatePixels
     """
     empty = TemplatePixels(np.zeros(0, int), np.zeros(0), np.zeros(0, int))
-    if normals is not None:
-        away = (np.asarray(normals) * xyz).sum(1) > 0
-        xyz = np.where(away[:, None], np.array([0.0, 0.0, -1.0]), xyz)    # behind the camera: not drawn
-    z = xyz[:, 2]
-    front = z > 1e-6
-    if not front.any():
+    xyz, box = cull_and_bound(xyz, normals, intr)
+    if box is None:
         return empty
-    uv = np.column_stack([intr.fx * xyz[front, 0] / z[front] + intr.cx, intr.fy * xyz[front, 1] / z[front] + intr.cy])
-    win = _crop(uv, intr)
+    win = _crop(box, intr)
     if win is None:
         return empty
     r = splat(xyz, win[0])
@@ -256,9 +345,14 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     rc, strength = local_extrema(np.nan_to_num(fine), known & np.isfinite(fine), radius)
     if groups is None:
         rc = _strongest(rc, strength, n_colour) if len(rc) else rc
+        if edge_fill and len(rc) < n_colour:
+            rc_e, g_e = gradient_maxima(np.nan_to_num(fine), known & np.isfinite(fine))
+            rc = np.concatenate([rc, _strongest(rc_e, g_e, n_colour - len(rc))]) if len(rc_e) else rc
     else:
         rc = _by_group(rc, strength, groups[np.maximum(r.index[tuple(rc.T)], 0)], n_colour)
     colour = _nearest_point(r.index, drawn, rc)
+    first = np.sort(np.unique(colour, return_index=True)[1])        # a point reached from two pixels: once
+    colour, rc = colour[first], rc[first]
     value = _bilinear(np.nan_to_num(intensity), xyz[np.maximum(colour, 0)], win[0])   # at the point's projection
     depth_idx = np.zeros(0, int)
     if n_depth > 0:
@@ -273,7 +367,7 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
             score = np.concatenate([s_d + 1.0, np.zeros(len(grid))])          # extrema first, then the grid
             pick = _by_group(cand, score, groups[np.maximum(r.index[tuple(cand.T)], 0)], n_depth)
         depth_idx = r.index[tuple(pick.T)] if len(pick) else depth_idx
-    keep = colour >= 0
+    keep = (colour >= 0) & np.isfinite(albedo[np.maximum(colour, 0)])   # an occluder's point is no template point
     return TemplatePixels(colour[keep], np.asarray(value, float)[keep], np.asarray(depth_idx, int))
 
 

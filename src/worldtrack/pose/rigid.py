@@ -144,20 +144,19 @@ def _face_normal_equations_kernel(grads, intr4, R, t, X, Q, c, length, JtJ, Jtr,
                 continue
             u0, v0 = min(int(u), w - 2), min(int(v), h - 2)
             a, b = u - u0, v - v0
-            s = np.zeros(3)
-            for ch in range(3):
-                top = grads[ch, v0, u0] + a * (grads[ch, v0, u0 + 1] - grads[ch, v0, u0])
-                bot = grads[ch, v0 + 1, u0] + a * (grads[ch, v0 + 1, u0 + 1] - grads[ch, v0 + 1, u0])
-                s[ch] = top + b * (bot - top)
-            V[i] = s[0]
-            g0, g1 = s[1] * fx / z, s[2] * fy / z
-            g2 = -(s[1] * fx * x + s[2] * fy * y) / (z * z)
+            w00, w01, w10, w11 = (1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b      # bilinear weights
+            s0 = w00 * grads[0, v0, u0] + w01 * grads[0, v0, u0 + 1] + w10 * grads[0, v0 + 1, u0] + w11 * grads[0, v0 + 1, u0 + 1]
+            s1 = w00 * grads[1, v0, u0] + w01 * grads[1, v0, u0 + 1] + w10 * grads[1, v0 + 1, u0] + w11 * grads[1, v0 + 1, u0 + 1]
+            s2 = w00 * grads[2, v0, u0] + w01 * grads[2, v0, u0 + 1] + w10 * grads[2, v0 + 1, u0] + w11 * grads[2, v0 + 1, u0 + 1]
+            V[i] = s0
+            g0, g1 = s1 * fx / z, s2 * fy / z
+            g2 = -(s1 * fx * x + s2 * fy * y) / (z * z)
             Nm[i, 0], Nm[i, 1], Nm[i, 2] = g0 * length, g1 * length, g2 * length
             Nm[i, 3] = 2.0 * (rm1 * g2 - rm2 * g1)                     # 2·(RM × g)
             Nm[i, 4] = 2.0 * (rm2 * g0 - rm0 * g2)
             Nm[i, 5] = 2.0 * (rm0 * g1 - rm1 * g0)
             for bb in range(B):
-                coef[bb] += Q[i, bb] * s[0]
+                coef[bb] += Q[i, bb] * s0
                 for j in range(6):
                     QN[bb, j] += Q[i, bb] * Nm[i, j]
         JtJ[k, :, :] = 0.0
@@ -181,8 +180,11 @@ def _face_normal_equations_kernel(grads, intr4, R, t, X, Q, c, length, JtJ, Jtr,
                 row[j] = wgt * acc
             for j in range(6):
                 Jtr[k, j] += row[j] * r
-                for l in range(6):
+                for l in range(j, 6):                                  # upper triangle; mirrored below
                     JtJ[k, j, l] += row[j] * row[l]
+        for j in range(6):
+            for l in range(j):
+                JtJ[k, j, l] = JtJ[k, l, j]
         eps[k] = total
 
 

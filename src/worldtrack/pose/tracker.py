@@ -34,7 +34,7 @@ from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
 from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
-from worldtrack.pose.render import Intrinsics, sparse_template_pixels
+from worldtrack.pose.render import Intrinsics, posed_points, sparse_template_pixels
 from worldtrack.pose.rigid import RigidSpace, face_normal_equations, gradient_images, shading_basis
 
 
@@ -55,6 +55,16 @@ class TrackerConfig:
         (not for appearance read from an image, which holds it already)
     shading_vectors : eigenvectors Φ of the eigen-template besides the mean v̄
     depth_sampling : "bilinear" (on one surface) or "nearest" pixel, for ``colour-depth``
+    window_margin_px : the frame is cut to the template's box at the kept candidates' starting poses
+        plus this margin (pixels) before it is smoothed and sampled — the same cost (a point
+        beyond it scores as one outside the image), cheaper, and its pixels stay in cache;
+        None: the whole frame
+    lm_tol : a kept candidate stops its LM once a step lowers ε by less than this (ε is a negative
+        log-likelihood in the candidates' weights exp(−ε): 1e-3 moves a weight by 0.1 %) or a step
+        with damping above JᵀJ's scale is refused (face cost only; 0: always ``lm_iterations``, as
+        the paper)
+    edge_points : fill the template up to ``n_template`` with crests of the drawing's gradient
+        magnitude after the extrema (worldtrack's addition; False: extrema only, as the paper)
     """
 
     stages: int = 1
@@ -75,6 +85,9 @@ class TrackerConfig:
     motion: str = "velocity"
     pf_points: int | None = 256
     depth_sampling: str = "bilinear"
+    edge_points: bool = True
+    window_margin_px: int | None = 48
+    lm_tol: float = 1e-3
     seed: int = 0
 
 
@@ -121,7 +134,11 @@ class RigidTracker:
             raise InputError(f"cost: expected eigen or colour-depth, got {self.cost!r}")
         self.space = RigidSpace(length=max(self.model.radius, 1e-3))
         self.sigma = self.space.increment_sigma(self.config.sigma_mm, self.config.sigma_deg)
-        self.basis = shading_basis(self.model.normals, n_vectors=self.config.shading_vectors) if self.cost == "eigen" else None
+        self.basis = None
+        if self.cost == "eigen":                               # over the textured points (an occluder's do not count)
+            known = np.isfinite(self.model.albedo)
+            self.basis = np.full((len(known), self.config.shading_vectors + 1), np.nan)
+            self.basis[known] = shading_basis(self.model.normals[known], n_vectors=self.config.shading_vectors)
         self.rng = np.random.default_rng(self.config.seed)
         self.reset(self.R0, self.t0)
 
@@ -152,28 +169,52 @@ class RigidTracker:
     def template(self, state: np.ndarray):
         """The sparse template (:class:`~worldtrack.pose.render.TemplatePixels`) at ``state``."""
         R, t = state_pose(state)
-        xyz = self.model.points @ R.T + t
+        xyz = posed_points(self.model.points, self.model.normals, R, t)        # back faces culled
         albedo = self.model.albedo
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
         sigma = float(np.hypot(self.config.smooth_px, 0.0 if self.model.from_image else self.config.camera_blur_px))
         return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma,
-                                      normals=self.model.normals @ R.T)
+                                      edge_fill=self.config.edge_points)
 
-    def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray, tp=None):
-        """The cost object for a (smoothed) grey frame, with the template taken at ``state`` (or ``tp``)."""
+    def window(self, tp, states: np.ndarray) -> tuple[Intrinsics, slice, slice]:
+        """The part of the frame the candidates ``states`` can read: the template's box under them
+        plus ``window_margin_px``; its intrinsics and the (rows, cols) slices of the frame."""
+        intr, margin = self.intr, self.config.window_margin_px
+        full = intr, slice(0, intr.height), slice(0, intr.width)
+        idx = np.concatenate([tp.colour, tp.depth])
+        if margin is None or len(idx) == 0:
+            return full
+        R, t = state_pose(states)
+        xyz = self.model.points[idx] @ np.swapaxes(R, 1, 2) + t[:, None]
+        z = xyz[..., 2]
+        if not (z > 1e-6).all():
+            return full
+        u, v = intr.fx * xyz[..., 0] / z + intr.cx, intr.fy * xyz[..., 1] / z + intr.cy
+        u0, v0 = max(int(np.floor(u.min())) - margin, 0), max(int(np.floor(v.min())) - margin, 0)
+        u1, v1 = min(int(np.ceil(u.max())) + margin + 1, intr.width), min(int(np.ceil(v.max())) + margin + 1, intr.height)
+        if u1 - u0 < 4 or v1 - v0 < 4:
+            return full
+        return (Intrinsics(intr.fx, intr.fy, intr.cx - u0, intr.cy - v0, u1 - u0, v1 - v0),
+                slice(v0, v1), slice(u0, u1))
+
+    def make_cost(self, grey: np.ndarray, depth: np.ndarray | None, state: np.ndarray, tp=None,
+                  intr: Intrinsics | None = None):
+        """The cost object for a (smoothed) grey frame, with the template taken at ``state`` (or ``tp``);
+        ``intr`` of the frame (default: the tracker's — pass a window's for a cut frame)."""
         tp = self.template(state) if tp is None else tp
+        intr = self.intr if intr is None else intr
         m = self.model
         value = tp.value
         colour = SparseTemplate(m.points[tp.colour], np.zeros(len(tp.colour), int), value)
         if self.cost == "eigen":
             basis = value[:, None] * self.basis[tp.colour]             # Φ̃ = diag(a)·Ψ
-            return EigenTemplateCost(colour, basis, grey, self.intr, 10.0 if self.config.c is None else self.config.c)
+            return EigenTemplateCost(colour, basis, grey, intr, 10.0 if self.config.c is None else self.config.c)
         R, t = state_pose(state)
         zd = (m.points[tp.depth] @ R.T + t)[:, 2]
         dt = SparseTemplate(m.points[tp.depth], np.zeros(len(tp.depth), int), zd)
         if depth is not None and self.depth_offset:
             depth = np.where(depth > 0, depth - np.float32(self.depth_offset), 0).astype(np.float32)
-        return ColourDepthCost(colour, dt, grey, depth, self.intr, self.config.c, self.config.c_depth_mm / 1000,
+        return ColourDepthCost(colour, dt, grey, depth, intr, self.config.c, self.config.c_depth_mm / 1000,
                                self.config.lam, DEPTH_SAMPLING[self.config.depth_sampling])
 
     def _lm(self, cost, states: np.ndarray, iterations: int):
@@ -184,20 +225,22 @@ class RigidTracker:
         if self.cost == "eigen" and self.config.jacobian == "analytic":
             grads = gradient_images(cost.images[0])
             normal = lambda X: face_normal_equations(cost, self.space, grads, X)
-        return levenberg_marquardt(self.space, residuals, states, iterations, normal_equations=normal, epsilon=eps)
+        return levenberg_marquardt(self.space, residuals, states, iterations, normal_equations=normal, epsilon=eps,
+                                   tol=self.config.lm_tol)
 
     def step(self, image: np.ndarray, depth: np.ndarray | None = None) -> PoseEstimate:
         """Track one frame: ``image`` BGR uint8 or grey; ``depth`` (H, W) metres, 0 = none."""
-        grey = cv2.GaussianBlur(to_grey(image), (0, 0), self.config.smooth_px)
         cfg = self.config
         tp = self.template(self.state)
-        cost = self.make_cost(grey, depth, self.state, tp)
+        start = self.space.retract(self.kept, np.broadcast_to(self.velocity, (len(self.kept), 6)))
+        intr, rows, cols = self.window(tp, np.vstack([start, self.state[None]]))
+        grey = cv2.GaussianBlur(to_grey(np.asarray(image)[rows, cols]), (0, 0), cfg.smooth_px)
+        cost = self.make_cost(grey, None if depth is None else np.asarray(depth)[rows, cols], self.state, tp, intr)
         if cost.size == 0:
             raise InputError("the model shows no textured point at the current pose (is it in view?)")
         eps = lambda X: cost.epsilon(self.space.transforms(X))
         pf_cost = cost.subset(cfg.pf_points) if cfg.pf_points else cost
         pf_eps = lambda X: pf_cost.epsilon(self.space.transforms(X))
-        start = self.space.retract(self.kept, np.broadcast_to(self.velocity, (len(self.kept), 6)))
         kept = coarse_to_fine(self.space, pf_eps, start, self.sigma, cfg.stages, cfg.n_candidates, cfg.n_keep, self.rng)
         res = self._lm(cost, kept.states, cfg.lm_iterations)
         w = candidate_weights(res.cost)

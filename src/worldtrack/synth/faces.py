@@ -157,10 +157,24 @@ def face_surface(face: Face, spacing: float = 0.001) -> tuple[np.ndarray, np.nda
     return np.column_stack([x, y, z]), n, face_albedo(face, x, y)
 
 
-def face_model(face: Face, spacing: float = 0.001) -> PointModel:
-    """The tracker's model of ``face``: surface points with grey albedo (the paper's 3-D face model)."""
+def face_model(face: Face, spacing: float = 0.001, head_spacing: float | None = 0.0015) -> PointModel:
+    """The tracker's model of ``face`` (the paper's 3-D face model): face surface points with grey
+    albedo and, unless ``head_spacing`` is None, the front half of the skull behind it (points
+    ``head_spacing`` m apart) with unknown appearance (NaN albedo: hair gives no stable texture).
+    The skull is never part of a template, but it hides the face points it covers when the head
+    turns: without it a template at 50° of yaw kept points the hair hides (LM started at the true
+    pose of such frames ended 1.8° away on average, 0.8° with it)."""
     p, n, bgr = face_surface(face, spacing)
-    return PointModel(p, n, (bgr @ GREY_WEIGHTS).astype(np.float32), spacing)
+    albedo = (bgr @ GREY_WEIGHTS).astype(np.float32)
+    if head_spacing is not None:
+        hp, hn, _ = _head_back(face, head_spacing)
+        front = hp[:, 2] < _SKULL_CENTRE_Z                         # the back half never hides the face
+        p, n = np.concatenate([p, hp[front]]), np.concatenate([n, hn[front]])
+        albedo = np.concatenate([albedo, np.full(int(front.sum()), np.nan, np.float32)])
+    return PointModel(p, n, albedo, spacing)
+
+
+_SKULL_CENTRE_Z = 0.09                                           # m behind the face frame's origin
 
 
 def _head_back(face: Face, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -168,8 +182,8 @@ def _head_back(face: Face, spacing: float) -> tuple[np.ndarray, np.ndarray, np.n
     a, b, c = face.width * 1.15, face.height * 1.2, 0.10
     u, v = np.meshgrid(np.arange(0, 2 * np.pi, spacing / a), np.arange(0.02, np.pi, spacing / b))
     p = np.column_stack([(a * np.sin(v) * np.cos(u)).ravel(), (-b * np.cos(v)).ravel(),
-                         (0.09 + c * np.sin(v) * np.sin(u)).ravel()])
-    n = (p - [0, 0, 0.09]) / np.array([a * a, b * b, c * c])
+                         (_SKULL_CENTRE_Z + c * np.sin(v) * np.sin(u)).ravel()])
+    n = (p - [0, 0, _SKULL_CENTRE_Z]) / np.array([a * a, b * b, c * c])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     inside = (p[:, 0] / face.width) ** 2 + (p[:, 1] / (face.height * 0.98)) ** 2 < 1
     keep = (p[:, 2] > 0.02) & (~inside | (p[:, 2] > face_depth(face, p[:, 0], p[:, 1]) + 0.004))
