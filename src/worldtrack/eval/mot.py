@@ -217,7 +217,8 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         gt = gt.select(inside_area(gt, ring))
         pred = pred.select(inside_area(pred, ring))
     pred = pred.select((pred.frame >= frames[0]) & (pred.frame <= frames[-1]))
-    acc = accumulate(_sorted_frame_distances(gt, pred, frames, gate))   # select() keeps the order
+    per_frame_d = list(_sorted_frame_distances(gt, pred, frames, gate))   # select() keeps the order
+    acc = accumulate(per_frame_d)
     m = summarize(acc)
 
     metrics: dict[str, Any] = {
@@ -235,7 +236,8 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         "num_frames": m["num_frames"],
         "gate_m": float(gate),
     }
-    metrics.update(hota_metrics(gt, pred, gate, frames))
+    metrics.update(hota_metrics(gt, pred, gate, frames, [f.distance for f in per_frame_d]))
+    del per_frame_d
 
     ev = acc.mot_events
     ev_frame = ev.index.get_level_values("FrameId").to_numpy(dtype=np.int64)
@@ -308,9 +310,11 @@ def evaluate(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GATE_M,
     return evaluate_detailed(gt, pred, gate=gate, area=area).metrics
 
 
-def hota_metrics(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray) -> dict[str, float | None]:
-    """``hota, hota_deta, hota_assa, hota_loca`` of the compared rows (None without TrackEval)."""
-    h = evaluate_hota(gt, pred, gate, frames)
+def hota_metrics(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray,
+                 distances: list[np.ndarray] | None = None) -> dict[str, float | None]:
+    """``hota, hota_deta, hota_assa, hota_loca`` of the compared rows (None without TrackEval);
+    ``distances``: the frames' gated distance matrices when already computed."""
+    h = evaluate_hota(gt, pred, gate, frames, distances)
     if h is None:
         return dict.fromkeys(("hota", "hota_deta", "hota_assa", "hota_loca"))
     return {"hota": h.hota, "hota_deta": h.deta, "hota_assa": h.assa, "hota_loca": h.loca}
