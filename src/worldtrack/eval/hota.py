@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import io
 from dataclasses import dataclass
+from collections.abc import Iterable
 from functools import cache
 from typing import Any
 
@@ -84,7 +85,7 @@ def _dense_ids(ids: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: float,
-                  distances: list[np.ndarray] | None = None) -> dict[str, Any]:
+                  distances: Iterable[np.ndarray] | None = None) -> dict[str, Any]:
     """TrackEval's per-sequence ``data`` dict for ``frames``, similarity ``max(0, 1 − d / gate)``.
 
     Parameters
@@ -92,8 +93,8 @@ def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: fl
     gt, pred : TrackTable — positions in metres
     frames : (F,) int — the frames evaluated, in order (frames without rows are empty time steps)
     gate : metres
-    distances : list of F (G, P) ndarrays, metres, optional
-        The frames' distance matrices if already computed (NaN = beyond the gate, similarity 0),
+    distances : iterable of F (G, P) ndarrays, metres, optional
+        The frames' distance matrices, in order, if already computed (NaN = beyond the gate, similarity 0),
         as :func:`worldtrack.eval.evaluate_detailed` passes them; computed here otherwise.
 
     Returns
@@ -109,9 +110,10 @@ def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: fl
     p_lo, p_hi = np.searchsorted(pred.frame, frames, "left"), np.searchsorted(pred.frame, frames, "right")
     gxy, pxy = gt.xy, pred.xy
     gt_ids, tracker_ids, similarity = [], [], []
+    given = None if distances is None else iter(distances)
     for k in range(frames.size):
         gs, ps = slice(g_lo[k], g_hi[k]), slice(p_lo[k], p_hi[k])
-        d = np.linalg.norm(gxy[gs, None, :] - pxy[None, ps, :], axis=-1) if distances is None else distances[k]
+        d = np.linalg.norm(gxy[gs, None, :] - pxy[None, ps, :], axis=-1) if given is None else next(given)
         gt_ids.append(gt_dense[gs])
         tracker_ids.append(pred_dense[ps])
         similarity.append(np.fmax(0.0, 1.0 - d / gate))   # fmax: NaN (beyond the gate) → 0
@@ -122,7 +124,7 @@ def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: fl
 
 
 def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray | None = None,
-                  distances: list[np.ndarray] | None = None) -> HotaResult | None:
+                  distances: Iterable[np.ndarray] | None = None) -> HotaResult | None:
     """HOTA of ``pred`` against ``gt`` on the floor, with TrackEval's ``HOTA`` metric.
 
     Parameters
@@ -133,7 +135,7 @@ def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndar
         Distance at which the similarity ``1 − d / gate`` reaches 0.
     frames : (F,) int, optional
         The frames to evaluate (default: every frame of either table).
-    distances : list of F (G, P) ndarrays, metres, optional
+    distances : iterable of F (G, P) ndarrays, metres, optional
         Each frame's distance matrix, rows and columns in :meth:`TrackTable.sorted` order (NaN
         beyond the gate); saves computing them again when the caller has them.
 
