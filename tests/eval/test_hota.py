@@ -86,3 +86,17 @@ def test_without_trackeval_hota_is_none_and_the_table_says_how_to_install_it(mon
     assert m["hota"] is None and m["hota_assa"] is None and m["mota"] == 1.0
     m.update(mean_error_m=0.0, mean_abs_dx_m=0.0, mean_abs_dy_m=0.0)
     assert "pip install --no-deps trackeval==1.3.0" in format_table(m)
+
+
+def test_evaluate_passes_hota_the_same_numbers_it_would_compute_itself():
+    # evaluate() hands HOTA its gated distance matrices (NaN beyond the gate); the result must
+    # equal evaluate_hota() computing them afresh, to the last bit, with noise and far pairs.
+    rng = np.random.default_rng(5)
+    gt = walking_pair(40)
+    keep = rng.random(len(gt)) > 0.1
+    pred = TrackTable.from_arrays(gt.frame[keep], gt.id[keep] + 10,
+                                  gt.x[keep] + rng.normal(0, 0.3, keep.sum()), gt.y[keep])
+    h = evaluate_hota(gt, pred, gate=0.5, frames=np.unique(gt.frame))
+    m = evaluate(gt, pred, gate=0.5)
+    assert (m["hota"], m["hota_deta"], m["hota_assa"], m["hota_loca"]) == (h.hota, h.deta, h.assa, h.loca)
+    assert 0.0 < h.hota < 1.0

@@ -36,6 +36,20 @@ def test_position_errors_maximise_pairs_before_nearest():
     assert e.mean_m == pytest.approx(0.525)
 
 
+@pytest.mark.parametrize("two_candidates", ["person", "prediction"])
+def test_position_errors_one_pair_when_one_side_has_two_candidates(two_candidates):
+    # Frame 0: one person and two predictions within the gate (or the reverse): one pair, the
+    # nearer (0.1 m), not both. Frame 1: disjoint pairs 0.2 and 0.3 m (the shortcut path).
+    one, two = ([0.0], [0.1, 0.2]) if two_candidates == "person" else ([0.1, 0.2], [0.0])
+    gt = TrackTable.from_arrays([0] * len(one) + [1, 1], list(range(1, len(one) + 1)) + [1, 2],
+                                one + [0.0, 5.0], [0.0] * (len(one) + 2))
+    pr = TrackTable.from_arrays([0] * len(two) + [1, 1], list(range(7, 7 + len(two))) + [7, 8],
+                                two + [0.2, 5.3], [0.0] * (len(two) + 2))
+    e = position_errors(gt, pr, gate=0.5)
+    assert e.frame.tolist() == [0, 1, 1]
+    assert e.distance.tolist() == pytest.approx([0.1, 0.2, 0.3])
+
+
 def test_position_errors_without_pairs_are_nan():
     gt = TrackTable.from_arrays([0], [1], [0.0], [0.0])
     pr = TrackTable.from_arrays([1], [1], [0.0], [0.0])         # a different frame

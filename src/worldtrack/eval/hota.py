@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import io
 from dataclasses import dataclass
+from collections.abc import Iterable
 from functools import cache
 from typing import Any
 
@@ -83,7 +84,8 @@ def _dense_ids(ids: np.ndarray) -> tuple[np.ndarray, int]:
     return dense.reshape(-1).astype(np.int64), int(unique.size)
 
 
-def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: float) -> dict[str, Any]:
+def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: float,
+                  distances: Iterable[np.ndarray] | None = None) -> dict[str, Any]:
     """TrackEval's per-sequence ``data`` dict for ``frames``, similarity ``max(0, 1 − d / gate)``.
 
     Parameters
@@ -91,6 +93,9 @@ def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: fl
     gt, pred : TrackTable — positions in metres
     frames : (F,) int — the frames evaluated, in order (frames without rows are empty time steps)
     gate : metres
+    distances : iterable of F (G, P) ndarrays, metres, optional
+        The frames' distance matrices, in order, if already computed (NaN = beyond the gate, similarity 0),
+        as :func:`worldtrack.eval.evaluate_detailed` passes them; computed here otherwise.
 
     Returns
     -------
@@ -105,19 +110,21 @@ def sequence_data(gt: TrackTable, pred: TrackTable, frames: np.ndarray, gate: fl
     p_lo, p_hi = np.searchsorted(pred.frame, frames, "left"), np.searchsorted(pred.frame, frames, "right")
     gxy, pxy = gt.xy, pred.xy
     gt_ids, tracker_ids, similarity = [], [], []
+    given = None if distances is None else iter(distances)
     for k in range(frames.size):
         gs, ps = slice(g_lo[k], g_hi[k]), slice(p_lo[k], p_hi[k])
-        d = np.linalg.norm(gxy[gs, None, :] - pxy[None, ps, :], axis=-1)    # (G, P) metres
+        d = np.linalg.norm(gxy[gs, None, :] - pxy[None, ps, :], axis=-1) if given is None else next(given)
         gt_ids.append(gt_dense[gs])
         tracker_ids.append(pred_dense[ps])
-        similarity.append(np.maximum(0.0, 1.0 - d / gate))
+        similarity.append(np.fmax(0.0, 1.0 - d / gate))   # fmax: NaN (beyond the gate) → 0
     return {"num_timesteps": int(frames.size), "num_gt_ids": n_gt, "num_tracker_ids": n_pred,
             "num_gt_dets": int(sum(g.size for g in gt_ids)),
             "num_tracker_dets": int(sum(p.size for p in tracker_ids)),
             "gt_ids": gt_ids, "tracker_ids": tracker_ids, "similarity_scores": similarity}
 
 
-def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray | None = None) -> HotaResult | None:
+def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray | None = None,
+                  distances: Iterable[np.ndarray] | None = None) -> HotaResult | None:
     """HOTA of ``pred`` against ``gt`` on the floor, with TrackEval's ``HOTA`` metric.
 
     Parameters
@@ -128,6 +135,9 @@ def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndar
         Distance at which the similarity ``1 − d / gate`` reaches 0.
     frames : (F,) int, optional
         The frames to evaluate (default: every frame of either table).
+    distances : iterable of F (G, P) ndarrays, metres, optional
+        Each frame's distance matrix, rows and columns in :meth:`TrackTable.sorted` order (NaN
+        beyond the gate); saves computing them again when the caller has them.
 
     Returns
     -------
@@ -145,7 +155,7 @@ def evaluate_hota(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndar
     if frames is None:
         frames = np.union1d(gt.frame, pred.frame)
     with np.errstate(invalid="ignore", divide="ignore"):   # 0/0 of ids never near each other
-        res = metric.eval_sequence(sequence_data(gt, pred, frames, gate))
+        res = metric.eval_sequence(sequence_data(gt, pred, frames, gate, distances))
     per_alpha = {k: np.asarray(res[k], dtype=float) for k in metric.float_array_fields + metric.integer_array_fields}
     return HotaResult(hota=float(per_alpha["HOTA"].mean()), deta=float(per_alpha["DetA"].mean()),
                       assa=float(per_alpha["AssA"].mean()), loca=float(per_alpha["LocA"].mean()),

@@ -217,7 +217,8 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         gt = gt.select(inside_area(gt, ring))
         pred = pred.select(inside_area(pred, ring))
     pred = pred.select((pred.frame >= frames[0]) & (pred.frame <= frames[-1]))
-    acc = accumulate(_sorted_frame_distances(gt, pred, frames, gate))   # select() keeps the order
+    per_frame_d = list(_sorted_frame_distances(gt, pred, frames, gate))   # select() keeps the order
+    acc = accumulate(per_frame_d)
     m = summarize(acc)
 
     metrics: dict[str, Any] = {
@@ -235,11 +236,9 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         "num_frames": m["num_frames"],
         "gate_m": float(gate),
     }
-    metrics.update(hota_metrics(gt, pred, gate, frames))
-
     ev = acc.mot_events
     ev_frame = ev.index.get_level_values("FrameId").to_numpy(dtype=np.int64)
-    ev_type = ev["Type"].astype(str).to_numpy()
+    ev_type = np.asarray(ev["Type"].cat.categories.astype(str))[ev["Type"].cat.codes.to_numpy()]
     is_pair = np.isin(ev_type, _PAIR_EVENTS)
     pairs = {
         "frame": ev_frame[is_pair],
@@ -266,6 +265,8 @@ def evaluate_detailed(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GA
         "switches": per(ev_type == "SWITCH").astype(np.int64),
         "mean_error_m": np.where(n_pairs > 0, mean_err, np.nan),
     }
+    del acc, ev   # motmetrics' events go before HOTA builds its similarity matrices (peak memory)
+    metrics.update(hota_metrics(gt, pred, gate, frames, _handed_over(per_frame_d)))
     return MotEvaluation(metrics=metrics, gt=gt, pred=pred, pairs=pairs, per_frame=per_frame)
 
 
@@ -308,12 +309,22 @@ def evaluate(gt: TrackTable, pred: TrackTable, gate: float = DEFAULT_GATE_M,
     return evaluate_detailed(gt, pred, gate=gate, area=area).metrics
 
 
-def hota_metrics(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray) -> dict[str, float | None]:
-    """``hota, hota_deta, hota_assa, hota_loca`` of the compared rows (None without TrackEval)."""
-    h = evaluate_hota(gt, pred, gate, frames)
+def hota_metrics(gt: TrackTable, pred: TrackTable, gate: float, frames: np.ndarray,
+                 distances: Iterable[np.ndarray] | None = None) -> dict[str, float | None]:
+    """``hota, hota_deta, hota_assa, hota_loca`` of the compared rows (None without TrackEval);
+    ``distances``: the frames' gated distance matrices when already computed."""
+    h = evaluate_hota(gt, pred, gate, frames, distances)
     if h is None:
         return dict.fromkeys(("hota", "hota_deta", "hota_assa", "hota_loca"))
     return {"hota": h.hota, "hota_deta": h.deta, "hota_assa": h.assa, "hota_loca": h.loca}
+
+
+def _handed_over(per_frame_d: list[FrameDistances]) -> Iterator[np.ndarray]:
+    """The frames' distance matrices, each dropped from ``per_frame_d`` once handed out, so that
+    HOTA's similarity matrices replace them instead of adding to the peak memory."""
+    for k in range(len(per_frame_d)):
+        item, per_frame_d[k] = per_frame_d[k], None
+        yield item.distance
 
 
 def _count_per_frame(row_frames: np.ndarray, frames: np.ndarray) -> np.ndarray:

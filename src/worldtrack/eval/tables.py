@@ -96,10 +96,18 @@ def position_errors(gt: TrackTable, pred: TrackTable, gate: float = 0.5) -> Posi
     for k in range(frames.size):
         a, b = gxy[g_lo[k]:g_hi[k]], pxy[p_lo[k]:p_hi[k]]
         d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=-1)
+        allowed = d <= gate
+        if allowed.sum(axis=0).max(initial=0) <= 1 and allowed.sum(axis=1).max(initial=0) <= 1:
+            # No person and no prediction has two candidates: the assignment below would take
+            # exactly these pairs (rows ascending, as linear_sum_assignment returns them).
+            r, c = np.nonzero(allowed)
+            gi_all.append(g_lo[k] + r)
+            pi_all.append(p_lo[k] + c)
+            continue
         # A forbidden pair costs more than any set of allowed ones: maximise pairs, then
         # minimise their summed distance.
         big = 2.0 * gate * (min(d.shape) + 1)
-        r, c = linear_sum_assignment(np.where(d <= gate, d, big))
+        r, c = linear_sum_assignment(np.where(allowed, d, big))
         ok = d[r, c] <= gate
         gi_all.append(g_lo[k] + r[ok])
         pi_all.append(p_lo[k] + c[ok])
