@@ -10,7 +10,7 @@ from worldtrack.pose.lm import central_difference_jacobian
 from worldtrack.pose.models import rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, mean_rotation
 from worldtrack.pose.rigid import face_jacobian, face_normal_equations, gradient_images
-from worldtrack.pose.render import gradient_maxima, local_extrema
+from worldtrack.pose.template import gradient_maxima, local_extrema
 from worldtrack.pose.tracker import to_grey
 from worldtrack.geometry.rotation import rodrigues
 from worldtrack.synth.faces import face_model, face_sequence, make_face

@@ -99,7 +99,7 @@ def test_colour_depth_epsilon_kernel_matches_residuals():
 def test_equal_shares_of_the_template():
     # The water-filling once let the remainder go negative on the last groups: with 128 points over
     # the body's 5 parts the right arm (parts 3, 4) got no colour point at all.
-    from worldtrack.pose.render import _by_group, equal_shares
+    from worldtrack.pose.template import _by_group, equal_shares
 
     np.testing.assert_array_equal(equal_shares([99, 77, 47, 58, 35], 128), [26, 26, 26, 25, 25])
     np.testing.assert_array_equal(equal_shares([3, 77, 10, 58, 2], 128), [3, 57, 10, 56, 2])
@@ -170,7 +170,7 @@ def test_posed_points_transform_and_cull_like_the_reference():
 def test_template_never_picks_a_point_of_unknown_appearance():
     """Where an occluder (NaN albedo) shows in single pixels among textured ones, the smoothed
     drawing is defined there; an extremum there must not make a template point of the occluder."""
-    from worldtrack.pose.render import sparse_template_pixels
+    from worldtrack.pose.template import sparse_template_pixels
 
     rng = np.random.default_rng(10)
     g = np.arange(-0.05, 0.05, 0.0008)

@@ -30,7 +30,8 @@ from worldtrack.pose.body import LEFT_ARM, RIGHT_ARM, TORSO, BodyModel, BodySpac
 from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, SparseTemplate
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
-from worldtrack.pose.render import Intrinsics, sparse_template_pixels
+from worldtrack.pose.render import Intrinsics
+from worldtrack.pose.template import sparse_template_pixels
 from worldtrack.pose.tracker import to_grey
 
 

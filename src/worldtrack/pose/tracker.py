@@ -34,7 +34,8 @@ from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
 from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
-from worldtrack.pose.render import Intrinsics, posed_points, sparse_template_pixels
+from worldtrack.pose.render import Intrinsics, posed_points
+from worldtrack.pose.template import sparse_template_pixels
 from worldtrack.pose.rigid import RigidSpace, face_normal_equations, gradient_images, shading_basis
 
 
@@ -167,7 +168,7 @@ class RigidTracker:
         return self.depth_offset
 
     def template(self, state: np.ndarray):
-        """The sparse template (:class:`~worldtrack.pose.render.TemplatePixels`) at ``state``."""
+        """The sparse template (:class:`~worldtrack.pose.template.TemplatePixels`) at ``state``."""
         R, t = state_pose(state)
         xyz = posed_points(self.model.points, self.model.normals, R, t)        # back faces culled
         albedo = self.model.albedo
