@@ -263,7 +263,7 @@ def _part_histograms(cam, crop: np.ndarray, mask: np.ndarray, origin: tuple[int,
     length2 = float(axis @ axis)
     if length2 < 1.0:
         return None
-    v, u = np.mgrid[0:crop.shape[0], 0:crop.shape[1]]
+    u, v = np.arange(crop.shape[1])[None, :], np.arange(crop.shape[0])[:, None]   # broadcast: no (h, w) grids
     share = ((u - head[0]) * axis[0] + (v - head[1]) * axis[1]) / length2
     hsv = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)
     parts = []
