@@ -174,7 +174,7 @@ def run_live(args: argparse.Namespace, cfg) -> int:
     try:
         position_map = None
         if worker is not None:
-            from worldtrack.map.worker import SharedPositionMap
+            from worldtrack.map.shared_ids import SharedPositionMap
             position_map = SharedPositionMap(worker.link.new_id)
 
         def build(backgrounds):

@@ -1,7 +1,7 @@
 """A worker on the shared map: owns some cameras (leases), runs a tracker on them, publishes what it
 sees and takes from the map the people it does not see.
 
-The worker's tracker needs no Redis code: it steps on its own :class:`SharedPositionMap`, and the
+The worker's tracker needs no Redis code: it steps on its own :class:`~worldtrack.map.shared_ids.SharedPositionMap`, and the
 worker, around each step (:class:`MapTracker`):
 
 * **before** — puts on that map the people the shared map holds near its cameras' views (a person
@@ -12,7 +12,7 @@ worker, around each step (:class:`MapTracker`):
   estimate, their support, and whether the cameras show them now (a person it holds but cannot see,
   hidden behind a desk, is published as not seen); and the ids its tracker ended there.
 
-New ids come from the map (:class:`SharedPositionMap`): a person the tracker confirms where the
+New ids come from the map (:class:`~worldtrack.map.shared_ids.SharedPositionMap`): a person the tracker confirms where the
 map has just lost somebody takes that person's id (a camera taken over after a worker died finds
 its people again), anyone else the next id of the map's counter, so ids never clash between workers.
 See :mod:`worldtrack.map.fusion` for how the estimates of a person two workers see are merged.
@@ -36,53 +36,8 @@ from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
 from worldtrack.map.timings import StepTimings
+from worldtrack.map.shared_ids import SharedPositionMap
 from worldtrack.trackers.base import Frame, Person, PositionMap, Track, Tracker
-
-
-class SharedPositionMap(PositionMap):
-    """A :class:`PositionMap` whose new ids come from ``new_id(x, y)`` (the shared map's) instead of
-    a local counter, so that trackers in different processes never give two people one id.
-
-    >>> ids = iter([41, 42])
-    >>> m = SharedPositionMap(lambda x, y: next(ids))
-    >>> m.add(1.0, 1.0).id, m.promote(m.add(2.0, 2.0, tentative=True).id)
-    (41, 42)
-    >>> m.promote(m.add(3.0, 3.0, tentative=True).id, known_id=7)   # re-identified: its id back
-    7
-    """
-
-    def __init__(self, new_id: Callable[[float, float], int]):
-        super().__init__()
-        self.new_id = new_id
-        #: While a tracker's warm start copies people from its private passes (local ids), their
-        #: ids are replaced by the shared map's: ``{local id: map id}``; None otherwise.
-        self.remap: dict[int, int] | None = None
-
-    def add(self, x: float, y: float, height: float = 1.65, width: float = 0.40, mode: str = "capture",
-            time: float = 0.0, track_id: int | None = None, tentative: bool = False,
-            confirmed: bool | None = None) -> Person:
-        if not tentative and (track_id is None or self.remap is not None):
-            new = self._free(self.new_id(x, y))
-            if self.remap is not None and track_id is not None:
-                self.remap[track_id] = new
-            track_id = new
-        return super().add(x, y, height, width, mode, time, track_id, tentative, confirmed)
-
-    def promote(self, person_id: int, known_id: int | None = None) -> int:
-        """As :meth:`PositionMap.promote`; a re-identified person's ``known_id`` (given by the shared
-        map before) is taken back as it is, every other id comes from the shared map."""
-        if known_id is not None:
-            self._next_id = max(self._next_id, known_id + 1)    # the base class accepts ids it gave
-            return super().promote(person_id, self._free(known_id))
-        p = self[person_id]
-        self._next_id = self._free(self.new_id(p.x, p.y))    # the base class gives out _next_id
-        return super().promote(person_id)
-
-    def _free(self, pid: int) -> int:
-        """Make room for ``pid``: a copy of that person taken from the shared map gives way."""
-        if pid in self:
-            self.remove(pid)
-        return pid
 
 
 class MapLink:
@@ -404,4 +359,4 @@ class MapTracker:
         return tracks
 
 
-__all__ = ["MapLink", "MapTracker", "SharedPositionMap", "in_views", "set_epoch"]
+__all__ = ["MapLink", "MapTracker", "in_views", "set_epoch"]
