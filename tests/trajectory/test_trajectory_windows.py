@@ -89,4 +89,5 @@ def test_the_race_by_gap_reaches_the_optimum_of_every_start(office_problem):
     result, wins, _ = race_by_gap(problem, starts, starts["map"], options)
     every = min(levenberg_marquardt(problem, X, options).costs.total for X in starts.values())
     assert result.costs.total <= every * (1 + 1e-6)
-    assert wins["shortest"] >= 1 and set(wins) == set(starts)
+    assert sum(v for k, v in wins.items() if "shortest" in k) >= 1
+    assert {name for label in wins for name in label.split("+")} <= set(starts)

@@ -36,7 +36,7 @@ from worldtrack.trajectory.solver import LevenbergMarquardt, SolveResult, Solver
 #: A run of this many observed steps pins the path well enough to cut the trajectory in its middle.
 MIN_RUN = 3
 #: The windows still moving are packed into a new problem once they are fewer than this share of its steps.
-REPACK = 0.85
+REPACK = 0.7
 
 
 def window_cuts(observed: np.ndarray, min_run: int = MIN_RUN) -> np.ndarray:
@@ -83,7 +83,7 @@ def pack(problem: Problem, cuts: np.ndarray, windows: np.ndarray) -> Packed:
     n = problem.grid.n
     lo, hi = cuts[windows], cuts[windows + 1]
     offsets = np.r_[0, np.cumsum(hi - lo + 1)]
-    index = np.concatenate([np.arange(a, b + 1) for a, b in zip(lo, hi)])
+    index = _ranges(lo, hi + 1)
     held = np.zeros(len(index), dtype=bool)
     held[offsets[:-1][lo > 0]] = True
     seams = offsets[1:][hi < n - 1] - 1
@@ -93,7 +93,7 @@ def pack(problem: Problem, cuts: np.ndarray, windows: np.ndarray) -> Packed:
         if term is None:
             return None
         first, last = np.searchsorted(term.step, lo, "left"), np.searchsorted(term.step, hi, "right")
-        rows = np.concatenate([np.arange(f, e) for f, e in zip(first, last)])
+        rows = _ranges(first, last)
         if len(rows) == 0:
             return None
         shift = np.repeat(offsets[:-1] - lo, last - first)
@@ -104,6 +104,12 @@ def pack(problem: Problem, cuts: np.ndarray, windows: np.ndarray) -> Packed:
     packed = Problem(grid, packed_term(problem.observations), motion, problem.environment, problem.robust,
                      packed_term(problem.feet))
     return Packed(packed, index, offsets, held, seams)
+
+
+def _ranges(first: np.ndarray, stop: np.ndarray) -> np.ndarray:
+    """The ranges first[i] … stop[i] − 1 one after the other (no Python loop)."""
+    length = stop - first
+    return np.repeat(first - np.r_[0, np.cumsum(length)[:-1]], length) + np.arange(length.sum())
 
 
 def _hold(lin: Linearisation, held: np.ndarray) -> None:
@@ -118,17 +124,24 @@ def _hold(lin: Linearisation, held: np.ndarray) -> None:
 class WindowedLM:
     """Levenberg–Marquardt on packed windows, each with its own μ, step limit, acceptance and stop.
 
-    ``mu``, ``nu`` (k,): each window's damping state to start from (carried over when repacking).
+    ``mu``, ``nu`` (k,): each window's damping state to start from (carried over when repacking);
+    ``carried``: (linearisation, per-step costs) at X0 when the windows come from an earlier packing
+    (:meth:`remaining`), so that repacking costs no new linearisation.
     """
 
-    def __init__(self, packed: Packed, X0: np.ndarray, options: SolverOptions, mu: np.ndarray, nu: np.ndarray):
+    def __init__(self, packed: Packed, X0: np.ndarray, options: SolverOptions, mu: np.ndarray, nu: np.ndarray,
+                 carried: tuple[Linearisation, np.ndarray] | None = None):
         self.packed, self.options = packed, options
         self.X = np.array(X0, dtype=float)
         m, k = len(self.X), len(packed.offsets) - 1
-        self.cost, self._spare_cost = np.empty(m), np.empty(m)
-        self.lin = linearise(packed.problem, self.X, step_cost=self.cost)
-        _hold(self.lin, packed.held)
-        self.cost[packed.seams] = 0.0
+        if carried is None:
+            self.cost = np.empty(m)
+            self.lin = linearise(packed.problem, self.X, step_cost=self.cost)
+            _hold(self.lin, packed.held)
+            self.cost[packed.seams] = 0.0
+        else:
+            self.lin, self.cost = carried
+        self._spare_cost = np.empty(m)
         lin = self.lin
         self._spare = Linearisation(lin.costs, lin.g.copy(), lin.D.copy(), lin.B.copy(), lin.barrier_steps.copy())
         self.F = window_sums(self.cost, packed.offsets[:-1])
@@ -137,23 +150,42 @@ class WindowedLM:
         self.done = np.zeros(k, dtype=bool)
         self._work = tuple(np.empty(s) for s in ((m, STATE, STATE), (m, STATE, STATE), (m, STATE), (m, STATE)))
 
+    def remaining(self) -> tuple[np.ndarray, tuple[Linearisation, np.ndarray]]:
+        """The windows not yet converged: their packed states and their rows of the normal equations and
+        costs, in the order :func:`pack` lays them out (a window's rows touch only its own states)."""
+        rows = np.flatnonzero(~self.done[self.owner])
+        lin = self.lin
+        B = np.zeros((max(len(rows) - 1, 1), STATE, STATE))
+        inner = rows[:-1] < len(lin.B)
+        B[:len(rows) - 1][inner] = lin.B[rows[:-1][inner]]
+        return self.X[rows], (Linearisation(lin.costs, lin.g[rows], lin.D[rows], B, lin.barrier_steps[rows]),
+                              self.cost[rows])
+
     def _sums(self, per_state: np.ndarray) -> np.ndarray:
         return window_sums(per_state.sum(axis=1), self.packed.offsets[:-1])
 
-    def _limit_moves(self, delta: np.ndarray) -> np.ndarray:
-        """As the solver's step limit, window by window: no floor position moves more than ``max_move``."""
+    def _limited_step(self, delta: np.ndarray, damping: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The step with the solver's limit applied window by window (no floor position moves more than
+        ``max_move``: each state shortened on its own, or, where that is no descent direction, the whole
+        window's step), and each window's predicted decrease −(2gᵀδ + δᵀHδ)."""
+        lin = self.lin
         move = np.hypot(delta[:, 0], delta[:, 2])
         worst = np.maximum.reduceat(move, self.packed.offsets[:-1])
         big = worst > self.options.max_move
-        if not big.any():
-            return delta
+        if not big.any():                          # (H + μ·diag H)·δ = −g: then −gᵀδ + δᵀ(μ·diag H)δ
+            return delta, self._sums(-lin.g * delta + damping * delta * delta)
         local = delta * np.minimum(1.0, self.options.max_move / np.maximum(move, 1e-300))[:, None]
-        lin = self.lin
-        descent = self._sums(-(2.0 * lin.g * local + local * block_matvec(lin.D, lin.B, local))) > 0
-        uniform = (big & ~descent)[self.owner]
-        scale = (self.options.max_move / np.maximum(worst, 1e-300))[self.owner]
-        local[uniform] = delta[uniform] * scale[uniform, None]
-        return local
+        pred_local = self._sums(-(2.0 * lin.g * local + local * block_matvec(lin.D, lin.B, local)))
+        uniform = big & ~(pred_local > 0)
+        if not uniform.any():
+            return local, pred_local
+        s = np.where(big, self.options.max_move / np.maximum(worst, 1e-300), 1.0)
+        g_delta = self._sums(lin.g * delta)
+        d_H_delta = self._sums(delta * block_matvec(lin.D, lin.B, delta))
+        scale = s[self.owner]
+        rows = uniform[self.owner]
+        local[rows] = delta[rows] * scale[rows, None]
+        return local, np.where(uniform, -(2.0 * s * g_delta + s * s * d_H_delta), pred_local)
 
     def iterate(self) -> None:
         """One step in every window not yet converged."""
@@ -165,8 +197,7 @@ class WindowedLM:
             return
         delta = x.copy()
         delta[self.done[owner]] = 0.0
-        delta = self._limit_moves(delta)
-        predicted = self._sums(-(2.0 * lin.g * delta + delta * block_matvec(lin.D, lin.B, delta)))
+        delta, predicted = self._limited_step(delta, damping)
         trial = linearise(self.packed.problem, self.X + delta, out=self._spare, step_cost=self._spare_cost)
         _hold(trial, self.packed.held)
         self._spare_cost[self.packed.seams] = 0.0
@@ -202,10 +233,10 @@ def solve_windows(problem: Problem, X: np.ndarray, cuts: np.ndarray, options: So
     windows = np.arange(len(cuts) - 1)
     mu = np.full(len(windows), options.initial_damping)
     nu = np.full(len(windows), 2.0)
-    work, iterations = 0.0, 0
+    work, iterations, carried, X_packed = 0.0, 0, None, None
     while len(windows) and iterations < options.max_iterations:
         packed = pack(problem, cuts, windows)
-        lm = WindowedLM(packed, X[packed.index], options, mu, nu)
+        lm = WindowedLM(packed, X[packed.index] if carried is None else X_packed, options, mu, nu, carried)
         size = len(packed.index)
         while not lm.done.all() and iterations < options.max_iterations:
             lm.iterate()
@@ -215,6 +246,8 @@ def solve_windows(problem: Problem, X: np.ndarray, cuts: np.ndarray, options: So
             if moving < REPACK * size:                # pack the windows still moving into a shorter problem
                 break
         X[packed.index] = lm.X                    # held states are written back unchanged
+        if not lm.done.all():
+            X_packed, carried = lm.remaining()
         windows, mu, nu = windows[~lm.done], lm.mu[~lm.done], lm.nu[~lm.done]
     return X, work / problem.grid.n
 
@@ -223,8 +256,9 @@ def race_by_gap(problem: Problem, starts: dict[str, np.ndarray], without: np.nda
                 options: SolverOptions) -> tuple[SolveResult, dict[str, int], float]:
     """Steps 1–3 of the module's notes from ``starts`` (name → (n, 6)), ends held at ``without`` (the MAP
     without the barrier). Returns the polished optimum, how many windows each start won (of the windows
-    where the starts' objectives differ; two starts that tie at the lowest both win), and the windowed
-    work in iterations over the whole trajectory."""
+    where the starts' objectives differ; starts that tie at the lowest are joined by "+", e.g.
+    "shortest+straight" where nothing blocks the straight line), and the windowed work in iterations
+    over the whole trajectory."""
     n = problem.grid.n
     cuts = window_cuts(np.bincount(problem.observations.step, minlength=n) > 0)
     cost = np.empty(n)
@@ -247,7 +281,9 @@ def race_by_gap(problem: Problem, starts: dict[str, np.ndarray], without: np.nda
     X0[cuts] = without[cuts]
     low = table.min(axis=0)
     tie = table <= low + 1e-9 * np.abs(low)                   # (starts, windows): at the window's lowest
-    contested = ~tie.all(axis=0)
-    wins = {name: int(np.sum(contested & tie[k])) for k, name in enumerate(names)}
+    wins: dict[str, int] = {}
+    for w in np.flatnonzero(~tie.all(axis=0)):                 # the windows where the starts differ
+        label = "+".join(name for k, name in enumerate(names) if tie[k, w])
+        wins[label] = wins.get(label, 0) + 1
     X1, work = solve_windows(problem, X0, cuts, options)
     return LevenbergMarquardt(problem, X1, options).run(), wins, work
