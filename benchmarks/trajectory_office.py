@@ -22,9 +22,9 @@ person seen by at least two cameras is estimated:
   in view, the solve again with H);
 - the MAP without the barrier (start ``map``, the paper's "without the environment model");
 
-(the MAPs with every start run to convergence, to count which start wins; the default race by
-gap is run too, and whether its objective is within 1e-6 of every start's best is counted, with the
-windows each start won; the seconds are the default's);
+(the MAPs with every start run to convergence, to count which start wins; the default estimate
+(its race) is run too, and whether its objective is within 1e-6 of every start's best is counted, with the
+windows each start won when the race is by gap; the seconds are the default's);
 - Kalman + RTS on the pixels back-projected to the same head height, same acceleration noise.
 
 Scores (``trajectory_common.score``): horizontal RMSE in view and between views, head-height RMSE in
@@ -185,10 +185,9 @@ def main(argv: list[str] | None = None) -> int:
             f"height H minus the stature: mean {np.mean(fitted):+.3f} m, RMS {np.sqrt(np.mean(np.square(fitted))):.3f} m "
             f"(the head top bobs below the stature while walking).\n\n"
             f"Start that won (every start run to convergence; a '+' joins starts whose optima agree within "
-            f"1e-6): {won}. The default race (by gap: in each window between two observed runs the start with "
-            f"the lowest objective, the windows solved on their own, then the whole polished) reached the "
+            f"1e-6): {won}. The default estimate (its race, or with ``race_by_gap`` the race per window) reached the "
             f"every-start optimum within 1e-6 for {race_agrees[True]} of {race_agrees[True] + race_agrees[False]} "
-            f"people; windows won (ties count for each start): {window_wins}.\n\n"
+            f"people; windows won (race by gap only): {window_wins or 'none'}.\n\n"
             f"## Per person (height known)\n\n{per}\n")
     print(text)
     if best and not args.quick:

@@ -19,6 +19,12 @@ barrier:
 
 The losing starts cost one evaluation each instead of iterations over the whole track, and a window
 converges in the iterations it needs rather than in those of the slowest gap.
+
+Measured (``benchmarks/results/tuning_trajectory_solver.md``, issue 34e): 25–30 % less time than the
+whole-trajectory race at T ≥ 10 000 steps, the same routes, but the objective has shallow minima a few
+centimetres apart in long gaps and this path may settle in a neighbour (within ±4e-5 relative of every
+start converging, lower as often as not), and on the office's head + feet estimate it found worse optima.
+So it is an option (``TrajectoryOptions(race_by_gap=True)``), not the default.
 """
 
 from __future__ import annotations
