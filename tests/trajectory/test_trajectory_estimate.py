@@ -76,6 +76,9 @@ def test_office_with_detours_map_beats_the_kalman_smoother_and_keeps_out_of_obst
     assert est.start == "shortest"                                      # only it knows the passages
     assert est.results["shortest"].converged                            # the race's leader went on
     assert est.start_objectives["shortest"] < est.start_objectives["straight"]
+    by_gap = estimate_trajectory(obs, field, TrajectoryOptions(height=office[1][1].height, race_by_gap=True))
+    assert sum(v for k, v in by_gap.window_wins.items() if "shortest" in k) >= 1
+    assert by_gap.costs["total"] <= est.costs["total"] * (1 + 1e-6)   # the race by gap: the same optimum here
     # without the barrier the MAP cuts through a screen, as the paper's figure shows
     assert inside_obstacles(field, est.without_barrier[:, [0, 2]]).any()
     # the uncertainty is larger between views than in them
@@ -172,6 +175,10 @@ def test_without_a_wall_near_the_map_there_is_no_race_and_the_same_optimum():
     walkable[46:, :] = False                         # the wall at y = 0.3 m: within the barrier's reach
     near = estimate_trajectory(case.obs, field_from_walkable(walkable, (-1.0, -2.0), 0.05), TrajectoryOptions(dt=0.1))
     assert set(near.results) == {"straight", "map", "shortest"}
+    by_gap = estimate_trajectory(case.obs, field_from_walkable(walkable, (-1.0, -2.0), 0.05),
+                                 TrajectoryOptions(dt=0.1, race_by_gap=True))
+    assert by_gap.window_wins and "map" not in by_gap.results          # the race by gap ran
+    assert by_gap.costs["total"] <= near.costs["total"] * (1 + 1e-6)
 
 
 def test_without_environment_the_map_is_solved_once_and_is_the_estimate():

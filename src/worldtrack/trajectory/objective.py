@@ -147,23 +147,29 @@ def evaluate(problem: Problem, X: np.ndarray) -> Costs:
 
 
 def _add_pixel_term(term: ObservationTerm, starts: np.ndarray, steps: np.ndarray, robust: float | None,
-                    X: np.ndarray, D: np.ndarray, g: np.ndarray) -> float:
+                    X: np.ndarray, D: np.ndarray, g: np.ndarray, step_cost: np.ndarray | None) -> float:
     """In place: one pixel term's JᵀWJ into D and JᵀWr into g (each row on one state; rows come in
-    runs of equal steps, time order); returns its cost (inf if a point goes behind a camera)."""
+    runs of equal steps, time order), its cost per step into ``step_cost`` (if given); returns its
+    cost (inf if a point goes behind a camera)."""
     r, J, depth = term.residuals(X)
     rho, w = huber(np.hypot(r[:, 0], r[:, 1]), robust)
     JtJ = np.einsum("nki,nkj->nij", J, J * w[:, None, None])
     Jtr = np.einsum("nki,nk->ni", J, r * w[:, None])
     D[steps] += np.add.reduceat(JtJ, starts, axis=0)
     g[steps] += np.add.reduceat(Jtr, starts, axis=0)
+    if step_cost is not None:
+        step_cost[steps] += np.add.reduceat(np.where(depth > 1e-3, rho, np.inf), starts)
     return float(rho.sum()) if np.all(depth > 1e-3) else np.inf
 
 
-def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None) -> Linearisation:
+def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
+              step_cost: np.ndarray | None = None) -> Linearisation:
     """Costs, gradient and the block-tridiagonal Gauss–Newton matrix at X (n, 6).
 
     ``out``: a linearisation of the same problem whose arrays are overwritten (an iteration's
-    tens of megabytes are then allocated once, not every time).
+    tens of megabytes are then allocated once, not every time). ``step_cost`` (n,): if given, filled
+    with the objective split by step (the motion and barrier terms between t and t + 1 on t, the
+    first velocity's prior on 0, observations and height on their step); it sums to the total.
     """
     n = problem.grid.n
     D0, B0 = problem.motion_normal
@@ -180,9 +186,13 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None)
     rv = first_velocity_residuals(X, gain)
     g[0, VEL] += gain * rv
     motion_cost += float(rv @ rv)
+    if step_cost is not None:
+        step_cost.fill(0.0)
+        step_cost[:-1] = np.einsum("ij,ij->i", *(2 * (motion_residuals(X, problem.A, problem.W),)))
+        step_cost[0] += float(rv @ rv)
     obs_cost = 0.0
     for term, (starts, steps) in zip(problem.pixel_terms, problem.observation_groups):
-        obs_cost += _add_pixel_term(term, starts, steps, problem.robust, X, D, g)
+        obs_cost += _add_pixel_term(term, starts, steps, problem.robust, X, D, g, step_cost)
     env = problem.environment
     barrier_cost = height_cost = 0.0
     if env.barrier is not None:
@@ -191,10 +201,14 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None)
             add_pair_terms(D, B, g, br.step, br.J, br.r, br.curvature)      # skips the r = 0 samples
             barrier_cost = float(br.r @ br.r)
             barrier_steps[br.step[br.inside]] = True
+            if step_cost is not None:
+                step_cost += np.bincount(br.step, br.r * br.r, minlength=n)
     if env.height is not None:
         rh, gain = height_residuals(X, env.height, env.weight)
         D[:, _W, _W] += gain * gain
         g[:, _W] += gain * rh
         height_cost = float(rh @ rh)
+        if step_cost is not None:
+            step_cost += rh * rh
     costs = Costs(motion_cost, obs_cost, barrier_cost, height_cost)
     return Linearisation(costs, g, D, B, barrier_steps)
