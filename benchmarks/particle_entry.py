@@ -63,6 +63,7 @@ from worldtrack.experiment import gt_table, synthetic_threshold  # noqa: E402
 from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
+from worldtrack.trackers import method_shadow_test  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
 
 
@@ -114,9 +115,11 @@ KIND = ["colour"]
 
 
 def foreground(seq: Sequence) -> dict:
-    """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart)."""
+    """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart, the
+    particle tracker's own shadow test)."""
     threshold = synthetic_threshold("particle", KIND[0]) if THRESHOLD[0] is None else THRESHOLD[0]
-    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], threshold)
+    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], threshold,
+                            shadow_test=method_shadow_test("particle"))
 
 
 def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
