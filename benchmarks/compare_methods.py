@@ -46,7 +46,7 @@ from worldtrack.experiment import bundle_frames, run_scenario, step_tracker, syn
 from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
-from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
+from worldtrack.trackers import METHODS, make_tracker, method_shadow_test  # noqa: E402
 
 SIZE = (320, 240)
 SEED = 0
@@ -75,7 +75,7 @@ def peak_memory_mb(scenario, bundles, method: str) -> float:
     # published figures (the blobs baseline does not keep the foreground models; dropping them lowers its peak).
     cams = scenario.camera_ids
     fgs = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, FOREGROUND,
-                           synthetic_threshold(method, FOREGROUND))
+                           synthetic_threshold(method, FOREGROUND), shadow_test=method_shadow_test(method))
     tracker = make_tracker(method, scenario.scene, fgs)
     for b in bundles:
         tracker.step({c: Frame(b.views[c].image, b.time, b.frame) for c in cams}, b.time)

@@ -25,7 +25,9 @@ Variants (all on the colour foreground at the synthetic threshold 20 with shadow
   walkable floor, judged shadows → background);
 - ``evidence`` — the shadow-evidence test of :mod:`worldtrack.foreground.evidence`
   (``foreground.shadow_test = "evidence"``) as the ellipsoid tracker and the blobs read it;
-- ``evidence-read`` — the same, as the particle tracker reads it.
+- ``evidence-read`` — the same, as the particle tracker reads it;
+- ``evidence-background`` — the same test, the shadows it judges labelled background (0) instead of
+  unsure (``foreground.shadow_test = "evidence-background"``).
 
 Seeds 100–107 by default (held out: the tests and the thresholds were worked out on seeds 0–3).
 
@@ -51,6 +53,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, median_time, mog2_apply_time, save_result  # noqa: E402
 
+from worldtrack.errors import InputError  # noqa: E402
 from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, StaticBackground  # noqa: E402
 from worldtrack.foreground.shadows import floor_pixels, read_shadows  # noqa: E402
 from worldtrack.synth import scenes  # noqa: E402
@@ -128,6 +131,11 @@ def variants(background: np.ndarray, floor: np.ndarray) -> dict:
         return out
     out["evidence"] = evidence.labels
     out["evidence-read"] = lambda im: read_shadows(evidence.labels(im), im, background, floor, shadow_as=0)
+    try:
+        judged = StaticBackground(background, t, "colour", shadows=True, shadow_test="evidence-background")
+    except InputError:       # the code measured has no evidence-background test
+        return out
+    out["evidence-background"] = judged.labels
     return out
 
 

@@ -63,6 +63,7 @@ from worldtrack.experiment import gt_table, synthetic_threshold  # noqa: E402
 from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
+from worldtrack.trackers import method_shadow_test  # noqa: E402
 from worldtrack.trackers.particle import ParticleConfig, ParticleTracker  # noqa: E402
 
 
@@ -113,16 +114,18 @@ THRESHOLD: list[float | None] = [None]
 KIND = ["colour"]
 
 
-def foreground(seq: Sequence) -> dict:
-    """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart)."""
+def foreground(seq: Sequence, preset: str = "default") -> dict:
+    """The camera's foreground model, as ``worldtrack track`` makes it (colour, shadows set apart, the
+    particle tracker's own shadow test for ``preset``)."""
     threshold = synthetic_threshold("particle", KIND[0]) if THRESHOLD[0] is None else THRESHOLD[0]
-    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], threshold)
+    return make_foregrounds(seq.scenario.scene, {"cam": seq.background}, KIND[0], threshold,
+                            shadow_test=method_shadow_test("particle", preset))
 
 
-def run(seq: Sequence, config: ParticleConfig) -> tuple[TrackTable, float]:
-    """Track the sequence; (predictions, seconds per frame)."""
+def run(seq: Sequence, config: ParticleConfig, preset: str = "default") -> tuple[TrackTable, float]:
+    """Track the sequence with ``config`` of ``preset``; (predictions, seconds per frame)."""
     sc = seq.scenario
-    tracker = ParticleTracker(sc.scene, foreground(seq), config)
+    tracker = ParticleTracker(sc.scene, foreground(seq, preset), config)
     rows = []
     t0 = time.perf_counter()
     for k, img in enumerate(seq.images):
@@ -301,7 +304,7 @@ def _entry_tracks(person: TrackTable, pred: TrackTable, pairs: dict, gid: int, s
     return int((counts >= 3).sum())
 
 
-def given_starts(seq: Sequence, config: ParticleConfig) -> dict:
+def given_starts(seq: Sequence, config: ParticleConfig, preset: str = "default") -> dict:
     """Tracking alone: every person's filter started on the true position, no detection.
 
     One tracker without detection filters, split or merge; each person gets a tracking filter (with
@@ -312,7 +315,7 @@ def given_starts(seq: Sequence, config: ParticleConfig) -> dict:
     """
     sc = seq.scenario
     alone = _config(config, {"detection.births": "none", "split.enabled": False, "merge.enabled": False})
-    tracker = ParticleTracker(sc.scene, foreground(seq), alone)
+    tracker = ParticleTracker(sc.scene, foreground(seq, preset), alone)
     started: set[int] = set()
     errors, near, alive = [], [], []
     for k, (img, gt) in enumerate(zip(seq.images, seq.gt)):
@@ -388,8 +391,9 @@ def _task(job: tuple) -> tuple:
     """One run: (config name, scenario seed, tracker seed) → (score, given-starts figures, s/frame)."""
     name, seq, options, tracker_seed, single = job
     cfg = CONFIGS[name]({**options, "seed": tracker_seed})
-    pred, spf = run(seq, cfg)
-    return score(seq, pred), (given_starts(seq, cfg) if single else None), spf
+    preset = name.split("-")[0]                                    # "paper" or "default"
+    pred, spf = run(seq, cfg, preset)
+    return score(seq, pred), (given_starts(seq, cfg, preset) if single else None), spf
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -154,7 +154,7 @@ def pets_case(frames: int, binary: Path, workdir: Path, core: int | None) -> lis
     from worldtrack.foreground.estimate import estimate_background
     from worldtrack.io.gt_import import boxes_to_world, read_boxes
     from worldtrack.scene.load import load_scene
-    from worldtrack.trackers import make_tracker
+    from worldtrack.trackers import make_tracker, method_shadow_test
     from worldtrack.trackers.base import Frame
 
     folder = DATA_DIR / "pets2009_s2l1"
@@ -175,7 +175,7 @@ def pets_case(frames: int, binary: Path, workdir: Path, core: int | None) -> lis
     ignore = np.zeros(len(gt), dtype=bool)
     rows = []
     for method in METHODS:
-        fgs = make_foregrounds(scene, {recipe.camera: background}, "colour")
+        fgs = make_foregrounds(scene, {recipe.camera: background}, "colour", shadow_test=method_shadow_test(method))
         tracker = make_tracker(method, scene, fgs)
         out, seconds = step_tracker(tracker, ((k, k / recipe.fps, {recipe.camera: Frame(img, k / recipe.fps, k)})
                                               for k, img in enumerate(images)))

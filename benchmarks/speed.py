@@ -59,7 +59,7 @@ from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.experiment import synthetic_threshold  # noqa: E402
 from worldtrack.foreground import make_foregrounds  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
-from worldtrack.trackers import METHODS, make_tracker  # noqa: E402
+from worldtrack.trackers import METHODS, make_tracker, method_shadow_test  # noqa: E402
 from worldtrack.trackers.ellipsoid.real import ternary_real  # noqa: E402
 
 SEED = 0
@@ -121,7 +121,7 @@ def empty_clip(clip: Clip, frames: int) -> Clip:
 def step_times(method: str, clip: Clip) -> tuple[float, float, object]:
     """Median seconds per ``tracker.step`` after the warm-up, the mean number of tracks, the tracker."""
     fgs = make_foregrounds(clip.scene, {clip.camera: clip.background}, FOREGROUND,
-                           synthetic_threshold(method, FOREGROUND))
+                           synthetic_threshold(method, FOREGROUND), shadow_test=method_shadow_test(method))
     tracker = make_tracker(method, clip.scene, fgs)
     try:
         for tid, x, y in clip.start:

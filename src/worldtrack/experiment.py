@@ -23,7 +23,7 @@ from worldtrack.eval.tables import PositionErrors, position_errors
 from worldtrack.trackers.base import Frame
 from worldtrack.io.tracks import TrackTable
 from worldtrack.foreground import SYNTHETIC_COLOUR_THRESHOLD, make_foregrounds
-from worldtrack.trackers import make_tracker, method_threshold
+from worldtrack.trackers import make_tracker, method_shadow_test, method_threshold
 from worldtrack.trackers.base import warm_started
 
 
@@ -90,7 +90,7 @@ def synthetic_threshold(method: str, foreground: str = "colour") -> float | None
 
 def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "default", foreground: str = "colour",
                       threshold: float | None = None, cameras: list[str] | None = None,
-                      shadow_texture_ncc: float | None = None, **options):
+                      shadow_texture_ncc: float | None = None, shadow_test: str | None = None, **options):
     """A tracker for a synthetic scenario, its foregrounds made from the scenario's background plates.
 
     Parameters
@@ -103,12 +103,15 @@ def synthetic_tracker(scenario, method: str = "ellipsoid", preset: str = "defaul
     cameras : the cameras to track with (default: all)
     shadow_texture_ncc : the foreground's texture test of shadow-like pixels (default off; see
         :func:`worldtrack.foreground.make_foregrounds`)
+    shadow_test : the foreground's shadow test, "colour" or "evidence" (default the method's own,
+        :func:`worldtrack.trackers.method_shadow_test`)
     """
     if threshold is None:
         threshold = synthetic_threshold(method, foreground)
     cams = list(cameras or scenario.camera_ids)
     foregrounds = make_foregrounds(scenario.scene, {c: scenario.background(c) for c in cams}, foreground, threshold,
-                                   shadow_texture_ncc=shadow_texture_ncc)
+                                   shadow_texture_ncc=shadow_texture_ncc,
+                                   shadow_test=shadow_test or method_shadow_test(method, preset))
     return make_tracker(method, scenario.scene, foregrounds, preset=preset, **options)
 
 
@@ -158,7 +161,7 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
                  threshold: float | None = None, min_visibility: float = 0.2, gate: float = 0.5,
                  score_rows: Callable[[TrackTable], np.ndarray] | None = None, init_from_gt: bool = False,
                  cameras: list[str] | None = None, bundles=None, shadow_texture_ncc: float | None = None,
-                 **options) -> ExperimentResult:
+                 shadow_test: str | None = None, **options) -> ExperimentResult:
     """Track a synthetic scenario and score it.
 
     Parameters
@@ -176,12 +179,13 @@ def run_scenario(scenario, method: str = "ellipsoid", preset: str = "default", f
         (the paper's static measurements start from a known person)
     cameras : use only these cameras (default: all)
     bundles : already rendered bundles (to render once and track several ways)
-    shadow_texture_ncc : see :func:`synthetic_tracker`
+    shadow_texture_ncc, shadow_test : see :func:`synthetic_tracker`
     """
     if bundles is None:
         bundles = scenario.render()
     cams = list(cameras or scenario.camera_ids)
-    tracker = synthetic_tracker(scenario, method, preset, foreground, threshold, cams, shadow_texture_ncc, **options)
+    tracker = synthetic_tracker(scenario, method, preset, foreground, threshold, cams, shadow_texture_ncc,
+                                shadow_test, **options)
     if init_from_gt and bundles:
         for r in bundles[0].gt:
             tracker.init_track(r["x"], r["y"], track_id=int(r["id"]))

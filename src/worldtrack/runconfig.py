@@ -25,7 +25,7 @@ import yaml
 
 from worldtrack.config import Section, dump_yaml, from_mapping, to_mapping, with_overrides
 from worldtrack.errors import InputError
-from worldtrack.foreground.config import ForegroundConfig
+from worldtrack.foreground.config import DEFAULT_SHADOW_TEST, ForegroundConfig
 
 METHODS = ("ellipsoid", "particle", "blobs")
 PRESETS = ("default", "paper")
@@ -83,6 +83,11 @@ def _method_threshold(method: str) -> float | None:
     return method_threshold(method)
 
 
+def _method_shadow_test(method: str, preset: str) -> str:
+    from worldtrack.trackers import method_shadow_test
+    return method_shadow_test(method, preset) or DEFAULT_SHADOW_TEST
+
+
 def _base(method: str, preset: str) -> Section:
     cls = _method_config_class(method)
     if preset == "paper":
@@ -110,7 +115,8 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
     method, preset : the command line's ``--method`` / ``--preset`` (None: the file's, else
         ellipsoid / default)
     flags : the command line's named settings: ``foreground`` (kind), ``threshold`` (default the
-        method's own, e.g. 25 for the particle tracker, else the kind's), ``births``
+        method's own, e.g. 25 for the particle tracker, else the kind's; ``foreground.shadow_test`` likewise
+        defaults to the method's own, evidence for the particle tracker), ``births``
         (where new people may appear; set on the method that runs)
     sets : ``--set`` pairs (dotted path from the top, value), applied last in order
 
@@ -171,6 +177,9 @@ def resolve_run_config(data: Mapping[str, Any] | None = None, *, method: str | N
     if foreground.threshold is None and foreground.kind in ("grey", "colour") and \
             _method_threshold(method) is not None:        # the method's own threshold (the particle's γ)
         foreground = with_overrides(foreground, {"threshold": _method_threshold(method)}, root="foreground")
+    if foreground.shadow_test is None:                    # the method's own shadow test (the particle's evidence)
+        foreground = with_overrides(foreground, {"shadow_test": _method_shadow_test(method, preset)},
+                                    root="foreground")
     return RunConfig(method, preset, foreground, methods, stages)
 
 

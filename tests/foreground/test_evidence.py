@@ -124,9 +124,16 @@ def test_static_background_with_the_evidence_test_and_its_setting():
     assert np.all(cloth_evidence[cloth_colour == UNSURE] == 1)             # (the grout it matches stays 0)
     assert np.all(evidence[7:33, 7:53] == UNSURE)                           # judged shadows stay unsure
     assert np.array_equal(evidence[colour != UNSURE], colour[colour != UNSURE])
-    with pytest.raises(InputError, match="shadow test: expected 'colour' or 'evidence', got 'texture'"):
+    background = StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test="evidence-background").labels(img)
+    assert np.all(background[7:33, 7:53] == 0)                              # judged shadows: background
+    changed = background != evidence
+    assert np.all(evidence[changed] == UNSURE) and np.all(background[changed] == 0)   # and nothing else
+    with pytest.raises(InputError, match="shadow test: expected one of 'colour', 'evidence', "
+                                         "'evidence-background', got 'texture'"):
         StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test="texture")
-    assert ForegroundConfig().shadow_test == "colour"
+    assert ForegroundConfig().shadow_test is None                           # the method's own (a run fills it in)
+    assert ForegroundConfig().resolved_shadow_test() == "colour"
+    assert ForegroundConfig(shadow_test="evidence").resolved_shadow_test() == "evidence"
     for kind in ("grey", "colour"):                                          # the registry passes it on
         assert FOREGROUNDS[kind](bg, 20.0, True, None, "evidence").shadow_test == "evidence"
     with pytest.raises(InputError, match="foreground.shadow_test"):

@@ -81,7 +81,8 @@ def make_foregrounds(scene, backgrounds: Mapping[str, np.ndarray], kind: str = "
     shadow_texture_ncc : for the static kinds with shadows, tell dark garments from shadows by
         texture (see :class:`StaticBackground`); default off
     shadow_test : for the static kinds with shadows, "colour" or "evidence" (see
-        :class:`StaticBackground`); default :class:`ForegroundConfig`'s
+        :class:`StaticBackground`); default "colour" (a tracker's own is
+        :func:`worldtrack.trackers.method_shadow_test`)
     """
     given = {"kind": kind, "threshold": threshold, "shadows": shadows, "shadow_texture_ncc": shadow_texture_ncc}
     if shadow_test is not None:
@@ -101,7 +102,7 @@ def foregrounds_from_config(scene, backgrounds: Mapping[str, np.ndarray],
             raise InputError(f"background for {cid}: image is {bg.shape[1]}x{bg.shape[0]} but the camera is "
                              f"{cam.width}x{cam.height}")
         out[cid] = make(bg, config.resolved_threshold(), config.resolved_shadows(), config.shadow_texture_ncc,
-                        config.shadow_test)
+                        config.resolved_shadow_test())
     return out
 
 

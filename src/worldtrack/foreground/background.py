@@ -25,6 +25,8 @@ from worldtrack.foreground.texture import relabel_cloth
 
 #: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
 UNSURE = 2
+#: The tests of shadow-like changes (``StaticBackground(shadow_test=)``, ``foreground.shadow_test``).
+SHADOW_TESTS = ("colour", "evidence", "evidence-background")
 
 #: MOG2/KNN output (0 background, 127 shadow, 255 foreground) → labels.
 _MOG = np.zeros(256, np.uint8)
@@ -95,11 +97,13 @@ class StaticBackground:
         correlate with the background's (NCC at most this over a 5-pixel window) is foreground — a
         dark garment of the floor's colour hides the floor's pattern, a shadow keeps it (see
         :mod:`worldtrack.foreground.texture`). None: no texture test.
-    shadow_test : {"colour", "evidence"}
+    shadow_test : {"colour", "evidence", "evidence-background"}
         With ``shadows``: ``"colour"`` leaves every shadow-like change unsure; ``"evidence"`` judges
         them (:func:`~worldtrack.foreground.evidence.judge_by_evidence`): the ones whose
         neighbourhood hides the floor's pattern, or that are darker than the frame's shadows, are
-        foreground (cloth of the floor's colour); the rest stay unsure.
+        foreground (cloth of the floor's colour); the rest stay unsure. ``"evidence-background"``:
+        the same, and the ones whose neighbourhood shows the floor's pattern through are background
+        (0, judged shadows), so that a silhouette that takes in its own shadow is penalised.
     """
 
     learns = False  #: a fixed background: the same frame always gives the same labels
@@ -115,8 +119,8 @@ class StaticBackground:
         self.background = background
         self.grey = cv2.cvtColor(background, cv2.COLOR_BGR2GRAY)
         self.threshold = float(threshold)
-        if shadow_test not in ("colour", "evidence"):
-            raise InputError(f"shadow test: expected 'colour' or 'evidence', got {shadow_test!r}")
+        if shadow_test not in SHADOW_TESTS:
+            raise InputError(f"shadow test: expected one of {', '.join(map(repr, SHADOW_TESTS))}, got {shadow_test!r}")
         self.mode = mode
         self.shadow_test = shadow_test
         self.kernel = (cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * open_px + 1, 2 * open_px + 1))
@@ -145,7 +149,8 @@ class StaticBackground:
         A shadow-like change may be a cast shadow or a dark, grey garment over a grey floor;
         trackers that can should treat it as no evidence either way rather than as background.
         With ``shadow_test="evidence"`` or ``shadow_texture_ncc`` the garments that hide a textured
-        floor, or are darker than the frame's shadows, are told apart (1).
+        floor, or are darker than the frame's shadows, are told apart (1); with
+        ``"evidence-background"`` the shadows the evidence finds are background (0).
         """
         self._check(image)
         if self.mode == "grey":
@@ -157,8 +162,9 @@ class StaticBackground:
         else:
             out = colour_labels(np.ascontiguousarray(image), self.background, self._bg_norm2, self.threshold,
                                 self.shadows, self.shadow_min_ratio, self.shadow_distortion)
-        if self.shadows and self.shadow_test == "evidence":
-            out = judge_by_evidence(out, image, self.background, candidate=UNSURE, cloth=1, shadow=UNSURE,
+        if self.shadows and self.shadow_test != "colour":
+            judged = 0 if self.shadow_test == "evidence-background" else UNSURE
+            out = judge_by_evidence(out, image, self.background, candidate=UNSURE, cloth=1, shadow=judged,
                                     grey_background=self.grey)
         if self.shadows and self.shadow_texture_ncc is not None:
             relabel_cloth(out, image, self.grey, self.shadow_texture_ncc, candidate=UNSURE)

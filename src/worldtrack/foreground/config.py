@@ -18,6 +18,8 @@ FOREGROUND_KINDS = ("grey", "colour", "mog2", "knn")
 DEFAULT_THRESHOLDS = {"grey": 25.0, "colour": 30.0}
 #: The threshold the synthetic world's experiments use (noise σ ≈ 3).
 SYNTHETIC_COLOUR_THRESHOLD = 20.0
+#: The shadow test of a method that has none of its own (``foreground.shadow_test``).
+DEFAULT_SHADOW_TEST = "colour"
 
 
 class ForegroundConfig(Section):
@@ -34,18 +36,26 @@ class ForegroundConfig(Section):
     shadow_texture_ncc: float | None = Field(
         None, ge=-1, le=1, description="with shadows: shadow-like pixels whose texture correlates with the "
                                        "background's at most this much are cloth (null: off; hurt on PETS)")
-    shadow_test: Literal["colour", "evidence"] = Field(
-        "colour", description="with shadows, for grey/colour: 'colour' leaves shadow-like changes unsure; "
-                              "'evidence' calls them foreground where the floor's pattern is gone or they "
-                              "are darker than the frame's shadows (worldtrack.foreground.evidence)")
+    shadow_test: Literal["colour", "evidence", "evidence-background"] | None = Field(
+        None, description="with shadows, for grey/colour: 'colour' leaves shadow-like changes unsure; "
+                          "'evidence' calls them foreground where the floor's pattern is gone or they "
+                          "are darker than the frame's shadows (worldtrack.foreground.evidence); "
+                          "'evidence-background' also calls the ones where the floor's pattern shows "
+                          "through background (null: the method's own, evidence for the particle tracker, "
+                          "else colour)")
 
     def resolved_threshold(self) -> float | None:
         """The threshold in use: :attr:`threshold`, else the default of :attr:`kind` (None for mog2/knn)."""
         return self.threshold if self.threshold is not None else DEFAULT_THRESHOLDS.get(self.kind)
+
+    def resolved_shadow_test(self) -> str:
+        """The shadow test in use: :attr:`shadow_test`, else ``"colour"`` (a run's configuration fills in
+        the method's own first, :func:`worldtrack.trackers.method_shadow_test`)."""
+        return self.shadow_test or DEFAULT_SHADOW_TEST
 
     def resolved_shadows(self) -> bool:
         """Whether shadows are set apart: :attr:`shadows`, else on for every kind but grey."""
         return (self.kind != "grey") if self.shadows is None else self.shadows
 
 
-__all__ = ["DEFAULT_THRESHOLDS", "FOREGROUND_KINDS", "ForegroundConfig", "SYNTHETIC_COLOUR_THRESHOLD"]
+__all__ = ["DEFAULT_SHADOW_TEST", "DEFAULT_THRESHOLDS", "FOREGROUND_KINDS", "ForegroundConfig", "SYNTHETIC_COLOUR_THRESHOLD"]

@@ -68,6 +68,18 @@ def method_threshold(method: str) -> float | None:
     return CONFIGS[method].foreground_threshold
 
 
+def method_shadow_test(method: str, preset: str = "default") -> str | None:
+    """The foreground shadow test ``method`` runs with when none is given (None: the foreground's
+    default, "colour"); the paper preset always has None (no published method has the test).
+
+    >>> method_shadow_test("ellipsoid"), method_shadow_test("particle"), method_shadow_test("particle", "paper")
+    (None, 'evidence', None)
+    """
+    if preset == "paper":
+        return None
+    return getattr(CONFIGS[method], "foreground_shadow_test", None)
+
+
 def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *, preset: str = "default",
                  overrides: Mapping[str, Any] | None = None, position_map: PositionMap | None = None,
                  **options: Any) -> Tracker:
@@ -96,4 +108,4 @@ def make_tracker(method: str, scene, foregrounds: Mapping, config: Any = None, *
 
 
 __all__ = ["CONFIGS", "METHODS", "PRESETS", "TRACKERS", "Frame", "Person", "PositionMap", "Track", "Tracker",
-           "TrackerBase", "method_threshold", "make_tracker", "method_config", "warm_started"]
+           "TrackerBase", "method_shadow_test", "method_threshold", "make_tracker", "method_config", "warm_started"]
