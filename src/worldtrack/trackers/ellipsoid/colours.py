@@ -141,7 +141,28 @@ def look(view: CameraView, people: Sequence[Person]) -> Sight:
     return Sight(forms, xy, hs, shown, alone, met)
 
 
-def colours_of(view: CameraView, image: np.ndarray, labels: np.ndarray, sight: Sight, wanted: np.ndarray, min_pixels: int) -> dict[int, Colours]:
+def _own_foreground(view: CameraView, labels: np.ndarray, forms: Forms, ask: np.ndarray):
+    """The foreground pixels (``labels`` 1) that the people asked about (``ask[k + 2]``) alone
+    cover: (owner k, u, v), each (P,) int64. The owner map is drawn over each one's box when those
+    are smaller together than the window holding them all (people spread over the image), else
+    once over that window."""
+    asked = np.flatnonzero(ask[2:])
+    box = forms.box
+    areas = (box[asked, 1] - box[asked, 0]) * (box[asked, 3] - box[asked, 2])
+    w = _union(box, asked)
+    pieces = [(w, ask)] if areas.sum() >= (w[1] - w[0]) * (w[3] - w[2]) else \
+        [(box[j], np.arange(-2, len(box)) == j) for j in asked]
+    out = []
+    for (u0, u1, v0, v1), mine in pieces:
+        owner = owner_crop(np.array([u0, u1, v0, v1], np.int64), forms, view.grid, view.camera.has_distortion)
+        flat = np.flatnonzero(mine[owner.ravel() + 2] & (labels[v0:v1, u0:u1].ravel() == 1))
+        v, u = np.divmod(flat, u1 - u0)
+        out.append((owner.ravel()[flat].astype(np.int64), u + u0, v + v0))
+    return tuple(np.concatenate(c) for c in zip(*out))
+
+
+def colours_of(view: CameraView, image: np.ndarray, labels: np.ndarray, sight: Sight, wanted: Sequence[int],
+               min_pixels: int) -> dict[int, Colours]:
     """The colours of the people ``wanted`` (indices into the people ``sight`` looked at), by
     index, in index order.
 
@@ -154,27 +175,25 @@ def colours_of(view: CameraView, image: np.ndarray, labels: np.ndarray, sight: S
     ask = np.zeros(n + 2, bool)                       # by owner index + 2 (−2 several, −1 nobody)
     ask[np.asarray(wanted, np.int64) + 2] = True
     ask[2:] &= sight.shown
-    # The axis from the head's top to the feet, relative to each box's corner (as in a crop).
-    xy, hs = sight.xy, sight.heights                  # where they were looked at (a swap moves people)
-    ends = view.camera.project(np.stack([np.c_[xy, hs], np.c_[xy, np.zeros(n)]], axis=1).reshape(-1, 3))
-    ends = ends.reshape(n, 2, 2)
+    # The axis from the head's top to the feet, relative to each box's corner (as in a crop), of
+    # the people asked about, at the places they were looked at (a swap moves people).
+    idx = np.flatnonzero(ask[2:])
+    if not len(idx):
+        return {}
+    xy, hs = sight.xy[idx], sight.heights[idx]
+    ends = view.camera.project(np.stack([np.c_[xy, hs], np.c_[xy, np.zeros(len(idx))]], axis=1).reshape(-1, 3))
+    ends = ends.reshape(len(idx), 2, 2)
     corner = sight.forms.box[:, [0, 2]]
-    head = ends[:, 0] - corner.astype(float)
-    axis = (ends[:, 1] - corner.astype(float)) - head
-    length2 = np.array([float(a @ a) for a in axis])   # person by person, as the reference does
-    ask[2:] &= np.isfinite(ends).all(axis=(1, 2)) & (length2 >= 1.0)
+    head, axis, length2 = np.zeros((n, 2)), np.zeros((n, 2)), np.ones(n)
+    head[idx] = ends[:, 0] - corner[idx].astype(float)
+    axis[idx] = (ends[:, 1] - corner[idx].astype(float)) - head[idx]
+    length2[idx] = [float(a @ a) for a in axis[idx]]   # person by person, as the reference does
+    ask[idx + 2] &= np.isfinite(ends).all(axis=(1, 2)) & (length2[idx] >= 1.0)
     if not ask.any():
         return {}
-    # One owner map over the window of the people asked about; their own foreground pixels.
-    w = _union(sight.forms.box, ask[2:])
-    owner = owner_crop(w, sight.forms, view.grid, view.camera.has_distortion)
-    width = w[1] - w[0]
-    flat = np.flatnonzero(ask[owner.ravel() + 2] & (labels[w[2]:w[3], w[0]:w[1]].ravel() == 1))
-    k = owner.ravel()[flat].astype(np.int64)
-    v, u = np.divmod(flat, width)
-    u, v = u + w[0], v + w[2]
+    k, u, v = _own_foreground(view, labels, sight.forms, ask)
     share = ((u - corner[k, 0] - head[k, 0]) * axis[k, 0] + (v - corner[k, 1] - head[k, 1]) * axis[k, 1]) / length2[k]
-    part = np.full(len(flat), -1, np.int64)
+    part = np.full(len(k), -1, np.int64)
     for p, (lo, hi) in enumerate(PARTS):
         part[(share >= lo) & (share < hi)] = p
     keep = part >= 0
