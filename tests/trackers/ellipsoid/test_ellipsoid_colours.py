@@ -104,3 +104,23 @@ def test_who_stands_clear_and_who_met_equal_the_per_person_test(crowd):
         steps += 1
     ids = tuple(sorted(p.id for p in pair))
     assert 10 < steps < 400 and not alone.any() and met == [ids, ids]
+
+
+def test_with_isolation_by_ellipse_rings_that_touch_still_leave_both_clear(crowd):
+    view, _, _, people = crowd
+    pair = people[2:4]
+    ray = np.array([pair[0].x, pair[0].y]) - view.camera.centre[:2]
+    across = np.array([-ray[1], ray[0]]) / np.hypot(*ray)
+    pair[1].x, pair[1].y = np.array([pair[0].x, pair[0].y]) + 1.5 * across
+    seen = []
+    for _ in range(300):
+        ring, ellipse = look(view, pair, "ring"), look(view, pair, "ellipse")
+        assert ring.met == ellipse.met and (ellipse.alone >= ring.alone).all()
+        seen.append((ring.alone.all(), ellipse.alone.all()))
+        if not ellipse.alone.any():
+            break
+        pair[1].x, pair[1].y = pair[1].x - 0.005 * across[0], pair[1].y - 0.005 * across[1]
+    # Far apart both clear; then rings meet while the ellipses do not; then the ellipses meet.
+    assert seen[0] == (True, True) and (False, True) in seen and seen[-1] == (False, False)
+    first = seen.index((False, True))
+    assert all(s == (True, True) for s in seen[:first]) and seen.count((False, True)) >= 3

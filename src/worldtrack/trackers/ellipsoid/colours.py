@@ -25,7 +25,7 @@ import numpy as np
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.args import Forms
 from worldtrack.trackers.ellipsoid.cameras import CameraView
-from worldtrack.trackers.ellipsoid.forms import owner_crop
+from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
 
 #: Histogram bins: hue, saturation, value (value keeps dark and light grey clothes apart).
 HIST_BINS = (8, 4, 4)
@@ -104,12 +104,14 @@ def _union(box: np.ndarray, which: np.ndarray) -> np.ndarray:
     return np.array([b[:, 0].min(), b[:, 1].max(), b[:, 2].min(), b[:, 3].max()], np.int64)
 
 
-def look(view: CameraView, people: Sequence[Person]) -> Sight:
+def look(view: CameraView, people: Sequence[Person], isolation: str = "ring") -> Sight:
     """Who stands clear of the others, for ``people`` in one camera.
 
     A person is clearly isolated when no other person's box meets theirs, or no pixel of their
     box is covered by two ellipses grown by the ring (one owner map of the grown ellipses over
-    the boxes of the people who have a neighbour).
+    the boxes of the people who have a neighbour). With ``isolation="ellipse"`` a person whose
+    own ellipse no other ellipse overlaps is isolated too (their rings may). ``Sight.met`` is the
+    same either way.
     """
     cam = view.camera
     n = len(people)
@@ -138,7 +140,19 @@ def look(view: CameraView, people: Sequence[Person]) -> Sight:
     rows, cols = np.nonzero(meets[crowded])                   # in the order of the people, then of j
     a, b = ids[crowded[rows]], ids[cols]
     met = list(zip(np.minimum(a, b).tolist(), np.maximum(a, b).tolist()))
+    if isolation == "ellipse" and len(crowded):
+        alone[crowded] = _unoverlapped(view, forms, crowded)
     return Sight(forms, xy, hs, shown, alone, met)
+
+
+def _unoverlapped(view: CameraView, forms: Forms, which: np.ndarray) -> np.ndarray:
+    """For the people ``which``: whether every pixel of their ellipse is theirs alone."""
+    w = _union(forms.box, which)
+    owner = owner_crop(w, forms, view.grid, view.camera.has_distortion)
+    owned = np.bincount(owner.ravel() + 2, minlength=len(forms.box) + 2)[2:]
+    drawn = np.array([ellipse_crop(forms.inner[k], forms.box[k], view.grid, view.camera.has_distortion).sum()
+                      for k in which])
+    return owned[which] == drawn
 
 
 def _own_foreground(view: CameraView, labels: np.ndarray, forms: Forms, ask: np.ndarray):

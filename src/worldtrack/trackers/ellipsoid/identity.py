@@ -88,7 +88,7 @@ class Identities:
         if not people:
             self.met = {k: v for k, v in self.met.items() if t - v <= cfg.swap_window_s}
             return
-        sights = {cid: look(views[cid], people) for cid in images if cid in labels}
+        sights = {cid: look(views[cid], people, cfg.isolation) for cid in images if cid in labels}
         for sight in sights.values():
             self.met.update(dict.fromkeys(sight.met, t))
         learners = np.array([p.mode == "capture" and p.id < 0 for p in people])  # a candidate learns from what it owns
