@@ -1,10 +1,12 @@
 """What the colour identity sees in one camera: who owns each pixel, who stands clear of the
 others, and the colours of the upper and lower body of the people it asks about.
 
-Per camera and frame, the people's ellipses are drawn **once** into two owner maps (which one
-person's ellipse covers each pixel; the same with the ellipses grown by the ring), and the
-histograms of every person asked for come from **one** ``np.bincount`` over the foreground
-pixels they own, indexed by (person, body part, HSV bin). The bins are OpenCV's own
+Per camera and frame, :func:`look` draws the ellipses grown by the ring **once** into one owner
+map (which one person's ellipse covers each pixel) to tell who stands clear of the others and who
+met whom. :func:`colours_of` then measures only the people it is asked about (those who can learn
+their colours, and those in a pair that is checked for a swap): the owner map of their ellipses
+over their boxes, and the histograms of all of them from **one** ``np.bincount`` over the
+foreground pixels they own, indexed by (person, body part, HSV bin). The bins are OpenCV's own
 (:func:`cv2.calcHist`'s, read from it once), so each histogram equals ``cv2.calcHist`` on that
 person's masked crop — :func:`part_histograms_reference`, the per-person version the tests
 compare against.
