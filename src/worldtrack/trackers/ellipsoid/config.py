@@ -255,6 +255,10 @@ class IdentityConfig(Section):
     reid_near_m: float = Field(1.0, ge=0, description="a lost person may be found this far from where they were lost, m, ...")
     walk_speed_mps: float = Field(2.0, ge=0, description="... plus this speed times the time since, m/s")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept for re-identification, s")
+    isolation: Literal["ring", "ellipse"] = Field(
+        "ring", description="when a view of a person is clear enough to learn their colours from: 'ring' — no other "
+        "person's ellipse grown by the ring overlaps theirs; 'ellipse' — no other person's ellipse overlaps theirs "
+        "(the rings may: people walking side by side in a group)")
 
 
 class WarmStartConfig(Section):

@@ -30,44 +30,13 @@ import math
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
-import cv2
 import numpy as np
 
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import IdentityConfig
-from worldtrack.trackers.ellipsoid.forms import owner_crop
-
-#: Histogram bins: hue, saturation, value (value keeps dark and light grey clothes apart).
-HIST_BINS = (8, 4, 4)
-#: The body parts, as shares of the image axis from the top of the head (0) to the feet (1):
-#: the upper body without the head, the lower body without the feet (and their shadow).
-PARTS = ((0.18, 0.5), (0.5, 0.9))
-
-
-def hist_distance(a: np.ndarray, b: np.ndarray) -> float:
-    """Bhattacharyya distance of two normalised histograms (OpenCV's ``HISTCMP_BHATTACHARYYA``)."""
-    return float(cv2.compareHist(a, b, cv2.HISTCMP_BHATTACHARYYA))
-
-
-@dataclass
-class Colours:
-    """One person's colours in one camera: a histogram (``HIST_BINS``, sums to 1) per body part;
-    ``alone``: seen clearly isolated (else from the pixels nobody else's ellipse covers)."""
-
-    parts: list[np.ndarray]
-    updates: int = 1
-    alone: bool = True
-
-    def distance(self, other: "Colours") -> float:
-        """Mean Bhattacharyya distance over the body parts."""
-        return float(np.mean([hist_distance(a, b) for a, b in zip(self.parts, other.parts)]))
-
-    def blend(self, seen: "Colours", rate: float) -> None:
-        """Move the model towards ``seen`` by ``rate`` (the first updates count more)."""
-        w = max(rate, 1.0 / (self.updates + 1))
-        self.parts = [(1 - w) * a + w * b for a, b in zip(self.parts, seen.parts)]
-        self.updates += 1
+from worldtrack.trackers.ellipsoid.colours import (HIST_BINS, PARTS, Colours, Sight, colours_of, hist_distance,
+                                                    look)
 
 
 @dataclass
@@ -116,15 +85,22 @@ class Identities:
                 self.lost.append(Lost(p.id, self.models[p], np.array([p.x, p.y]), p.last_seen))
             del self.models[p]
         self.lost = [g for g in self.lost if t - g.t <= cfg.reid_s]
-        seen: dict[str, dict[int, Colours]] = {}
-        for cid, image in images.items():
-            if cid in labels:
-                seen[cid] = see_colours(views[cid], image, labels[cid], people, cfg.min_pixels,
-                                        lambda i, j: self.met.__setitem__((min(i, j), max(i, j)), t))
-        self._undo_swaps(people, seen, t)
-        for cid, found in seen.items():
+        if not people:
+            self.met = {k: v for k, v in self.met.items() if t - v <= cfg.swap_window_s}
+            return
+        sights = {cid: look(views[cid], people, cfg.isolation) for cid in images if cid in labels}
+        for sight in sights.values():
+            self.met.update(dict.fromkeys(sight.met, t))
+        learners = np.array([p.mode == "capture" and p.id < 0 for p in people])  # a candidate learns from what it owns
+        seen = _Seen(views, images, labels, sights, cfg.min_pixels)
+        pairs = self._pairs(people)
+        for cid, sight in sights.items():
+            checked = [x for i, j, _, cameras in pairs if cid in cameras for x in (i, j)]
+            seen.ask(cid, np.flatnonzero(sight.alone | learners).tolist() + checked)
+        self._undo_swaps(people, seen, pairs, t)
+        for cid, found in seen.found.items():
             for k, colours in found.items():
-                if not (colours.alone or (people[k].mode == "capture" and people[k].id < 0)):
+                if not (colours.alone or learners[k]):
                     continue  # a model learns from clear views only (a candidate: from what it owns)
                 model = self.models.setdefault(people[k], {})
                 if cid in model:
@@ -133,38 +109,57 @@ class Identities:
                     model[cid] = colours
         self.met = {k: v for k, v in self.met.items() if t - v <= cfg.swap_window_s}
 
-    def _undo_swaps(self, people: Sequence[Person], seen: Mapping[str, Mapping[int, Colours]], t: float) -> None:
+    def _pairs(self, people: Sequence[Person]) -> list[tuple[int, int, tuple[int, int], set[str]]]:
+        """The pairs that met whose colours can be compared, in the order they met: (index i,
+        index j, their ids, the cameras where both are confirmed and have models that have learnt
+        enough). A pair of people on the map with no such camera clears its doubt."""
+        index = {p.id: k for k, p in enumerate(people)}
+        mature: dict[int, set[str]] = {}   # by person id
+        for p in people:
+            if p.confirmed and p in self.models:
+                cameras = {cid for cid, c in self.models[p].items() if c.updates >= self.config.min_updates}
+                if cameras:
+                    mature[p.id] = cameras
+        out = []
+        if len(mature) > 1:
+            for (a, b) in self.met:
+                if a in mature and b in mature and mature[a] & mature[b]:
+                    out.append((index[a], index[b], (a, b), mature[a] & mature[b]))
+        for (a, b) in [q for q in self.doubts if q in self.met]:
+            i, j = index.get(a), index.get(b)
+            if i is not None and j is not None and people[i].confirmed and people[j].confirmed and \
+                    not (mature.get(a, set()) & mature.get(b, set())):
+                del self.doubts[(a, b)]
+        return out
+
+    def _undo_swaps(self, people: Sequence[Person], seen: "_Seen", pairs, t: float) -> None:
         """Exchange the places of two people who met and now each look like the other."""
         cfg = self.config
-        index = {p.id: k for k, p in enumerate(people)}
-        for (a, b) in list(self.met):
-            i, j = index.get(a), index.get(b)
-            if i is None or j is None or not (people[i].confirmed and people[j].confirmed):
-                continue
-            mi, mj = self.models.get(people[i], {}), self.models.get(people[j], {})
+        for i, j, pair, cameras in pairs:
+            mi, mj = self.models[people[i]], self.models[people[j]]
             same = swapped = 0.0
             n = 0
-            for cid, found in seen.items():
-                if i in found and j in found and cid in mi and cid in mj and \
-                        min(mi[cid].updates, mj[cid].updates) >= cfg.min_updates:
+            for cid, found in seen.found.items():
+                if cid in cameras and i in found and j in found:
                     same += mi[cid].distance(found[i]) + mj[cid].distance(found[j])
                     swapped += mi[cid].distance(found[j]) + mj[cid].distance(found[i])
                     n += 1
             if not (n and swapped + cfg.swap_margin * n < same):
-                self.doubts.pop((a, b), None)
+                self.doubts.pop(pair, None)
                 continue
             # Two frames in a row, and not back again soon: one noisy view swaps nobody.
-            self.doubts[(a, b)] = self.doubts.get((a, b), 0) + 1
-            if self.doubts[(a, b)] < 2 or t - self.swapped.get((a, b), -np.inf) <= cfg.swap_window_s:
+            self.doubts[pair] = self.doubts.get(pair, 0) + 1
+            if self.doubts[pair] < 2 or t - self.swapped.get(pair, -np.inf) <= cfg.swap_window_s:
                 continue
             swap_places(people[i], people[j])
-            for found in seen.values():
+            for cid, found in seen.found.items():
+                seen.ask(cid, [i, j])          # their colours go with them in every camera
                 if i in found and j in found:
                     found[i], found[j] = found[j], found[i]
             self.swaps += 1
-            self.swapped[(a, b)] = t
-            del self.met[(a, b)]
-            del self.doubts[(a, b)]
+            self.swapped[pair] = t
+            del self.met[pair]
+            del self.doubts[pair]
 
     def reidentify(self, p: Person, t: float, taken) -> int | None:
         """The id of the lost person a newly confirmed ``p`` is, or None (``taken(id)``: the id is
@@ -202,78 +197,41 @@ def swap_places(a: Person, b: Person) -> None:
         setattr(b, name, va)
 
 
+class _Seen:
+    """People's colours in each camera this frame, measured when first asked for (``found``: by
+    camera, index → :class:`Colours`, in index order)."""
+
+    def __init__(self, views, images, labels, sights: Mapping[str, Sight], min_pixels: int):
+        self.views, self.images, self.labels, self.sights = views, images, labels, sights
+        self.min_pixels = min_pixels
+        self.found: dict[str, dict[int, Colours]] = {cid: {} for cid in sights}
+        self.asked: dict[str, set[int]] = {cid: set() for cid in sights}
+
+    def ask(self, cid: str, indices: Sequence[int]) -> None:
+        """Measure the colours in ``cid`` of those of ``indices`` not measured yet."""
+        new = sorted(set(indices) - self.asked[cid])
+        if not new:
+            return
+        self.asked[cid].update(new)
+        found = self.found[cid]
+        found.update(colours_of(self.views[cid], self.images[cid], self.labels[cid], self.sights[cid],
+                                np.array(new, np.int64), self.min_pixels))
+        ordered = sorted(found.items())
+        found.clear()
+        found.update(ordered)
+
+
 def see_colours(view: CameraView, image: np.ndarray, labels: np.ndarray, people: Sequence[Person],
                 min_pixels: int, met) -> dict[int, Colours]:
-    """The colours of each clearly isolated person in one camera, by index into ``people``.
-
-    A person's pixels are the foreground pixels (label 1) of their own ellipse that no other
-    ellipse covers, split into :data:`PARTS` along the image of their vertical axis. They are
-    clearly isolated (``Colours.alone``) when no other person's ellipse grown by the ring overlaps
-    theirs (grown too); ``met(i, j)`` is called for every pair whose grown ellipses overlap. A part
-    with fewer than ``min_pixels`` pixels leaves the person out.
-    """
+    """The colours of everyone ``people`` holds in one camera, by index (:func:`.colours.look`
+    then :func:`.colours.colours_of` for all of them); ``met(i, j)`` is called for every pair of
+    ids whose grown ellipses crowd each other. ``Colours.alone``: clearly isolated."""
     if not people:
         return {}
-    cam = view.camera
-    xy = np.array([[p.x, p.y] for p in people], float)
-    hs = np.array([p.height for p in people], float)
-    ws = np.array([p.width for p in people], float)
-    forms = view.forms(xy, hs, ws)
-    grown = forms._replace(inner=forms.ring)
-    out: dict[int, Colours] = {}
-    for k in range(len(people)):
-        if not forms.valid[k]:
-            continue
-        u0, u1, v0, v1 = (int(c) for c in forms.box[k])
-        if u0 >= u1 or v0 >= v1:
-            continue
-        window = np.array([u0, u1, v0, v1], np.int64)
-        others = _overlapping(k, window, forms, grown)
-        alone = True
-        if others and (owner_crop(window, grown, view.grid, cam.has_distortion) == -2).any():
-            alone = False
-            for j in others:
-                met(people[k].id, people[j].id)
-        own = owner_crop(window, forms, view.grid, cam.has_distortion) == k
-        mask = own & (labels[v0:v1, u0:u1] == 1)
-        colours = _part_histograms(cam, image[v0:v1, u0:u1], mask, (u0, v0), xy[k], hs[k], min_pixels)
-        if colours is not None:
-            colours.alone = alone
-            out[k] = colours
-    return out
-
-
-def _overlapping(k: int, window: np.ndarray, forms, grown) -> list[int]:
-    """Indices of the people whose grown ellipse's box meets person ``k``'s box (a cheap first test)."""
-    u0, u1, v0, v1 = window
-    box = grown.box
-    hit = forms.valid & (box[:, 0] < u1) & (box[:, 1] > u0) & (box[:, 2] < v1) & (box[:, 3] > v0)
-    hit[k] = False
-    return [int(j) for j in np.flatnonzero(hit)]
-
-
-def _part_histograms(cam, crop: np.ndarray, mask: np.ndarray, origin: tuple[int, int], xy: np.ndarray,
-                     height: float, min_pixels: int) -> Colours | None:
-    """HSV histograms of the masked pixels of ``crop`` in each of :data:`PARTS`, or None."""
-    ends = cam.project(np.array([[xy[0], xy[1], height], [xy[0], xy[1], 0.0]]))
-    if not np.isfinite(ends).all():
-        return None
-    head, feet = ends[0] - np.asarray(origin, float), ends[1] - np.asarray(origin, float)
-    axis = feet - head
-    length2 = float(axis @ axis)
-    if length2 < 1.0:
-        return None
-    u, v = np.arange(crop.shape[1])[None, :], np.arange(crop.shape[0])[:, None]   # broadcast: no (h, w) grids
-    share = ((u - head[0]) * axis[0] + (v - head[1]) * axis[1]) / length2
-    hsv = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)
-    parts = []
-    for lo, hi in PARTS:
-        part = (mask & (share >= lo) & (share < hi)).astype(np.uint8)
-        if cv2.countNonZero(part) < min_pixels:
-            return None
-        h = cv2.calcHist([hsv], [0, 1, 2], part, list(HIST_BINS), [0, 180, 0, 256, 0, 256])
-        parts.append(h / max(float(h.sum()), 1.0))
-    return Colours(parts)
+    sight = look(view, people)
+    for i, j in sight.met:
+        met(i, j)
+    return colours_of(view, image, labels, sight, np.arange(len(people)), min_pixels)
 
 
 __all__ = ["Colours", "HIST_BINS", "Identities", "Lost", "PARTS", "hist_distance", "see_colours", "swap_places"]
