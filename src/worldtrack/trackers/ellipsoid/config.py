@@ -188,6 +188,12 @@ class HeightConfig(Section):
     min_px: int = Field(
         60, ge=0, description="measure in one view only where the person is at least this tall, px, and seen at "
         "more than 45 degrees from the vertical")
+    deadband_sigmas: float = Field(
+        0.0, ge=0, description="when > 0, replaces deadband_m: the measured height replaces the default when it "
+        "differs by more than this many of its own standard errors (the median's, from the samples' spread)")
+    feet_unsure_max: float = Field(
+        1.0, ge=0, le=1, description="in one view, the silhouette's bottom counts as the feet only where at most this "
+        "share of a leg-wide band below it is shadow-like (legs the floor's colour go on below the waist); 1 = no test")
     ray_gap_m: float = Field(
         0.03, ge=0, description="head rays of several cameras give a height only when each passes this close to "
         "their nearest common point, m (else some view took another head for this one's)")
@@ -227,6 +233,30 @@ class FeetConfig(Section):
     measured_height_sigma_m: float = Field(
         0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter)")
     min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
+
+
+class DepthConfig(Section):
+    """Depth along one camera's line of sight from every cue, each weighed by its σ
+    (:mod:`worldtrack.trackers.ellipsoid.depth`); the feet's and the head's σ are ``ellipsoid.feet``'s."""
+
+    path: ClassVar[str] = "ellipsoid.depth"
+
+    fuse: bool = Field(
+        False, description="place people one camera alone shows along its line of sight by the inverse-variance mean "
+        "of the ellipse, the prediction, the feet (where the legs are foreground) and the top of the head; off by "
+        "default (issue 37: helps one oblique camera, not measured to be harmless in crowds and PETS)")
+    prior_speed_mps: float = Field(
+        1.5, gt=0, description="σ of the constant-velocity prediction along the line of sight is this times the "
+        "frame interval, m/s (the velocity prior: no 0.6 m jump in 0.1 s)")
+    weak_sigma_m: float = Field(
+        0.6, gt=0, description="σ of the matched ellipse's place along the line of sight where its evidence is weak "
+        "(legs not foreground, or others cover the person), m")
+    legs_min_share: float = Field(
+        0.5, ge=0, le=1, description="the feet count only where at least this share of the labelled pixels below the "
+        "knees is foreground (not shadow-like)")
+    remeasure_after_encounter: bool = Field(
+        False, description="drop a person's height samples once others stop covering them: the height is measured "
+        "afresh, not carried through a crossing")
 
 
 class IdentityConfig(Section):
@@ -284,6 +314,7 @@ class EllipsoidConfig(Section):
     height: HeightConfig = Field(HeightConfig(), description="measuring people's heights")
     warm_start: WarmStartConfig = Field(WarmStartConfig(), description="starting with the people in view")
     feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
+    depth: DepthConfig = Field(DepthConfig(), description="depth along one camera's line of sight from every cue")
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
 
     @classmethod
@@ -298,5 +329,5 @@ class EllipsoidConfig(Section):
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
+__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
            "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

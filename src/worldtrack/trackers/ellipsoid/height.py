@@ -31,6 +31,7 @@ from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
+from worldtrack.trackers.ellipsoid.legs import unsure_below
 
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 MAX_COVERED_FOR_HEIGHT = 0.3
@@ -39,7 +40,7 @@ MAX_COVERED_FOR_HEIGHT = 0.3
 def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                    region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
                    height_range_m: tuple[float, float] = (1.2, 2.2), down: np.ndarray | None = None,
-                   max_depth_offset_m: float | None = None) -> float | None:
+                   max_depth_offset_m: float | None = None, max_unsure_below: float = 1.0) -> float | None:
     """Height (m) of the person whose foreground lies in ``region`` of ``box``, or None.
 
     Parameters
@@ -65,7 +66,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
         None when the view is not clear: too few pixels, head or feet at the image border or
         hidden by an obstacle, or a result outside the plausible range.
     """
-    found = measure_feet(camera, labels, occ, xy, region, box, max_offset_m, down, max_depth_offset_m)
+    found = measure_feet(camera, labels, occ, xy, region, box, max_offset_m, down, max_depth_offset_m, max_unsure_below)
     if found is None:
         return None
     h = found[1]
@@ -75,20 +76,23 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
 
 def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                  region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
-                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None
-                 ) -> tuple[np.ndarray, float] | None:
+                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None,
+                 max_unsure_below: float = 1.0) -> tuple[np.ndarray, float] | None:
     """The feet's floor point (3,) and the height (m) of the top of the head's ray above it, of
     the person whose foreground lies in ``region`` of ``box``, or None (parameters and the
-    conditions as :func:`measure_height`, which is this without a height range)."""
+    conditions as :func:`measure_height`, which is this without a height range); None too when
+    more than ``max_unsure_below`` of the band below the bottom is unsure (:func:`.legs.unsure_below`)."""
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
         return None  # the person may extend past the image border
-    ends = _ends(camera, labels, region, box, down)
+    ends = silhouette_ends(camera, labels, region, box, down)
     if ends is None:
         return None
     top, bottom, down = ends
     if not pixel_clear(camera, occ, bottom + 2 * down):
         return None  # feet at the border or on an obstacle's edge
+    if max_unsure_below < 1.0 and unsure_below(labels, top, bottom, down) > max_unsure_below:
+        return None  # the legs go on below, shadow-like: this is the waist
     feet = camera.backproject(bottom[None], 0.0)[0]
     if not np.isfinite(feet).all():
         return None
@@ -119,7 +123,7 @@ def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.nda
     u0, u1, v0, v1 = box
     if v0 <= 0 or u0 <= 0 or u1 >= camera.width:
         return None
-    ends = _ends(camera, labels, region, box, down)
+    ends = silhouette_ends(camera, labels, region, box, down)
     if ends is None:
         return None
     top = ends[0]
@@ -174,9 +178,9 @@ def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray
 _MIN_PIXELS = 30
 
 
-def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
+def silhouette_ends(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
           down: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Top and bottom (pixels) of the foreground in ``region`` along the image's world-down
+    """Top and bottom pixels (2,) of the foreground (label 1) in ``region`` along the image's world-down
     direction, and that direction; None with fewer than ``_MIN_PIXELS`` pixels.
 
     The ends are the means of the extreme 1 % of the pixels along ``down`` (:func:`extreme_ends`),
@@ -338,7 +342,19 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
         if len(samples) >= 3:
             default = default_height(p.id)
             median = float(np.median(samples))
-            p.height = median if abs(median - default) > config.deadband_m else default
+            p.height = median if abs(median - default) > replace_margin(samples, config) else default
+
+
+def median_sigma(samples: Sequence[float], floor_m: float = 0.005) -> float:
+    """Standard error (m) of the median of height ``samples``: 1.2533 · 1.4826 · MAD / √n, at least ``floor_m``."""
+    s = np.asarray(samples, dtype=float)
+    return max(1.2533 * 1.4826 * float(np.median(np.abs(s - np.median(s)))) / np.sqrt(len(s)), floor_m)
+
+
+def replace_margin(samples: Sequence[float], config: HeightConfig) -> float:
+    """How far (m) the median must be from the default height to replace it: ``deadband_m``, or
+    ``deadband_sigmas`` standard errors of the median."""
+    return config.deadband_sigmas * median_sigma(samples) if config.deadband_sigmas > 0 else config.deadband_m
 
 
 def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -383,10 +399,10 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
         if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < config.min_px:
             continue
         h = measure_height(cam, labels, view.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
-                           max_depth_offset_m=config.depth_offset_m)
+                           max_depth_offset_m=config.depth_offset_m, max_unsure_below=config.feet_unsure_max)
         if h is not None:
             samples_now.setdefault(k, []).append(h)
 
 
 __all__ = ["MAX_COVERED_FOR_HEIGHT", "extreme_ends", "extreme_ends_reference", "head_ray", "heights_due",
-           "measure_feet", "measure_height", "triangulate_height", "update_heights"]
+           "measure_feet", "measure_height", "median_sigma", "replace_margin", "silhouette_ends", "triangulate_height", "update_heights"]
