@@ -6,8 +6,8 @@ import pytest
 from worldtrack.experiment import synthetic_tracker
 from worldtrack.synth import make_scenario
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
-from worldtrack.trackers.ellipsoid.depth import DepthFusion, fuse_along, height_sigma
-from worldtrack.trackers.ellipsoid.height import median_sigma, replace_margin
+from worldtrack.trackers.ellipsoid.depth import DepthFusion, fuse_along
+from worldtrack.trackers.ellipsoid.height_sigma import height_sigma, median_sigma, replace_margin
 from worldtrack.trackers.people import Person
 
 

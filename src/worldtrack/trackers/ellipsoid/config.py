@@ -191,9 +191,6 @@ class HeightConfig(Section):
     deadband_sigmas: float = Field(
         0.0, ge=0, description="when > 0, replaces deadband_m: the measured height replaces the default when it "
         "differs by more than this many of its own standard errors (the median's, from the samples' spread)")
-    feet_unsure_max: float = Field(
-        1.0, ge=0, le=1, description="in one view, the silhouette's bottom counts as the feet only where at most this "
-        "share of a leg-wide band below it is shadow-like (legs the floor's colour go on below the waist); 1 = no test")
     ray_gap_m: float = Field(
         0.03, ge=0, description="head rays of several cameras give a height only when each passes this close to "
         "their nearest common point, m (else some view took another head for this one's)")
@@ -218,7 +215,7 @@ class FeetConfig(Section):
     anchor: bool = Field(
         False, description="move people one camera alone shows towards their feet (or the top of the head) along its "
         "line of sight; off by default: on the line-of-sight scenario MOTA -0.06 -> 0.28 (10 held-out seeds), "
-        "but PETS 2009 0.853 -> 0.785 (issue 37)")
+        "but PETS 2009 0.853 -> 0.785 (issue 37); ellipsoid.depth.fuse weighs these cues with the others")
     sigma_m: float = Field(
         0.1, gt=0, description="uncertainty of the feet's place along the line of sight, m (the feet's pixel "
         "scatter, a shoe's length)")
@@ -231,7 +228,8 @@ class FeetConfig(Section):
         0.1, gt=0, description="where the feet are not to be trusted, the top of the head places the person at their "
         "height, uncertain by this much while it is not measured, m (people's heights scatter by 0.1 m)")
     measured_height_sigma_m: float = Field(
-        0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter)")
+        0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter; with depth.fuse, the "
+        "least σ of a measured height)")
     min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
 
 

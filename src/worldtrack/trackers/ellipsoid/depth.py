@@ -24,7 +24,8 @@ the top of the head     clear of others; placed where its ray is at the person's
 ======================  ==========================================================  ==============
 
 σ_h is the person's height uncertainty: ``feet.height_sigma_m`` until three measurements are in,
-then their median's own standard error (at least 1 cm). Where nothing but the ellipse and the
+then their median's own standard error, at least ``feet.measured_height_sigma_m`` (3 cm: the
+measurements share their biases, and one wrong height must not outweigh the rest). Where nothing but the ellipse and the
 prediction are left (a person behind another), the prediction carries them: no 0.6 m jump in
 0.1 s because a covered silhouette fits a farther ellipse.
 
@@ -48,9 +49,9 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet import under_head
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
+from worldtrack.trackers.ellipsoid.height import MAX_COVERED_FOR_HEIGHT, head_ray, measure_feet, silhouette_ends
+from worldtrack.trackers.ellipsoid.height_sigma import height_sigma
 from worldtrack.trackers.ellipsoid.legs import legs_foreground_share
-from worldtrack.trackers.ellipsoid.height import (MAX_COVERED_FOR_HEIGHT, head_ray, measure_feet, median_sigma,
-                                                 silhouette_ends)
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS
 
 #: The prediction's σ stops growing after this many frames without trusted feet.
@@ -62,12 +63,6 @@ def fuse_along(cues: Sequence[tuple[float, float]]) -> float:
     w = np.array([1.0 / s ** 2 for _, s in cues])
     a = np.array([o for o, _ in cues])
     return float(w @ a / w.sum()) if len(cues) else 0.0
-
-
-def height_sigma(p: Person, unmeasured_sigma_m: float) -> float:
-    """σ of a person's height (m): the standard error of the median of their samples (at least
-    1 cm) from 3 samples on, else ``unmeasured_sigma_m``."""
-    return median_sigma(p.height_samples, 0.01) if len(p.height_samples) >= 3 else unmeasured_sigma_m
 
 
 class DepthFusion:
@@ -164,13 +159,12 @@ class DepthFusion:
         if down is None:
             return False
         feet = measure_feet(cam, labels, view.occ, xy, region, box, down=down,
-                            max_depth_offset_m=self.height.depth_offset_m,
-                            max_unsure_below=self.height.feet_unsure_max)
+                            max_depth_offset_m=self.height.depth_offset_m)
         if (feet is not None and lo <= feet[1] <= hi and abs(feet[1] - p.height) <= self.feet.height_match_m
                 and self._legs_shown(cam, labels, region, box, down)):
             found.append((float((feet[0][:2] - xy) @ ray), self.feet.sigma_m))
             return True
-        sigma_h = height_sigma(p, self.feet.height_sigma_m)
+        sigma_h = height_sigma(p, self.feet.height_sigma_m, self.feet.measured_height_sigma_m)
         place = under_head(head_ray(cam, labels, view.occ, region, box, down), p.height, sigma_h, xy, cam,
                            self.height.depth_offset_m)
         if place is not None:
@@ -194,4 +188,4 @@ class DepthFusion:
             p.height_tries = 0
 
 
-__all__ = ["DepthFusion", "fuse_along", "height_sigma"]
+__all__ = ["DepthFusion", "MAX_WEAK_FRAMES", "fuse_along"]

@@ -31,7 +31,7 @@ from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
-from worldtrack.trackers.ellipsoid.legs import unsure_below
+from worldtrack.trackers.ellipsoid.height_sigma import replace_margin
 
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 MAX_COVERED_FOR_HEIGHT = 0.3
@@ -40,7 +40,7 @@ MAX_COVERED_FOR_HEIGHT = 0.3
 def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                    region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
                    height_range_m: tuple[float, float] = (1.2, 2.2), down: np.ndarray | None = None,
-                   max_depth_offset_m: float | None = None, max_unsure_below: float = 1.0) -> float | None:
+                   max_depth_offset_m: float | None = None) -> float | None:
     """Height (m) of the person whose foreground lies in ``region`` of ``box``, or None.
 
     Parameters
@@ -66,7 +66,7 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
         None when the view is not clear: too few pixels, head or feet at the image border or
         hidden by an obstacle, or a result outside the plausible range.
     """
-    found = measure_feet(camera, labels, occ, xy, region, box, max_offset_m, down, max_depth_offset_m, max_unsure_below)
+    found = measure_feet(camera, labels, occ, xy, region, box, max_offset_m, down, max_depth_offset_m)
     if found is None:
         return None
     h = found[1]
@@ -76,12 +76,11 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
 
 def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                  region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
-                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None,
-                 max_unsure_below: float = 1.0) -> tuple[np.ndarray, float] | None:
+                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None
+                 ) -> tuple[np.ndarray, float] | None:
     """The feet's floor point (3,) and the height (m) of the top of the head's ray above it, of
     the person whose foreground lies in ``region`` of ``box``, or None (parameters and the
-    conditions as :func:`measure_height`, which is this without a height range); None too when
-    more than ``max_unsure_below`` of the band below the bottom is unsure (:func:`.legs.unsure_below`)."""
+    conditions as :func:`measure_height`, which is this without a height range)."""
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
         return None  # the person may extend past the image border
@@ -91,8 +90,6 @@ def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.nda
     top, bottom, down = ends
     if not pixel_clear(camera, occ, bottom + 2 * down):
         return None  # feet at the border or on an obstacle's edge
-    if max_unsure_below < 1.0 and unsure_below(labels, top, bottom, down) > max_unsure_below:
-        return None  # the legs go on below, shadow-like: this is the waist
     feet = camera.backproject(bottom[None], 0.0)[0]
     if not np.isfinite(feet).all():
         return None
@@ -345,18 +342,6 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
             p.height = median if abs(median - default) > replace_margin(samples, config) else default
 
 
-def median_sigma(samples: Sequence[float], floor_m: float = 0.005) -> float:
-    """Standard error (m) of the median of height ``samples``: 1.2533 · 1.4826 · MAD / √n, at least ``floor_m``."""
-    s = np.asarray(samples, dtype=float)
-    return max(1.2533 * 1.4826 * float(np.median(np.abs(s - np.median(s)))) / np.sqrt(len(s)), floor_m)
-
-
-def replace_margin(samples: Sequence[float], config: HeightConfig) -> float:
-    """How far (m) the median must be from the default height to replace it: ``deadband_m``, or
-    ``deadband_sigmas`` standard errors of the median."""
-    return config.deadband_sigmas * median_sigma(samples) if config.deadband_sigmas > 0 else config.deadband_m
-
-
 def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
                      due: Sequence[int], config: HeightConfig, triangulate: bool,
                      out: tuple[dict[int, list[float]], dict[int, list]]) -> None:
@@ -399,10 +384,10 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
         if flat < cam.centre[2] - 0.5 * hs[k] or (b[3] - b[2]) < config.min_px:
             continue
         h = measure_height(cam, labels, view.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
-                           max_depth_offset_m=config.depth_offset_m, max_unsure_below=config.feet_unsure_max)
+                           max_depth_offset_m=config.depth_offset_m)
         if h is not None:
             samples_now.setdefault(k, []).append(h)
 
 
 __all__ = ["MAX_COVERED_FOR_HEIGHT", "extreme_ends", "extreme_ends_reference", "head_ray", "heights_due",
-           "measure_feet", "measure_height", "median_sigma", "replace_margin", "silhouette_ends", "triangulate_height", "update_heights"]
+           "measure_feet", "measure_height", "silhouette_ends", "triangulate_height", "update_heights"]

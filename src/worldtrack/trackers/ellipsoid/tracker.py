@@ -8,6 +8,8 @@ One :meth:`EllipsoidTracker.step`:
    is moved in turn to the best of 9 candidates, K rounds (:mod:`.match`, eq. 5 in
    :mod:`.score`), and failing tracks are rescued along their lines of sight (:mod:`.search`);
 4. propose new people from unexplained foreground (:mod:`.births`) and match them;
+   with ``depth.fuse``, place people one camera alone shows along its line of sight from every
+   cue (:mod:`.depth`);
 5. measure each person's support (:mod:`.support`), then confirm, follow or end them
    (:mod:`.life`), flag the unmeasurable, measure heights (:mod:`.height`), end duplicates;
 6. measure each person's position uncertainty σ, filter their velocity and say their state
