@@ -7,7 +7,7 @@ from worldtrack.experiment import synthetic_tracker
 from worldtrack.synth import make_scenario
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.depth import DepthFusion, fuse_along
-from worldtrack.trackers.ellipsoid.height_sigma import height_sigma, median_sigma, replace_margin
+from worldtrack.trackers.ellipsoid.height_sigma import height_estimate, height_sigma, median_sigma
 from worldtrack.trackers.people import Person
 
 
@@ -127,10 +127,15 @@ def test_the_height_has_its_own_uncertainty_and_replaces_the_default_beyond_it()
     samples = [1.70, 1.72, 1.74, 1.76, 1.78, 1.72, 1.74, 1.76, 1.73]
     # median 1.74, MAD 0.02 m: σ of the median 1.2533 · 1.4826 · 0.02 / 3 ≈ 1.2 cm.
     assert median_sigma(samples) == pytest.approx(1.2533 * 1.4826 * 0.02 / 3)
-    assert replace_margin(samples, HeightConfig()) == 0.05            # the fixed deadband
-    assert replace_margin(samples, HeightConfig(deadband_sigmas=2)) == pytest.approx(2 * 1.2533 * 1.4826 * 0.02 / 3)
+    assert height_estimate(samples, 1.70, HeightConfig()) == 1.70     # within the fixed 5 cm deadband
+    # With the default as a prior (σ 0.1 m): nearly all the way to the median (1.74).
+    w = 0.01 / (0.01 + median_sigma(samples) ** 2)
+    assert height_estimate(samples, 1.70, HeightConfig(prior_sigma_m=0.1)) == pytest.approx(1.70 + w * 0.04)
+    assert 1.735 < 1.70 + w * 0.04 < 1.74
     tight = [1.73] * 9
-    assert replace_margin(tight, HeightConfig(deadband_sigmas=2)) == pytest.approx(0.01)   # σ at least 5 mm
+    assert median_sigma(tight) == 0.005                                 # at least 5 mm
+    scattered = [1.60, 1.73, 1.86]                                      # three far apart: the prior counts more
+    assert 1.70 < height_estimate(scattered, 1.70, HeightConfig(prior_sigma_m=0.1)) < 1.72
     assert height_sigma(Person(1, 0.0, 0.0, height_samples=tight), 0.1) == 0.01         # here at least 1 cm
     assert height_sigma(Person(2, 0.0, 0.0, height_samples=[1.7, 1.8]), 0.1) == 0.1     # unmeasured
     assert fuse_along([(0.0, 0.3), (0.6, 0.1)]) == pytest.approx(0.54)

@@ -188,9 +188,9 @@ class HeightConfig(Section):
     min_px: int = Field(
         60, ge=0, description="measure in one view only where the person is at least this tall, px, and seen at "
         "more than 45 degrees from the vertical")
-    deadband_sigmas: float = Field(
-        0.0, ge=0, description="when > 0, replaces deadband_m: the measured height replaces the default when it "
-        "differs by more than this many of its own standard errors (the median's, from the samples' spread)")
+    prior_sigma_m: float = Field(
+        0.0, ge=0, description="when > 0, replaces deadband_m: the height is the precision-weighted mean of the default "
+        "(people's heights scatter by this much about it, m) and the measurements' median (its own standard error)")
     ray_gap_m: float = Field(
         0.03, ge=0, description="head rays of several cameras give a height only when each passes this close to "
         "their nearest common point, m (else some view took another head for this one's)")

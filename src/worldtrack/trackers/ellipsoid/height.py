@@ -31,7 +31,7 @@ from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
-from worldtrack.trackers.ellipsoid.height_sigma import replace_margin
+from worldtrack.trackers.ellipsoid.height_sigma import height_estimate
 
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 MAX_COVERED_FOR_HEIGHT = 0.3
@@ -337,9 +337,7 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
         samples.extend(new)
         del samples[:-config.samples]
         if len(samples) >= 3:
-            default = default_height(p.id)
-            median = float(np.median(samples))
-            p.height = median if abs(median - default) > replace_margin(samples, config) else default
+            p.height = height_estimate(samples, default_height(p.id), config)
 
 
 def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
