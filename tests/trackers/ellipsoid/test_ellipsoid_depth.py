@@ -86,6 +86,11 @@ def test_where_the_legs_are_not_foreground_the_prediction_carries_the_depth(seen
     q, _ = _misplaced(tracker, truth, 0.6)
     _fusion().apply([q], tracker.views, {"cam": cut}, tracker.walkable, 0.1)
     assert 0.1 < np.hypot(q.x - xy[0], q.y - xy[1]) < 0.45
+    # Once the height is measured (σ 3 cm, ~0.2 m along the ray here), the head counts for more.
+    r, _ = _misplaced(tracker, truth, 0.6)
+    r.height_samples.extend([truth["height"]] * 3)
+    _fusion().apply([r], tracker.views, {"cam": cut}, tracker.walkable, 0.1)
+    assert np.hypot(r.x - xy[0], r.y - xy[1]) < np.hypot(q.x - xy[0], q.y - xy[1]) - 0.1
 
 
 def test_the_prediction_weighs_less_the_longer_the_feet_are_not_seen(seen):
