@@ -6,28 +6,31 @@ in front move the matched ellipse metres along the ray. After the matching round
 that one camera alone shows is placed along that camera's line of sight by the inverse-variance
 mean of the cues (a Kalman update along the ray; across it the match stands):
 
-======================  ==========================================================  ==============
-cue                     used when                                                   σ along, m
-======================  ==========================================================  ==============
-the matched ellipse     always                                                      0.3 clear; 1.0
-                                                                                    (``weak_sigma_m``)
-                                                                                    when the legs are
-                                                                                    not foreground or
-                                                                                    others cover it
-the prediction          a tracked person (constant velocity, the velocity prior)    ``prior_speed_mps``
-                                                                                    × dt
-the feet                the silhouette is clear of others, its bottom reaches the   0.1
-                        floor (the head's ray above it is at the person's height)
-                        and below the knees it is foreground (not "unsure")
-the top of the head     clear of others; placed where its ray is at the person's     σ_h · d / (H − h)
-                        height
-======================  ==========================================================  ==============
+===================  ==============================================  ==================================
+cue                  used when                                       σ along the ray, m
+===================  ==============================================  ==================================
+the matched ellipse  always                                          0.3 where the feet are trusted,
+                                                                     else ``weak_sigma_m`` (0.6: legs
+                                                                     not foreground, others cover it)
+the prediction       a tracked person (constant velocity: the        ``prior_speed_mps`` × dt × √(1 + n),
+                     velocity prior)                                 n the frames since the feet were
+                                                                     last trusted (at most 25)
+the feet             clear of others, the head's ray above them at   0.1
+                     the person's height, and the legs below the
+                     knees foreground, not "unsure" (:mod:`.legs`)
+the top of the head  clear of others, where the feet are not         σ_h · d / (H − h)
+                     trusted: where its ray is at the person's
+                     height
+===================  ==============================================  ==================================
 
 σ_h is the person's height uncertainty: ``feet.height_sigma_m`` until three measurements are in,
 then their median's own standard error, at least ``feet.measured_height_sigma_m`` (3 cm: the
-measurements share their biases, and one wrong height must not outweigh the rest). Where nothing but the ellipse and the
-prediction are left (a person behind another), the prediction carries them: no 0.6 m jump in
-0.1 s because a covered silhouette fits a farther ellipse.
+measurements share their biases, and one wrong height must not outweigh the rest). Where nothing
+but the ellipse and the prediction are left (a person behind another), the prediction carries
+them: no 0.6 m jump in 0.1 s because a covered silhouette fits a farther ellipse. Its σ grows
+while the feet are unseen, so that a wrong velocity does not carry a person away (a fixed σ let
+one coast 1.8 m towards the camera in a crossing). People no camera shows are held by the
+prediction along the first camera's line of sight.
 
 With ``depth.remeasure_after_encounter``, a person whose view was covered by others has their
 height samples dropped once they are clear again, so the height is measured afresh instead of
