@@ -188,6 +188,9 @@ class HeightConfig(Section):
     min_px: int = Field(
         60, ge=0, description="measure in one view only where the person is at least this tall, px, and seen at "
         "more than 45 degrees from the vertical")
+    prior_sigma_m: float = Field(
+        0.0, ge=0, description="when > 0, replaces deadband_m: the height is the precision-weighted mean of the default "
+        "(people's heights scatter by this much about it, m) and the measurements' median (its own standard error)")
     ray_gap_m: float = Field(
         0.03, ge=0, description="head rays of several cameras give a height only when each passes this close to "
         "their nearest common point, m (else some view took another head for this one's)")
@@ -212,7 +215,7 @@ class FeetConfig(Section):
     anchor: bool = Field(
         False, description="move people one camera alone shows towards their feet (or the top of the head) along its "
         "line of sight; off by default: on the line-of-sight scenario MOTA -0.06 -> 0.28 (10 held-out seeds), "
-        "but PETS 2009 0.853 -> 0.785 (issue 37)")
+        "but PETS 2009 0.853 -> 0.785 (issue 37); ellipsoid.depth.fuse weighs these cues with the others")
     sigma_m: float = Field(
         0.1, gt=0, description="uncertainty of the feet's place along the line of sight, m (the feet's pixel "
         "scatter, a shoe's length)")
@@ -225,8 +228,33 @@ class FeetConfig(Section):
         0.1, gt=0, description="where the feet are not to be trusted, the top of the head places the person at their "
         "height, uncertain by this much while it is not measured, m (people's heights scatter by 0.1 m)")
     measured_height_sigma_m: float = Field(
-        0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter)")
+        0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter; with depth.fuse, the "
+        "least σ of a measured height)")
     min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
+
+
+class DepthConfig(Section):
+    """Depth along one camera's line of sight from every cue, each weighed by its σ
+    (:mod:`worldtrack.trackers.ellipsoid.depth`); the feet's and the head's σ are ``ellipsoid.feet``'s."""
+
+    path: ClassVar[str] = "ellipsoid.depth"
+
+    fuse: bool = Field(
+        False, description="place people one camera alone shows along its line of sight by the inverse-variance mean "
+        "of the ellipse, the prediction, the feet (where the legs are foreground) and the top of the head; off by "
+        "default (issue 37: helps one oblique camera, not measured to be harmless in crowds and PETS)")
+    prior_speed_mps: float = Field(
+        1.5, gt=0, description="σ of the constant-velocity prediction along the line of sight is this times the "
+        "frame interval, m/s (the velocity prior: no 0.6 m jump in 0.1 s)")
+    weak_sigma_m: float = Field(
+        0.6, gt=0, description="σ of the matched ellipse's place along the line of sight where its evidence is weak "
+        "(legs not foreground, or others cover the person), m")
+    legs_min_share: float = Field(
+        0.5, ge=0, le=1, description="the feet count only where at least this share of the labelled pixels below the "
+        "knees is foreground (not shadow-like)")
+    remeasure_after_encounter: bool = Field(
+        False, description="drop a person's height samples once others stop covering them: the height is measured "
+        "afresh, not carried through a crossing")
 
 
 class IdentityConfig(Section):
@@ -288,6 +316,7 @@ class EllipsoidConfig(Section):
     height: HeightConfig = Field(HeightConfig(), description="measuring people's heights")
     warm_start: WarmStartConfig = Field(WarmStartConfig(), description="starting with the people in view")
     feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
+    depth: DepthConfig = Field(DepthConfig(), description="depth along one camera's line of sight from every cue")
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
 
     @classmethod
@@ -302,5 +331,5 @@ class EllipsoidConfig(Section):
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
+__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
            "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

@@ -116,13 +116,13 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
             continue
         head = head_ray(cam, labels, view.occ, region & free, tuple(b), down)
         sigma_h = config.measured_height_sigma_m if len(p.height_samples) >= 3 else config.height_sigma_m
-        place = _under_head(head, hs[k], sigma_h, xy[k], cam, height.depth_offset_m)
+        place = under_head(head, hs[k], sigma_h, xy[k], cam, height.depth_offset_m)
         if place is not None:
             out[k] = place
     return out
 
 
-def _under_head(head, h: float, sigma_h: float, xy: np.ndarray, cam, depth_offset_m: float
+def under_head(head, h: float, sigma_h: float, xy: np.ndarray, cam, depth_offset_m: float
                 ) -> tuple[np.ndarray, float] | None:
     """The floor point under where the head ray ``head`` (origin, direction) is at height ``h``
     (m), and its σ along the line of sight for a height uncertain by ``sigma_h`` (m); None when
@@ -145,4 +145,4 @@ def _under_head(head, h: float, sigma_h: float, xy: np.ndarray, cam, depth_offse
     return place, sigma
 
 
-__all__ = ["anchor_to_feet", "feet_weight"]
+__all__ = ["anchor_to_feet", "feet_weight", "under_head"]

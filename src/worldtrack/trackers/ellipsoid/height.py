@@ -31,6 +31,7 @@ from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
+from worldtrack.trackers.ellipsoid.height_sigma import height_estimate
 
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 MAX_COVERED_FOR_HEIGHT = 0.3
@@ -83,7 +84,7 @@ def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.nda
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
         return None  # the person may extend past the image border
-    ends = _ends(camera, labels, region, box, down)
+    ends = silhouette_ends(camera, labels, region, box, down)
     if ends is None:
         return None
     top, bottom, down = ends
@@ -119,7 +120,7 @@ def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.nda
     u0, u1, v0, v1 = box
     if v0 <= 0 or u0 <= 0 or u1 >= camera.width:
         return None
-    ends = _ends(camera, labels, region, box, down)
+    ends = silhouette_ends(camera, labels, region, box, down)
     if ends is None:
         return None
     top = ends[0]
@@ -174,9 +175,9 @@ def triangulate_height(rays: list[tuple[np.ndarray, np.ndarray]], xy: np.ndarray
 _MIN_PIXELS = 30
 
 
-def _ends(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
+def silhouette_ends(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
           down: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Top and bottom (pixels) of the foreground in ``region`` along the image's world-down
+    """Top and bottom pixels (2,) of the foreground (label 1) in ``region`` along the image's world-down
     direction, and that direction; None with fewer than ``_MIN_PIXELS`` pixels.
 
     The ends are the means of the extreme 1 % of the pixels along ``down`` (:func:`extreme_ends`),
@@ -336,9 +337,7 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
         samples.extend(new)
         del samples[:-config.samples]
         if len(samples) >= 3:
-            default = default_height(p.id)
-            median = float(np.median(samples))
-            p.height = median if abs(median - default) > config.deadband_m else default
+            p.height = height_estimate(samples, default_height(p.id), config)
 
 
 def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -389,4 +388,4 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
 
 
 __all__ = ["MAX_COVERED_FOR_HEIGHT", "extreme_ends", "extreme_ends_reference", "head_ray", "heights_due",
-           "measure_feet", "measure_height", "triangulate_height", "update_heights"]
+           "measure_feet", "measure_height", "silhouette_ends", "triangulate_height", "update_heights"]

@@ -8,6 +8,8 @@ One :meth:`EllipsoidTracker.step`:
    is moved in turn to the best of 9 candidates, K rounds (:mod:`.match`, eq. 5 in
    :mod:`.score`), and failing tracks are rescued along their lines of sight (:mod:`.search`);
 4. propose new people from unexplained foreground (:mod:`.births`) and match them;
+   with ``depth.fuse``, place people one camera alone shows along its line of sight from every
+   cue (:mod:`.depth`);
 5. measure each person's support (:mod:`.support`), then confirm, follow or end them
    (:mod:`.life`), flag the unmeasurable, measure heights (:mod:`.height`), end duplicates;
 6. measure each person's position uncertainty σ, filter their velocity and say their state
@@ -34,6 +36,7 @@ from worldtrack.trackers.ellipsoid.args import DrawArgs, People, Scoring, StepAr
 from worldtrack.trackers.ellipsoid.births import Births
 from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
+from worldtrack.trackers.ellipsoid.depth import DepthFusion
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.height import heights_due, update_heights
 from worldtrack.trackers.ellipsoid.identity import Identities
@@ -101,6 +104,8 @@ class EllipsoidTracker(TrackerBase):
         self.last_images: dict[str, np.ndarray] = {}
         #: The people's colour models (:mod:`.identity`).
         self.identity = Identities(cfg.identity)
+        #: Depth along one camera's line of sight from every cue (:mod:`.depth`; ``depth.fuse``).
+        self.depth = DepthFusion(cfg.depth, cfg.feet, cfg.height)
         self._now = 0.0
 
     # ------------------------------------------------------------------ the Tracker protocol
@@ -143,6 +148,7 @@ class EllipsoidTracker(TrackerBase):
         real = self._read(frames)
         people = list(self.position_map)
         self._predict(people, dt, t)
+        self.depth.remember_prediction(people)
         judged = self._judged(people, t)
         bystanders = [p for p in people if not any(p is q for q in judged)]
         scores = self._match(judged, real, t, bystanders)
@@ -151,6 +157,7 @@ class EllipsoidTracker(TrackerBase):
             scores += self._match(born, real, t, judged + bystanders)
         anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet,
                        self.config.height)
+        self.depth.apply(judged + born, self.views, self.last_labels, self.walkable, dt if dt > 0 else self.frame_interval)
         if self.config.identity.enabled:  # before the life cycle: a person confirmed now is re-identified by it
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
                                  lambda p: self.position_map.get(p.id) is p)
