@@ -68,8 +68,9 @@ class PIDFollower:
     def reset(self) -> None:
         self._state.clear()
 
-    def command(self, step, camera: Camera, t: float) -> tuple[float, float]:
-        """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep`."""
+    def command(self, step, camera: Camera, t: float, frame=None) -> tuple[float, float]:
+        """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep` (``frame``
+        is not used: the paper's follower reads only the tracker's output)."""
         s = self._state
         if step.found:
             s["seen"] = t
