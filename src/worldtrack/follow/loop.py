@@ -2,8 +2,9 @@
 
 Each frame of a ``follow-target`` scenario is rendered from where the simulated robot stands *now*:
 the robot's pose becomes the camera pose of that frame before the frame is drawn (the scenario
-renders lazily, frame by frame), the follower sees the frame, the PID turns what it saw into
-(v, ω), and the robot drives by them for one frame time — a unicycle with limited speed, turn rate
+renders lazily, frame by frame), the tracker sees the frame, the follower — by default the local
+planner (:mod:`~worldtrack.follow.planner`), or the paper's PID (:mod:`~worldtrack.follow.pid`) —
+turns what it saw (and the frame's depth, for its safety layer) into (v, ω), and the robot drives by them for one frame time — a unicycle with limited speed, turn rate
 and acceleration that stops rather than drive into a wall or an obstacle (a bumper, counted).
 
 The camera sits on the robot as in the scenario: ``camera_height`` m up, 0.1 m ahead of the

@@ -69,7 +69,8 @@ class NavigationGrid:
         """Drivable path length (m) from every grid cell to ``goal`` (2,) (the nearest free cell to it
         when it stands in a blocked one); :data:`FAR` where no path leads."""
         ny, nx = self.shape
-        idx = np.clip(np.rint((np.asarray(goal, float) - self.origin) / self.resolution).astype(int), 0, [nx - 1, ny - 1])
+        cell = np.rint((np.asarray(goal, float) - self.origin) / self.resolution).astype(int)
+        idx = np.clip(cell, 0, [nx - 1, ny - 1])
         start = idx[1] * nx + idx[0]
         if not self.free.ravel()[start]:
             fj, fi = np.nonzero(self.free)

@@ -132,7 +132,8 @@ class LocalPlanner:
     points are remembered this long (s), their clearance growing by this (m/s: a person's walk);
     lost_timeout, search_distance : the target unseen this long (s), the robot drives to this
     distance (m) of the point halfway between where it was last seen and where it is predicted to
-    be (it may have stopped, or walked on), to look for it there; weights : (view, hidden, obstacles, people, points, smooth) against the
+    be (it may have stopped, or walked on), to look for it there;
+    weights : (view, hidden, obstacles, people, points, smooth) against the
     following error in m².
     """
 
