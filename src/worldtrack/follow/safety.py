@@ -29,19 +29,20 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from worldtrack.follow.planview import back_project
+from worldtrack.follow.planview import auto_stride, back_project
 from worldtrack.geometry.camera import Camera
 
 
 def near_points(depth: np.ndarray | None, camera: Camera, max_range: float = 3.0, heights=(0.35, 2.0),
-                cell: float = 0.05, stride: int = 1, min_support: int = 8) -> np.ndarray:
+                cell: float = 0.05, stride: int = 0, min_support: int = 8) -> np.ndarray:
     """(M, 2) floor positions (m) of the depth image's points within ``max_range`` m of the camera and
     ``heights`` (m) above the floor, one per ``cell`` × ``cell`` m floor cell whose 3 × 3 cell
     neighbourhood holds at least ``min_support`` points (a stereo mismatch is a lone point; a body,
-    even at the edge of the image, is many); empty without depth."""
+    even at the edge of the image, is many); ``stride`` : pixel step (0: about 160 columns, as the
+    detector reads, so the support counts mean the same at any resolution); empty without depth."""
     if depth is None or depth.size == 0:
         return np.zeros((0, 2))
-    pts = back_project(depth, camera, stride, max_range)
+    pts = back_project(depth, camera, stride or auto_stride(depth.shape[1]), max_range)
     z = pts.xyz[:, 2]
     xy = pts.xyz[(z >= heights[0]) & (z <= heights[1]), :2]
     if len(xy) == 0:
