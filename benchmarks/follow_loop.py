@@ -42,7 +42,8 @@ RECOVER_S = 3.0
 
 def run_seed(seed: int, frames: int, size, follower: str = "planner") -> dict:
     sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, distance=DISTANCE, **SCENARIO)
-    pid = PIDFollower(distance=DISTANCE) if follower == "pid" else LocalPlanner(sc.scene, distance=DISTANCE)
+    pid = (LocalPlanner(sc.scene, distance=DISTANCE) if follower == "planner"
+           else PIDFollower(distance=DISTANCE, depth_stop=follower == "pid+depth"))
     blocked = []
     result = run_closed_loop(sc, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked))
     blocked = np.array(blocked)
@@ -57,8 +58,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", default="0-9")
     ap.add_argument("--frames", type=int, default=1500)
-    ap.add_argument("--follower", choices=("planner", "pid"), default="planner",
-                    help="planner: the dynamic-window local planner (default); pid: the paper's PID")
+    ap.add_argument("--follower", choices=("planner", "pid", "pid+depth"), default="planner",
+                    help="planner: the dynamic-window local planner (default); pid: the paper's PID; "
+                         "pid+depth: the PID with the planner's depth safety layer")
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")

@@ -109,3 +109,19 @@ def test_a_lone_stereo_mismatch_is_not_an_obstacle():
     assert len(near_points(depth, cam)) == 0
     depth[50:70, 75:85] = 1.0                         # a surface
     assert len(near_points(depth, cam)) > 0
+
+
+def test_the_pid_with_the_depth_stop_stops_for_what_the_detector_missed():
+    from worldtrack.follow import PIDFollower
+    cam = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1), hfov_deg=66)
+    depth = np.zeros((120, 160), np.float32)
+    depth[20:100, 60:100] = 0.55
+    st = SimpleNamespace(found=True, xy=np.array([3.5, 0.0]), velocity=np.zeros(2), chosen=0,
+                         candidates=SimpleNamespace(xy=np.array([[3.5, 0.0]])), others_xy=np.zeros((0, 2)))
+    frame = SimpleNamespace(depth=depth)
+    v_paper, _ = PIDFollower().command(st, cam, 0.0, frame=frame)
+    stopping = PIDFollower(depth_stop=True)
+    v_safe, _ = stopping.command(st, cam, 0.0, frame=frame)
+    # 0.55 m ahead of the camera, 0.65 m from the robot's centre: 0.3 m before the body (0.35 m) touches,
+    # so at most √(2·1.2·0.3) − 1.2·0.1 = 0.73 m/s, the speed it can still stop from
+    assert v_paper > 1.0 and 0.6 < v_safe < 0.8 and stopping.blocked
