@@ -58,9 +58,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", default="0-9")
     ap.add_argument("--frames", type=int, default=1500)
-    ap.add_argument("--follower", choices=("planner", "pid", "pid+depth"), default="planner",
-                    help="planner: the dynamic-window local planner (default); pid: the paper's PID; "
-                         "pid+depth: the PID with the planner's depth safety layer")
+    ap.add_argument("--follower", choices=("pid+depth", "pid", "planner"), default="pid+depth",
+                    help="pid+depth: the paper's PID with the depth safety layer (default); pid: the paper's PID; "
+                         "planner: the dynamic-window local planner")
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")

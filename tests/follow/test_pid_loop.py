@@ -7,6 +7,7 @@ import pytest
 
 from worldtrack.follow import PIDFollower
 from worldtrack.follow.loop import Robot, camera_pose, run_closed_loop
+from worldtrack.follow.planner import LocalPlanner
 from worldtrack.geometry.camera import Camera
 
 CAM = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1), hfov_deg=66)
@@ -74,7 +75,7 @@ def test_robot_kinematics_limits_and_bumper():
 def test_closed_loop_keeps_the_distance_without_collisions(follower, within, worst):
     from worldtrack.synth import make_scenario
     sc = make_scenario("follow-target", size=(160, 120), frames=150, seed=5, others=1, clear_route=True)
-    result = run_closed_loop(sc, follower=PIDFollower() if follower == "pid" else None)
+    result = run_closed_loop(sc, follower=PIDFollower() if follower == "pid" else LocalPlanner(sc.scene))
     err = np.abs(result.distance - 1.8)
     assert result.found.mean() > 0.95
     # a person crosses 0.6-0.9 m in front of the robot: it waits (the PID used to pass them at 0.51 m,

@@ -2,9 +2,10 @@
 
 Each frame of a ``follow-target`` scenario is rendered from where the simulated robot stands *now*:
 the robot's pose becomes the camera pose of that frame before the frame is drawn (the scenario
-renders lazily, frame by frame), the tracker sees the frame, the follower — by default the local
-planner (:mod:`~worldtrack.follow.planner`), or the paper's PID (:mod:`~worldtrack.follow.pid`) —
-turns what it saw (and the frame's depth, for its safety layer) into (v, ω), and the robot drives by them for one frame time — a unicycle with limited speed, turn rate
+renders lazily, frame by frame), the tracker sees the frame, the follower — by default the paper's
+PID (:mod:`~worldtrack.follow.pid`) with worldtrack's depth safety layer, or the local planner
+(:mod:`~worldtrack.follow.planner`) — turns what it saw (and the frame's depth) into (v, ω), and
+the robot drives by them for one frame time — a unicycle with limited speed, turn rate
 and acceleration that stops rather than drive into a wall or an obstacle (a bumper, counted).
 
 The camera sits on the robot as in the scenario: ``camera_height`` m up, 0.1 m ahead of the
@@ -168,7 +169,7 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
     ``on_frame(bundle, step, (v, ω))`` is called after every frame (e.g. to write a video).
     """
     tracker = tracker or FollowTracker(scene=scenario.scene)
-    follower = follower or LocalPlanner(scenario.scene, distance=float(scenario.params.get("distance", 1.8)))
+    follower = follower or PIDFollower(distance=float(scenario.params.get("distance", 1.8)), depth_stop=True)
     poses = scenario.rigs[camera_id].poses
     if poses is None:
         raise ValueError(f"camera {camera_id!r} of scenario {scenario.name!r} does not move")

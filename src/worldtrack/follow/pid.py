@@ -25,8 +25,7 @@ where the target should be, to look for it.
 
 >>> import numpy as np
 >>> from types import SimpleNamespace
->>> from worldtrack.follow.safety import free_path, near_points
-from worldtrack.geometry.camera import Camera
+>>> from worldtrack.geometry.camera import Camera
 >>> cam = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1), hfov_deg=66)
 >>> step = SimpleNamespace(found=True, xy=np.array([3.0, 0.5]), velocity=np.zeros(2), t=0.0,
 ...                        candidates=SimpleNamespace(xy=np.array([[3.0, 0.5]])), others_xy=np.zeros((0, 2)))
