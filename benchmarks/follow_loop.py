@@ -31,6 +31,7 @@ from follow_common import SCENARIO, save_tagged, seed_cached  # noqa: E402
 from follow_synth import parse_seeds  # noqa: E402
 
 from worldtrack.follow import PIDFollower  # noqa: E402
+from worldtrack.follow.planner import LocalPlanner  # noqa: E402
 from worldtrack.follow.loop import run_closed_loop  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 
@@ -39,9 +40,10 @@ TOLERANCE = 0.3
 RECOVER_S = 3.0
 
 
-def run_seed(seed: int, frames: int, size) -> dict:
+def run_seed(seed: int, frames: int, size, follower: str = "planner") -> dict:
     sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, distance=DISTANCE, **SCENARIO)
-    pid = PIDFollower(distance=DISTANCE)
+    pid = (LocalPlanner(sc.scene, distance=DISTANCE) if follower == "planner"
+           else PIDFollower(distance=DISTANCE, depth_stop=follower == "pid+depth"))
     blocked = []
     result = run_closed_loop(sc, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked))
     blocked = np.array(blocked)
@@ -56,6 +58,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", default="0-9")
     ap.add_argument("--frames", type=int, default=1500)
+    ap.add_argument("--follower", choices=("pid+depth", "pid", "planner"), default="pid+depth",
+                    help="pid+depth: the paper's PID with the depth safety layer (default); pid: the paper's PID; "
+                         "planner: the dynamic-window local planner")
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")
@@ -69,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
     collision_rows = []
     for seed in seeds:
         ts = time.perf_counter()
-        s = seed_cached(args.cache, f"loop-{seed}-{frames}", lambda: run_seed(seed, frames, (160, 120)))
+        s = seed_cached(args.cache, f"loop-{args.follower}-{seed}-{frames}",
+                        lambda: run_seed(seed, frames, (160, 120), args.follower))
         r = s["result"]
         err = np.abs(r.distance - DISTANCE)
         all_within.append(s["within"])
@@ -94,7 +100,8 @@ def main(argv: list[str] | None = None) -> int:
                             "median |error| m", "95th pct m", "max m", "target found", "contacts",
                             "collisions (robot driving at them)", "bumper stops", "nearest person m",
                             "nearest wall m"], rows)
-    text = (f"Seeds {', '.join(map(str, seeds))}; {frames} frames at 10 fps, 160x120; set distance {DISTANCE} m.\n\n"
+    text = (f"Follower: {args.follower}. Seeds {', '.join(map(str, seeds))}; {frames} frames at 10 fps, 160x120; "
+            f"set distance {DISTANCE} m.\n\n"
             f"- within ±{TOLERANCE} m of the set distance: **{pooled:.3f}** of all frames (target ≥ 0.95); "
             f"{pooled_free:.3f} of the frames when nobody held the robot up (those frames and the {RECOVER_S:g} s "
             f"after left out)\n- collisions (the robot driving at someone within 0.5 m, centre to centre): "

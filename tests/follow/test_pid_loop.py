@@ -7,6 +7,7 @@ import pytest
 
 from worldtrack.follow import PIDFollower
 from worldtrack.follow.loop import Robot, camera_pose, run_closed_loop
+from worldtrack.follow.planner import LocalPlanner
 from worldtrack.geometry.camera import Camera
 
 CAM = Camera.look_at("robot", 160, 120, position=(0, 0, 1.1), target=(1, 0, 1.1), hfov_deg=66)
@@ -70,15 +71,18 @@ def test_robot_kinematics_limits_and_bumper():
 
 
 @pytest.mark.slow
-def test_closed_loop_keeps_the_distance_without_collisions():
+@pytest.mark.parametrize("follower, within, worst", [("planner", 0.70, 2.0), ("pid", 0.75, 1.4)])
+def test_closed_loop_keeps_the_distance_without_collisions(follower, within, worst):
     from worldtrack.synth import make_scenario
     sc = make_scenario("follow-target", size=(160, 120), frames=150, seed=5, others=1, clear_route=True)
-    result = run_closed_loop(sc)
+    result = run_closed_loop(sc, follower=PIDFollower() if follower == "pid" else LocalPlanner(sc.scene))
     err = np.abs(result.distance - 1.8)
     assert result.found.mean() > 0.95
-    # a person crosses 0.6-0.9 m in front of the robot: it waits (it used to pass them at 0.51 m,
-    # centre to centre, with contact at 0.5), then catches up
-    assert np.mean(err <= 0.3) > 0.75 and err.max() < 1.4
+    # a person crosses 0.6-0.9 m in front of the robot: it waits (the PID used to pass them at 0.51 m,
+    # centre to centre, with contact at 0.5), then catches up. The planner waits longer here: the
+    # crosser's track is new and its Kalman velocity not yet learnt (0.72 within the band against
+    # the PID's 0.80)
+    assert np.mean(err <= 0.3) > within and err.max() < worst
     assert result.collisions == 0 and result.bumps == 0 and result.nearest_person.min() > 0.65
     # the camera was where the robot put it: the frames were drawn from the closed loop
     assert np.linalg.norm(result.camera_xy[-1] - result.robot_xy[-1]) == pytest.approx(0.1, abs=1e-6)

@@ -46,6 +46,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--preset", default="default", help="default, paper, colour-only, position-only, paper+undo, "
                    "paper+undo+others (default: default)")
     p.add_argument("--distance", type=float, default=1.8, help="following distance for the commands, m (1.8)")
+    p.add_argument("--follower", choices=("pid+depth", "pid", "planner"), default="pid+depth",
+                   help="what turns the track into (v, ω): pid+depth (the paper's PID on distance and bearing with "
+                        "a stop for near depth points, default), pid (the paper's), planner (local planner round "
+                        "the scene's obstacles and people)")
     p.add_argument("--fps", type=float, help="frame rate when frames.csv gives no times (default: video, else 10)")
     p.add_argument("--frames", type=int, metavar="N", help="stop after N frames")
     p.add_argument("--no-video", action="store_true", help="do not write follow.mp4")
@@ -155,6 +159,7 @@ class _Outputs:
 
 def run(args: argparse.Namespace) -> int:
     from worldtrack.follow import FollowConfig, FollowTracker, PIDFollower
+    from worldtrack.follow.planner import LocalPlanner
     from worldtrack.io.rgbd import RGBDSource, read_gains, read_poses
     from worldtrack.scene import load_scene
 
@@ -178,7 +183,8 @@ def run(args: argparse.Namespace) -> int:
     source = RGBDSource(camera, args.rgb, args.depth, args.disparity, args.right, args.baseline, gains, times, poses,
                         args.fps, args.frames)
     tracker = FollowTracker(config, scene)
-    follower = PIDFollower(distance=args.distance)
+    follower = (LocalPlanner(scene, distance=args.distance) if args.follower == "planner"
+                else PIDFollower(distance=args.distance, depth_stop=args.follower == "pid+depth"))
     out = _Outputs(Path(args.out), not args.no_video, source.fps)
     n = found = 0
     try:
@@ -188,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
             it = tqdm(source, desc="follow", unit="frame", file=sys.stderr)
         for frame, cam in it:
             step = tracker.follow(frame, cam, start_xy=target if n == 0 else None)
-            command = follower.command(step, cam, frame.t)
+            command = follower.command(step, cam, frame.t, frame=frame)
             out.write(frame, cam, step, command, follower.blocked, frame.image)
             n += 1
             found += int(step.found)

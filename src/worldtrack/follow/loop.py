@@ -2,8 +2,10 @@
 
 Each frame of a ``follow-target`` scenario is rendered from where the simulated robot stands *now*:
 the robot's pose becomes the camera pose of that frame before the frame is drawn (the scenario
-renders lazily, frame by frame), the follower sees the frame, the PID turns what it saw into
-(v, ω), and the robot drives by them for one frame time — a unicycle with limited speed, turn rate
+renders lazily, frame by frame), the tracker sees the frame, the follower — by default the paper's
+PID (:mod:`~worldtrack.follow.pid`) with worldtrack's depth safety layer, or the local planner
+(:mod:`~worldtrack.follow.planner`) — turns what it saw (and the frame's depth) into (v, ω), and
+the robot drives by them for one frame time — a unicycle with limited speed, turn rate
 and acceleration that stops rather than drive into a wall or an obstacle (a bumper, counted).
 
 The camera sits on the robot as in the scenario: ``camera_height`` m up, 0.1 m ahead of the
@@ -23,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from worldtrack.follow.pid import PIDFollower
+from worldtrack.follow.planner import LocalPlanner
 from worldtrack.follow.observation import frame_from_synth
 from worldtrack.follow.tracker import FollowStep, FollowTracker
 from worldtrack.geometry.camera import look_at_rotation
@@ -158,7 +161,7 @@ def _collision(k: int, pid: int, rel: np.ndarray, robot, person_velocity: np.nda
     return Collision(k, pid, dist, robot_speed, person_speed, visible, tracked, blocked, cause)
 
 
-def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PIDFollower | None = None,
+def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: LocalPlanner | PIDFollower | None = None,
                     camera_id: str = "robot", camera_height: float | None = None, keep_steps: bool = False,
                     on_frame=None, **robot_limits) -> LoopResult:
     """Render ``scenario`` frame by frame from the robot that follows its person 1 (see the module docstring).
@@ -166,7 +169,7 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PI
     ``on_frame(bundle, step, (v, ω))`` is called after every frame (e.g. to write a video).
     """
     tracker = tracker or FollowTracker(scene=scenario.scene)
-    follower = follower or PIDFollower(distance=float(scenario.params.get("distance", 1.8)))
+    follower = follower or PIDFollower(distance=float(scenario.params.get("distance", 1.8)), depth_stop=True)
     poses = scenario.rigs[camera_id].poses
     if poses is None:
         raise ValueError(f"camera {camera_id!r} of scenario {scenario.name!r} does not move")
@@ -192,8 +195,9 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: PI
         for r in bundle.gt:
             visible.setdefault(r["id"], []).append(float(r.get(f"vis_{camera_id}", 1.0)))
         start = people.get(1) if k == 0 else None
-        step = tracker.follow(frame_from_synth(bundle, camera_id), cam, start_xy=start)
-        v, w = follower.command(step, cam, bundle.time)
+        frame = frame_from_synth(bundle, camera_id)
+        step = tracker.follow(frame, cam, start_xy=start)
+        v, w = follower.command(step, cam, bundle.time, frame=frame)
         rec["robot"][k] = (robot.x, robot.y)
         rec["camera"][k] = cam.centre[:2]
         rec["target"][k] = people.get(1, np.full(2, np.nan))

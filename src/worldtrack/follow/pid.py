@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from worldtrack.follow.safety import free_path, near_points
 from worldtrack.geometry.camera import Camera
 
 
@@ -48,6 +49,8 @@ class PIDFollower:
     """PID on distance (m) and bearing (rad) to the target; see the module docstring.
 
     distance_gains, bearing_gains : (Kp, Ki, Kd) in 1/s, 1/s², 1 (distance) and 1/s, 1/s², 1 (bearing)
+    depth_stop : also stop short of near depth points nobody detected (worldtrack's safety layer; False:
+    the paper's PID)
     """
 
     distance: float = 1.8
@@ -63,13 +66,15 @@ class PIDFollower:
     lost_timeout: float = 1.0
     search_turn_rate: float = 0.5
     integral_limit: float = 0.5
+    depth_stop: bool = False
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
         self._state.clear()
 
-    def command(self, step, camera: Camera, t: float) -> tuple[float, float]:
-        """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep`."""
+    def command(self, step, camera: Camera, t: float, frame=None) -> tuple[float, float]:
+        """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep`; ``frame``'s
+        depth is read only with ``depth_stop`` (the paper's follower reads only the tracker's output)."""
         s = self._state
         if step.found:
             s["seen"] = t
@@ -98,6 +103,8 @@ class PIDFollower:
         v = float(np.clip(v, -self.max_reverse, self.max_speed))
         w = float(np.clip(w, -self.max_turn_rate, self.max_turn_rate))
         limit = self._speed_limit(step, pos, fwd, dt if dt > 0 else 0.1)
+        if self.depth_stop and frame is not None:
+            limit = min(limit, self._depth_limit(frame, camera, w, dt if dt > 0 else 0.1))
         s["blocked"] = bool(limit < v)
         return min(v, limit), w
 
@@ -116,6 +123,20 @@ class PIDFollower:
             deriv = (error - s[name + "_e"]) / dt
         s[name + "_i"], s[name + "_e"] = integral, error
         return kp * error + ki * integral + kd * deriv
+
+    def _depth_limit(self, frame, camera: Camera, w: float, dt: float) -> float:
+        """The local planner's safety layer (:mod:`~worldtrack.follow.safety`) on the PID: the speed that
+        stops 0.35 m (body) short of any near depth point along the next 1.5 s arc at ω."""
+        points = near_points(getattr(frame, "depth", None), camera)
+        if len(points) == 0:
+            return np.inf
+        fwd = camera.floor_direction
+        yaw = np.arctan2(fwd[1], fwd[0]) + w * np.linspace(0.0, 1.5, 16)
+        centre = camera.centre[:2] - 0.1 * fwd
+        step_xy = (self.max_speed * 0.1) * np.column_stack([np.cos(yaw), np.sin(yaw)])
+        path = centre + np.vstack([np.zeros(2), np.cumsum(step_xy[1:], axis=0)])
+        gap = free_path(path, points, 0.35)
+        return np.inf if not np.isfinite(gap) else float(max(0.0, np.sqrt(2 * self.brake * gap) - self.brake * dt))
 
     def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float) -> float:
         """Largest forward speed (m/s) that stops ``stop_distance`` short of anybody in the path (the

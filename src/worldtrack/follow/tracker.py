@@ -32,7 +32,7 @@ Per frame (:meth:`FollowTracker.step`):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -81,7 +81,8 @@ class FollowStep:
     D, RBhat, E : (N,) each candidate against the target (eqs. 3, 1, 2)
     alpha : float (eq. 3); w_steps : float — |W| in gain steps; gate : float, metres
     owner : (N,) int — who each candidate was given to: 1 the target, ≥ 2 another person, 0 nobody
-    others_ids : (K,) int; others_xy : (K, 2) — the other people tracked (predicted when unseen)
+    others_ids : (K,) int; others_xy : (K, 2) — the other people tracked (predicted when unseen);
+    others_velocity : (K, 2) m/s — their Kalman velocities (a planner predicts where they walk)
     """
 
     t: float
@@ -101,6 +102,7 @@ class FollowStep:
     owner: np.ndarray
     others_ids: np.ndarray
     others_xy: np.ndarray
+    others_velocity: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
 
 class FollowTracker:
@@ -374,4 +376,4 @@ class FollowTracker:
         return FollowStep(t, chosen >= 0, self.x[:2].copy(), self.x[2:].copy(), measured, int(chosen), c,
                           obs.silhouettes, np.asarray(D, float), np.asarray(rb, float), np.asarray(E, float),
                           float(alpha), float(w), float(gate), owner, self.others.ids.copy(),
-                          self.others.x[:, :2].copy())
+                          self.others.x[:, :2].copy(), self.others.x[:, 2:].copy())
