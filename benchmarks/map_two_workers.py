@@ -31,6 +31,7 @@ from map_rig import WORLDTRACK, Server, load_average, run_workers  # noqa: E402
 from worldtrack.eval.mot import evaluate_detailed  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.map.connection import MapKeys, connect  # noqa: E402
+from worldtrack.map.messages import Estimate, MapPerson  # noqa: E402
 from worldtrack.map.replay import replay  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 
@@ -42,11 +43,42 @@ def worse_frames(one, fused) -> list[int]:
     return [int(f) for f, m, fp in zip(b["frame"], b["misses"], b["false_positives"]) if m + fp > errors.get(int(f), 0)]
 
 
+def dump_run(client, cameras: list[str], seq: Path, run: int, out: Path) -> None:
+    """The run's evidence as CSV files in ``out``: ``estimates.csv`` (every worker's published
+    estimate of every person, per camera and frame), ``map.csv`` (the record: per bucket every
+    person, their lead and how many workers), ``gt.csv`` and ``one.csv`` (the one process)."""
+    import shutil
+
+    from worldtrack.map.messages import decode_map_state, decode_observation
+
+    out.mkdir(parents=True, exist_ok=True)
+    keys = MapKeys()
+    with open(out / "estimates.csv", "w") as f:
+        f.write("t,camera,worker,frame," + ",".join(Estimate._fields) + "\n")
+        for cam in cameras:
+            for _, fields in client.xrange(keys.observations(cam)):
+                o = decode_observation(fields)
+                for e in o.people:
+                    f.write(f"{o.t:.3f},{o.camera},{o.worker},{o.frame}," + ",".join(str(v) for v in e) + "\n")
+    with open(out / "map.csv", "w") as f:
+        f.write("t," + ",".join(MapPerson._fields) + "\n")
+        for _, fields in client.xrange(keys.map_stream):
+            s = decode_map_state(fields)
+            for p in s.people:
+                f.write(f"{s.t:.3f}," + ",".join(str(v) for v in p) + "\n")
+    shutil.copy(seq / "gt.csv", out / "gt.csv")
+    shutil.copy(seq / "one" / "tracks.csv", out / "one.csv")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", default="2,3,4,5,6")
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="seed 2, one run; prints only")
+    ap.add_argument("--set", action="append", default=[], metavar="map.NAME=VALUE",
+                    help="a map setting for the workers (e.g. map.share_rule=support-lead)")
+    ap.add_argument("--dump", type=Path, help="write per run the workers' published estimates, the map and the "
+                                             "one process's tracks as CSV files in this folder (to find out why)")
     args = ap.parse_args()
     seeds, repeats = ([2], 1) if args.quick else ([int(s) for s in args.seeds.split(",")], args.repeats)
     start, rows, gaps = time.time(), [], {"mota": [], "idf1": []}
@@ -65,9 +97,11 @@ def main() -> None:
                 one = evaluate_detailed(gt, read_tracks(seq / "one" / "tracks.csv"))
                 for k in range(repeats):
                     server.flush()
-                    run_workers(seq, server.url, sc.camera_ids, seq / f"workers{k}", sets=["map.pace_files=false"])
+                    run_workers(seq, server.url, sc.camera_ids, seq / f"workers{k}", sets=["map.pace_files=false", *args.set])
                     fused = evaluate_detailed(gt, read_tracks(replay(connect(server.url), MapKeys(),
                                                                      seq / f"replay{k}").tracks_csv))
+                    if args.dump:
+                        dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
                     worse = worse_frames(one, fused)
                     m1, m2 = one.metrics, fused.metrics
                     rows.append([seed, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],

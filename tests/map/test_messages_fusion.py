@@ -27,6 +27,13 @@ def test_observation_and_map_state_round_trip_with_nan():
     back = decode_observation(encode_observation(o))
     assert back.people[0].id == 3 and back.people[0].seen is False and math.isnan(back.people[0].support)
     assert back.people[0][:4] == (3, 1.25, 2.5, 1.7) and back.people[0].iyy == 900.0 and back.ended == (5,)
+    assert math.isnan(back.people[0].cxx)                         # no covariance from the tracker
+    measured = Estimate(3, 1.0, 2.0, 1.7, 0.45, 0, 0, 0.7, 0.8, True, 40.0, -3.0, 900.0, 1.0, 0.09, -0.01, 0.0025)
+    assert decode_observation(encode_observation(obs("cam1", 1.0, "w", [measured]))).people[0] == measured
+    # A worker from before the covariance (14 columns) still reads: NaN covariance.
+    old = decode_observation({"v": "2", "t": "1.0", "o": '["c", "w", 1, 1.0, [[1, 2, 3, 1.7, 0.45, 0, 0, 0.5, 0.6, '
+                                                       '1, 10, 0, 10, 1.0]], []]'})
+    assert old.people[0].x == 2 and math.isnan(old.people[0].cyy)
     s = MapState(12.3, (MapPerson(3, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "lost", 11.0, 3.0, 1),),
                  (("cam1", 12.34, 12.35),), {7: 3}, 12.5, 2)
     assert decode_map_state(encode_map_state(s)) == s
@@ -51,6 +58,23 @@ def test_support_and_geometry_weigh_two_workers():
     s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(1, 2.0, 1.0, info=(100.0, 0.0, 1.0))]),
                                         obs("b", 1.0, "w2", [est(1, 3.0, 2.0, info=(10.0, 0.0, 1.0))])], cfg)
     assert s.people[0].x == pytest.approx((100 * 2.0 + 10 * 3.0) / 110) and s.people[0].y == pytest.approx(1.5)
+
+
+def test_weighed_by_the_trackers_covariances_when_asked_and_every_estimate_has_one():
+    cfg = MapConfig(weigh_by="tracker")
+    # w1 measured σ 0.1 m along x, w2 0.3 m: information 100 against 11.1 along x; y equal.
+    a = est(1, 2.0, 1.0)._replace(cxx=0.01, cxy=0.0, cyy=0.0025)
+    b = est(1, 3.0, 2.0)._replace(cxx=0.09, cxy=0.0, cyy=0.0025)
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])], cfg).people
+    assert p.x == pytest.approx((100 * 2.0 + 3.0 / 0.09) / (100 + 1 / 0.09)) and p.y == pytest.approx(1.5)
+    assert p.lead == "w1"                                        # the smaller covariance
+    # One estimate without a covariance: support × geometry for both (here equal: the mean).
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [est(1, 3.0, 2.0)])],
+                     cfg).people
+    assert p.x == pytest.approx(2.5)
+    # By default (geometry) the covariances are not used.
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])], MapConfig()).people
+    assert p.x == pytest.approx(2.5)
 
 
 def test_the_live_map_refines_a_bucket_as_reports_come_and_leaves_the_others_as_they_were():
@@ -116,6 +140,24 @@ def test_two_ids_of_one_person_from_two_workers_merge_into_the_elder():
     assert [p.id for p in s.people] == [1, 2]
 
 
+def test_two_workers_starting_the_same_person_together_are_merged_at_once():
+    cfg = MapConfig(merge_after_s=0.2)
+    s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(4, 2.0, 0.0)]),
+                                        obs("b", 1.0, "w2", [est(9, 2.2, 0.0)])], cfg)
+    assert s.aliases == {9: 4} and [p.id for p in s.people] == [4]
+
+
+def test_two_people_crossing_in_one_workers_view_are_not_merged_when_another_worker_sees_one():
+    # w2 sees both people (ids 1 and 2) as they cross; w1 sees only person 1 (2 is behind 1 there).
+    cfg = MapConfig(merge_after_s=0.2)
+    st = FusionState()
+    for b in range(10, 20):
+        s = fuse_bucket(st, b, [obs("a", b / 10, "w1", [est(1, 2.0, 0.0)]),
+                                obs("b", b / 10, "w2", [est(1, 2.0, 0.0), est(2, 2.2, 0.0)])], cfg)
+        assert not s.aliases
+    assert [p.id for p in s.people] == [1, 2]
+
+
 def test_fusion_state_survives_json():
     cfg = MapConfig()
     st = FusionState()
@@ -132,6 +174,23 @@ def test_floor_information_is_finer_near_the_camera_and_along_its_image_plane():
     assert near[0] > 4 * far[0] and near[2] > far[2]
     assert far[2] > far[0]              # across the line of sight resolves better than along it
     assert all(math.isnan(v) for v in floor_information([cam], np.array([-3.0, 0.0]), 1.7))   # behind it
+
+
+def test_a_person_behind_another_is_resolved_worse_along_the_line_of_sight():
+    from worldtrack.geometry.camera import Camera
+    from worldtrack.map.fusion import people_boxes
+    cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
+    front = people_boxes(cam, np.array([[3.0, 0.0, 1.7, 0.45]]))
+    u0, v0, u1, v1, dist = front[0]
+    assert dist == pytest.approx(3.0) and u0 < 160 < u1 and v0 < 120 < v1          # a box around the image's centre
+    free = floor_information([cam], np.array([6.0, 0.0]), 1.7)
+    behind = floor_information([cam], np.array([6.0, 0.0]), 1.7, blockers=[front])
+    assert behind[0] < 0.8 * free[0]            # feet hidden: depth along the line of sight resolves worse
+    ahead = floor_information([cam], np.array([2.0, 0.0]), 1.7, blockers=[front])
+    assert ahead == floor_information([cam], np.array([2.0, 0.0]), 1.7)     # in front of the other: unchanged
+    beside = np.array([6.0, 2.5])
+    assert floor_information([cam], beside, 1.7, blockers=[front]) == floor_information([cam], beside, 1.7)
+    assert people_boxes(cam, np.array([[-2.0, 0.0, 1.7, 0.45]]))[0, 4] == np.inf   # behind the camera: no box
 
 
 def test_passwords_never_shown_and_taken_from_the_environment():

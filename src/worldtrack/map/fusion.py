@@ -140,28 +140,56 @@ def estimate_weight(e: Estimate) -> float:
     return MIN_WEIGHT
 
 
+def people_boxes(cam: Camera, people: np.ndarray) -> np.ndarray:
+    """The image boxes of ``people`` (m, 4: x, y, height, width in metres) in ``cam``, as
+    (m, 5) ``u0, v0, u1, v1, floor distance`` (pixels, m): an upright box from feet to head,
+    as wide as the person across the camera's line of sight. People behind the camera get an
+    empty box."""
+    people = np.asarray(people, float).reshape(-1, 4)
+    if not len(people):
+        return np.zeros((0, 5))
+    along, dist = cam.floor_rays(people[:, :2])
+    across = np.column_stack([-along[:, 1], along[:, 0]]) * people[:, 3:4] / 2
+    corners = np.concatenate([np.column_stack([people[:, :2] + s * across, np.full(len(people), z * 1.0) * zs])
+                              for s in (-1, 1) for z, zs in ((0.0, 0.0), (1.0, people[:, 2]))])
+    uv, depth = cam.project(corners, return_depth=True)
+    uv, depth = uv.reshape(4, -1, 2), depth.reshape(4, -1)
+    box = np.column_stack([uv[..., 0].min(0), uv[..., 1].min(0), uv[..., 0].max(0), uv[..., 1].max(0), dist])
+    box[~((depth > 0).all(0) & np.isfinite(box).all(1))] = [0, 0, -1, -1, np.inf]
+    return box
+
+
 def _body_points(cam: Camera, xy: np.ndarray, height: float, occlusion: np.ndarray | None,
-                 step_m: float) -> tuple[np.ndarray, np.ndarray]:
+                 step_m: float, blockers: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Five points on a person's axis (feet to head) and four neighbours of each a step away on
     the floor, in ``cam``'s image: (5, 5, 2) pixels, and which of the five show (inside the image,
-    not behind an obstacle), (5,) bool."""
+    not behind an obstacle, nor inside the box of a person of ``blockers`` (:func:`people_boxes`)
+    nearer to the camera), (5,) bool."""
     offsets = np.array([[0.0, 0.0], [step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
     heights = np.linspace(0.0, height, 5)
     pts = np.concatenate([np.column_stack([xy[None, :] + offsets, np.full(5, z)]) for z in heights])
     uv = cam.project(pts).reshape(len(heights), 5, 2)
     seen = cam.in_image(uv[:, 0]) & np.isfinite(uv).all(axis=(1, 2))
-    if occlusion is not None and seen.any():
-        px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
+    if (occlusion is not None or blockers is not None) and seen.any():
         mine = float(cam.floor_distance(np.append(xy, 0.0)[None, :])[0])
-        seen &= occlusion[px[:, 1], px[:, 0]] > mine - 0.3
+        if occlusion is not None:
+            px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
+            seen &= occlusion[px[:, 1], px[:, 0]] > mine - 0.3
+        if blockers is not None and len(blockers):
+            b = blockers[blockers[:, 4] < mine - 0.3]
+            u, v = uv[:, 0, 0][:, None], uv[:, 0, 1][:, None]
+            seen &= ~((u >= b[:, 0]) & (u <= b[:, 2]) & (v >= b[:, 1]) & (v <= b[:, 3])).any(axis=1)
     return uv, seen
 
 
 def visible_share(cameras: Sequence[Camera], xy: np.ndarray, height: float,
-                  occlusion: Sequence[np.ndarray | None] | None = None) -> float:
+                  occlusion: Sequence[np.ndarray | None] | None = None,
+                  blockers: Sequence[np.ndarray | None] | None = None) -> float:
     """The largest share, over ``cameras``, of a person's five axis points (feet to head) that the
-    camera shows: 1 in full view, 0.2 when one camera sees only their head through a door."""
-    shares = [_body_points(cam, xy, height, occlusion[k] if occlusion else None, 0.05)[1].mean()
+    camera shows: 1 in full view, 0.2 when one camera sees only their head through a door.
+    ``occlusion`` and ``blockers``: per camera, as in :func:`floor_information`."""
+    shares = [_body_points(cam, xy, height, occlusion[k] if occlusion else None, 0.05,
+                           blockers[k] if blockers else None)[1].mean()
               for k, cam in enumerate(cameras)]
     return float(max(shares, default=0.0))
 
@@ -176,14 +204,15 @@ def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m:
 
 
 def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
-                      step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None
-                      ) -> tuple[float, float, float]:
+                      step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None,
+                      blockers: Sequence[np.ndarray | None] | None = None) -> tuple[float, float, float]:
     """How finely ``cameras`` resolve a person standing at floor point ``xy`` (metres): the
     information matrix ``Σ Jᵀ J / σ²`` (1/m², as ``ixx, ixy, iyy``) of five points on the person's
     axis (feet to head), ``J`` the pixels a point moves per metre on the floor, ``σ = sigma_px``.
     Points outside a camera's image, or hidden there by a structure (``occlusion``: per camera the
-    scene's floor-distance map of obstacles, (H, W) metres), add nothing; so a person seen only
-    through a door counts for less. No visible point gives ``(nan, nan, nan)``.
+    scene's floor-distance map of obstacles, (H, W) metres) or behind another person
+    (``blockers``: per camera the others' :func:`people_boxes`) add nothing; so a person seen only
+    through a door, or behind somebody, counts for less. No visible point gives ``(nan, nan, nan)``.
 
     >>> from worldtrack.geometry.camera import Camera
     >>> cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
@@ -193,7 +222,8 @@ def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, 
     """
     info = np.zeros((2, 2))
     for k, cam in enumerate(cameras):
-        uv, seen = _body_points(cam, xy, height, occlusion[k] if occlusion is not None else None, step_m)
+        uv, seen = _body_points(cam, xy, height, occlusion[k] if occlusion is not None else None, step_m,
+                                blockers[k] if blockers is not None else None)
         for i in np.flatnonzero(seen):
             J = np.column_stack([(uv[i, 1] - uv[i, 2]) / (2 * step_m), (uv[i, 3] - uv[i, 4]) / (2 * step_m)])
             info += J.T @ J / sigma_px ** 2
@@ -207,15 +237,34 @@ def _information(e: Estimate) -> np.ndarray:
     return m if np.isfinite(m).all() and np.linalg.det(m) > 0 else np.eye(2)
 
 
-def _weighted(estimates: list[Estimate]) -> tuple[float, ...]:
+def measured_information(e: Estimate) -> np.ndarray | None:
+    """The information (2, 2) 1/m² of an estimate as its worker's tracker measured it (the inverse
+    of its covariance ``cxx, cxy, cyy``); None when the tracker gave none (or a degenerate one)."""
+    c = np.array([[e.cxx, e.cxy], [e.cxy, e.cyy]], float)
+    if not np.isfinite(c).all() or c[0, 0] <= 0 or np.linalg.det(c) <= 0:
+        return None
+    return np.linalg.inv(c)
+
+
+def _weights(estimates: list[Estimate], weigh_by: str) -> tuple[list[np.ndarray], bool]:
+    """Each estimate's weight matrix, and whether they are the trackers' measured information
+    (``weigh_by="tracker"`` and every estimate has one) rather than support × floor geometry."""
+    measured = [measured_information(e) for e in estimates] if weigh_by == "tracker" else [None]
+    if all(m is not None for m in measured):
+        return measured, True
+    w = [estimate_weight(e) for e in estimates]
+    infos = [wi * _information(e) for wi, e in zip(w, estimates)]
+    scale = np.mean([np.trace(m) for m in infos])
+    return [m / scale for m in infos], False         # relative weights: keeps the solve well scaled
+
+
+def _weighted(estimates: list[Estimate], weigh_by: str = "geometry") -> tuple[float, ...]:
     if len(estimates) == 1:           # most people, most of the time: one worker sees them
         e = estimates[0]
         return e.x, e.y, e.height, e.width, e.vx, e.vy, e.score, e.support
     w = [estimate_weight(e) for e in estimates]
     total = sum(w)
-    infos = [wi * _information(e) for wi, e in zip(w, estimates)]
-    scale = np.mean([np.trace(m) for m in infos])
-    infos = [m / scale for m in infos]            # relative weights: keeps the solve well scaled
+    infos, _ = _weights(estimates, weigh_by)
     total_info = sum(infos)
     xy = np.linalg.solve(total_info, sum(m @ np.array([e.x, e.y]) for m, e in zip(infos, estimates)))
     v_ok = [(m, e) for m, e in zip(infos, estimates) if math.isfinite(e.vx) and math.isfinite(e.vy)]
@@ -230,6 +279,18 @@ def _weighted(estimates: list[Estimate]) -> tuple[float, ...]:
     supports = [e.support for e in estimates if math.isfinite(e.support)]
     return (float(xy[0]), float(xy[1]), mean("height"), mean("width"), float(vxy[0]), float(vxy[1]),
             sum(wi * e.score for wi, e in zip(w, estimates)) / total, max(supports) if supports else float("nan"))
+
+
+def _lead(by_worker: Mapping[str, Estimate], use: list[Estimate], weigh_by: str) -> str:
+    """The worker whose estimate of a person weighs most: with the trackers' covariances
+    (``weigh_by="tracker"``) the smallest (trace); else a worker showing at least
+    :data:`LEAD_SHARE` of the body, then the largest support × trace of floor information."""
+    if len(by_worker) == 1:
+        return next(iter(by_worker))
+    if _weights(use, weigh_by)[1]:
+        return min((e.cxx + e.cyy, k) for k, e in by_worker.items() if e in use)[1]
+    return max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
+                for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
 
 
 def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict[int, dict[str, Estimate]]:
@@ -260,7 +321,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     """
     t = bucket * cfg.bucket_s
     estimates = _per_worker(state, observations)
-    workers_of = _update_people(state.people, estimates, t)
+    workers_of = _update_people(state.people, estimates, t, cfg.weigh_by)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -278,7 +339,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 
 
 def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
-                   copy: bool = False) -> dict[int, set[str]]:
+                   weigh_by: str = "geometry", copy: bool = False) -> dict[int, set[str]]:
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
     committed state stay as they are). Returns, per person, the workers that see them."""
@@ -286,7 +347,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
     for pid, by_worker in estimates.items():
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
-        x, y, h, w, vx, vy, score, support = _weighted(use)
+        x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by)
         p = people.get(pid)
         if p is None:
             p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
@@ -296,9 +357,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
-        p.lead = next(iter(by_worker)) if len(by_worker) == 1 else \
-            max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
-                 for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
+        p.lead = _lead(by_worker, use, weigh_by)
         workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
     return workers_of
 
@@ -323,7 +382,7 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     """
     people = dict(state.people)
     for b in sorted(buckets):
-        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, copy=True)
+        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True)
     t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
     reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
@@ -334,8 +393,11 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
 def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
                       cfg: MapConfig) -> dict[int, int]:
     """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
-    the elder, unless the very same workers see both (then they are two people those workers tell
-    apart). Returns ``{younger: elder}``."""
+    the elder, unless a worker sees both (then they are two people that worker tells apart: two
+    people crossing in one worker's view while another worker sees only one of them are not
+    merged). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
+    the same frames: no history could tell them apart) are merged at once. Returns
+    ``{younger: elder}``."""
     from scipy.spatial import cKDTree
     ids = sorted(workers_of)
     close_now = set()
@@ -343,15 +405,16 @@ def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: fl
         xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
         for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
             a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
-            if workers_of[a] == workers_of[b] or not workers_of[a] or not workers_of[b]:
-                continue      # the same workers hold both apart: two people
+            if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
+                continue      # a worker that sees both holds them apart: two people
             close_now.add((a, b))
     state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
     merged: dict[int, int] = {}
     for (a, b), since in sorted(state.close_since.items()):
-        if t - since < cfg.merge_after_s or a in merged or b in merged:
-            continue
         pa, pb = state.people[a], state.people[b]
+        newborn = t - min(pa.born, pb.born) < cfg.merge_after_s    # both just started: nothing to wait for
+        if (t - since < cfg.merge_after_s and not newborn) or a in merged or b in merged:
+            continue
         elder, younger = (pa, pb) if (pa.born, pa.id) <= (pb.born, pb.id) else (pb, pa)
         wa, wb = max(MIN_WEIGHT, _finite(elder.support)), max(MIN_WEIGHT, _finite(younger.support))
         elder.x = (wa * elder.x + wb * younger.x) / (wa + wb)
@@ -369,4 +432,4 @@ def _finite(v: float) -> float:
 
 
 __all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket",
-           "in_views", "provisional_state", "visible_share"]
+           "in_views", "measured_information", "people_boxes", "provisional_state", "visible_share"]
