@@ -5,29 +5,39 @@ each with its own cameras, share one person map — who updates a person two of 
 
 * **Every worker that sees a person updates them, on its own map, from its own cameras**, and
   publishes its estimate. A worker never moves a person its cameras do not show: those it takes
-  from the shared map as they are (:mod:`worldtrack.map.worker`). Of the workers that see a person,
-  the one whose estimate weighs most (``lead``) continues from its own estimate; the others start
-  each frame from the map's and move the person by their own cameras' evidence, so a worker that
-  sees somebody poorly (far, through a door) contributes without drifting away on its own.
-  The reset is what keeps two workers' copies of an id on the same person: letting every worker
-  that sees a person well keep its own estimate (the map then a pure information-weighted mean)
-  lost up to 0.74 MOTA on held-out two-rooms seeds (ids swapped in one worker, the mean between
-  two people); keeping it while within 0.5 m of the map's, up to 0.17 (issue 39d).
-* **The shared map keeps each worker's estimate and weighs them by support and by geometry** —
-  the support is the share of the person's own pixels that are foreground in that worker's views
-  (the evidence the estimate rests on; else the match score; at least 0.05), and the geometry is
-  how finely the worker's cameras resolve the floor where the person stands: the information
-  matrix ``I_k`` of a one-pixel error of their feet and head (:func:`floor_information`; a camera
-  8 m away resolves depth ~6× worse than one 3 m away, and only along its line of sight). Within
-  a time bucket the map position is the information-weighted mean
-  ``x = (Σ w_k I_k)⁻¹ Σ w_k I_k x_k`` over the workers ``k`` that saw the person. Estimates of a
-  person a worker holds without evidence (hidden behind a desk in its view) count only when no
-  worker saw them.
+  from the shared map as they are (:mod:`worldtrack.map.worker`). With ``map.share_rule``
+  ``information`` (the default), every worker that sees a person starts each frame from the
+  map's estimate (the common prior, at the time of its previous step: its tracker predicts it on
+  itself) and refines it with its own images; the map then adds their measurements in
+  information form, so no view is thrown away. (Before issue 39e only the worker whose estimate
+  weighed most, the ``lead``, continued from its own estimate and the others restarted from the
+  map's each frame: a better view corrected the lead by one frame's evidence only, and on
+  two-rooms two people in line in one camera pulled the map between them —
+  ``share_rule=support-lead`` keeps that rule. Letting every worker keep its own estimate
+  instead lost up to 0.74 MOTA, ids swapping in one worker: issue 39d.)
+* **The shared map weighs each worker's estimate by support and by geometry** — the support is
+  the share of the person's own pixels that are foreground in that worker's views (the evidence
+  the estimate rests on; else the match score; at least 0.05), and the geometry is how finely the
+  worker's cameras resolve the floor where the person stands: the information matrix ``I_k`` of
+  a one-pixel error of the body points they show (:func:`~worldtrack.map.evidence.floor_information`; a camera 8 m away
+  resolves depth ~6× worse than one 3 m away, and only along its line of sight; points hidden by
+  the scene's obstacles or behind another person the worker holds add nothing, so the view in
+  which a person stands in front tells their depth). Within a time bucket the map position is
+  ``x = (Σ w_k I_k)⁻¹ Σ w_k I_k x_k`` over the workers ``k`` that saw the person (each
+  ``x_k`` is the fit of that worker's images from the common prior, its own measurement: the
+  prior only starts the search and is not added again). ``weigh_by=tracker`` uses the inverse
+  of each tracker's measured covariance instead (the ellipsoid tracker's σ, from the curvature of
+  its score): on two-rooms its σ along the line of sight sits at its 0.29 m cap in a third of the
+  estimates and does not tell the occluded view from the clear one (MOTA 0.83 / 0.90 against 1.00
+  / 1.00 on seeds 1 and 3). Estimates of a person a worker holds without evidence (hidden behind a
+  desk in its view) count only when no worker saw them.
 * **Ids are the map's.** A worker's tracker takes new ids from the map (one counter in Redis) and,
   for a person walking in from a neighbour's view, finds them already on its map under their id.
-  If two workers still start the same person at once (both saw them first in the same frame), the
-  two ids are close for ``merge_after_s`` with estimates from different sets of workers: the
-  younger id is folded into the elder (``aliases``), and the workers rename their copy.
+  If two workers still start the same person (both saw them first in the same frame), the two
+  ids are close, and no worker sees both: the younger id is folded into the elder (``aliases``)
+  after ``merge_after_s``, at once when both ids are that young, and the workers rename their
+  copy. Two ids one worker sees at the same time are two people it tells apart (two people
+  crossing in its view, while another worker sees only one of them), never merged.
 * **The map does not wait for the slowest worker.** Until a bucket is complete, the live map is
   :func:`provisional_state`: each person reported so far in the bucket where those reports put
   them (weighed as above; a later worker's report of the same bucket refines the estimate), and
@@ -56,12 +66,12 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field, fields, replace
-from typing import Iterable, Mapping, Sequence
+from typing import Iterable, Mapping
 
 import numpy as np
 
-from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
+from worldtrack.map.evidence import floor_information, in_views, people_boxes, visible_share  # noqa: F401 (public here too)
 from worldtrack.map.messages import Estimate, MapPerson, MapState, Observation
 
 #: The least weight an estimate has (support 0 still says "a worker sees somebody here").
@@ -138,98 +148,6 @@ def estimate_weight(e: Estimate) -> float:
         if v is not None and math.isfinite(v) and v > 0:
             return max(MIN_WEIGHT, float(v))
     return MIN_WEIGHT
-
-
-def people_boxes(cam: Camera, people: np.ndarray) -> np.ndarray:
-    """The image boxes of ``people`` (m, 4: x, y, height, width in metres) in ``cam``, as
-    (m, 5) ``u0, v0, u1, v1, floor distance`` (pixels, m): an upright box from feet to head,
-    as wide as the person across the camera's line of sight. People behind the camera get an
-    empty box."""
-    people = np.asarray(people, float).reshape(-1, 4)
-    if not len(people):
-        return np.zeros((0, 5))
-    along, dist = cam.floor_rays(people[:, :2])
-    across = np.column_stack([-along[:, 1], along[:, 0]]) * people[:, 3:4] / 2
-    corners = np.concatenate([np.column_stack([people[:, :2] + s * across, np.full(len(people), z * 1.0) * zs])
-                              for s in (-1, 1) for z, zs in ((0.0, 0.0), (1.0, people[:, 2]))])
-    uv, depth = cam.project(corners, return_depth=True)
-    uv, depth = uv.reshape(4, -1, 2), depth.reshape(4, -1)
-    box = np.column_stack([uv[..., 0].min(0), uv[..., 1].min(0), uv[..., 0].max(0), uv[..., 1].max(0), dist])
-    box[~((depth > 0).all(0) & np.isfinite(box).all(1))] = [0, 0, -1, -1, np.inf]
-    return box
-
-
-def _body_points(cam: Camera, xy: np.ndarray, height: float, occlusion: np.ndarray | None,
-                 step_m: float, blockers: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Five points on a person's axis (feet to head) and four neighbours of each a step away on
-    the floor, in ``cam``'s image: (5, 5, 2) pixels, and which of the five show (inside the image,
-    not behind an obstacle, nor inside the box of a person of ``blockers`` (:func:`people_boxes`)
-    nearer to the camera), (5,) bool."""
-    offsets = np.array([[0.0, 0.0], [step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
-    heights = np.linspace(0.0, height, 5)
-    pts = np.concatenate([np.column_stack([xy[None, :] + offsets, np.full(5, z)]) for z in heights])
-    uv = cam.project(pts).reshape(len(heights), 5, 2)
-    seen = cam.in_image(uv[:, 0]) & np.isfinite(uv).all(axis=(1, 2))
-    if (occlusion is not None or blockers is not None) and seen.any():
-        mine = float(cam.floor_distance(np.append(xy, 0.0)[None, :])[0])
-        if occlusion is not None:
-            px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
-            seen &= occlusion[px[:, 1], px[:, 0]] > mine - 0.3
-        if blockers is not None and len(blockers):
-            b = blockers[blockers[:, 4] < mine - 0.3]
-            u, v = uv[:, 0, 0][:, None], uv[:, 0, 1][:, None]
-            seen &= ~((u >= b[:, 0]) & (u <= b[:, 2]) & (v >= b[:, 1]) & (v <= b[:, 3])).any(axis=1)
-    return uv, seen
-
-
-def visible_share(cameras: Sequence[Camera], xy: np.ndarray, height: float,
-                  occlusion: Sequence[np.ndarray | None] | None = None,
-                  blockers: Sequence[np.ndarray | None] | None = None) -> float:
-    """The largest share, over ``cameras``, of a person's five axis points (feet to head) that the
-    camera shows: 1 in full view, 0.2 when one camera sees only their head through a door.
-    ``occlusion`` and ``blockers``: per camera, as in :func:`floor_information`."""
-    shares = [_body_points(cam, xy, height, occlusion[k] if occlusion else None, 0.05,
-                           blockers[k] if blockers else None)[1].mean()
-              for k, cam in enumerate(cameras)]
-    return float(max(shares, default=0.0))
-
-
-def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
-    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
-    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
-    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
-    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
-    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
-    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
-
-
-def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
-                      step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None,
-                      blockers: Sequence[np.ndarray | None] | None = None) -> tuple[float, float, float]:
-    """How finely ``cameras`` resolve a person standing at floor point ``xy`` (metres): the
-    information matrix ``Σ Jᵀ J / σ²`` (1/m², as ``ixx, ixy, iyy``) of five points on the person's
-    axis (feet to head), ``J`` the pixels a point moves per metre on the floor, ``σ = sigma_px``.
-    Points outside a camera's image, or hidden there by a structure (``occlusion``: per camera the
-    scene's floor-distance map of obstacles, (H, W) metres) or behind another person
-    (``blockers``: per camera the others' :func:`people_boxes`) add nothing; so a person seen only
-    through a door, or behind somebody, counts for less. No visible point gives ``(nan, nan, nan)``.
-
-    >>> from worldtrack.geometry.camera import Camera
-    >>> cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
-    >>> near, far = (floor_information([cam], np.array([x, 0.0]), 1.7) for x in (2.0, 6.0))
-    >>> near[0] > 4 * far[0]                      # depth resolves worse far away
-    True
-    """
-    info = np.zeros((2, 2))
-    for k, cam in enumerate(cameras):
-        uv, seen = _body_points(cam, xy, height, occlusion[k] if occlusion is not None else None, step_m,
-                                blockers[k] if blockers is not None else None)
-        for i in np.flatnonzero(seen):
-            J = np.column_stack([(uv[i, 1] - uv[i, 2]) / (2 * step_m), (uv[i, 3] - uv[i, 4]) / (2 * step_m)])
-            info += J.T @ J / sigma_px ** 2
-    if not info.any():
-        return float("nan"), float("nan"), float("nan")
-    return float(info[0, 0]), float(info[0, 1]), float(info[1, 1])
 
 
 def _information(e: Estimate) -> np.ndarray:

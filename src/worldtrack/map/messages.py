@@ -37,9 +37,9 @@ class Estimate(NamedTuple):
     does not say); ``seen`` is False for a person the worker holds in its view without evidence in
     this frame (hidden behind something), True when its cameras show them. ``ixx, ixy, iyy``
     (1/m²): how finely the worker's cameras resolve the floor there, the information matrix of a
-    one-pixel error of the person's feet and head (:func:`worldtrack.map.fusion.floor_information`);
+    one-pixel error of the person's feet and head (:func:`worldtrack.map.evidence.floor_information`);
     ``visible``: the share of the person's body the worker's best camera shows
-    (:func:`worldtrack.map.fusion.visible_share`). ``cxx, cxy, cyy`` (m²): the covariance of the
+    (:func:`worldtrack.map.evidence.visible_share`). ``cxx, cxy, cyy`` (m²): the covariance of the
     estimate as the worker's tracker measured it this frame (the ellipsoid tracker's, from the
     curvature of its score: it knows what other people hide), NaN when the tracker gives none.
     """

@@ -31,13 +31,15 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.fusion import LEAD_SHARE, floor_information, in_views, people_boxes, visible_share
+from worldtrack.map.evidence import (floor_information, in_views, people_boxes, support_of, tracker_covariance,
+                                     visible_share)
+from worldtrack.map.fusion import LEAD_SHARE
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
 from worldtrack.map.timings import StepTimings
 from worldtrack.map.shared_ids import SharedPositionMap
-from worldtrack.trackers.base import Frame, Person, PositionMap, Track, Tracker
+from worldtrack.trackers.base import Frame, PositionMap, Track, Tracker
 
 
 class MapLink:
@@ -53,7 +55,7 @@ class MapLink:
     fps : the cameras' frame rate (for the fusion's wait)
     clock : wall clock, seconds
     occlusion : {camera_id: (H, W) floor distance of the obstacles} — the scene's occlusion maps
-        (:func:`~worldtrack.map.fusion.floor_information` leaves hidden body points out)
+        (:func:`~worldtrack.map.evidence.floor_information` leaves hidden body points out)
     """
 
     def __init__(self, client: Any, keys: MapKeys, cfg: MapConfig, name: str, cameras: Mapping[str, Camera],
@@ -265,7 +267,7 @@ class MapLink:
                 self.ever_seen.add(tr.id)
                 self.placed.discard(tr.id)
             now_ids.add(tr.id)
-            support = _support(person, tr)
+            support = support_of(person, tr)
             info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ,
                                      blockers=[np.delete(boxes[c], k, axis=0) for c in mine])
             cov = tracker_covariance(tracker, person, t) if seen else None
@@ -315,31 +317,6 @@ def set_epoch(client: Any, keys: MapKeys, lead_s: float, bucket_s: float, clock:
     epoch = (math.floor((clock() + lead_s) / bucket_s) + 0.5) * bucket_s
     client.set(keys.epoch, repr(epoch), nx=only_if_unset)
     return float(client.get(keys.epoch))
-
-
-_NO_COVARIANCE = (float("nan"),) * 3
-
-
-def tracker_covariance(tracker: Tracker, person: Person | None, t: float) -> np.ndarray | None:
-    """The (2, 2) m² position covariance ``tracker`` measured for ``person`` at ``t`` from its
-    cameras' images, or None when it measured none then (not shown, not confirmed, or a tracker
-    that does not measure one). The ellipsoid tracker's comes from the curvature of its score
-    (:mod:`worldtrack.trackers.ellipsoid.uncertainty`): larger along the line of sight, and larger
-    where others hide the person."""
-    parts = getattr(getattr(tracker, "uncertainty", None), "components", None)
-    found = parts.get(person) if parts is not None and person is not None else None
-    if found is None or found.t != t:
-        return None
-    from worldtrack.trackers.ellipsoid.uncertainty import position_covariance
-    return position_covariance(*found[:4])
-
-
-def _support(person: Person | None, tr: Track) -> float:
-    for v in (getattr(person, "support", float("nan")), (person.extra if person is not None else {}).get("support"),
-              tr.extra.get("support")):
-        if v is not None and math.isfinite(float(v)):
-            return float(v)
-    return float("nan")
 
 
 class MapTracker:
