@@ -207,3 +207,19 @@ def test_map_settings_errors_name_the_field():
         map_settings(sets=["map.renew_s=0.9"])
     with pytest.raises(InputError, match=r"^--set ellipsoid.x: only the map's settings"):
         map_settings(sets=["ellipsoid.x=1"])
+
+
+def test_which_worker_starts_a_person_from_the_maps_estimate():
+    from types import SimpleNamespace
+
+    from worldtrack.map.worker import MapLink
+
+    def follows(rule, workers, lead, mine=True):
+        link = SimpleNamespace(cfg=MapConfig(share_rule=rule), mine_seen={7} if mine else set(), name="w1")
+        p = MapPerson(7, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "tracking", 1.0, 0.0, workers, lead)
+        return MapLink._follows_map(link, p)
+    assert follows("information", 1, "w1", mine=False) and follows("support-lead", 1, "w1", mine=False)  # not shown
+    assert not follows("information", 1, "w1") and not follows("support-lead", 1, "w1")   # its own person alone
+    # Seen by two workers: under the information rule both start from the map's estimate, even the lead.
+    assert follows("information", 2, "w1") and follows("information", 2, "w2")
+    assert not follows("support-lead", 2, "w1") and follows("support-lead", 2, "w2")
