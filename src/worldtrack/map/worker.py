@@ -20,6 +20,7 @@ See :mod:`worldtrack.map.fusion` for how the estimates of a person two workers s
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -135,12 +136,17 @@ class MapLink:
         """The latest map state (None before the first): the live map, or in a batch run (lockstep) the
         last complete bucket (every worker's reports, not whichever came first: runs repeat)."""
         if self.lockstep:
-            last = self.client.xrevrange(self.keys.map_stream, count=1)
-            if not last:
-                return None
-            if self.state is None or last[0][0] != self._record_id:
-                self._record_id, self.state = last[0][0], decode_map_state(last[0][1])
-                self.complete_until = self.state.t + self.cfg.bucket_s
+            # Every bucket written since the last read, not only the newest: a merge (alias) is in
+            # the state of its own bucket only, and a worker that skipped it would go on publishing
+            # the merged id, a new person to the map once the alias is forgotten.
+            new = (self.client.xrange(self.keys.map_stream, min=f"({self._record_id}", max="+") if self._record_id
+                   else self.client.xrevrange(self.keys.map_stream, count=1))
+            if not new:
+                return self.state
+            states = [decode_map_state(fields) for _, fields in new]
+            aliases = {young: elder for s in states for young, elder in s.aliases.items()}
+            self._record_id, self.state = new[-1][0], dataclasses.replace(states[-1], aliases=aliases)
+            self.complete_until = self.state.t + self.cfg.bucket_s
             return self.state
         raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports",
                                                     "last_bucket"])
