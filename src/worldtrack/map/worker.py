@@ -87,6 +87,7 @@ class MapLink:
         self._prev_t: float | None = None
         #: The end (s) of the last complete bucket of the map (every live camera's report in).
         self.complete_until, self._record_id = -math.inf, ""
+        self._aliases: dict[int, tuple[int, float]] = {}      # batch runs: merges read from the record
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
@@ -140,12 +141,16 @@ class MapLink:
             # the state of its own bucket only, and a worker that skipped it would go on publishing
             # the merged id, a new person to the map once the alias is forgotten.
             new = (self.client.xrange(self.keys.map_stream, min=f"({self._record_id}", max="+") if self._record_id
-                   else self.client.xrevrange(self.keys.map_stream, count=1))
+                   else self.client.xrevrange(self.keys.map_stream, count=self._alias_window())[::-1])
             if not new:
                 return self.state
             states = [decode_map_state(fields) for _, fields in new]
-            aliases = {young: elder for s in states for young, elder in s.aliases.items()}
-            self._record_id, self.state = new[-1][0], dataclasses.replace(states[-1], aliases=aliases)
+            # Kept for forget_after_s: several reads may come between two steps (the lockstep wait).
+            self._aliases.update({young: (elder, s.t) for s in states for young, elder in s.aliases.items()})
+            recent = states[-1].t - self.cfg.forget_after_s
+            self._aliases = {y: (e, t) for y, (e, t) in self._aliases.items() if t > recent}
+            self._record_id, self.state = new[-1][0], dataclasses.replace(
+                states[-1], aliases={young: elder for young, (elder, _) in self._aliases.items()})
             self.complete_until = self.state.t + self.cfg.bucket_s
             return self.state
         raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports",
@@ -160,6 +165,10 @@ class MapLink:
                       "reports": raw[4] or "[]"}
             self.state = decode_map_state(fields)
         return self.state
+
+    def _alias_window(self) -> int:
+        """How many buckets back a merge is still applied (``forget_after_s``): what a first read takes."""
+        return max(1, int(math.ceil(self.cfg.forget_after_s / self.cfg.bucket_s)))
 
     def _wait_for_map(self, t: float) -> None:
         if self._first_t is None:
