@@ -223,3 +223,43 @@ def test_which_worker_starts_a_person_from_the_maps_estimate():
     # Seen by two workers: under the information rule both start from the map's estimate, even the lead.
     assert follows("information", 2, "w1") and follows("information", 2, "w2")
     assert not follows("support-lead", 2, "w1") and follows("support-lead", 2, "w2")
+
+
+class _Record:
+    """The map stream of a batch run, as far as a worker's read of the record needs (no server)."""
+
+    def __init__(self):
+        self.entries: list[tuple[str, dict]] = []
+
+    def register_script(self, _):
+        return None
+
+    def add(self, bucket: int, aliases: dict) -> None:
+        state = MapState(bucket / 10, (MapPerson(4, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "tracking", 0.0, 0.0, 1),),
+                         aliases=aliases)
+        self.entries.append((f"{bucket * 100}-0", encode_map_state(state)))
+
+    def xrevrange(self, _key, count):
+        return self.entries[::-1][:count]
+
+    def xrange(self, _key, min, max):
+        return [e for e in self.entries if int(e[0].split("-")[0]) > int(min[1:].split("-")[0])]
+
+
+def test_a_batch_worker_does_not_miss_a_merge_between_two_steps():
+    from worldtrack.map.connection import MapKeys
+    from worldtrack.map.worker import MapLink
+    record = _Record()
+    link = MapLink(record, MapKeys(), MapConfig(), "w1", {})
+    link.lockstep = True
+    record.add(0, {9: 4})                      # id 9 merged into 4 in bucket 0
+    record.add(1, {})
+    assert link.read_map().aliases == {9: 4}   # the first read takes the recent records, not only the newest
+    record.add(2, {11: 4})
+    record.add(3, {})
+    link.read_map()                            # the lockstep wait reads more than once before a step
+    record.add(4, {})
+    assert link.read_map().aliases == {9: 4, 11: 4}
+    for b in range(5, 40):
+        record.add(b, {})
+    assert link.read_map().aliases == {}       # forgotten after forget_after_s (3 s)
