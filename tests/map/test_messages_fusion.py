@@ -263,3 +263,20 @@ def test_a_batch_worker_does_not_miss_a_merge_between_two_steps():
     for b in range(5, 40):
         record.add(b, {})
     assert link.read_map().aliases == {}       # forgotten after forget_after_s (3 s)
+
+
+def test_a_worker_renames_its_copy_of_a_merged_person_and_keeps_tracking_it():
+    from types import SimpleNamespace
+
+    from worldtrack.map.connection import MapKeys
+    from worldtrack.map.shared_ids import SharedPositionMap
+    from worldtrack.map.worker import MapLink
+    record = _Record()
+    link = MapLink(record, MapKeys(), MapConfig(), "w1", {})
+    link.lockstep = True
+    local = SharedPositionMap(lambda x, y: 100)
+    mine = local.add(1.0, 2.0, track_id=9, mode="tracking")
+    link.mine_seen = {9}
+    record.add(0, {9: 4})                            # the map folded this worker's 9 into 4
+    link.sync(SimpleNamespace(position_map=local), 0.05)
+    assert [p.id for p in local] == [4] and local[4] is mine and link.mine_seen == {4}

@@ -118,7 +118,8 @@ def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, 
     return float(info[0, 0]), float(info[0, 1]), float(info[1, 1])
 
 
-_NO_COVARIANCE = (float("nan"),) * 3
+#: The covariance fields of an estimate whose tracker measured none.
+NO_COVARIANCE = (float("nan"),) * 3
 
 
 def tracker_covariance(tracker: Tracker, person: Person | None, t: float) -> np.ndarray | None:
@@ -143,4 +144,4 @@ def support_of(person: Person | None, tr: Track) -> float:
     return float("nan")
 
 
-__all__ = ["floor_information", "in_views", "people_boxes", "support_of", "tracker_covariance", "visible_share"]
+__all__ = ["NO_COVARIANCE", "floor_information", "in_views", "people_boxes", "support_of", "tracker_covariance", "visible_share"]

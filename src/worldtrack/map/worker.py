@@ -32,8 +32,8 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.evidence import (floor_information, in_views, people_boxes, support_of, tracker_covariance,
-                                     visible_share)
+from worldtrack.map.evidence import (NO_COVARIANCE, floor_information, in_views, people_boxes, support_of,
+                                     tracker_covariance, visible_share)
 from worldtrack.map.fusion import LEAD_SHARE
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
@@ -191,9 +191,18 @@ class MapLink:
             return
         local = tracker.position_map
         for young, elder in state.aliases.items():
-            if young in local:
+            if young not in local:
+                continue
+            if elder not in local and isinstance(local, SharedPositionMap):
+                local.promote(young, known_id=elder)     # its copy goes on under the elder id, as tracked
+                for held in (self.mine_seen, self.ever_seen):
+                    if young in held:
+                        held.add(elder)
+            else:
                 local.remove(young)
-                self.mine_seen.discard(young)
+            self.mine_seen.discard(young)
+            self.ever_seen.discard(young)
+            self.placed.discard(young)
         present = {p.id: p for p in state.present()}
         cams = list(self.cameras.values())
         dt = min(max(t - state.captured, 0.0), 0.5)
@@ -287,7 +296,7 @@ class MapLink:
                                      blockers=[np.delete(boxes[c], k, axis=0) for c in mine])
             cov = tracker_covariance(tracker, person, t) if seen else None
             e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info,
-                         share, *(_NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])))
+                         share, *(NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])))
             for c, ok in zip(cams, views):
                 if ok:
                     per_cam[c].append(e)
