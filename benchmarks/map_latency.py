@@ -17,9 +17,12 @@ subscriber's receive time is the cross-check). Parts:
 * capture → record: the same observation's bucket written to the map stream once every worker has
   reported it (or ``max_wait_s``) — what ``replay`` reads; it waits for the slowest worker.
 
-Steady state leaves out the first ``--settle`` seconds (the trackers' warm start holds the first
-10 frames back and then catches up; the start-up is given separately: p99 over every frame). Each
-repetition is a fresh run; the table gives every repetition and the median.
+The target is over the whole run, start-up included (``capture→live map, whole run``: every frame
+from the first); steady state leaves out the first ``--settle`` seconds. (Until issue 39e the
+trackers' warm start held every worker's first 10 frames back on live cameras and caught up over
+~1.5 s: p99 over the whole run 1.09 s. A worker on live cameras now skips it.) ``--cv-threads N``
+gives each worker N OpenCV threads (``OPENCV_FOR_THREADS_NUM``; default: OpenCV's own, one per
+core). Each repetition is a fresh run; the table gives every repetition and the median.
 
 Run: ``nice -n -15 .venv/bin/python benchmarks/map_latency.py [--repeats 3] [--quick]``. Writes
 ``benchmarks/results/map_latency.md``. On a shared Linux machine with autogroup scheduling
@@ -33,6 +36,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import os
 import shutil
 import statistics
 import subprocess
@@ -130,7 +134,10 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=200)
     ap.add_argument("--settle", type=float, default=3.0, help="seconds of start-up left out of the steady state")
     ap.add_argument("--quick", action="store_true", help="one run of 60 frames; prints only")
+    ap.add_argument("--cv-threads", type=int, help="OpenCV threads per worker (OPENCV_FOR_THREADS_NUM)")
     args = ap.parse_args()
+    if args.cv_threads:
+        os.environ["OPENCV_FOR_THREADS_NUM"] = str(args.cv_threads)     # inherited by the workers
     repeats, frames = (1, 60) if args.quick else (args.repeats, args.frames)
     start = time.time()
     rows = []
@@ -143,7 +150,8 @@ def main() -> None:
             for k in range(repeats):
                 r = one_run(server, tmp / "seq", sc.camera_ids, tmp / f"run{k}", args.settle)
                 rows.append(r)
-                print(f"run {k}: capture→live map p50 {r['total'][0] * 1000:.1f} ms p99 {r['total'][1] * 1000:.1f} ms;"
+                print(f"run {k}: capture→live map p50 {r['total'][0] * 1000:.1f} ms p99 {r['total'][1] * 1000:.1f} ms"
+                      f" (whole run p99 {r['all'][1] * 1000:.1f} ms);"
                       " worker parts p50/p99 (ms): " + ", ".join(f"{name} {a * 1000:.1f}/{b * 1000:.1f}"
                                                                  for name, (a, b) in r["parts"].items()),
                       file=sys.stderr)
@@ -164,13 +172,15 @@ def main() -> None:
     table_rows.append(["median", "", *[f"{ms(med[key][0])} / {ms(med[key][1])}" for key in keys], ""])
     table = markdown_table(["run", "observations", *[f"{p} p50 / p99 (ms)" for p in PARTS],
                             "capture→published", "published→live map", "**capture→live map**",
-                            "capture→received", "capture→record", "capture→live map with start-up", "late / missing"],
+                            "capture→received", "capture→record", "**capture→live map, whole run**", "late / missing"],
                            table_rows)
-    p99 = med[("total", None)][1]
+    p99, p99_all = med[("total", None)][1], med[("all", None)][1]
+    threads = f"{args.cv_threads} OpenCV thread(s) per worker" if args.cv_threads else "OpenCV's default threads"
     text = (f"{table}\n\nFour workers (one camera each, `crowd` seed 3, 4 cameras, 5 people, 320x240, "
-            f"{frames} frames at 10 frames/s played as live cameras), the fusion role in its own process "
-            f"(core 1). Steady state: captures from {args.settle:g} s on. Target: capture→live map p99 < 50 ms; "
-            f"median p99 {ms(p99)} ms ({'met' if p99 < 0.05 else 'not met'}). The worker's parts are its "
+            f"{frames} frames at 10 frames/s played as live cameras, {threads}), the fusion role in its own "
+            f"process (core 1). Steady state: captures from {args.settle:g} s on. Target: capture→live map "
+            f"p99 < 50 ms over the whole run, start-up included: median p99 {ms(p99_all)} ms "
+            f"({'met' if p99_all < 0.05 else 'not met'}; steady state {ms(p99)} ms). The worker's parts are its "
             f"step's (map_timings.csv); capture→received is when this script's subscriber got the update; "
             f"capture→record is the complete bucket in the map stream (waits for the slowest worker); late: "
             f"observations that came after their bucket was closed, missing: of those, in steady state (counted "

@@ -27,6 +27,13 @@ def test_observation_and_map_state_round_trip_with_nan():
     back = decode_observation(encode_observation(o))
     assert back.people[0].id == 3 and back.people[0].seen is False and math.isnan(back.people[0].support)
     assert back.people[0][:4] == (3, 1.25, 2.5, 1.7) and back.people[0].iyy == 900.0 and back.ended == (5,)
+    assert math.isnan(back.people[0].cxx)                         # no covariance from the tracker
+    measured = Estimate(3, 1.0, 2.0, 1.7, 0.45, 0, 0, 0.7, 0.8, True, 40.0, -3.0, 900.0, 1.0, 0.09, -0.01, 0.0025)
+    assert decode_observation(encode_observation(obs("cam1", 1.0, "w", [measured]))).people[0] == measured
+    # A worker from before the covariance (14 columns) still reads: NaN covariance.
+    old = decode_observation({"v": "2", "t": "1.0", "o": '["c", "w", 1, 1.0, [[1, 2, 3, 1.7, 0.45, 0, 0, 0.5, 0.6, '
+                                                       '1, 10, 0, 10, 1.0]], []]'})
+    assert old.people[0].x == 2 and math.isnan(old.people[0].cyy)
     s = MapState(12.3, (MapPerson(3, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "lost", 11.0, 3.0, 1),),
                  (("cam1", 12.34, 12.35),), {7: 3}, 12.5, 2)
     assert decode_map_state(encode_map_state(s)) == s
@@ -51,6 +58,23 @@ def test_support_and_geometry_weigh_two_workers():
     s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(1, 2.0, 1.0, info=(100.0, 0.0, 1.0))]),
                                         obs("b", 1.0, "w2", [est(1, 3.0, 2.0, info=(10.0, 0.0, 1.0))])], cfg)
     assert s.people[0].x == pytest.approx((100 * 2.0 + 10 * 3.0) / 110) and s.people[0].y == pytest.approx(1.5)
+
+
+def test_weighed_by_the_trackers_covariances_when_asked_and_every_estimate_has_one():
+    cfg = MapConfig(weigh_by="tracker")
+    # w1 measured σ 0.1 m along x, w2 0.3 m: information 100 against 11.1 along x; y equal.
+    a = est(1, 2.0, 1.0)._replace(cxx=0.01, cxy=0.0, cyy=0.0025)
+    b = est(1, 3.0, 2.0)._replace(cxx=0.09, cxy=0.0, cyy=0.0025)
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])], cfg).people
+    assert p.x == pytest.approx((100 * 2.0 + 3.0 / 0.09) / (100 + 1 / 0.09)) and p.y == pytest.approx(1.5)
+    assert p.lead == "w1"                                        # the smaller covariance
+    # One estimate without a covariance: support × geometry for both (here equal: the mean).
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [est(1, 3.0, 2.0)])],
+                     cfg).people
+    assert p.x == pytest.approx(2.5)
+    # By default (geometry) the covariances are not used.
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])], MapConfig()).people
+    assert p.x == pytest.approx(2.5)
 
 
 def test_the_live_map_refines_a_bucket_as_reports_come_and_leaves_the_others_as_they_were():
@@ -116,6 +140,24 @@ def test_two_ids_of_one_person_from_two_workers_merge_into_the_elder():
     assert [p.id for p in s.people] == [1, 2]
 
 
+def test_two_workers_starting_the_same_person_together_are_merged_at_once():
+    cfg = MapConfig(merge_after_s=0.2)
+    s = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [est(4, 2.0, 0.0)]),
+                                        obs("b", 1.0, "w2", [est(9, 2.2, 0.0)])], cfg)
+    assert s.aliases == {9: 4} and [p.id for p in s.people] == [4]
+
+
+def test_two_people_crossing_in_one_workers_view_are_not_merged_when_another_worker_sees_one():
+    # w2 sees both people (ids 1 and 2) as they cross; w1 sees only person 1 (2 is behind 1 there).
+    cfg = MapConfig(merge_after_s=0.2)
+    st = FusionState()
+    for b in range(10, 20):
+        s = fuse_bucket(st, b, [obs("a", b / 10, "w1", [est(1, 2.0, 0.0)]),
+                                obs("b", b / 10, "w2", [est(1, 2.0, 0.0), est(2, 2.2, 0.0)])], cfg)
+        assert not s.aliases
+    assert [p.id for p in s.people] == [1, 2]
+
+
 def test_fusion_state_survives_json():
     cfg = MapConfig()
     st = FusionState()
@@ -134,6 +176,23 @@ def test_floor_information_is_finer_near_the_camera_and_along_its_image_plane():
     assert all(math.isnan(v) for v in floor_information([cam], np.array([-3.0, 0.0]), 1.7))   # behind it
 
 
+def test_a_person_behind_another_is_resolved_worse_along_the_line_of_sight():
+    from worldtrack.geometry.camera import Camera
+    from worldtrack.map.fusion import people_boxes
+    cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
+    front = people_boxes(cam, np.array([[3.0, 0.0, 1.7, 0.45]]))
+    u0, v0, u1, v1, dist = front[0]
+    assert dist == pytest.approx(3.0) and u0 < 160 < u1 and v0 < 120 < v1          # a box around the image's centre
+    free = floor_information([cam], np.array([6.0, 0.0]), 1.7)
+    behind = floor_information([cam], np.array([6.0, 0.0]), 1.7, blockers=[front])
+    assert behind[0] < 0.8 * free[0]            # feet hidden: depth along the line of sight resolves worse
+    ahead = floor_information([cam], np.array([2.0, 0.0]), 1.7, blockers=[front])
+    assert ahead == floor_information([cam], np.array([2.0, 0.0]), 1.7)     # in front of the other: unchanged
+    beside = np.array([6.0, 2.5])
+    assert floor_information([cam], beside, 1.7, blockers=[front]) == floor_information([cam], beside, 1.7)
+    assert people_boxes(cam, np.array([[-2.0, 0.0, 1.7, 0.45]]))[0, 4] == np.inf   # behind the camera: no box
+
+
 def test_passwords_never_shown_and_taken_from_the_environment():
     assert redacted("redis://u:pw@h:1/0") == "redis://u:***@h:1/0"
     assert hide_passwords("x rtsp://a:b@c/d redis://h:1") == "x rtsp://a:***@c/d redis://h:1"
@@ -148,3 +207,76 @@ def test_map_settings_errors_name_the_field():
         map_settings(sets=["map.renew_s=0.9"])
     with pytest.raises(InputError, match=r"^--set ellipsoid.x: only the map's settings"):
         map_settings(sets=["ellipsoid.x=1"])
+
+
+def test_which_worker_starts_a_person_from_the_maps_estimate():
+    from types import SimpleNamespace
+
+    from worldtrack.map.worker import MapLink
+
+    def follows(rule, workers, lead, mine=True):
+        link = SimpleNamespace(cfg=MapConfig(share_rule=rule), mine_seen={7} if mine else set(), name="w1")
+        p = MapPerson(7, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "tracking", 1.0, 0.0, workers, lead)
+        return MapLink._follows_map(link, p)
+    assert follows("information", 1, "w1", mine=False) and follows("support-lead", 1, "w1", mine=False)  # not shown
+    assert not follows("information", 1, "w1") and not follows("support-lead", 1, "w1")   # its own person alone
+    # Seen by two workers: under the information rule both start from the map's estimate, even the lead.
+    assert follows("information", 2, "w1") and follows("information", 2, "w2")
+    assert not follows("support-lead", 2, "w1") and follows("support-lead", 2, "w2")
+
+
+class _Record:
+    """The map stream of a batch run, as far as a worker's read of the record needs (no server)."""
+
+    def __init__(self):
+        self.entries: list[tuple[str, dict]] = []
+
+    def register_script(self, _):
+        return None
+
+    def add(self, bucket: int, aliases: dict) -> None:
+        state = MapState(bucket / 10, (MapPerson(4, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "tracking", 0.0, 0.0, 1),),
+                         aliases=aliases)
+        self.entries.append((f"{bucket * 100}-0", encode_map_state(state)))
+
+    def xrevrange(self, _key, count):
+        return self.entries[::-1][:count]
+
+    def xrange(self, _key, min, max):
+        return [e for e in self.entries if int(e[0].split("-")[0]) > int(min[1:].split("-")[0])]
+
+
+def test_a_batch_worker_does_not_miss_a_merge_between_two_steps():
+    from worldtrack.map.connection import MapKeys
+    from worldtrack.map.worker import MapLink
+    record = _Record()
+    link = MapLink(record, MapKeys(), MapConfig(), "w1", {})
+    link.lockstep = True
+    record.add(0, {9: 4})                      # id 9 merged into 4 in bucket 0
+    record.add(1, {})
+    assert link.read_map().aliases == {9: 4}   # the first read takes the recent records, not only the newest
+    record.add(2, {11: 4})
+    record.add(3, {})
+    link.read_map()                            # the lockstep wait reads more than once before a step
+    record.add(4, {})
+    assert link.read_map().aliases == {9: 4, 11: 4}
+    for b in range(5, 40):
+        record.add(b, {})
+    assert link.read_map().aliases == {}       # forgotten after forget_after_s (3 s)
+
+
+def test_a_worker_renames_its_copy_of_a_merged_person_and_keeps_tracking_it():
+    from types import SimpleNamespace
+
+    from worldtrack.map.connection import MapKeys
+    from worldtrack.map.shared_ids import SharedPositionMap
+    from worldtrack.map.worker import MapLink
+    record = _Record()
+    link = MapLink(record, MapKeys(), MapConfig(), "w1", {})
+    link.lockstep = True
+    local = SharedPositionMap(lambda x, y: 100)
+    mine = local.add(1.0, 2.0, track_id=9, mode="tracking")
+    link.mine_seen = {9}
+    record.add(0, {9: 4})                            # the map folded this worker's 9 into 4
+    link.sync(SimpleNamespace(position_map=local), 0.05)
+    assert [p.id for p in local] == [4] and local[4] is mine and link.mine_seen == {4}

@@ -7,6 +7,8 @@
   writes fenced by the lease);
 * :mod:`~worldtrack.map.worker` — a worker's side: new ids from the map, the map's people put on
   its tracker's map before a step, its estimates published after;
+* :mod:`~worldtrack.map.evidence` — what a worker's cameras show of a person (body points not
+  hidden by obstacles or other people) and how finely they resolve the floor: the fusion's weights;
 * :mod:`~worldtrack.map.fusion` — merging the estimates of one person from several workers (the
   answer to "who updates a person two workers see?"), pure;
 * :mod:`~worldtrack.map.fusion_role` — the fusion on Redis: buckets, take-over, nothing skipped;

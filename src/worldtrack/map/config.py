@@ -5,7 +5,7 @@ Set them like any other setting: ``map:`` in a ``--config`` file or ``--set map.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 from pydantic import Field, model_validator
 
@@ -33,6 +33,17 @@ class MapConfig(Section):
                                                               "them) this often")
     retention_s: float = Field(3600.0, gt=0, description="streams keep this much capture time (older entries "
                                                          "are trimmed with MINID)")
+    share_rule: Literal["information", "support-lead"] = Field(
+        "information", description="how workers that see the same person share the work (worldtrack.map.fusion): "
+                                   "'information': each starts every frame from the map's estimate and the map "
+                                   "adds their measurements by information; 'support-lead': the worker with the "
+                                   "best view by share and support continues from its own estimate, the others "
+                                   "start from the map's (the rule before issue 39e)")
+    weigh_by: Literal["geometry", "tracker"] = Field(
+        "geometry", description="what the map weighs each worker's estimate by: 'geometry': support x how finely "
+                                "its cameras resolve the floor where the person stands, counting what obstacles "
+                                "and other people hide; 'tracker': the inverse of the covariance its tracker "
+                                "measured (the ellipsoid tracker's sigma), when every estimate has one")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

@@ -5,29 +5,39 @@ each with its own cameras, share one person map — who updates a person two of 
 
 * **Every worker that sees a person updates them, on its own map, from its own cameras**, and
   publishes its estimate. A worker never moves a person its cameras do not show: those it takes
-  from the shared map as they are (:mod:`worldtrack.map.worker`). Of the workers that see a person,
-  the one whose estimate weighs most (``lead``) continues from its own estimate; the others start
-  each frame from the map's and move the person by their own cameras' evidence, so a worker that
-  sees somebody poorly (far, through a door) contributes without drifting away on its own.
-  The reset is what keeps two workers' copies of an id on the same person: letting every worker
-  that sees a person well keep its own estimate (the map then a pure information-weighted mean)
-  lost up to 0.74 MOTA on held-out two-rooms seeds (ids swapped in one worker, the mean between
-  two people); keeping it while within 0.5 m of the map's, up to 0.17 (issue 39d).
-* **The shared map keeps each worker's estimate and weighs them by support and by geometry** —
-  the support is the share of the person's own pixels that are foreground in that worker's views
-  (the evidence the estimate rests on; else the match score; at least 0.05), and the geometry is
-  how finely the worker's cameras resolve the floor where the person stands: the information
-  matrix ``I_k`` of a one-pixel error of their feet and head (:func:`floor_information`; a camera
-  8 m away resolves depth ~6× worse than one 3 m away, and only along its line of sight). Within
-  a time bucket the map position is the information-weighted mean
-  ``x = (Σ w_k I_k)⁻¹ Σ w_k I_k x_k`` over the workers ``k`` that saw the person. Estimates of a
-  person a worker holds without evidence (hidden behind a desk in its view) count only when no
-  worker saw them.
+  from the shared map as they are (:mod:`worldtrack.map.worker`). With ``map.share_rule``
+  ``information`` (the default), every worker that sees a person starts each frame from the
+  map's estimate (the common prior, at the time of its previous step: its tracker predicts it on
+  itself) and refines it with its own images; the map then adds their measurements in
+  information form, so no view is thrown away. (Before issue 39e only the worker whose estimate
+  weighed most, the ``lead``, continued from its own estimate and the others restarted from the
+  map's each frame: a better view corrected the lead by one frame's evidence only, and on
+  two-rooms two people in line in one camera pulled the map between them —
+  ``share_rule=support-lead`` keeps that rule. Letting every worker keep its own estimate
+  instead lost up to 0.74 MOTA, ids swapping in one worker: issue 39d.)
+* **The shared map weighs each worker's estimate by support and by geometry** — the support is
+  the share of the person's own pixels that are foreground in that worker's views (the evidence
+  the estimate rests on; else the match score; at least 0.05), and the geometry is how finely the
+  worker's cameras resolve the floor where the person stands: the information matrix ``I_k`` of
+  a one-pixel error of the body points they show (:func:`~worldtrack.map.evidence.floor_information`; a camera 8 m away
+  resolves depth ~6× worse than one 3 m away, and only along its line of sight; points hidden by
+  the scene's obstacles or behind another person the worker holds add nothing, so the view in
+  which a person stands in front tells their depth). Within a time bucket the map position is
+  ``x = (Σ w_k I_k)⁻¹ Σ w_k I_k x_k`` over the workers ``k`` that saw the person (each
+  ``x_k`` is the fit of that worker's images from the common prior, its own measurement: the
+  prior only starts the search and is not added again). ``weigh_by=tracker`` uses the inverse
+  of each tracker's measured covariance instead (the ellipsoid tracker's σ, from the curvature of
+  its score): on two-rooms its σ along the line of sight sits at its 0.29 m cap in a third of the
+  estimates and does not tell the occluded view from the clear one (MOTA 0.83 / 0.90 against 1.00
+  / 1.00 on seeds 1 and 3). Estimates of a person a worker holds without evidence (hidden behind a
+  desk in its view) count only when no worker saw them.
 * **Ids are the map's.** A worker's tracker takes new ids from the map (one counter in Redis) and,
   for a person walking in from a neighbour's view, finds them already on its map under their id.
-  If two workers still start the same person at once (both saw them first in the same frame), the
-  two ids are close for ``merge_after_s`` with estimates from different sets of workers: the
-  younger id is folded into the elder (``aliases``), and the workers rename their copy.
+  If two workers still start the same person (both saw them first in the same frame), the two
+  ids are close, and no worker sees both: the younger id is folded into the elder (``aliases``)
+  after ``merge_after_s``, at once when both ids are that young, and the workers rename their
+  copy. Two ids one worker sees at the same time are two people it tells apart (two people
+  crossing in its view, while another worker sees only one of them), never merged.
 * **The map does not wait for the slowest worker.** Until a bucket is complete, the live map is
   :func:`provisional_state`: each person reported so far in the bucket where those reports put
   them (weighed as above; a later worker's report of the same bucket refines the estimate), and
@@ -56,12 +66,12 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field, fields, replace
-from typing import Iterable, Mapping, Sequence
+from typing import Iterable, Mapping
 
 import numpy as np
 
-from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
+from worldtrack.map.evidence import floor_information, in_views, people_boxes, visible_share  # noqa: F401 (public here too)
 from worldtrack.map.messages import Estimate, MapPerson, MapState, Observation
 
 #: The least weight an estimate has (support 0 still says "a worker sees somebody here").
@@ -140,82 +150,39 @@ def estimate_weight(e: Estimate) -> float:
     return MIN_WEIGHT
 
 
-def _body_points(cam: Camera, xy: np.ndarray, height: float, occlusion: np.ndarray | None,
-                 step_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Five points on a person's axis (feet to head) and four neighbours of each a step away on
-    the floor, in ``cam``'s image: (5, 5, 2) pixels, and which of the five show (inside the image,
-    not behind an obstacle), (5,) bool."""
-    offsets = np.array([[0.0, 0.0], [step_m, 0.0], [-step_m, 0.0], [0.0, step_m], [0.0, -step_m]])
-    heights = np.linspace(0.0, height, 5)
-    pts = np.concatenate([np.column_stack([xy[None, :] + offsets, np.full(5, z)]) for z in heights])
-    uv = cam.project(pts).reshape(len(heights), 5, 2)
-    seen = cam.in_image(uv[:, 0]) & np.isfinite(uv).all(axis=(1, 2))
-    if occlusion is not None and seen.any():
-        px = np.clip(np.nan_to_num(np.round(uv[:, 0])).astype(int), 0, [cam.width - 1, cam.height - 1])
-        mine = float(cam.floor_distance(np.append(xy, 0.0)[None, :])[0])
-        seen &= occlusion[px[:, 1], px[:, 0]] > mine - 0.3
-    return uv, seen
-
-
-def visible_share(cameras: Sequence[Camera], xy: np.ndarray, height: float,
-                  occlusion: Sequence[np.ndarray | None] | None = None) -> float:
-    """The largest share, over ``cameras``, of a person's five axis points (feet to head) that the
-    camera shows: 1 in full view, 0.2 when one camera sees only their head through a door."""
-    shares = [_body_points(cam, xy, height, occlusion[k] if occlusion else None, 0.05)[1].mean()
-              for k, cam in enumerate(cameras)]
-    return float(max(shares, default=0.0))
-
-
-def in_views(cameras: Sequence[Camera], xy: np.ndarray, height: float, margin_m: float = 0.0) -> list[bool]:
-    """Per camera: does a person ``height`` m tall at floor point ``xy`` show in its image (feet or head
-    inside, the paper's rule), or come within ``margin_m`` metres of doing so."""
-    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]], float) * margin_m
-    pts = xy[None, :] + (offsets if margin_m > 0 else offsets[:1])
-    points = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in (0.0, height)])
-    return [bool(cam.in_image(cam.project(points)).any()) for cam in cameras]
-
-
-def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, sigma_px: float = 1.0,
-                      step_m: float = 0.05, occlusion: Sequence[np.ndarray | None] | None = None
-                      ) -> tuple[float, float, float]:
-    """How finely ``cameras`` resolve a person standing at floor point ``xy`` (metres): the
-    information matrix ``Σ Jᵀ J / σ²`` (1/m², as ``ixx, ixy, iyy``) of five points on the person's
-    axis (feet to head), ``J`` the pixels a point moves per metre on the floor, ``σ = sigma_px``.
-    Points outside a camera's image, or hidden there by a structure (``occlusion``: per camera the
-    scene's floor-distance map of obstacles, (H, W) metres), add nothing; so a person seen only
-    through a door counts for less. No visible point gives ``(nan, nan, nan)``.
-
-    >>> from worldtrack.geometry.camera import Camera
-    >>> cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
-    >>> near, far = (floor_information([cam], np.array([x, 0.0]), 1.7) for x in (2.0, 6.0))
-    >>> near[0] > 4 * far[0]                      # depth resolves worse far away
-    True
-    """
-    info = np.zeros((2, 2))
-    for k, cam in enumerate(cameras):
-        uv, seen = _body_points(cam, xy, height, occlusion[k] if occlusion is not None else None, step_m)
-        for i in np.flatnonzero(seen):
-            J = np.column_stack([(uv[i, 1] - uv[i, 2]) / (2 * step_m), (uv[i, 3] - uv[i, 4]) / (2 * step_m)])
-            info += J.T @ J / sigma_px ** 2
-    if not info.any():
-        return float("nan"), float("nan"), float("nan")
-    return float(info[0, 0]), float(info[0, 1]), float(info[1, 1])
-
-
 def _information(e: Estimate) -> np.ndarray:
     m = np.array([[e.ixx, e.ixy], [e.ixy, e.iyy]], float)
     return m if np.isfinite(m).all() and np.linalg.det(m) > 0 else np.eye(2)
 
 
-def _weighted(estimates: list[Estimate]) -> tuple[float, ...]:
+def measured_information(e: Estimate) -> np.ndarray | None:
+    """The information (2, 2) 1/m² of an estimate as its worker's tracker measured it (the inverse
+    of its covariance ``cxx, cxy, cyy``); None when the tracker gave none (or a degenerate one)."""
+    c = np.array([[e.cxx, e.cxy], [e.cxy, e.cyy]], float)
+    if not np.isfinite(c).all() or c[0, 0] <= 0 or np.linalg.det(c) <= 0:
+        return None
+    return np.linalg.inv(c)
+
+
+def _weights(estimates: list[Estimate], weigh_by: str) -> tuple[list[np.ndarray], bool]:
+    """Each estimate's weight matrix, and whether they are the trackers' measured information
+    (``weigh_by="tracker"`` and every estimate has one) rather than support × floor geometry."""
+    measured = [measured_information(e) for e in estimates] if weigh_by == "tracker" else [None]
+    if all(m is not None for m in measured):
+        return measured, True
+    w = [estimate_weight(e) for e in estimates]
+    infos = [wi * _information(e) for wi, e in zip(w, estimates)]
+    scale = np.mean([np.trace(m) for m in infos])
+    return [m / scale for m in infos], False         # relative weights: keeps the solve well scaled
+
+
+def _weighted(estimates: list[Estimate], weigh_by: str = "geometry") -> tuple[float, ...]:
     if len(estimates) == 1:           # most people, most of the time: one worker sees them
         e = estimates[0]
         return e.x, e.y, e.height, e.width, e.vx, e.vy, e.score, e.support
     w = [estimate_weight(e) for e in estimates]
     total = sum(w)
-    infos = [wi * _information(e) for wi, e in zip(w, estimates)]
-    scale = np.mean([np.trace(m) for m in infos])
-    infos = [m / scale for m in infos]            # relative weights: keeps the solve well scaled
+    infos, _ = _weights(estimates, weigh_by)
     total_info = sum(infos)
     xy = np.linalg.solve(total_info, sum(m @ np.array([e.x, e.y]) for m, e in zip(infos, estimates)))
     v_ok = [(m, e) for m, e in zip(infos, estimates) if math.isfinite(e.vx) and math.isfinite(e.vy)]
@@ -230,6 +197,18 @@ def _weighted(estimates: list[Estimate]) -> tuple[float, ...]:
     supports = [e.support for e in estimates if math.isfinite(e.support)]
     return (float(xy[0]), float(xy[1]), mean("height"), mean("width"), float(vxy[0]), float(vxy[1]),
             sum(wi * e.score for wi, e in zip(w, estimates)) / total, max(supports) if supports else float("nan"))
+
+
+def _lead(by_worker: Mapping[str, Estimate], use: list[Estimate], weigh_by: str) -> str:
+    """The worker whose estimate of a person weighs most: with the trackers' covariances
+    (``weigh_by="tracker"``) the smallest (trace); else a worker showing at least
+    :data:`LEAD_SHARE` of the body, then the largest support × trace of floor information."""
+    if len(by_worker) == 1:
+        return next(iter(by_worker))
+    if _weights(use, weigh_by)[1]:
+        return min((e.cxx + e.cyy, k) for k, e in by_worker.items() if e in use)[1]
+    return max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
+                for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
 
 
 def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict[int, dict[str, Estimate]]:
@@ -260,7 +239,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     """
     t = bucket * cfg.bucket_s
     estimates = _per_worker(state, observations)
-    workers_of = _update_people(state.people, estimates, t)
+    workers_of = _update_people(state.people, estimates, t, cfg.weigh_by)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -278,7 +257,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 
 
 def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
-                   copy: bool = False) -> dict[int, set[str]]:
+                   weigh_by: str = "geometry", copy: bool = False) -> dict[int, set[str]]:
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
     committed state stay as they are). Returns, per person, the workers that see them."""
@@ -286,7 +265,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
     for pid, by_worker in estimates.items():
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
-        x, y, h, w, vx, vy, score, support = _weighted(use)
+        x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by)
         p = people.get(pid)
         if p is None:
             p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
@@ -296,9 +275,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
-        p.lead = next(iter(by_worker)) if len(by_worker) == 1 else \
-            max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
-                 for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
+        p.lead = _lead(by_worker, use, weigh_by)
         workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
     return workers_of
 
@@ -323,7 +300,7 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     """
     people = dict(state.people)
     for b in sorted(buckets):
-        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, copy=True)
+        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True)
     t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
     reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
@@ -334,8 +311,11 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
 def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
                       cfg: MapConfig) -> dict[int, int]:
     """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
-    the elder, unless the very same workers see both (then they are two people those workers tell
-    apart). Returns ``{younger: elder}``."""
+    the elder, unless a worker sees both (then they are two people that worker tells apart: two
+    people crossing in one worker's view while another worker sees only one of them are not
+    merged). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
+    the same frames: no history could tell them apart) are merged at once. Returns
+    ``{younger: elder}``."""
     from scipy.spatial import cKDTree
     ids = sorted(workers_of)
     close_now = set()
@@ -343,15 +323,16 @@ def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: fl
         xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
         for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
             a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
-            if workers_of[a] == workers_of[b] or not workers_of[a] or not workers_of[b]:
-                continue      # the same workers hold both apart: two people
+            if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
+                continue      # a worker that sees both holds them apart: two people
             close_now.add((a, b))
     state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
     merged: dict[int, int] = {}
     for (a, b), since in sorted(state.close_since.items()):
-        if t - since < cfg.merge_after_s or a in merged or b in merged:
-            continue
         pa, pb = state.people[a], state.people[b]
+        newborn = t - min(pa.born, pb.born) < cfg.merge_after_s    # both just started: nothing to wait for
+        if (t - since < cfg.merge_after_s and not newborn) or a in merged or b in merged:
+            continue
         elder, younger = (pa, pb) if (pa.born, pa.id) <= (pb.born, pb.id) else (pb, pa)
         wa, wb = max(MIN_WEIGHT, _finite(elder.support)), max(MIN_WEIGHT, _finite(younger.support))
         elder.x = (wa * elder.x + wb * younger.x) / (wa + wb)
@@ -369,4 +350,4 @@ def _finite(v: float) -> float:
 
 
 __all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket",
-           "in_views", "provisional_state", "visible_share"]
+           "in_views", "measured_information", "people_boxes", "provisional_state", "visible_share"]

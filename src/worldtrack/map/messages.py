@@ -12,7 +12,7 @@ message stays small (256 cameras × 5 people at 10 Hz is ~13,000 people a second
 Entry ids are capture times in ms (``<ms>-<seq>``), so streams can be read and trimmed by time
 (``XRANGE``, ``MINID``) and a map bucket is written once: a second ``XADD`` of the same id fails.
 
->>> e = Estimate(3, 1.5, 2.0, 1.7, 0.45, 0.2, 0.0, 0.8, 0.6, True)
+>>> e = Estimate(3, 1.5, 2.0, 1.7, 0.45, 0.2, 0.0, 0.8, 0.6, True, cxx=0.04, cxy=0.0, cyy=0.0025)
 >>> o = Observation("cam1", 12.3, "w1", 123, 12.35, (e,), ended=(2,))
 >>> decode_observation(encode_observation(o)) == o
 True
@@ -37,9 +37,11 @@ class Estimate(NamedTuple):
     does not say); ``seen`` is False for a person the worker holds in its view without evidence in
     this frame (hidden behind something), True when its cameras show them. ``ixx, ixy, iyy``
     (1/m²): how finely the worker's cameras resolve the floor there, the information matrix of a
-    one-pixel error of the person's feet and head (:func:`worldtrack.map.fusion.floor_information`);
+    one-pixel error of the person's feet and head (:func:`worldtrack.map.evidence.floor_information`);
     ``visible``: the share of the person's body the worker's best camera shows
-    (:func:`worldtrack.map.fusion.visible_share`).
+    (:func:`worldtrack.map.evidence.visible_share`). ``cxx, cxy, cyy`` (m²): the covariance of the
+    estimate as the worker's tracker measured it this frame (the ellipsoid tracker's, from the
+    curvature of its score: it knows what other people hide), NaN when the tracker gives none.
     """
 
     id: int
@@ -56,6 +58,9 @@ class Estimate(NamedTuple):
     ixy: float = 0.0
     iyy: float = 1.0
     visible: float = 1.0
+    cxx: float = float("nan")
+    cxy: float = float("nan")
+    cyy: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -140,7 +145,8 @@ def encode_observation(o: Observation) -> dict[str, str]:
     reads thousands a second). NaN stays NaN (Python's JSON)."""
     people = [[int(e.id), round(e.x, 4), round(e.y, 4), round(e.height, 3), round(e.width, 3), round(e.vx, 3),
                round(e.vy, 3), round(float(e.score), 3), round(float(e.support), 3), int(bool(e.seen)), _sig(e.ixx),
-               _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2)] for e in o.people]
+               _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2), _sig(e.cxx), _sig(e.cxy), _sig(e.cyy)]
+              for e in o.people]
     body = [o.camera, o.worker, int(o.frame), float(o.sent), people, [int(i) for i in o.ended]]
     return {"v": FORMAT_VERSION, "t": repr(float(o.t)), "o": json.dumps(body, separators=(",", ":"))}
 
@@ -154,7 +160,7 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
         for p in people:
             p[9] = p[9] == 1
         return Observation(str(camera), float(fields["t"]), str(worker), int(frame), float(sent),
-                           tuple(map(Estimate._make, people)), tuple(ended))
+                           tuple(Estimate(*p) for p in people), tuple(ended))
     except (KeyError, IndexError, TypeError, ValueError, json.JSONDecodeError) as e:
         if isinstance(e, ValueError) and str(e).startswith("format version"):
             raise

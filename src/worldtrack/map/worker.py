@@ -20,6 +20,7 @@ See :mod:`worldtrack.map.fusion` for how the estimates of a person two workers s
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -31,13 +32,15 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.fusion import LEAD_SHARE, floor_information, in_views, visible_share
+from worldtrack.map.evidence import (NO_COVARIANCE, floor_information, in_views, people_boxes, support_of,
+                                     tracker_covariance, visible_share)
+from worldtrack.map.fusion import LEAD_SHARE
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
 from worldtrack.map.timings import StepTimings
 from worldtrack.map.shared_ids import SharedPositionMap
-from worldtrack.trackers.base import Frame, Person, PositionMap, Track, Tracker
+from worldtrack.trackers.base import Frame, PositionMap, Track, Tracker
 
 
 class MapLink:
@@ -53,7 +56,7 @@ class MapLink:
     fps : the cameras' frame rate (for the fusion's wait)
     clock : wall clock, seconds
     occlusion : {camera_id: (H, W) floor distance of the obstacles} — the scene's occlusion maps
-        (:func:`~worldtrack.map.fusion.floor_information` leaves hidden body points out)
+        (:func:`~worldtrack.map.evidence.floor_information` leaves hidden body points out)
     """
 
     def __init__(self, client: Any, keys: MapKeys, cfg: MapConfig, name: str, cameras: Mapping[str, Camera],
@@ -81,8 +84,10 @@ class MapLink:
         self.lockstep = False
         self.lockstep_wait_s = 2.0
         self._first_t: float | None = None
+        self._prev_t: float | None = None
         #: The end (s) of the last complete bucket of the map (every live camera's report in).
         self.complete_until, self._record_id = -math.inf, ""
+        self._aliases: dict[int, tuple[int, float]] = {}      # batch runs: merges read from the record
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
@@ -132,12 +137,21 @@ class MapLink:
         """The latest map state (None before the first): the live map, or in a batch run (lockstep) the
         last complete bucket (every worker's reports, not whichever came first: runs repeat)."""
         if self.lockstep:
-            last = self.client.xrevrange(self.keys.map_stream, count=1)
-            if not last:
-                return None
-            if self.state is None or last[0][0] != self._record_id:
-                self._record_id, self.state = last[0][0], decode_map_state(last[0][1])
-                self.complete_until = self.state.t + self.cfg.bucket_s
+            # Every bucket written since the last read, not only the newest: a merge (alias) is in
+            # the state of its own bucket only, and a worker that skipped it would go on publishing
+            # the merged id, a new person to the map once the alias is forgotten.
+            new = (self.client.xrange(self.keys.map_stream, min=f"({self._record_id}", max="+") if self._record_id
+                   else self.client.xrevrange(self.keys.map_stream, count=self._alias_window())[::-1])
+            if not new:
+                return self.state
+            states = [decode_map_state(fields) for _, fields in new]
+            # Kept for forget_after_s: several reads may come between two steps (the lockstep wait).
+            self._aliases.update({young: (elder, s.t) for s in states for young, elder in s.aliases.items()})
+            recent = states[-1].t - self.cfg.forget_after_s
+            self._aliases = {y: (e, t) for y, (e, t) in self._aliases.items() if t > recent}
+            self._record_id, self.state = new[-1][0], dataclasses.replace(
+                states[-1], aliases={young: elder for young, (elder, _) in self._aliases.items()})
+            self.complete_until = self.state.t + self.cfg.bucket_s
             return self.state
         raw = self.client.hmget(self.keys.current, ["map_people", "map_aliases", "t", "written", "map_reports",
                                                     "last_bucket"])
@@ -151,6 +165,10 @@ class MapLink:
                       "reports": raw[4] or "[]"}
             self.state = decode_map_state(fields)
         return self.state
+
+    def _alias_window(self) -> int:
+        """How many buckets back a merge is still applied (``forget_after_s``): what a first read takes."""
+        return max(1, int(math.ceil(self.cfg.forget_after_s / self.cfg.bucket_s)))
 
     def _wait_for_map(self, t: float) -> None:
         if self._first_t is None:
@@ -173,12 +191,26 @@ class MapLink:
             return
         local = tracker.position_map
         for young, elder in state.aliases.items():
-            if young in local:
+            if young not in local:
+                continue
+            if elder not in local and isinstance(local, SharedPositionMap):
+                local.promote(young, known_id=elder)     # its copy goes on under the elder id, as tracked
+                for held in (self.mine_seen, self.ever_seen):
+                    if young in held:
+                        held.add(elder)
+            else:
                 local.remove(young)
-                self.mine_seen.discard(young)
+            self.mine_seen.discard(young)
+            self.ever_seen.discard(young)
+            self.placed.discard(young)
         present = {p.id: p for p in state.present()}
         cams = list(self.cameras.values())
         dt = min(max(t - state.captured, 0.0), 0.5)
+        # A person this worker's tracker holds is set to where the map had them at the time of its
+        # previous step (the tracker then predicts them to ``t`` itself); see _follows_map.
+        dt_held = dt if self.cfg.share_rule == "support-lead" else \
+            min(max((self._prev_t if self._prev_t is not None else t) - state.captured, 0.0), 0.5)
+        self._prev_t = t
         for p in present.values():
             x, y = p.x + p.vx * dt, p.y + p.vy * dt
             q = local.get(p.id)
@@ -188,16 +220,31 @@ class MapLink:
                 if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)) and \
                         not self._holds_near(local, x, y):
                     self._place(tracker, p, x, y, t)
-            elif p.id not in self.mine_seen or p.lead not in ("", self.name):
-                # Not shown by this worker's cameras, or shown better by another worker's: from
-                # where the map has them (this worker's cameras then move them by their evidence).
-                q.x, q.y, q.vx, q.vy = x, y, p.vx, p.vy
+            elif self._follows_map(p):
+                # Not shown by this worker's cameras, or also by another worker's: from where the
+                # map has them (this worker's cameras then move them by their evidence).
+                q.x, q.y, q.vx, q.vy = p.x + p.vx * dt_held, p.y + p.vy * dt_held, p.vx, p.vy
                 if math.isfinite(p.height):
                     q.height = p.height
         for q in list(local):
             if q.id > 0 and q.id in self.placed and q.id not in present and q.id not in self.mine_seen:
                 local.remove(q.id)
                 self.placed.discard(q.id)
+
+    def _follows_map(self, p) -> bool:
+        """Does this worker start person ``p`` (on the map and on its own) from the map's estimate?
+
+        Yes when its cameras do not show them. When they do, by ``map.share_rule``:
+        ``information`` — yes whenever another worker's estimate is in the map's (every worker
+        that sees a person refines the common estimate with its own images each frame, and the
+        map adds their measurements by information, :mod:`worldtrack.map.fusion`);
+        ``support-lead`` — unless this worker is the person's lead (it continues from its own).
+        """
+        if p.id not in self.mine_seen:
+            return True
+        if self.cfg.share_rule == "information":
+            return p.workers > 1 or p.lead not in ("", self.name)
+        return p.lead not in ("", self.name)
 
     def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
         return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m for q in local)
@@ -224,7 +271,11 @@ class MapLink:
         cams = [c for c in per_cam]
         now_ids = set()
         self.mine_seen = set()
-        for tr in tracks:
+        # Everybody this worker's tracker holds, as boxes in each camera: a person behind another
+        # one in a view is measured worse there (their feet, which tell the depth, are hidden).
+        bodies = np.array([[tr.x, tr.y, tr.height, tr.width] for tr in tracks]).reshape(-1, 4)
+        boxes = {c: people_boxes(self.cameras[c], bodies) for c in cams}
+        for k, tr in enumerate(tracks):
             person = local.get(tr.id)
             seen = person is not None and (person.last_seen >= t or person.seen_now(t))
             views = in_views([self.cameras[c] for c in cams], np.array([tr.x, tr.y]), tr.height)
@@ -240,10 +291,12 @@ class MapLink:
                 self.ever_seen.add(tr.id)
                 self.placed.discard(tr.id)
             now_ids.add(tr.id)
-            support = _support(person, tr)
-            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ)
+            support = support_of(person, tr)
+            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ,
+                                     blockers=[np.delete(boxes[c], k, axis=0) for c in mine])
+            cov = tracker_covariance(tracker, person, t) if seen else None
             e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info,
-                         share)
+                         share, *(NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])))
             for c, ok in zip(cams, views):
                 if ok:
                     per_cam[c].append(e)
@@ -290,22 +343,15 @@ def set_epoch(client: Any, keys: MapKeys, lead_s: float, bucket_s: float, clock:
     return float(client.get(keys.epoch))
 
 
-def _support(person: Person | None, tr: Track) -> float:
-    for v in (getattr(person, "support", float("nan")), (person.extra if person is not None else {}).get("support"),
-              tr.extra.get("support")):
-        if v is not None and math.isfinite(float(v)):
-            return float(v)
-    return float("nan")
-
-
 class MapTracker:
     """A tracker stepping on the shared map: :class:`MapLink` ``sync`` before each step and
     ``publish`` after. Everything else is the inner tracker's (the :class:`Tracker` protocol).
 
     The inner tracker's warm start (tracking the first frames forwards and backwards, to start on
-    frame 0 with the people in view) runs only when the shared map has nobody near this worker's
-    views (a worker starting with the map, not one taking a camera over), its people taking the
-    map's ids.
+    frame 0 with the people in view) runs only in batch runs (files read as fast as the worker
+    can): on live cameras it would hold the first frames back (~1 s) and publish them late. And
+    only when the shared map has nobody near this worker's views (a worker starting with the map,
+    not one taking a camera over), its people taking the map's ids.
     """
 
     def __init__(self, inner: Tracker, link: MapLink, on_step: Callable[[float], None] | None = None,
@@ -319,8 +365,8 @@ class MapTracker:
 
     @property
     def warm_start_frames(self) -> int:
-        if not isinstance(self.position_map, SharedPositionMap):
-            return 0
+        if not isinstance(self.position_map, SharedPositionMap) or not self.link.lockstep:
+            return 0        # live cameras (or files played as such): holding frames back is latency
         state = self.link.read_map()
         cams = list(self.link.cameras.values())
         if state is not None and any(any(in_views(cams, np.array([p.x, p.y]), p.height,
