@@ -35,7 +35,7 @@ and picks (v, ω) by a dynamic-window search:
 >>> cam = sc.camera_at("robot", 0)
 >>> fwd = cam.floor_direction
 >>> target = cam.centre[:2] + 3.0 * fwd                        # 3 m straight ahead, standing
->>> step = SimpleNamespace(found=True, xy=target, velocity=np.zeros(2), measured=target,
+>>> step = SimpleNamespace(t=0.0, found=True, xy=target, velocity=np.zeros(2), measured=target,
 ...                        others_xy=np.zeros((0, 2)), others_velocity=np.zeros((0, 2)),
 ...                        candidates=SimpleNamespace(xy=target[None]))
 >>> v, w = LocalPlanner(sc.scene).command(step, cam, 0.0)
