@@ -14,7 +14,8 @@ filter's candidates ranked on the 256 strongest template points (LM uses all), a
 extrema filled up to N = 1024 with crests of the drawing's gradient magnitude. KLT + solvePnP
 (``worldtrack.pose.baselines``) runs on the same frames as a second baseline.
 
-Seeds: 200–204 are held out (development used seed 100).
+Seeds: 200–209 are held out (development used seed 100). ``PF1LM10+v@36d`` runs the defaults as they
+were before issue 36e (extrema picked on a 0.5 px drawing, point-sampled model albedo), for before/after rows.
 
     .venv/bin/python benchmarks/pose_faces.py                    # both tables, seeds 200-204
     .venv/bin/python benchmarks/pose_faces.py --motion sim2      # Table 4 only → results/pose_faces_sim2.md
