@@ -14,7 +14,8 @@ filter's candidates ranked on the 256 strongest template points (LM uses all), a
 extrema filled up to N = 1024 with crests of the drawing's gradient magnitude. KLT + solvePnP
 (``worldtrack.pose.baselines``) runs on the same frames as a second baseline.
 
-Seeds: 200–204 are held out (development used seed 100).
+Seeds: 200–209 are held out (development used seed 100). ``PF1LM10+v@36d`` runs the defaults as they
+were before issue 36e (extrema picked on a 0.5 px drawing, point-sampled model albedo), for before/after rows.
 
     .venv/bin/python benchmarks/pose_faces.py                    # both tables, seeds 200-204
     .venv/bin/python benchmarks/pose_faces.py --motion sim2      # Table 4 only → results/pose_faces_sim2.md
@@ -52,11 +53,19 @@ PAPER_SIM2 = {"PF1LM0": [F, 5.480, 5.053, 4.317, F, F, F, 4.506, 5.237],
 PAPER_SIM2_MS = {"PF1LM0": 30, "PF1LM10": 45, "PF1LM30": 60}
 
 
+PREVIOUS = "@36d"          # suffix: worldtrack's defaults as they were before issue 36e (for before/after rows)
+
+
 def config(name: str, seed: int = 0) -> TrackerConfig:
     """``PFsLMn`` — the paper's method (random walk, every template point in the particle filter,
     a template of intensity extrema only); ``PFsLMn+v`` — worldtrack's defaults (constant-velocity
-    start, candidates ranked on 256 points, the template filled up with gradient crests)."""
-    s, l = name[2:].removesuffix("+v").split("LM")
+    start, candidates ranked on 256 points, the template filled up with gradient crests);
+    ``PFsLMn+v@36d`` — those defaults before issue 36e (extrema and crests picked on a drawing
+    smoothed by 0.5 px instead of the matched one; with :func:`model` the model's albedo
+    point-sampled)."""
+    s, l = name[2:].removesuffix(PREVIOUS).removesuffix("+v").split("LM")
+    if name.endswith(PREVIOUS):
+        return TrackerConfig(stages=int(s), lm_iterations=int(l), select_px=0.5, seed=seed)
     if name.endswith("+v"):
         return TrackerConfig(stages=int(s), lm_iterations=int(l), seed=seed)
     return TrackerConfig(stages=int(s), lm_iterations=int(l), motion="none", pf_points=None, edge_points=False,
@@ -66,7 +75,7 @@ def config(name: str, seed: int = 0) -> TrackerConfig:
 def run(face, frames, intr, method: str, seed: int) -> dict:
     """Track one sequence; returns errors, translation errors, step times and failures."""
     f0 = frames[0]
-    model = face_model(face)
+    model = face_model(face, albedo_samples=1 if method.endswith(PREVIOUS) else 3)
     if method == "KLT+PnP":
         tr = KltPnpTracker(model, intr, f0.R, f0.t, f0.image)
     else:
@@ -98,7 +107,7 @@ def table(motion: str, methods: list[str], faces: list[int], seeds: list[int], n
             print(f"{motion} P{i + 1} seed {s}: " + ", ".join(
                 f"{m} {np.mean(results[(m, i)][-1]['err']):.3f}" + (f" fail {results[(m, i)][-1]['fail']}"
                                                                      if results[(m, i)][-1]['fail'] else "")
-                for m in methods), file=sys.stderr, flush=True)
+                + f" max {np.max(results[(m, i)][-1]['err']):.2f}" for m in methods), file=sys.stderr, flush=True)
     rows, summary = [], {}
     for i in faces:
         row = [f"P{i + 1}"]
@@ -116,7 +125,9 @@ def table(motion: str, methods: list[str], faces: list[int], seeds: list[int], n
                       "worst_face": max(float(np.mean([e for r in results[(m, i)] for e in r["err"]])) for i in faces),
                       "trans": float(np.mean([e for r in allr for e in r["terr"]])),
                       "ms": statistics.median([t for r in allr for t in r["ms"]]),
-                      "fail": sum(r["fail"] for r in allr), "failed_faces": sum(any(r["fail"] for r in results[(m, i)]) for i in faces)}
+                      "fail": sum(r["fail"] for r in allr), "failed_faces": sum(any(r["fail"] for r in results[(m, i)]) for i in faces),
+                      "per_seed": [float(np.mean([np.mean(results[(m, i)][j]["err"]) for i in faces])) for j in range(len(seeds))],
+                      "seeds": seeds}
     rows.append(["mean"] + [f"{summary[m]['mean']:.3f}" for m in methods])
     rows.append(["trans (mm)"] + [f"{summary[m]['trans']:.2f}" for m in methods])
     rows.append(["failures"] + [f"{summary[m]['fail']} ({summary[m]['failed_faces']} faces)" for m in methods])
@@ -165,7 +176,8 @@ def main() -> None:
         for m, s in summ.items():
             lines.append(f"- {mo} {m}: mean {s['mean']:.3f} deg, worst face {s['worst_face']:.3f} deg, "
                          f"translation {s['trans']:.2f} mm, {s['fail']} failures on {s['failed_faces']} faces, "
-                         f"{s['ms']:.1f} ms/frame ({s['ms'] / mog2:.2f} x MOG2)")
+                         f"{s['ms']:.1f} ms/frame ({s['ms'] / mog2:.2f} x MOG2); mean over faces per seed: "
+                         + ", ".join(f"{sd} {v:.3f}" for sd, v in zip(s["seeds"], s["per_seed"])))
     out += ["## Summary\n"] + lines
     text = "\n".join(out)
     print(text)

@@ -13,7 +13,7 @@ from worldtrack.pose.rigid import face_jacobian, face_normal_equations, gradient
 from worldtrack.pose.template import gradient_maxima, local_extrema
 from worldtrack.pose.tracker import to_grey
 from worldtrack.geometry.rotation import rodrigues
-from worldtrack.synth.faces import face_model, face_sequence, make_face
+from worldtrack.synth.faces import GREY_WEIGHTS, face_albedo, face_model, face_sequence, make_face
 
 
 @pytest.fixture(scope="module")
@@ -196,3 +196,36 @@ def test_the_head_hides_face_points_but_is_never_a_template_point():
     behind[inside] = hidden.depth[v[inside], u[inside]] < pts[inside, 2] - 0.005
     assert sum(behind[i] for i in picked["bare"]) > 5                # without the skull: hidden points kept
     assert sum(behind[i] for i in picked["head"]) <= 2
+
+
+def test_model_albedo_is_the_mean_over_each_points_cell():
+    """A texture finer than the model's spacing (stubble: 1.5 mm) is averaged over each point's
+    cell instead of aliased: the model is closer to a fine (9×9) cell average than a point sample is."""
+    face = make_face(7)                                               # a face with stubble
+    assert face.stubble
+    model = face_model(face, head_spacing=None)
+    point = face_model(face, head_spacing=None, albedo_samples=1)
+    idx = np.random.default_rng(0).choice(len(model.points), 400, replace=False)
+    x, y = model.points[idx, 0], model.points[idx, 1]
+    offsets = ((np.arange(9) + 0.5) / 9 - 0.5) * model.spacing
+    fine = sum(face_albedo(face, x + dx, y + dy) for dx in offsets for dy in offsets) / 81 @ GREY_WEIGHTS
+    err_model, err_point = np.abs(model.albedo[idx] - fine).mean(), np.abs(point.albedo[idx] - fine).mean()
+    assert err_model < 0.5 * err_point, (err_model, err_point)
+
+
+def test_minimum_of_the_cost_is_near_the_truth_on_a_finely_textured_face():
+    """LM started at the true pose, with the template drawn at the previous true pose, ends within
+    0.4° of the truth on a face with stubble (640×480, three frames). Picking extrema on a drawing
+    finer than the matched one (0.5 px) and a point-sampled albedo left it 0.56° away: half the
+    template then sat on stubble extrema the matched drawing had smoothed away."""
+    face = make_face(7)
+    seq = face_sequence(face, "sim1", seed=7, n_frames=4)
+    frames = list(seq.frames())
+    tr = RigidTracker(face_model(face), seq.intr, frames[0].R, frames[0].t, TrackerConfig(lm_tol=0))
+    errors = []
+    for prev, f in zip(frames, frames[1:]):
+        tp = tr.template(rigid_state(prev.R, prev.t))
+        cost = tr.make_cost(cv2.GaussianBlur(to_grey(f.image), (0, 0), 1.0), None, rigid_state(prev.R, prev.t), tp)
+        res = tr._lm(cost, rigid_state(f.R, f.t)[None], 30)
+        errors.append(float(rotation_error_deg(f.R, state_pose(res.states)[0][0])))
+    assert np.mean(errors) < 0.4, errors

@@ -147,7 +147,10 @@ def sparse_template_pixels(albedo: np.ndarray, xyz: np.ndarray, intr: Intrinsics
     known = surface & np.isfinite(intensity)
     known = cv2.erode(known.astype(np.uint8), k, iterations=2, borderValue=0).astype(bool)   # off the silhouette
     # Extrema of the lightly smoothed drawing (more of them, N ≤ n_colour); values from the smoothed one.
-    fine = smooth_valid(np.nan_to_num(raw), drawn & np.isfinite(raw), select_sigma) if select_sigma > 0 else raw
+    if select_sigma == sigma:
+        fine = intensity
+    else:
+        fine = smooth_valid(np.nan_to_num(raw), drawn & np.isfinite(raw), select_sigma) if select_sigma > 0 else raw
     rc, strength = local_extrema(np.nan_to_num(fine), known & np.isfinite(fine), radius)
     if groups is None:
         rc = _strongest(rc, strength, n_colour) if len(rc) else rc

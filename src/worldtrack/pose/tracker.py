@@ -66,6 +66,9 @@ class TrackerConfig:
         the paper)
     edge_points : fill the template up to ``n_template`` with crests of the drawing's gradient
         magnitude after the extrema (worldtrack's addition; False: extrema only, as the paper)
+    select_px : Gaussian σ (pixels) of the drawing whose extrema and crests are picked; None: the
+        drawing the template's values are read from (σ of ``smooth_px`` and ``camera_blur_px``), so a
+        point is an extremum of what is matched
     """
 
     stages: int = 1
@@ -89,6 +92,7 @@ class TrackerConfig:
     edge_points: bool = True
     window_margin_px: int | None = 48
     lm_tol: float = 1e-3
+    select_px: float | None = None
     seed: int = 0
 
 
@@ -174,8 +178,9 @@ class RigidTracker:
         albedo = self.model.albedo
         n_depth = self.config.n_depth if self.cost == "colour-depth" else 0
         sigma = float(np.hypot(self.config.smooth_px, 0.0 if self.model.from_image else self.config.camera_blur_px))
+        select = sigma if self.config.select_px is None else self.config.select_px
         return sparse_template_pixels(albedo, xyz, self.intr, self.config.n_template, n_depth, sigma=sigma,
-                                      edge_fill=self.config.edge_points)
+                                      select_sigma=select, edge_fill=self.config.edge_points)
 
     def window(self, tp, states: np.ndarray) -> tuple[Intrinsics, slice, slice]:
         """The part of the frame the candidates ``states`` can read: the template's box under them

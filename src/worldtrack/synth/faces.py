@@ -157,14 +157,24 @@ def face_surface(face: Face, spacing: float = 0.001) -> tuple[np.ndarray, np.nda
     return np.column_stack([x, y, z]), n, face_albedo(face, x, y)
 
 
-def face_model(face: Face, spacing: float = 0.001, head_spacing: float | None = 0.0015) -> PointModel:
+def face_model(face: Face, spacing: float = 0.001, head_spacing: float | None = 0.0015,
+               albedo_samples: int = 3) -> PointModel:
     """The tracker's model of ``face`` (the paper's 3-D face model): face surface points with grey
     albedo and, unless ``head_spacing`` is None, the front half of the skull behind it (points
     ``head_spacing`` m apart) with unknown appearance (NaN albedo: hair gives no stable texture).
     The skull is never part of a template, but it hides the face points it covers when the head
     turns: without it a template at 50° of yaw kept points the hair hides (LM started at the true
-    pose of such frames ended 1.8° away on average, 0.8° with it)."""
+    pose of such frames ended 1.8° away on average, 0.8° with it).
+
+    A point's albedo is the mean over its ``spacing``-wide cell (``albedo_samples``² samples, as a
+    scanned model's texel averages its patch of skin; 1 = the texture sampled at the point): a
+    texture finer than the spacing (stubble, 1.5 mm) would otherwise alias in the model.
+    """
     p, n, bgr = face_surface(face, spacing)
+    if albedo_samples > 1:
+        offsets = ((np.arange(albedo_samples) + 0.5) / albedo_samples - 0.5) * spacing
+        bgr = sum(face_albedo(face, p[:, 0] + dx, p[:, 1] + dy) for dx in offsets for dy in offsets)
+        bgr = bgr / albedo_samples ** 2
     albedo = (bgr @ GREY_WEIGHTS).astype(np.float32)
     if head_spacing is not None:
         hp, hn, _ = _head_back(face, head_spacing)
