@@ -208,7 +208,7 @@ def run_live(args: argparse.Namespace, cfg) -> int:
             tracker.init_track(x, y, track_id=tid)
         if worker is not None:
             from worldtrack.map.timings import StepTimings
-            from worldtrack.map.worker import MapTracker
+            from worldtrack.map.map_tracker import MapTracker
 
             def stepped(t: float) -> None:
                 worker.frames += 1
