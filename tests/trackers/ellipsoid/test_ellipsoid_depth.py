@@ -2,9 +2,8 @@
 
 import numpy as np
 import pytest
+from _line_of_sight import line_of_sight_frame, misplaced
 
-from worldtrack.experiment import synthetic_tracker
-from worldtrack.synth import make_scenario
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.depth import DepthFusion, fuse_along
 from worldtrack.trackers.ellipsoid.height_sigma import height_estimate, height_sigma, median_sigma
@@ -13,28 +12,7 @@ from worldtrack.trackers.people import Person
 
 @pytest.fixture(scope="module")
 def seen():
-    """One rendered frame of the line-of-sight room (320x240, one camera 2.5-3 m high, people
-    5-10 m away): the tracker, its foreground labels, the instance image and the truth of the
-    person seen best."""
-    sc = make_scenario("line-of-sight", size=(320, 240), frames=1, seed=7, floor_clothes=0)
-    bundle = next(iter(sc.frames()))
-    tracker = synthetic_tracker(sc, "ellipsoid")
-    view = bundle.views["cam"]
-    labels = tracker.views["cam"].foreground.labels(view.image)
-    whole = [g for g in bundle.gt if g["head_cam"] and g["feet_cam"]]
-    best = max(whole, key=lambda g: np.count_nonzero(view.instance == g["id"]))
-    return tracker, labels, view.instance, best
-
-
-def _misplaced(tracker, truth, along_m):
-    """A tracked person ``along_m`` metres beyond the truth along the camera's line of sight, with
-    the true height; and the truth's floor point."""
-    cam = tracker.scene.cameras["cam"]
-    xy = np.array([truth["x"], truth["y"]])
-    ray = (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
-    start = xy + along_m * ray
-    return tracker.fresh().position_map.add(float(start[0]), float(start[1]), truth["height"], 0.45,
-                                            mode="tracking", time=0.0), xy
+    return line_of_sight_frame()
 
 
 def _legs_unsure(labels, instance, truth, shoes_px=0):
@@ -55,11 +33,11 @@ def _fusion(**depth):
 
 def test_the_feet_of_a_whole_silhouette_pull_a_track_back_and_nothing_moves_with_fusion_off(seen):
     tracker, labels, _, truth = seen
-    p, xy = _misplaced(tracker, truth, 0.6)
+    p, xy = misplaced(tracker, truth, 0.6)
     assert _fusion().apply([p], tracker.views, {"cam": labels}, tracker.walkable, 0.1) == 1
     # Feet σ 0.1 m against the clear ellipse's 0.3 m: 90 % of the 0.6 m back.
     assert np.hypot(p.x - xy[0], p.y - xy[1]) < 0.15
-    q, _ = _misplaced(tracker, truth, 0.6)
+    q, _ = misplaced(tracker, truth, 0.6)
     off = DepthFusion(DepthConfig(), FeetConfig(), HeightConfig())
     off.remember_prediction([q])
     assert off.apply([q], tracker.views, {"cam": labels}, tracker.walkable, 0.1) == 0
@@ -72,7 +50,7 @@ def test_where_the_legs_are_not_foreground_the_prediction_carries_the_depth(seen
     # The silhouette ends at the waist, or at shoes below unsure trousers: the feet are not trusted.
     cut = _legs_unsure(labels, instance, truth, shoes_px)
     # The prediction said the truth; the match put the person 0.6 m beyond it.
-    p, xy = _misplaced(tracker, truth, 0.0)
+    p, xy = misplaced(tracker, truth, 0.0)
     fusion = _fusion()
     fusion.remember_prediction([p])
     start = xy + 0.6 * (xy - tracker.scene.cameras["cam"].centre[:2]) / np.hypot(
@@ -83,11 +61,11 @@ def test_where_the_legs_are_not_foreground_the_prediction_carries_the_depth(seen
     # and the head (height unmeasured: σ ~0.6 m) bring it nearly all the way back.
     assert np.hypot(p.x - xy[0], p.y - xy[1]) < 0.1
     # Without the prediction, the head alone against the weak ellipse: part of the way.
-    q, _ = _misplaced(tracker, truth, 0.6)
+    q, _ = misplaced(tracker, truth, 0.6)
     _fusion().apply([q], tracker.views, {"cam": cut}, tracker.walkable, 0.1)
     assert 0.1 < np.hypot(q.x - xy[0], q.y - xy[1]) < 0.45
     # Once the height is measured (σ 3 cm, ~0.2 m along the ray here), the head counts for more.
-    r, _ = _misplaced(tracker, truth, 0.6)
+    r, _ = misplaced(tracker, truth, 0.6)
     r.height_samples.extend([truth["height"]] * 3)
     _fusion().apply([r], tracker.views, {"cam": cut}, tracker.walkable, 0.1)
     assert np.hypot(r.x - xy[0], r.y - xy[1]) < np.hypot(q.x - xy[0], q.y - xy[1]) - 0.1
@@ -96,7 +74,7 @@ def test_where_the_legs_are_not_foreground_the_prediction_carries_the_depth(seen
 def test_the_prediction_weighs_less_the_longer_the_feet_are_not_seen(seen):
     tracker, labels, instance, truth = seen
     cut = _legs_unsure(labels, instance, truth)
-    p, xy = _misplaced(tracker, truth, 0.0)
+    p, xy = misplaced(tracker, truth, 0.0)
     cam = tracker.scene.cameras["cam"]
     beyond = xy + 0.6 * (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
     fusion = _fusion()
