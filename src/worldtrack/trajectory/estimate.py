@@ -242,15 +242,33 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
             return {"+".join(won): result}, wins
         options = replace(options, race_iterations=None)       # a step inside an obstacle: every start converges
     runs = {name: LevenbergMarquardt(problem, starts[name], options.solver) for name in options.starts}
-    for run in runs.values():
-        run.run(options.race_iterations)
-    if options.race_iterations is not None:      # only the leader goes on to convergence
+    if options.race_iterations is None:
+        for run in runs.values():
+            run.run()
+    else:                                        # only the leader goes on to convergence
+        _race(runs, options.race_iterations)
         leader = min(runs.values(), key=lambda run: run.lin.costs.total)
         leader.run()
         if sample_field(problem.environment.barrier.field, leader.X[:, [POS[0], POS[1]]])[0].min() < 0:
             for run in runs.values():            # the leader ended inside an obstacle: a local optimum the
                 run.run()                        # barrier could not push out of; every start converges
     return {name: run.result for name, run in runs.items()}, {}
+
+
+def _race(runs: dict[str, LevenbergMarquardt], iterations: int) -> None:
+    """Every start ``iterations`` iterations, round by round; a start leaves the race as soon as the
+    minimum of its Gauss–Newton model (:meth:`~.solver.LevenbergMarquardt.model_floor`) is above the
+    objective some start already has — even the decrease its local model promises would leave it behind
+    (the model's minimum foretells where a start is heading: 34f's traces put the winner's within
+    1–3 % of its optimum from the first iteration on). The leader's own iterations are not changed."""
+    racing = list(runs.values())
+    for k in range(iterations + 1):
+        best = min(run.lin.costs.total for run in runs.values())
+        racing = [run for run in racing if run.model_floor() <= best]    # the holder of ``best`` stays
+        if k == iterations:
+            break
+        for run in racing:
+            run.run(1)
 
 
 def with_height(options: TrajectoryOptions, height: float) -> TrajectoryOptions:
