@@ -111,18 +111,6 @@ class Barrier:
         """Samples per step so that a walker at ``max_speed`` (m/s) moves at most ``clearance`` between them."""
         return max(1, int(np.ceil(max_speed * dt / max(clearance, 1e-3))))
 
-    def gain(self, weight: float) -> float:
-        """√(λ/m)/s_h: each of the m samples of a step carries 1/m of the weight λ."""
-        return float(np.sqrt(weight / self.substeps) / self.scale)
-
-    def kernel_arguments(self, weight: float, dt: float):
-        """The field and the hinge as the compiled kernels take them (:mod:`.kernels`)."""
-        from worldtrack.trajectory.kernels import FieldArrays, Hinge
-        f = self.field
-        return (FieldArrays(np.ascontiguousarray(f.values, dtype=float), np.asarray(f.origin, dtype=float),
-                            float(f.resolution)),
-                Hinge(float(dt), float(self.clearance), float(self.softness), self.gain(weight)))
-
     def samples(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """(step t, fraction α) of every sample on a grid of ``n`` steps: α = j/m on steps
         0 … n − 2, plus α = 1 on step n − 2 (the last state)."""
@@ -221,12 +209,13 @@ def barrier_residuals(X: np.ndarray, barrier: Barrier, weight: float, dt: float,
     """
     from worldtrack.trajectory.kernels import barrier_samples
     t, alpha = barrier.samples(len(X))
+    gain = np.sqrt(weight / barrier.substeps) / barrier.scale
+    f = barrier.field
     if reference:
-        r, J, d, curvature = barrier_samples_reference(X, t, alpha, dt, barrier.field, barrier.clearance,
-                                                       barrier.softness, barrier.gain(weight))
+        r, J, d, curvature = barrier_samples_reference(X, t, alpha, dt, f, barrier.clearance, barrier.softness, gain)
     else:
-        field, hinge = barrier.kernel_arguments(weight, dt)
-        r, J, d, curvature = barrier_samples(X, t, alpha, field, hinge)
+        r, J, d, curvature = barrier_samples(X, t, alpha, dt, f.values, np.asarray(f.origin, dtype=float),
+                                             float(f.resolution), barrier.clearance, barrier.softness, gain)
     if only_active:
         keep = np.flatnonzero(barrier.clearance - d > Z_CUTOFF * barrier.softness)
         r, J, d, curvature, t = r[keep], J[keep], d[keep], curvature[keep], t[keep]

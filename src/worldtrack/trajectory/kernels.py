@@ -8,7 +8,7 @@ it. These are plain loops in Numba over buffers that are allocated once.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import heapq
 
 import numpy as np
 from numba import njit
@@ -57,35 +57,31 @@ def add_motion_terms_reference(X: np.ndarray, A: np.ndarray, W: np.ndarray, g: n
 
 
 @njit(cache=True)
-def _add_pair(D: np.ndarray, B: np.ndarray, g: np.ndarray, t: int, J: np.ndarray, r: float,
-              w: float) -> None:  # pragma: no cover (compiled)
-    """In place: one residual r with Jacobian J (12,) on (x_t, x_{t+1}) as w·JᵀJ into D, B and Jᵀr into g."""
-    for i in range(2 * STATE):
-        ji = J[i]
-        if ji == 0.0:
-            continue
-        if i < STATE:
-            g[t, i] += ji * r
-        else:
-            g[t + 1, i - STATE] += ji * r
-        for j in range(2 * STATE):
-            v = w * ji * J[j]
-            if i < STATE and j < STATE:
-                D[t, i, j] += v
-            elif i >= STATE and j >= STATE:
-                D[t + 1, i - STATE, j - STATE] += v
-            elif i < STATE:
-                B[t, i, j - STATE] += v
-
-
-@njit(cache=True)
 def add_pair_terms(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray, J: np.ndarray,
                    r: np.ndarray, weight: np.ndarray) -> None:  # pragma: no cover (compiled)
     """In place: residuals r (M,) with Jacobians J (M, 12) on (x_t, x_{t+1}), t = step, added into
     the diagonal blocks D and upper blocks B (as weight·JᵀJ) and the half-gradient g (as Jᵀr)."""
     for m in range(step.shape[0]):
-        if r[m] != 0.0:                # r = 0: a sample left out (beyond the barrier's reach)
-            _add_pair(D, B, g, step[m], J[m], r[m], weight[m])
+        if r[m] == 0.0:                # a sample left out (beyond the barrier's reach): nothing to add
+            continue
+        t = step[m]
+        w = weight[m]
+        for i in range(2 * STATE):
+            ji = J[m, i]
+            if ji == 0.0:
+                continue
+            if i < STATE:
+                g[t, i] += ji * r[m]
+            else:
+                g[t + 1, i - STATE] += ji * r[m]
+            for j in range(2 * STATE):
+                v = w * ji * J[m, j]
+                if i < STATE and j < STATE:
+                    D[t, i, j] += v
+                elif i >= STATE and j >= STATE:
+                    D[t + 1, i - STATE, j - STATE] += v
+                elif i < STATE:
+                    B[t, i, j - STATE] += v
 
 
 def add_pair_terms_reference(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray, J: np.ndarray,
@@ -124,6 +120,30 @@ def block_matvec_reference(D: np.ndarray, B: np.ndarray, x: np.ndarray) -> np.nd
     y[:-1] += np.einsum("nij,nj->ni", B, x[1:])
     y[1:] += np.einsum("nji,nj->ni", B, x[:-1])
     return y
+
+
+@njit(cache=True)
+def model_decrease(D: np.ndarray, B: np.ndarray, g: np.ndarray, x: np.ndarray) -> float:  # pragma: no cover
+    """−(2·gᵀx + xᵀHx): how much the Gauss–Newton model F + 2gᵀx + xᵀHx falls along the step x (n, 6),
+    H block-tridiagonal (D, B); one pass, no H·x temporary (H·x is :func:`block_matvec`)."""
+    n = D.shape[0]
+    acc = 0.0
+    for t in range(n):
+        for i in range(STATE):
+            hx = 0.0
+            for j in range(STATE):
+                hx += D[t, i, j] * x[t, j]
+                if t + 1 < n:
+                    hx += B[t, i, j] * x[t + 1, j]
+                if t > 0:
+                    hx += B[t - 1, j, i] * x[t - 1, j]
+            acc += x[t, i] * (2.0 * g[t, i] + hx)
+    return -acc
+
+
+def model_decrease_reference(D: np.ndarray, B: np.ndarray, g: np.ndarray, x: np.ndarray) -> float:
+    """NumPy reference of :func:`model_decrease`."""
+    return float(-(2.0 * np.sum(g * x) + np.sum(x * block_matvec_reference(D, B, x))))
 
 
 @njit(cache=True)
@@ -217,100 +237,136 @@ def fill_banded_reference(D: np.ndarray, B: np.ndarray) -> np.ndarray:
     return ab
 
 
-class FieldArrays(NamedTuple):
-    """A floor field as the kernels read it: ``values[j, i]`` at ``origin + (i, j)·resolution`` (m)."""
-
-    values: np.ndarray
-    origin: np.ndarray
-    resolution: float
-
-
-class Hinge(NamedTuple):
-    """The rounded hinge of :class:`~worldtrack.trajectory.environment.Barrier` with its gain √(λ/m)/s_h,
-    and the grid step dt (s) of the Hermite curve between states."""
-
-    dt: float
-    clearance: float
-    softness: float
-    gain: float
-
-
 @njit(cache=True)
-def _barrier_point(X: np.ndarray, t: int, a: float, field: FieldArrays, hinge: Hinge, J: np.ndarray):  # pragma: no cover
-    """One barrier sample: Hermite point of (x_t, x_{t+1}) at α = a, bilinear distance and gradient
-    (extrapolated outside the grid), rounded hinge. Writes ∂r/∂(x_t, x_{t+1}) into the 8 non-zero
-    entries of J (12,) (the other four are left alone) unless the sample is beyond the barrier's reach;
-    returns (r, d, curvature factor), r = 0 beyond the reach (then J is not written)."""
-    values, origin, res = field.values, field.origin, field.resolution
-    ny, nx = values.shape
-    dt = hinge.dt
-    h0 = 2 * a ** 3 - 3 * a ** 2 + 1
-    h1 = (a ** 3 - 2 * a ** 2 + a) * dt
-    h2 = -2 * a ** 3 + 3 * a ** 2
-    h3 = (a ** 3 - a ** 2) * dt
-    px = h0 * X[t, 0] + h1 * X[t, 1] + h2 * X[t + 1, 0] + h3 * X[t + 1, 1]
-    py = h0 * X[t, 2] + h1 * X[t, 3] + h2 * X[t + 1, 2] + h3 * X[t + 1, 3]
-    cx = min(max(px, origin[0]), origin[0] + res * (nx - 1))
-    cy = min(max(py, origin[1]), origin[1] + res * (ny - 1))
-    fi = (cx - origin[0]) / res
-    fj = (cy - origin[1]) / res
-    i0 = min(int(fi), nx - 2)
-    j0 = min(int(fj), ny - 2)
-    u, v = fi - i0, fj - j0
-    v00, v01 = values[j0, i0], values[j0, i0 + 1]
-    v10, v11 = values[j0 + 1, i0], values[j0 + 1, i0 + 1]
-    d = (1 - u) * (1 - v) * v00 + u * (1 - v) * v01 + (1 - u) * v * v10 + u * v * v11
-    gx = ((1 - v) * (v01 - v00) + v * (v11 - v10)) / res
-    gy = ((1 - u) * (v10 - v00) + u * (v11 - v01)) / res
-    ox, oy = cx - px, cy - py
-    gap = np.sqrt(ox * ox + oy * oy)
-    if gap > 0:                    # d(p) = d(c(p)) − |c(p) − p|, c the clamped point
-        d -= gap
-        gx = (0.0 if ox != 0 else gx) + ox / gap
-        gy = (0.0 if oy != 0 else gy) + oy / gap
-    gain, softness = hinge.gain, hinge.softness
-    z = (hinge.clearance - d) / softness
-    if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
-        return 0.0, d, 1.0
-    soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
-    sig = 1.0 / (1.0 + np.exp(-z))
-    r = gain * softness * soft
-    sx, sy = -gain * sig * gx, -gain * sig * gy
-    J[0], J[1], J[6], J[7] = sx * h0, sx * h1, sx * h2, sx * h3
-    J[2], J[3], J[8], J[9] = sy * h0, sy * h1, sy * h2, sy * h3
-    return r, d, 1.0 + r * (1.0 - sig) / (gain * softness * sig)
-
-
-@njit(cache=True)
-def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, field: FieldArrays,
-                    hinge: Hinge):  # pragma: no cover (compiled)
+def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: float, values: np.ndarray,
+                    origin: np.ndarray, res: float, clearance: float, softness: float,
+                    gain: float):  # pragma: no cover (compiled)
     """The barrier at every sample in one pass (see ``environment.barrier_samples_reference``):
-    the rounded hinge r (M,), its Jacobian J (M, 12) on (x_t, x_{t+1}), the distance d (M,) and the
-    curvature factor (M,)."""
+    Hermite point of (x_t, x_{t+1}) at α, bilinear distance and gradient (extrapolated outside the
+    grid), rounded hinge r, its Jacobian J (M, 12), the distance d (M,) and the curvature factor."""
     m_count = step.shape[0]
+    ny, nx = values.shape
+    hi_x = origin[0] + res * (nx - 1)
+    hi_y = origin[1] + res * (ny - 1)
     r = np.empty(m_count)
     J = np.zeros((m_count, 2 * STATE))
-    d = np.empty(m_count)
+    d_out = np.empty(m_count)
     curvature = np.empty(m_count)
     for m in range(m_count):
-        r[m], d[m], curvature[m] = _barrier_point(X, step[m], alpha[m], field, hinge, J[m])
-    return r, J, d, curvature
+        t, a = step[m], alpha[m]
+        h0 = 2 * a ** 3 - 3 * a ** 2 + 1
+        h1 = (a ** 3 - 2 * a ** 2 + a) * dt
+        h2 = -2 * a ** 3 + 3 * a ** 2
+        h3 = (a ** 3 - a ** 2) * dt
+        px = h0 * X[t, 0] + h1 * X[t, 1] + h2 * X[t + 1, 0] + h3 * X[t + 1, 1]
+        py = h0 * X[t, 2] + h1 * X[t, 3] + h2 * X[t + 1, 2] + h3 * X[t + 1, 3]
+        cx = min(max(px, origin[0]), hi_x)
+        cy = min(max(py, origin[1]), hi_y)
+        fi = (cx - origin[0]) / res
+        fj = (cy - origin[1]) / res
+        i0 = min(int(fi), nx - 2)
+        j0 = min(int(fj), ny - 2)
+        u, v = fi - i0, fj - j0
+        v00, v01 = values[j0, i0], values[j0, i0 + 1]
+        v10, v11 = values[j0 + 1, i0], values[j0 + 1, i0 + 1]
+        d = (1 - u) * (1 - v) * v00 + u * (1 - v) * v01 + (1 - u) * v * v10 + u * v * v11
+        gx = ((1 - v) * (v01 - v00) + v * (v11 - v10)) / res
+        gy = ((1 - u) * (v10 - v00) + u * (v11 - v01)) / res
+        ox, oy = cx - px, cy - py
+        gap = np.sqrt(ox * ox + oy * oy)
+        if gap > 0:                    # d(p) = d(c(p)) − |c(p) − p|, c the clamped point
+            d -= gap
+            gx = (0.0 if ox != 0 else gx) + ox / gap
+            gy = (0.0 if oy != 0 else gy) + oy / gap
+        z = (clearance - d) / softness
+        d_out[m] = d
+        if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
+            r[m] = 0.0
+            curvature[m] = 1.0
+            continue
+        soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
+        sig = 1.0 / (1.0 + np.exp(-z))
+        r[m] = gain * softness * soft
+        curvature[m] = 1.0 + r[m] * (1.0 - sig) / (gain * softness * sig)
+        sx, sy = -gain * sig * gx, -gain * sig * gy
+        J[m, 0], J[m, 1], J[m, 6], J[m, 7] = sx * h0, sx * h1, sx * h2, sx * h3
+        J[m, 2], J[m, 3], J[m, 8], J[m, 9] = sy * h0, sy * h1, sy * h2, sy * h3
+    return r, J, d_out, curvature
 
 
 @njit(cache=True)
-def add_barrier_terms(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, field: FieldArrays, hinge: Hinge,
-                      D: np.ndarray, B: np.ndarray, g: np.ndarray, inside: np.ndarray) -> float:  # pragma: no cover
-    """:func:`barrier_samples` and :func:`add_pair_terms` in one pass, without the (M, 12) Jacobian:
-    each sample's curvature·JᵀJ into D, B and Jᵀr into g, ``inside[t] = True`` where a sample of step t
-    is within the clearance; returns Σ r². (The solver's linearisation; the two-pass version is its
-    reference.)"""
-    J = np.zeros(2 * STATE)
-    cost = 0.0
-    for m in range(step.shape[0]):
-        r, d, curvature = _barrier_point(X, step[m], alpha[m], field, hinge, J)
-        if d < hinge.clearance:
-            inside[step[m]] = True
-        if r != 0.0:
-            cost += r * r
-            _add_pair(D, B, g, step[m], J, r, curvature)
-    return cost
+def field_values(values: np.ndarray, origin: np.ndarray, res: float, xy: np.ndarray) -> np.ndarray:  # pragma: no cover
+    """The value d (N,) of ``environment.sample_field`` at floor points xy (N, 2) without its gradient:
+    bilinear on the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus
+    the distance to it. The same arithmetic in the same order (the free-space routes' rasters)."""
+    ny, nx = values.shape
+    hi_x = origin[0] + res * (nx - 1)
+    hi_y = origin[1] + res * (ny - 1)
+    d = np.empty(xy.shape[0])
+    for k in range(xy.shape[0]):
+        cx = min(max(xy[k, 0], origin[0]), hi_x)
+        cy = min(max(xy[k, 1], origin[1]), hi_y)
+        fi = (cx - origin[0]) / res
+        fj = (cy - origin[1]) / res
+        i0 = min(int(fi), nx - 2)
+        j0 = min(int(fj), ny - 2)
+        a, b = fi - i0, fj - j0
+        d[k] = ((1 - a) * (1 - b) * values[j0, i0] + a * (1 - b) * values[j0, i0 + 1]
+                + (1 - a) * b * values[j0 + 1, i0] + a * b * values[j0 + 1, i0 + 1])
+        gap = np.hypot(cx - xy[k, 0], cy - xy[k, 1])
+        if gap > 0:
+            d[k] -= gap
+    return d
+
+
+#: The 8 neighbours of a raster cell (dj, di) and their lengths in cells.
+_NEIGHBOURS = ((0, 1, 1.0), (1, 0, 1.0), (0, -1, 1.0), (-1, 0, 1.0),
+               (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0)), (-1, 1, np.sqrt(2.0)), (-1, -1, np.sqrt(2.0)))
+
+
+@njit(cache=True)
+def raster_route(weight: np.ndarray, free: np.ndarray, start: int, goal: int, res: float) -> np.ndarray:  # pragma: no cover
+    """Dijkstra on an 8-connected raster (ny, nx), stopping at the goal: an edge between free cells p, q
+    costs its length (res or res·√2) times the mean of their weights. Returns the flat cells from start
+    to goal, or an empty array if the goal cannot be reached. (``scipy.sparse.csgraph.dijkstra`` on the
+    same graph is the reference: same cost, the same path up to ties.)"""
+    ny, nx = weight.shape
+    w, ok = weight.ravel(), free.ravel()
+    dist = np.full(ny * nx, np.inf)
+    pred = np.full(ny * nx, -1)
+    done = np.zeros(ny * nx, dtype=np.bool_)
+    dist[start] = 0.0
+    heap = [(0.0, start)]
+    while len(heap):
+        d, p = heapq.heappop(heap)
+        if done[p]:
+            continue
+        done[p] = True
+        if p == goal:
+            break
+        j, i = p // nx, p % nx
+        for dj, di, ell in _NEIGHBOURS:
+            jj, ii = j + dj, i + di
+            if jj < 0 or jj >= ny or ii < 0 or ii >= nx:
+                continue
+            q = jj * nx + ii
+            if not ok[q] or done[q]:
+                continue
+            nd = d + res * ell * 0.5 * (w[p] + w[q])
+            if nd < dist[q]:
+                dist[q] = nd
+                pred[q] = p
+                heapq.heappush(heap, (nd, q))
+    if not done[goal]:
+        return np.empty(0, dtype=np.int64)
+    count = 1
+    p = goal
+    while p != start:
+        p = pred[p]
+        count += 1
+    cells = np.empty(count, dtype=np.int64)
+    p = goal
+    for k in range(count - 1, -1, -1):
+        cells[k] = p
+        p = pred[p]
+    return cells

@@ -17,7 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from worldtrack.trajectory.environment import (EnvironmentModel, barrier_residuals, height_residuals)
-from worldtrack.trajectory.kernels import add_barrier_terms, add_motion_terms, add_pair_terms
+from worldtrack.trajectory.kernels import add_motion_terms, add_pair_terms
 from worldtrack.trajectory.model import (STATE, VEL, MotionPrior, TimeGrid, first_velocity_residuals, motion_blocks,
                                         motion_residuals)
 from worldtrack.trajectory.observation import ObservationTerm, Observations
@@ -195,17 +195,14 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
         obs_cost += _add_pixel_term(term, starts, steps, problem.robust, X, D, g, step_cost)
     env = problem.environment
     barrier_cost = height_cost = 0.0
-    if env.barrier is not None and step_cost is None:      # one compiled pass, no (M, 12) Jacobian
-        t, alpha = env.barrier.samples(n)
-        barrier_cost = add_barrier_terms(X, t, alpha, *env.barrier.kernel_arguments(env.weight, problem.grid.dt),
-                                         D, B, g, barrier_steps)
-    elif env.barrier is not None:                            # the same in two passes, with the cost per step
+    if env.barrier is not None:
         br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
         if len(br.r):
             add_pair_terms(D, B, g, br.step, br.J, br.r, br.curvature)      # skips the r = 0 samples
             barrier_cost = float(br.r @ br.r)
             barrier_steps[br.step[br.inside]] = True
-            step_cost += np.bincount(br.step, br.r * br.r, minlength=n)
+            if step_cost is not None:
+                step_cost += np.bincount(br.step, br.r * br.r, minlength=n)
     if env.height is not None:
         rh, gain = height_residuals(X, env.height, env.weight)
         D[:, _W, _W] += gain * gain

@@ -21,7 +21,7 @@ import scipy.linalg
 import scipy.optimize
 
 from worldtrack.trajectory.environment import barrier_residuals, height_residuals
-from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, block_matvec, fill_banded
+from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, fill_banded, model_decrease
 from worldtrack.trajectory.model import STATE, VEL, first_velocity_residuals, motion_residuals
 from worldtrack.trajectory.objective import (Costs, Linearisation, Problem, evaluate, huber,
                                              linearise)
@@ -209,7 +209,7 @@ def levenberg_marquardt(problem: Problem, X0: np.ndarray, options: SolverOptions
 
 def _predicted_decrease(lin: Linearisation, delta: np.ndarray) -> float:
     """F(X) − F_model(X + δ) = −(2·gᵀδ + δᵀHδ) of the Gauss–Newton model."""
-    return float(-(2.0 * np.sum(lin.g * delta) + np.sum(delta * block_matvec(lin.D, lin.B, delta))))
+    return model_decrease(lin.D, lin.B, lin.g, delta)
 
 
 def _limit_moves(lin: Linearisation, delta: np.ndarray, predicted: float, max_move: float) -> tuple[np.ndarray, float]:
