@@ -49,6 +49,8 @@ class TrajectoryOptions:
     environment : bool — False: no barrier at all (the paper's comparison without e_h)
     race_iterations : int or None — every start gets this many iterations; only the one with the
         lowest objective then goes on to convergence (None: every start converges, as the paper).
+        A start leaves the race earlier, even before its first iteration, once the minimum of its
+        Gauss–Newton model is above the objective another start already has (``_race``).
         With a race, when the MAP without the barrier keeps so clear of every obstacle that its
         barrier cost is below the solver's tolerance, it is the optimum within that tolerance and
         is the only start run; when the leader converges to a path with a step inside an obstacle
@@ -221,8 +223,9 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
     """Levenberg–Marquardt with the barrier from each start: the race by gap, the race (every start
     ``options.race_iterations``, then only the leader to convergence) or every start to convergence.
     Returns the result per start (or per winning starts) and the windows each start won."""
+    made: dict[str, LevenbergMarquardt] = {}       # runs already set up (linearised) at their start
     if options.race_iterations is not None and "map" in options.starts:
-        polish = LevenbergMarquardt(problem, without.X, options.solver)
+        made["map"] = polish = LevenbergMarquardt(problem, without.X, options.solver)
         if polish.lin.costs.barrier <= options.solver.barrier_relative_decrease * polish.lin.costs.total:
             # F(X) ≥ F_free(X) ≥ F_free(X_free) = F(X_free) − barrier(X_free) for every X: no start
             # beats the MAP without the barrier by more than its barrier cost, here below the
@@ -241,7 +244,7 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
             won = sorted((name for name in count if count[name]), key=lambda name: -count[name]) or list(options.starts)
             return {"+".join(won): result}, wins
         options = replace(options, race_iterations=None)       # a step inside an obstacle: every start converges
-    runs = {name: LevenbergMarquardt(problem, starts[name], options.solver) for name in options.starts}
+    runs = {name: made.get(name) or LevenbergMarquardt(problem, starts[name], options.solver) for name in options.starts}
     if options.race_iterations is None:
         for run in runs.values():
             run.run()
