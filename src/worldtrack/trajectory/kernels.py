@@ -133,9 +133,11 @@ def model_decrease(D: np.ndarray, B: np.ndarray, g: np.ndarray, x: np.ndarray) -
             hx = 0.0
             for j in range(STATE):
                 hx += D[t, i, j] * x[t, j]
-                if t + 1 < n:
+            if t + 1 < n:
+                for j in range(STATE):
                     hx += B[t, i, j] * x[t + 1, j]
-                if t > 0:
+            if t > 0:
+                for j in range(STATE):
                     hx += B[t - 1, j, i] * x[t - 1, j]
             acc += x[t, i] * (2.0 * g[t, i] + hx)
     return -acc
@@ -249,7 +251,7 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
     hi_x = origin[0] + res * (nx - 1)
     hi_y = origin[1] + res * (ny - 1)
     r = np.empty(m_count)
-    J = np.zeros((m_count, 2 * STATE))
+    J = np.empty((m_count, 2 * STATE))        # every entry written below (no separate pass to zero it)
     d_out = np.empty(m_count)
     curvature = np.empty(m_count)
     for m in range(m_count):
@@ -280,9 +282,11 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
             gy = (0.0 if oy != 0 else gy) + oy / gap
         z = (clearance - d) / softness
         d_out[m] = d
+        J[m, 4], J[m, 5], J[m, 10], J[m, 11] = 0.0, 0.0, 0.0, 0.0     # the hinge reads positions only
         if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
             r[m] = 0.0
             curvature[m] = 1.0
+            J[m, 0], J[m, 1], J[m, 2], J[m, 3], J[m, 6], J[m, 7], J[m, 8], J[m, 9] = 0, 0, 0, 0, 0, 0, 0, 0
             continue
         soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
         sig = 1.0 / (1.0 + np.exp(-z))
