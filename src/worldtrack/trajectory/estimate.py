@@ -104,8 +104,8 @@ class TrajectoryEstimate:
     costs : dict — each term of the objective at X, and the total
     start : str — the start whose optimum won; with the race by gap, the starts that won a window
         joined by "+", most windows first (all of them when every window is a tie)
-    start_objectives : dict str → float — the final objective of every start that was run (with the race
-        by gap: ``start`` → the final objective)
+    start_objectives : dict str → float — the final objective of every start that was run (a start that
+        left the race: its objective then; with the race by gap: ``start`` → the final objective)
     observed : (n,) int — observations at each step
     barrier_active : (n,) bool — steps where the barrier pushes (a sample inside the clearance)
     without_barrier : (n, 6) — the MAP without the barrier (start ``map``), for comparison
