@@ -8,6 +8,8 @@ it. These are plain loops in Numba over buffers that are allocated once.
 
 from __future__ import annotations
 
+import heapq
+
 import numpy as np
 from numba import njit
 
@@ -121,6 +123,32 @@ def block_matvec_reference(D: np.ndarray, B: np.ndarray, x: np.ndarray) -> np.nd
 
 
 @njit(cache=True)
+def model_decrease(D: np.ndarray, B: np.ndarray, g: np.ndarray, x: np.ndarray) -> float:  # pragma: no cover
+    """−(2·gᵀx + xᵀHx): how much the Gauss–Newton model F + 2gᵀx + xᵀHx falls along the step x (n, 6),
+    H block-tridiagonal (D, B); one pass, no H·x temporary (H·x is :func:`block_matvec`)."""
+    n = D.shape[0]
+    acc = 0.0
+    for t in range(n):
+        for i in range(STATE):
+            hx = 0.0
+            for j in range(STATE):
+                hx += D[t, i, j] * x[t, j]
+            if t + 1 < n:
+                for j in range(STATE):
+                    hx += B[t, i, j] * x[t + 1, j]
+            if t > 0:
+                for j in range(STATE):
+                    hx += B[t - 1, j, i] * x[t - 1, j]
+            acc += x[t, i] * (2.0 * g[t, i] + hx)
+    return -acc
+
+
+def model_decrease_reference(D: np.ndarray, B: np.ndarray, g: np.ndarray, x: np.ndarray) -> float:
+    """NumPy reference of :func:`model_decrease`."""
+    return float(-(2.0 * np.sum(g * x) + np.sum(x * block_matvec_reference(D, B, x))))
+
+
+@njit(cache=True)
 def block_cholesky_solve(D: np.ndarray, B: np.ndarray, damping: np.ndarray, rhs: np.ndarray, L: np.ndarray,
                          C: np.ndarray, y: np.ndarray, x: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """Solve (H + diag(damping))·x = rhs for the SPD block-tridiagonal H of D (n, 6, 6), B (n − 1, 6, 6):
@@ -223,7 +251,7 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
     hi_x = origin[0] + res * (nx - 1)
     hi_y = origin[1] + res * (ny - 1)
     r = np.empty(m_count)
-    J = np.zeros((m_count, 2 * STATE))
+    J = np.empty((m_count, 2 * STATE))        # every entry written below (no separate pass to zero it)
     d_out = np.empty(m_count)
     curvature = np.empty(m_count)
     for m in range(m_count):
@@ -254,9 +282,11 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
             gy = (0.0 if oy != 0 else gy) + oy / gap
         z = (clearance - d) / softness
         d_out[m] = d
+        J[m, 4], J[m, 5], J[m, 10], J[m, 11] = 0.0, 0.0, 0.0, 0.0     # the hinge reads positions only
         if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
             r[m] = 0.0
             curvature[m] = 1.0
+            J[m, 0], J[m, 1], J[m, 2], J[m, 3], J[m, 6], J[m, 7], J[m, 8], J[m, 9] = 0, 0, 0, 0, 0, 0, 0, 0
             continue
         soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
         sig = 1.0 / (1.0 + np.exp(-z))
@@ -266,3 +296,81 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
         J[m, 0], J[m, 1], J[m, 6], J[m, 7] = sx * h0, sx * h1, sx * h2, sx * h3
         J[m, 2], J[m, 3], J[m, 8], J[m, 9] = sy * h0, sy * h1, sy * h2, sy * h3
     return r, J, d_out, curvature
+
+
+@njit(cache=True)
+def field_values(values: np.ndarray, origin: np.ndarray, res: float, xy: np.ndarray) -> np.ndarray:  # pragma: no cover
+    """The value d (N,) of ``environment.sample_field`` at floor points xy (N, 2) without its gradient:
+    bilinear on the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus
+    the distance to it. The same arithmetic in the same order (the free-space routes' rasters)."""
+    ny, nx = values.shape
+    hi_x = origin[0] + res * (nx - 1)
+    hi_y = origin[1] + res * (ny - 1)
+    d = np.empty(xy.shape[0])
+    for k in range(xy.shape[0]):
+        cx = min(max(xy[k, 0], origin[0]), hi_x)
+        cy = min(max(xy[k, 1], origin[1]), hi_y)
+        fi = (cx - origin[0]) / res
+        fj = (cy - origin[1]) / res
+        i0 = min(int(fi), nx - 2)
+        j0 = min(int(fj), ny - 2)
+        a, b = fi - i0, fj - j0
+        d[k] = ((1 - a) * (1 - b) * values[j0, i0] + a * (1 - b) * values[j0, i0 + 1]
+                + (1 - a) * b * values[j0 + 1, i0] + a * b * values[j0 + 1, i0 + 1])
+        gap = np.hypot(cx - xy[k, 0], cy - xy[k, 1])
+        if gap > 0:
+            d[k] -= gap
+    return d
+
+
+#: The 8 neighbours of a raster cell (dj, di) and their lengths in cells.
+_NEIGHBOURS = ((0, 1, 1.0), (1, 0, 1.0), (0, -1, 1.0), (-1, 0, 1.0),
+               (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0)), (-1, 1, np.sqrt(2.0)), (-1, -1, np.sqrt(2.0)))
+
+
+@njit(cache=True)
+def raster_route(weight: np.ndarray, free: np.ndarray, start: int, goal: int, res: float) -> np.ndarray:  # pragma: no cover
+    """Dijkstra on an 8-connected raster (ny, nx), stopping at the goal: an edge between free cells p, q
+    costs its length (res or res·√2) times the mean of their weights. Returns the flat cells from start
+    to goal, or an empty array if the goal cannot be reached. (``scipy.sparse.csgraph.dijkstra`` on the
+    same graph is the reference: same cost, the same path up to ties.)"""
+    ny, nx = weight.shape
+    w, ok = weight.ravel(), free.ravel()
+    dist = np.full(ny * nx, np.inf)
+    pred = np.full(ny * nx, -1)
+    done = np.zeros(ny * nx, dtype=np.bool_)
+    dist[start] = 0.0
+    heap = [(0.0, start)]
+    while len(heap):
+        d, p = heapq.heappop(heap)
+        if done[p]:
+            continue
+        done[p] = True
+        if p == goal:
+            break
+        j, i = p // nx, p % nx
+        for dj, di, ell in _NEIGHBOURS:
+            jj, ii = j + dj, i + di
+            if jj < 0 or jj >= ny or ii < 0 or ii >= nx:
+                continue
+            q = jj * nx + ii
+            if not ok[q] or done[q]:
+                continue
+            nd = d + res * ell * 0.5 * (w[p] + w[q])
+            if nd < dist[q]:
+                dist[q] = nd
+                pred[q] = p
+                heapq.heappush(heap, (nd, q))
+    if not done[goal]:
+        return np.empty(0, dtype=np.int64)
+    count = 1
+    p = goal
+    while p != start:
+        p = pred[p]
+        count += 1
+    cells = np.empty(count, dtype=np.int64)
+    p = goal
+    for k in range(count - 1, -1, -1):
+        cells[k] = p
+        p = pred[p]
+    return cells

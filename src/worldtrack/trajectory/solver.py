@@ -21,7 +21,7 @@ import scipy.linalg
 import scipy.optimize
 
 from worldtrack.trajectory.environment import barrier_residuals, height_residuals
-from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, block_matvec, fill_banded
+from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, fill_banded, model_decrease
 from worldtrack.trajectory.model import STATE, VEL, first_velocity_residuals, motion_residuals
 from worldtrack.trajectory.objective import (Costs, Linearisation, Problem, evaluate, huber,
                                              linearise)
@@ -109,7 +109,9 @@ class LevenbergMarquardt:
             raise ValueError("the start puts the head behind a camera")
         self.mu, self.nu = options.initial_damping, 2.0
         # buffers reused by every iteration: the trial's linearisation and the linear solver's work
-        self._spare = linearise(problem, self.X)
+        lin = self.lin
+        self._spare = Linearisation(lin.costs, lin.g.copy(), lin.D.copy(), lin.B.copy(), lin.barrier_steps.copy())
+        self._pending: tuple[np.ndarray, np.ndarray] | None = None     # the next step, if already solved
         n = len(self.X)
         if options.linear_solver == "lapack":
             self._ab = np.zeros((BANDWIDTH + 1, self.X.size), order="F")
@@ -139,6 +141,19 @@ class LevenbergMarquardt:
             self.message = "iteration limit"
         return self.result
 
+    def model_floor(self) -> float:
+        """The objective at the minimum of the current Gauss–Newton model, F − (predicted decrease of the
+        next step, before the step limit): where the local quadratic model says this start is heading
+        (−inf if the damped system is not positive definite). The step is kept for the next iteration."""
+        if self.converged:
+            return self.lin.costs.total
+        if self._pending is None:
+            self._pending = self._step(self.lin)
+        if self._pending is None:
+            return -np.inf
+        delta, damping = self._pending
+        return self.lin.costs.total - float(-np.sum(self.lin.g * delta) + np.sum(damping * delta ** 2))
+
     def _step(self, lin: Linearisation) -> tuple[np.ndarray, np.ndarray] | None:
         """The damped Gauss–Newton step δ (n, 6) and the damping μ·diag(H) (n, 6); None if H + damping
         is not positive definite."""
@@ -159,7 +174,7 @@ class LevenbergMarquardt:
 
     def _iterate(self) -> None:
         lin, options = self.lin, self.options
-        step = self._step(lin)
+        step, self._pending = self._pending or self._step(lin), None
         if step is None:
             self.mu, self.nu = self.mu * self.nu, self.nu * 2
             return
@@ -194,7 +209,7 @@ def levenberg_marquardt(problem: Problem, X0: np.ndarray, options: SolverOptions
 
 def _predicted_decrease(lin: Linearisation, delta: np.ndarray) -> float:
     """F(X) − F_model(X + δ) = −(2·gᵀδ + δᵀHδ) of the Gauss–Newton model."""
-    return float(-(2.0 * np.sum(lin.g * delta) + np.sum(delta * block_matvec(lin.D, lin.B, delta))))
+    return model_decrease(lin.D, lin.B, lin.g, delta)
 
 
 def _limit_moves(lin: Linearisation, delta: np.ndarray, predicted: float, max_move: float) -> tuple[np.ndarray, float]:

@@ -20,7 +20,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from worldtrack.errors import InputError
 from worldtrack.scene.floor import FloorGrid
-from worldtrack.trajectory.environment import sample_field
+from worldtrack.trajectory.kernels import field_values, raster_route
 from worldtrack.trajectory.model import STATE, TimeGrid
 from worldtrack.trajectory.observation import ObservationTerm
 
@@ -87,8 +87,7 @@ def shortest_path_start(term: ObservationTerm, grid: TimeGrid, head_height: floa
 def _blocked(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: float) -> bool:
     n = max(2, int(np.ceil(np.linalg.norm(b - a) / (field.resolution / 2))) + 1)
     pts = a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)
-    d, _ = sample_field(field, pts)
-    return bool(np.any(d < clearance))
+    return bool(np.any(_distances(field, pts) < clearance))
 
 
 def resample_by_length(route: np.ndarray, n: int) -> np.ndarray:
@@ -122,11 +121,11 @@ def free_space_route(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: 
 
 
 def _route_in_box(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: float, resolution: float,
-                  lo: np.ndarray, hi: np.ndarray) -> np.ndarray | None:
+                  lo: np.ndarray, hi: np.ndarray, reference: bool = False) -> np.ndarray | None:
     xs = np.arange(lo[0], hi[0] + resolution / 2, resolution)
     ys = np.arange(lo[1], hi[1] + resolution / 2, resolution)
     gx, gy = np.meshgrid(xs, ys)
-    d, _ = sample_field(field, np.column_stack([gx.ravel(), gy.ravel()]))
+    d = _distances(field, np.column_stack([gx.ravel(), gy.ravel()]))
     soft = 1.5 * max(clearance, 1e-3)
     weight = 1.0 + 10.0 * np.clip((soft - d) / soft, 0.0, 1.0)
     ny, nx = gx.shape
@@ -134,6 +133,20 @@ def _route_in_box(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: flo
     goal = _nearest_cell(b, lo, resolution, nx, ny)
     free = d >= 0
     free[[start, goal]] = True
+    if reference:
+        cells = _scipy_route(weight.reshape(ny, nx), free.reshape(ny, nx), start, goal, resolution)
+    else:
+        cells = raster_route(weight.reshape(ny, nx), free.reshape(ny, nx), start, goal, float(resolution))
+    if len(cells) == 0:
+        return None
+    pts = np.column_stack([gx.ravel()[cells], gy.ravel()[cells]])
+    return np.vstack([a, pts[1:-1], b]) if len(pts) > 2 else np.vstack([a, b])
+
+
+def _scipy_route(weight: np.ndarray, free: np.ndarray, start: int, goal: int, resolution: float) -> np.ndarray:
+    """The reference of :func:`~.kernels.raster_route`: the raster's graph for
+    ``scipy.sparse.csgraph.dijkstra`` (from the start to every cell), then the path back from the goal."""
+    ny, nx = free.shape
     idx = np.arange(nx * ny).reshape(ny, nx)
     src, dst, length = [], [], []
     for dj, di in ((0, 1), (1, 0), (1, 1), (1, -1)):
@@ -141,21 +154,27 @@ def _route_in_box(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: flo
         i0, i1 = max(0, -di), nx - max(0, di)
         p = idx[j0:j1, i0:i1].ravel()
         q = idx[j0 + dj:j1 + dj, i0 + di:i1 + di].ravel()
-        ok = free[p] & free[q]
+        ok = free.ravel()[p] & free.ravel()[q]
         src.append(p[ok])
         dst.append(q[ok])
         length.append(np.full(int(ok.sum()), resolution * np.hypot(di, dj)))
     p, q, ell = np.concatenate(src), np.concatenate(dst), np.concatenate(length)
-    graph = coo_matrix((ell * 0.5 * (weight[p] + weight[q]), (p, q)), shape=(nx * ny, nx * ny)).tocsr()
+    w = weight.ravel()
+    graph = coo_matrix((ell * 0.5 * (w[p] + w[q]), (p, q)), shape=(nx * ny, nx * ny)).tocsr()
     dist, pred = dijkstra(graph, directed=False, indices=start, return_predecessors=True)
     if not np.isfinite(dist[goal]):
-        return None
+        return np.empty(0, dtype=np.int64)
     cells = [goal]
     while cells[-1] != start:
         cells.append(pred[cells[-1]])
-    cells = np.array(cells[::-1])
-    pts = np.column_stack([gx.ravel()[cells], gy.ravel()[cells]])
-    return np.vstack([a, pts[1:-1], b]) if len(pts) > 2 else np.vstack([a, b])
+    return np.array(cells[::-1])
+
+
+def _distances(field: FloorGrid, xy: np.ndarray) -> np.ndarray:
+    """``sample_field(field, xy)[0]`` (the same numbers) without the gradient, compiled: the route's
+    raster holds thousands of points per gap."""
+    return field_values(np.ascontiguousarray(field.values, dtype=float), np.asarray(field.origin, dtype=float),
+                        float(field.resolution), np.ascontiguousarray(xy, dtype=float))
 
 
 def _nearest_cell(p: np.ndarray, lo: np.ndarray, res: float, nx: int, ny: int) -> int:
