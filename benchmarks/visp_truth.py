@@ -108,8 +108,8 @@ def image_only_poses(sequence: Path, cMo0: np.ndarray, half: float) -> tuple[lis
     """A check of the board truth from the colour images alone: per frame, SIFT features matched to
     frame 0's on the cube (3-D points where their rays meet the cube at the given ``cMo(0)``), then
     ``cv2.solvePnPRansac`` (2 px) and ``cv2.solvePnPRefineLM`` on the inliers. No tracking (nothing
-    drifts), no depth, no tags. Frames with fewer than 8 inliers (motion blur) keep the previous
-    pose. Returns the poses (camera ← cube) and the inlier counts (0: kept the previous pose)."""
+    drifts), no depth, no tags. Frames with fewer than 8 inliers (motion blur: 4 of 99 here) get a
+    NaN pose. Returns the poses (camera ← cube) and the inlier counts."""
     cam = json.loads((sequence / "cam.json").read_text())
     K = np.array([[cam["px"], 0, cam["u0"]], [0, cam["py"], cam["v0"]], [0, 0, 1]])
     grey = lambda k: cv2.imread(str(sequence / f"color_image_{k:04d}.png"), cv2.IMREAD_GRAYSCALE)
@@ -124,15 +124,15 @@ def image_only_poses(sequence: Path, cMo0: np.ndarray, half: float) -> tuple[lis
         kp, des = sift.detectAndCompute(grey(k), None)
         good = [a for a, b in matcher.knnMatch(des0, des, k=2) if a.distance < 0.75 * b.distance]
         obj, img = X[[a.queryIdx for a in good]], np.array([kp[a.trainIdx].pt for a in good]).reshape(-1, 2)
-        prev = poses[-1]
+        prev = next(M for M in poses[::-1] if np.isfinite(M).all())
         rvec, tvec = cv2.Rodrigues(prev[:3, :3])[0], prev[:3, 3].reshape(3, 1).copy()
         inliers = None
         if len(good) >= 8:
             _, rvec, tvec, inliers = cv2.solvePnPRansac(obj, img, K, None, rvec, tvec, useExtrinsicGuess=True,
                                                         reprojectionError=2.0, iterationsCount=500)
         if inliers is None or len(inliers) < 8:
-            poses.append(prev.copy())
-            counts.append(0)
+            poses.append(np.full((4, 4), np.nan))
+            counts.append(0 if inliers is None else len(inliers))
             continue
         rvec, tvec = cv2.solvePnPRefineLM(obj[inliers.ravel()], img[inliers.ravel()], K, None, rvec, tvec)
         M = np.eye(4)
