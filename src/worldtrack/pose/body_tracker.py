@@ -123,8 +123,11 @@ def representative_pose(P: np.ndarray, eps, step_scale: np.ndarray) -> np.ndarra
     best = int(np.argmin(cost))
     order = np.argsort(np.linalg.norm((P - P[best]) / step_scale, axis=1), kind="stable")
     P, cost = P[order], cost[order]
-    means = np.stack([mean_body_pose(P[:k], candidate_weights(cost[:k])) for k in range(1, len(P) + 1)])
-    ok = eps(means) <= np.maximum.accumulate(cost) + 1e-12
+    plain = mean_body_pose(P, candidate_weights(cost))
+    if eps(plain[None])[0] <= cost.max() + 1e-12:                      # the common case: one basin
+        return plain
+    means = np.stack([mean_body_pose(P[:k], candidate_weights(cost[:k])) for k in range(1, len(P))])
+    ok = eps(means) <= np.maximum.accumulate(cost[:-1]) + 1e-12
     return means[np.flatnonzero(ok)[-1]] if ok.any() else P[0]
 
 
