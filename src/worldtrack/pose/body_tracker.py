@@ -6,7 +6,7 @@ arm (4) — the paper's cascade (§4.4), 1500 candidates each, σ of Table 6 hal
 refines all 14 parameters *jointly* (§4.6) with central-difference Jacobians (eq. 20) on the
 colour + depth cost (eqs. 16–19). ``lm_iterations = 0`` is the paper's conventional cascade.
 The representative pose is the cost-weighted mean, with rotation means for the torso and for
-each joint's ``Rz·Ry``.
+each joint's ``Rz·Ry``, of the kept candidates in the best one's basin (:func:`representative_pose`).
 
 >>> from worldtrack.synth.upper_body import body_sequence
 >>> seq = body_sequence(2, n_frames=3, size=(320, 240))
