@@ -6,7 +6,8 @@ import pytest
 from worldtrack.geometry.rotation import rot_y, rot_z
 from worldtrack.pose import axis_angle_deg
 from worldtrack.pose.body import body_geometry, body_transforms, body_transforms_reference, limb_axes
-from worldtrack.pose.body_tracker import BodyConfig, BodyTracker, mean_body_pose
+from worldtrack.pose.body_tracker import BodyConfig, BodyTracker, mean_body_pose, representative_pose
+from worldtrack.pose.particle import candidate_weights
 from worldtrack.synth.upper_body import body_sequence
 
 
@@ -38,6 +39,34 @@ def test_mean_pose_uses_rotation_means():
     m = mean_body_pose(P, np.array([0.5, 0.5]))
     R = rot_z(m[6]) @ rot_y(m[7])
     np.testing.assert_allclose(R, rot_z(np.pi), atol=1e-9)        # not the naive 0°
+
+
+def _two_basin_cost(X: np.ndarray) -> np.ndarray:
+    """ε of states (n, 14): two wells in the right elbow's θe (index 12), at 0° (deeper) and 20°."""
+    th = np.degrees(np.atleast_2d(X)[:, 12])
+    return np.minimum((th / 3) ** 2, 1.0 + ((th - 20) / 3) ** 2) + 10 * (np.atleast_2d(X)[:, :12] ** 2).sum(1)
+
+
+def test_representative_pose_stays_in_the_best_basin():
+    # no3's slip (issue 36f): kept candidates in two basins of the elbow; their weighted mean sat
+    # between them (θe ≈ 12°, a pose none held). The representative stays with the best one's basin.
+    rng = np.random.default_rng(3)
+    P = np.zeros((10, 14))
+    P[:, 12] = np.radians(np.r_[rng.normal(0, 0.5, 3), rng.normal(20, 0.5, 7)])
+    plain = mean_body_pose(P, candidate_weights(_two_basin_cost(P)))
+    assert np.degrees(plain[12]) > 8                                    # the plain mean is between the wells
+    rep = representative_pose(P, _two_basin_cost, np.full(14, 0.1))
+    assert abs(np.degrees(rep[12])) < 3.0                              # inside the deeper well (its ε < 1)
+    assert _two_basin_cost(rep[None])[0] < _two_basin_cost(plain[None])[0]
+
+
+def test_representative_pose_is_the_plain_mean_within_one_basin():
+    rng = np.random.default_rng(4)
+    P = np.zeros((10, 14))
+    P[:, 12] = np.radians(rng.normal(0, 1.0, 10))
+    rep = representative_pose(P, _two_basin_cost, np.full(14, 0.1))
+    np.testing.assert_allclose(rep, mean_body_pose(P, candidate_weights(_two_basin_cost(P))), atol=1e-12)
+    assert abs(rep[12] - P[np.argmin(_two_basin_cost(P)), 12]) > 1e-4          # not just the best candidate
 
 
 def test_tracks_a_synthetic_upper_body():

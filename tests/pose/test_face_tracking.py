@@ -229,3 +229,29 @@ def test_minimum_of_the_cost_is_near_the_truth_on_a_finely_textured_face():
         res = tr._lm(cost, rigid_state(f.R, f.t)[None], 30)
         errors.append(float(rotation_error_deg(f.R, state_pose(res.states)[0][0])))
     assert np.mean(errors) < 0.4, errors
+
+
+def test_learnt_depth_bias_removes_an_offset_and_a_tilt():
+    # A stereo camera's depth bias, smooth over the image (issue 36f: the ViSP camera's depth reads
+    # 4 mm far and is tilted 1-2 deg against the colour geometry). Learnt at the known first pose,
+    # the correction gives back the true depth everywhere, also in a window of the frame.
+    from worldtrack.pose.models import PointModel
+    from worldtrack.pose.render import Intrinsics
+    from worldtrack.pose.tracker import RigidTracker
+
+    bump = lambda x, y: 0.004 * np.sin(60 * x) * np.cos(60 * y)
+    g = np.mgrid[-0.06:0.06:0.001, -0.06:0.06:0.001].reshape(2, -1).T
+    pts = np.c_[g, bump(g[:, 0], g[:, 1])]
+    albedo = (100 + 50 * np.sin(90 * g[:, 0]) * np.cos(70 * g[:, 1])).astype(np.float32)
+    intr = Intrinsics(500.0, 500.0, 160.0, 120.0, 320, 240)
+    tr = RigidTracker(PointModel(pts, np.tile([0, 0, -1.0], (len(g), 1)), albedo, 0.001), intr, np.eye(3),
+                      np.array([0, 0, 0.5]), cost="colour-depth")
+    x, y = (np.arange(320) - 160) / 500, (np.arange(240) - 120) / 500
+    true = (0.5 + bump(0.5 * x[None, :], 0.5 * y[:, None])).astype(np.float32)
+    bias = 0.004 + 0.012 * x[None, :] - 0.009 * y[:, None]
+    measured = (true + bias).astype(np.float32)
+    np.testing.assert_allclose(tr.learn_depth_offset(measured), [0.004, 0.012, -0.009], atol=2e-4)
+    np.testing.assert_allclose(tr.corrected_depth(measured, intr), true, atol=3e-4)
+    window = intr._replace(cx=intr.cx - 40, cy=intr.cy - 30)                  # a cut starting at (40, 30)
+    np.testing.assert_allclose(tr.corrected_depth(measured[30:, 40:], window), true[30:, 40:], atol=3e-4)
+    assert tr.learn_depth_offset(measured, tilt=False)[1:].tolist() == [0.0, 0.0]

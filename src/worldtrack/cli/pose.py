@@ -196,6 +196,8 @@ def run(args: argparse.Namespace) -> int:
     config = TrackerConfig(stages=args.stages, lm_iterations=10 if args.lm_iterations is None else args.lm_iterations,
                            n_candidates=1000 if args.candidates is None else args.candidates, lam=args.lam, seed=args.seed)
     tracker = RigidTracker(model, intr, R0, t0, config, cost=cost)
+    if cost == "colour-depth" and depths is not None:
+        tracker.learn_depth_offset(d0)          # the sensor's depth bias at the object, at the known first pose
     return _track_rigid(args, colour, depths, tracker, intr, model, (R0, t0), (w, h))
 
 

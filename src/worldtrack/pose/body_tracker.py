@@ -6,7 +6,7 @@ arm (4) — the paper's cascade (§4.4), 1500 candidates each, σ of Table 6 hal
 refines all 14 parameters *jointly* (§4.6) with central-difference Jacobians (eq. 20) on the
 colour + depth cost (eqs. 16–19). ``lm_iterations = 0`` is the paper's conventional cascade.
 The representative pose is the cost-weighted mean, with rotation means for the torso and for
-each joint's ``Rz·Ry``.
+each joint's ``Rz·Ry``, of the kept candidates in the best one's basin (:func:`representative_pose`).
 
 >>> from worldtrack.synth.upper_body import body_sequence
 >>> seq = body_sequence(2, n_frames=3, size=(320, 240))
@@ -93,6 +93,44 @@ def mean_body_pose(P: np.ndarray, w: np.ndarray) -> np.ndarray:
     return out
 
 
+def representative_pose(P: np.ndarray, eps, step_scale: np.ndarray) -> np.ndarray:
+    """The frame's pose: the cost-weighted mean (§5.1) of the kept candidates in the best one's basin.
+
+    A weighted mean stands for its candidates only if they sit in one basin of the cost: there
+    (the cost quasi-convex) the mean costs no more than the worst candidate averaged. Kept
+    candidates can straddle two basins — e.g. a forearm swung 15–25° one way and the right one —
+    and their mean is then a pose none of them holds, worse than all of them. So the candidates
+    are taken in order of distance from the best (parameter steps divided by ``step_scale``), the
+    means of the nearest 1, 2, …, K are scored together, and the largest group whose mean costs no
+    more than its worst member is used (all K whenever their plain mean passes: the paper's mean).
+
+    Parameters
+    ----------
+    P : (K, 14) kept candidates; eps : states (n, 14) → ε (n,); step_scale : (14,) parameter units
+    (e.g. the first-stage σ) in which distances from the best candidate are measured
+
+    Returns
+    -------
+    (14,) the representative pose
+
+    >>> bowl = lambda X: np.minimum(((X - 0.1) ** 2).sum(1), ((X + 0.1) ** 2).sum(1))   # two basins
+    >>> P = np.zeros((3, 14)); P[0], P[1], P[2] = 0.1, 0.12, -0.09
+    >>> float(representative_pose(P, bowl, np.ones(14))[0].round(2))   # the first two's mean, not 0.05
+    0.11
+    """
+    P = np.asarray(P, float)
+    cost = eps(P)
+    best = int(np.argmin(cost))
+    order = np.argsort(np.linalg.norm((P - P[best]) / step_scale, axis=1), kind="stable")
+    P, cost = P[order], cost[order]
+    plain = mean_body_pose(P, candidate_weights(cost))
+    if eps(plain[None])[0] <= cost.max() + 1e-12:                      # the common case: one basin
+        return plain
+    means = np.stack([mean_body_pose(P[:k], candidate_weights(cost[:k])) for k in range(1, len(P))])
+    ok = eps(means) <= np.maximum.accumulate(cost[:-1]) + 1e-12
+    return means[np.flatnonzero(ok)[-1]] if ok.any() else P[0]
+
+
 class BodyTracker:
     """Track an upper body (see the module docstring).
 
@@ -164,6 +202,6 @@ class BodyTracker:
         eps = lambda X: cost.epsilon(self.space.transforms(X))
         kept = self._pf(eps, self.kept)
         res = levenberg_marquardt(self.space, residuals, kept.states, self.config.lm_iterations)
-        self.state = mean_body_pose(res.states, candidate_weights(res.cost))
+        self.state = representative_pose(res.states, eps, self.sigma * np.r_[[self.space.length] * 3, [1.0] * 11])
         self.kept = res.states
         return BodyEstimate(self.state.copy(), float(eps(self.state[None])[0]) / cost.size, cost.size)

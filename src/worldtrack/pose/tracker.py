@@ -152,24 +152,66 @@ class RigidTracker:
         self.state = rigid_state(np.asarray(R, float), np.asarray(t, float))
         self.kept = self.state[None].copy()
         self.velocity = np.zeros(6)
-        self.depth_offset = getattr(self, "depth_offset", 0.0)
+        self.depth_bias = getattr(self, "depth_bias", np.zeros(3))
 
-    def learn_depth_offset(self, depth: np.ndarray) -> float:
-        """Learn the depth sensor's offset (m) on a frame taken at the current (known) pose.
+    def learn_depth_offset(self, depth: np.ndarray, tilt: bool = True) -> np.ndarray:
+        """Learn the depth sensor's bias at the object on a frame taken at the current (known) pose.
 
-        The median of ``Ẑ − Z`` over the depth template; later depth readings are corrected by it
-        (a real RGB-D camera read the ViSP cube 4 mm too far). Returns the offset.
+        ``Ẑ − Z`` (measured minus model depth, m) over the visible model points is fitted as
+        ``a + b·x + c·y`` of the normalised image coordinates ``x = (u − cx)/fx``, ``y = (v − cy)/fy``
+        (least squares over the points within 20 mm of the median — the silhouette's background left
+        out); later depth readings are corrected by it. A stereo RGB-D camera's error is smooth over
+        the image but not constant: the real ViSP camera reads the cube 4 mm too far and its depth
+        is tilted by 1–2° against the colour geometry (the AprilTag board shows the same tilt), which
+        pulled the colour+depth tracker's rotation off by 2.4°. ``tilt=False``: the offset ``a``
+        alone (the median). Returns ``(a, b, c)`` (m).
+
+        >>> from worldtrack.pose.models import PointModel
+        >>> from worldtrack.pose.render import Intrinsics
+        >>> bump = lambda x, y: 0.004 * np.sin(60 * x) * np.cos(60 * y)            # a bumpy 12 cm patch
+        >>> g = np.mgrid[-0.06:0.06:0.001, -0.06:0.06:0.001].reshape(2, -1).T
+        >>> pts = np.c_[g, bump(g[:, 0], g[:, 1])]; nrm = np.tile([0, 0, -1.0], (len(g), 1))
+        >>> albedo = (100 + 50 * np.sin(90 * g[:, 0]) * np.cos(70 * g[:, 1])).astype(np.float32)
+        >>> intr = Intrinsics(500.0, 500.0, 160.0, 120.0, 320, 240)
+        >>> tr = RigidTracker(PointModel(pts, nrm, albedo, 0.001), intr, np.eye(3), np.array([0, 0, 0.5]),
+        ...                   cost="colour-depth")
+        >>> x, y = (np.arange(320) - 160) / 500, (np.arange(240) - 120) / 500
+        >>> depth = 0.5 + bump(0.5 * x[None, :], 0.5 * y[:, None])               # what a true camera reads
+        >>> depth = (depth + 0.004 + 0.01 * x[None, :]).astype(np.float32)       # 4 mm far, tilted
+        >>> np.round(1000 * tr.learn_depth_offset(depth)).tolist()               # a, b, c (mm)
+        [4.0, 10.0, 0.0]
         """
         from worldtrack.pose.cost import NEAREST_POSITIVE, project_sample
+        from worldtrack.pose.render import splat
 
-        tp = self.template(self.state)
         R, t = state_pose(self.state)
-        pts = self.model.points[tp.depth]
-        z_hat, z = project_sample(np.asarray(depth, np.float32), self.intr, self.space.transforms(self.state[None]),
+        drawn = splat(posed_points(self.model.points, self.model.normals, R, t), self.intr)   # z-buffered
+        inner = cv2.erode((drawn.index >= 0).astype(np.uint8), np.ones((3, 3), np.uint8), iterations=2).astype(bool)
+        pts = self.model.points[np.unique(drawn.index[inner])]           # visible, off the silhouette
+        T = self.space.transforms(self.state[None])
+        z_hat, z = project_sample(np.asarray(depth, np.float32), self.intr, T,
                                   SparseTemplate(pts, np.zeros(len(pts), int), np.zeros(len(pts))), NEAREST_POSITIVE)
-        d = z_hat[0, 0] - z[0]
-        self.depth_offset = float(np.nanmedian(d)) if np.isfinite(d).any() else 0.0
-        return self.depth_offset
+        d = z_hat[0, 0].astype(float) - z[0]
+        xyz = pts @ T[0, 0, :, :3].T + T[0, 0, :, 3]
+        ok = np.isfinite(d)
+        self.depth_bias = np.zeros(3)
+        if ok.any():
+            self.depth_bias[0] = float(np.median(d[ok]))
+            ok &= np.abs(d - self.depth_bias[0]) < 0.02
+            if tilt and ok.sum() >= 10:
+                A = np.c_[np.ones(ok.sum()), xyz[ok, 0] / xyz[ok, 2], xyz[ok, 1] / xyz[ok, 2]]
+                self.depth_bias = np.linalg.lstsq(A, d[ok], rcond=None)[0]
+        return self.depth_bias.copy()
+
+    def corrected_depth(self, depth: np.ndarray, intr: Intrinsics) -> np.ndarray:
+        """``depth`` (H, W, m; 0 = none) of a frame (or a window with intrinsics ``intr``) minus the
+        learnt bias (:meth:`learn_depth_offset`)."""
+        a, b, c = self.depth_bias
+        H, W = depth.shape
+        x = ((np.arange(W) - intr.cx) / intr.fx).astype(np.float32)
+        y = ((np.arange(H) - intr.cy) / intr.fy).astype(np.float32)
+        bias = np.float32(a) + np.float32(b) * x[None, :] + np.float32(c) * y[:, None]
+        return np.where(depth > 0, depth - bias, 0).astype(np.float32)
 
     def template(self, state: np.ndarray):
         """The sparse template (:class:`~worldtrack.pose.template.TemplatePixels`) at ``state``."""
@@ -218,8 +260,8 @@ class RigidTracker:
         R, t = state_pose(state)
         zd = (m.points[tp.depth] @ R.T + t)[:, 2]
         dt = SparseTemplate(m.points[tp.depth], np.zeros(len(tp.depth), int), zd)
-        if depth is not None and self.depth_offset:
-            depth = np.where(depth > 0, depth - np.float32(self.depth_offset), 0).astype(np.float32)
+        if depth is not None and self.depth_bias.any():
+            depth = self.corrected_depth(np.asarray(depth), intr)
         return ColourDepthCost(colour, dt, grey, depth, intr, self.config.c, self.config.c_depth_mm / 1000,
                                self.config.lam, DEPTH_SAMPLING[self.config.depth_sampling])
 
