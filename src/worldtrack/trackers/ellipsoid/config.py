@@ -283,6 +283,16 @@ class IdentityConfig(Section):
     reid_near_m: float = Field(1.0, ge=0, description="a lost person may be found this far from where they were lost, m, ...")
     walk_speed_mps: float = Field(2.0, ge=0, description="... plus this speed times the time since, m/s")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept for re-identification, s")
+    lost_s: float = Field(
+        2.0, ge=0, description="a confirmed track that ended this recently gives its id back by place alone "
+        "(trackers/ellipsoid/reentry.py): a person who comes out from behind a pole or another person, s (0 = off)")
+    lost_speed_mps: float = Field(
+        1.0, ge=0, description="... when the new person stands within reid_near_m plus this speed times the time "
+        "since of where the lost one was heading, m/s")
+    lost_margin_m: float = Field(
+        1.0, ge=0, description="... and no other lost person's place is within this much as near, m")
+    lost_veto: float = Field(
+        0.6, ge=0, le=1, description="... unless both have colour models and their colour distance is above this")
     isolation: Literal["ring", "ellipse"] = Field(
         "ring", description="when a view of a person is clear enough to learn their colours from: 'ring' — no other "
         "person's ellipse grown by the ring overlaps theirs; 'ellipse' — no other person's ellipse overlaps theirs "
