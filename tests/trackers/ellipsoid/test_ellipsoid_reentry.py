@@ -8,7 +8,7 @@ from worldtrack.config import with_overrides
 from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.base import Frame, PositionMap
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
-from worldtrack.trackers.ellipsoid.config import IdentityConfig
+from worldtrack.trackers.ellipsoid.config import LostConfig
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
 
 FPS = 10.0
@@ -22,7 +22,7 @@ def _walk_with_gap(lost_s: float, comes_back_at: tuple[float, float] | None = No
     scene = one_camera_scene()
     rng = np.random.default_rng(3)
     bg = noise_backgrounds(scene, rng)["cam"]
-    cfg = with_overrides(EllipsoidConfig(), {"identity.lost_s": lost_s, "identity.reid_distance": 0.0})
+    cfg = with_overrides(EllipsoidConfig(), {"lost.keep_s": lost_s, "identity.reid_distance": 0.0})
     tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"), cfg)
     ids = []
     for i in range(40):
@@ -49,11 +49,11 @@ def test_somebody_appearing_far_from_where_the_person_was_heading_gets_a_new_id(
 
 
 def _lost(**settings) -> LostTracks:
-    return LostTracks(IdentityConfig(**settings))
+    return LostTracks(LostConfig(**settings))
 
 
 def test_the_motion_gate_is_in_metres_and_widens_with_the_time_since():
-    lost = _lost()   # reid_near_m 1 m + lost_speed_mps 1 m/s x time since, around the place ahead
+    lost = _lost()   # near_m 1 m + speed_mps 1 m/s x time since, around the place ahead
     lost.file(4, xy=(0.0, 0.0), v=(1.0, 0.0), t=0.0)
     free = lambda pid: False  # noqa: E731
     assert lost.claim((0.5, 1.6), t=0.5, taken=free) is None     # 1.6 m off the place ahead (reach 1.5 m)
@@ -72,14 +72,14 @@ def test_a_return_two_lost_people_could_make_is_nobody_s_and_a_taken_id_is_not_g
 
 
 def test_colours_that_differ_veto_a_return():
-    lost = _lost(lost_veto=0.6)
+    lost = _lost(colour_veto=0.6)
     lost.file(4, xy=(0.0, 0.0), v=(0.0, 0.0), t=0.0)
     assert lost.claim((0.2, 0.0), t=0.5, taken=lambda pid: False, colour_distance=lambda pid: 0.7) is None
     assert lost.claim((0.2, 0.0), t=0.5, taken=lambda pid: False, colour_distance=lambda pid: 0.3) == 4
 
 
 def test_watch_files_confirmed_tracks_that_lived_long_enough_and_forgets_them_after_lost_s():
-    lost = _lost(lost_s=2.0, min_age_s=1.0)
+    lost = _lost(keep_s=2.0, min_age_s=1.0)
     m = PositionMap()
     old = m.add(0.0, 0.0, 1.7, 0.45, mode="tracking", time=0.0)
     young = m.add(3.0, 0.0, 1.7, 0.45, mode="tracking", time=1.2)

@@ -283,20 +283,28 @@ class IdentityConfig(Section):
     reid_near_m: float = Field(1.0, ge=0, description="a lost person may be found this far from where they were lost, m, ...")
     walk_speed_mps: float = Field(2.0, ge=0, description="... plus this speed times the time since, m/s")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept for re-identification, s")
-    lost_s: float = Field(
-        2.0, ge=0, description="a confirmed track that ended this recently gives its id back by place alone "
-        "(trackers/ellipsoid/reentry.py): a person who comes out from behind a pole or another person, s (0 = off)")
-    lost_speed_mps: float = Field(
-        1.0, ge=0, description="... when the new person stands within reid_near_m plus this speed times the time "
-        "since of where the lost one was heading, m/s")
-    lost_margin_m: float = Field(
-        1.0, ge=0, description="... and no other lost person's place is within this much as near, m")
-    lost_veto: float = Field(
-        0.6, ge=0, le=1, description="... unless both have colour models and their colour distance is above this")
     isolation: Literal["ring", "ellipse"] = Field(
         "ring", description="when a view of a person is clear enough to learn their colours from: 'ring' — no other "
         "person's ellipse grown by the ring overlaps theirs; 'ellipse' — no other person's ellipse overlaps theirs "
         "(the rings may: people walking side by side in a group)")
+
+
+class LostConfig(Section):
+    """Track management: confirmed tracks that ended, kept a moment to give their ids back
+    (:mod:`worldtrack.trackers.ellipsoid.reentry`)."""
+
+    path: ClassVar[str] = "ellipsoid.lost"
+
+    keep_s: float = Field(
+        2.0, ge=0, description="a confirmed track that ended this recently gives its id back by place alone: a person "
+        "who comes out from behind a pole or another person, s (0 = off)")
+    near_m: float = Field(1.0, ge=0, description="... to a new person within this distance, m, ...")
+    speed_mps: float = Field(
+        1.0, ge=0, description="... plus this speed times the time since, of where the lost one was heading, m/s")
+    margin_m: float = Field(1.0, ge=0, description="... when no other lost person is within this much as near, m")
+    colour_veto: float = Field(
+        0.6, ge=0, le=1, description="... and, when both have colour models, their colour distance is at most this")
+    min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept, s")
 
 
 class WarmStartConfig(Section):
@@ -328,6 +336,7 @@ class EllipsoidConfig(Section):
     feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
     depth: DepthConfig = Field(DepthConfig(), description="depth along one camera's line of sight from every cue")
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
+    lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -337,9 +346,9 @@ class EllipsoidConfig(Section):
             "score.kind": "paper", "score.target_pixels": 0, "score.ring_fraction": 0.0,
             "match.adaptive_step": False, "match.predict": False,
             "births.search_m": 0.0, "rescue.search_m": 0.0, "height.measure": False, "warm_start.frames": 0,
-            "identity.enabled": False,
+            "identity.enabled": False, "lost.keep_s": 0.0,
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
+__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig",
            "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

@@ -8,17 +8,17 @@ the colour models of people in groups never mature, and a model of a few views i
 strict threshold.
 
 This module keeps every confirmed track that ended, after living at least
-``identity.min_age_s``, for ``identity.lost_s`` seconds: where it was last, how it moved, when.
+``lost.min_age_s``, for ``lost.keep_s`` seconds: where it was last, how it moved, when.
 A newly confirmed person takes the id back when exactly one lost person could have walked to where
-they stand — within ``identity.reid_near_m`` + ``identity.lost_speed_mps`` × (time since) of the
+they stand — within ``lost.near_m`` + ``lost.speed_mps`` × (time since) of the
 lost person's last place moved on at their last velocity — and no other lost person comes within
-``identity.lost_margin_m`` of that (an ambiguous return gets a new id, as before). The motion
+``lost.margin_m`` of that (an ambiguous return gets a new id, as before). The motion
 gate is in world metres, so it reads the same in every camera and room. When both people have
 colour models in a common camera (:mod:`.identity`), a colour distance above
-``identity.lost_veto`` refuses the return: someone else came out.
+``lost.colour_veto`` refuses the return: someone else came out.
 
->>> from worldtrack.trackers.ellipsoid.config import IdentityConfig
->>> lost = LostTracks(IdentityConfig())
+>>> from worldtrack.trackers.ellipsoid.config import LostConfig
+>>> lost = LostTracks(LostConfig())
 >>> lost.file(7, xy=(0.0, 0.0), v=(1.0, 0.0), t=1.0)
 >>> lost.claim((1.4, 0.1), t=2.0, taken=lambda i: False)   # 1 s later, 1 m on: the same person
 7
@@ -35,7 +35,7 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 
 from worldtrack.trackers.base import Person
-from worldtrack.trackers.ellipsoid.config import IdentityConfig
+from worldtrack.trackers.ellipsoid.config import LostConfig
 
 
 @dataclass
@@ -50,14 +50,14 @@ class Vanished:
 
 @dataclass
 class LostTracks:
-    """The people one tracker lost in the last ``identity.lost_s`` seconds.
+    """The people one tracker lost in the last ``lost.keep_s`` seconds.
 
     Parameters
     ----------
-    config : IdentityConfig
+    config : LostConfig
     """
 
-    config: IdentityConfig
+    config: LostConfig
     lost: list[Vanished] = field(default_factory=list)
     #: Confirmed people on the map at the last :meth:`watch`: id → (person, place, velocity, time).
     _alive: dict[int, tuple[Person, np.ndarray, np.ndarray, float]] = field(default_factory=dict)
@@ -70,7 +70,7 @@ class LostTracks:
     def watch(self, people: Iterable[Person], t: float, alive: Callable[[Person], bool]) -> None:
         """After a step: file the confirmed people seen at the last call who are no longer on the
         map (``alive(person)`` is False), remember the confirmed people now on it, forget the lost
-        older than ``identity.lost_s``."""
+        older than ``lost.keep_s``."""
         cfg = self.config
         for pid, (p, xy, v, seen) in list(self._alive.items()):
             if not alive(p):
@@ -81,7 +81,7 @@ class LostTracks:
             # The place where the evidence last held them, not where a failing track slid to.
             if p.confirmed and p.id > 0 and (p.count("low") == 0 or _new(self._alive, p)):
                 self._alive[p.id] = (p, np.array([p.x, p.y]), np.array([p.vx, p.vy]), t)
-        self.lost = [g for g in self.lost if t - g.t <= cfg.lost_s]
+        self.lost = [g for g in self.lost if t - g.t <= cfg.keep_s]
 
     def claim(self, xy: Sequence[float], t: float, taken: Callable[[int], bool],
               colour_distance: Callable[[int], float | None] | None = None) -> int | None:
@@ -95,19 +95,19 @@ class LostTracks:
             if taken(g.id):
                 continue
             since = max(t - g.t, 0.0)
-            ahead = g.xy + g.v * min(since, cfg.lost_s)
+            ahead = g.xy + g.v * min(since, cfg.keep_s)
             miss = min(float(np.linalg.norm(here - ahead)), float(np.linalg.norm(here - g.xy)))
-            fits.append((miss - (cfg.reid_near_m + cfg.lost_speed_mps * since), miss, g))
+            fits.append((miss - (cfg.near_m + cfg.speed_mps * since), miss, g))
         inside = sorted((f for f in fits if f[0] <= 0), key=lambda f: f[1])
         if not inside:
             return None
         best = inside[0]
-        if any(f is not best and f[1] - best[1] < cfg.lost_margin_m for f in fits):
+        if any(f is not best and f[1] - best[1] < cfg.margin_m for f in fits):
             return None
         g = best[2]
         if colour_distance is not None:
             d = colour_distance(g.id)
-            if d is not None and d > cfg.lost_veto:
+            if d is not None and d > cfg.colour_veto:
                 return None
         self.lost.remove(g)
         self.given_back += 1
