@@ -284,9 +284,9 @@ class IdentityConfig(Section):
     walk_speed_mps: float = Field(2.0, ge=0, description="... plus this speed times the time since, m/s")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept for re-identification, s")
     isolation: Literal["ring", "ellipse"] = Field(
-        "ring", description="when a view of a person is clear enough to learn their colours from: 'ring' — no other "
-        "person's ellipse grown by the ring overlaps theirs; 'ellipse' — no other person's ellipse overlaps theirs "
-        "(the rings may: people walking side by side in a group)")
+        "ellipse", description="when a view of a person is clear enough to learn their colours from: 'ellipse' — no "
+        "other person's ellipse overlaps theirs (the rings may: people walking side by side in a group, who are never "
+        "clear by the ring); 'ring' — no other person's ellipse grown by the ring overlaps theirs (stricter)")
 
 
 class LostConfig(Section):
