@@ -284,9 +284,27 @@ class IdentityConfig(Section):
     walk_speed_mps: float = Field(2.0, ge=0, description="... plus this speed times the time since, m/s")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept for re-identification, s")
     isolation: Literal["ring", "ellipse"] = Field(
-        "ring", description="when a view of a person is clear enough to learn their colours from: 'ring' — no other "
-        "person's ellipse grown by the ring overlaps theirs; 'ellipse' — no other person's ellipse overlaps theirs "
-        "(the rings may: people walking side by side in a group)")
+        "ellipse", description="when a view of a person is clear enough to learn their colours from: 'ellipse' — no "
+        "other person's ellipse overlaps theirs (the rings may: people walking side by side in a group, who are never "
+        "clear by the ring); 'ring' — no other person's ellipse grown by the ring overlaps theirs (stricter)")
+
+
+class LostConfig(Section):
+    """Track management: confirmed tracks that ended, kept a moment to give their ids back
+    (:mod:`worldtrack.trackers.ellipsoid.reentry`)."""
+
+    path: ClassVar[str] = "ellipsoid.lost"
+
+    keep_s: float = Field(
+        2.0, ge=0, description="a confirmed track that ended this recently gives its id back by place alone: a person "
+        "who comes out from behind a pole or another person, s (0 = off)")
+    near_m: float = Field(1.0, ge=0, description="... to a new person within this distance, m, ...")
+    speed_mps: float = Field(
+        1.0, ge=0, description="... plus this speed times the time since, of where the lost one was heading, m/s")
+    margin_m: float = Field(1.0, ge=0, description="... when no other lost person is within this much as near, m")
+    colour_veto: float = Field(
+        0.6, ge=0, le=1, description="... and, when both have colour models, their colour distance is at most this")
+    min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept, s")
 
 
 class WarmStartConfig(Section):
@@ -318,6 +336,7 @@ class EllipsoidConfig(Section):
     feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
     depth: DepthConfig = Field(DepthConfig(), description="depth along one camera's line of sight from every cue")
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
+    lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -327,9 +346,9 @@ class EllipsoidConfig(Section):
             "score.kind": "paper", "score.target_pixels": 0, "score.ring_fraction": 0.0,
             "match.adaptive_step": False, "match.predict": False,
             "births.search_m": 0.0, "rescue.search_m": 0.0, "height.measure": False, "warm_start.frames": 0,
-            "identity.enabled": False,
+            "identity.enabled": False, "lost.keep_s": 0.0,
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "MatchConfig",
+__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig",
            "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]

@@ -187,6 +187,17 @@ class Identities:
         self.reidentified += 1
         return g.id
 
+    def colour_distance(self, p: Person, lost_id: int) -> float | None:
+        """Colour distance (mean over the cameras both have models in) between ``p`` and the lost
+        person ``lost_id``; None when either has no model there."""
+        mine = self.models.get(p)
+        for g in self.lost:
+            if g.id == lost_id and mine:
+                common = [cid for cid in mine if cid in g.colours]
+                if common:
+                    return float(np.mean([mine[c].distance(g.colours[c]) for c in common]))
+        return None
+
 
 def swap_places(a: Person, b: Person) -> None:
     """Exchange where two people are and how they move (their identities — id, height, colours —

@@ -44,6 +44,7 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
 from worldtrack.trackers.ellipsoid.real import ternary_real
+from worldtrack.trackers.ellipsoid.reentry import LostTracks
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS, flag_unmeasurable, measure_support
 from worldtrack.trackers.ellipsoid.uncertainty import PositionUncertainty
@@ -104,6 +105,8 @@ class EllipsoidTracker(TrackerBase):
         self.last_images: dict[str, np.ndarray] = {}
         #: The people's colour models (:mod:`.identity`).
         self.identity = Identities(cfg.identity)
+        #: Confirmed people lost in the last ``lost.keep_s`` s, to give their ids back (:mod:`.reentry`).
+        self.reentry = LostTracks(cfg.lost)
         #: Depth along one camera's line of sight from every cue (:mod:`.depth`; ``depth.fuse``).
         self.depth = DepthFusion(cfg.depth, cfg.feet, cfg.height)
         self._now = 0.0
@@ -163,6 +166,8 @@ class EllipsoidTracker(TrackerBase):
                                  lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
         self.uncertainty.measure(self, real, t)
+        if self.config.lost.keep_s > 0:
+            self.reentry.watch(self.position_map, t, lambda p: self.position_map.get(p.id) is p)
         self._last_t = t
         self.frames_stepped += 1
         return self.uncertainty.tracks(self.position_map, t)
@@ -296,6 +301,10 @@ class EllipsoidTracker(TrackerBase):
             return
         back = self.identity.reidentify(p, self._now, lambda pid: pid in self.position_map) \
             if self.config.identity.enabled else None
+        if back is None and self.config.lost.keep_s > 0:
+            colours = self.identity.colour_distance if self.config.identity.enabled else (lambda q, pid: None)
+            back = self.reentry.claim((p.x, p.y), self._now, lambda pid: pid in self.position_map,
+                                      lambda pid: colours(p, pid))
         new = self.position_map.promote(p.id, back)
         height, p.width = self.scene.people.size_of(new)
         if not p.height_samples:  # else keep what was measured (at birth, or since)
