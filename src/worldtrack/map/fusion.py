@@ -133,6 +133,19 @@ class FusionState:
                    {(int(a), int(b)): float(t) for a, b, t in d["close_since"]},
                    {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"])
 
+    def copy(self) -> "FusionState":
+        """An independent copy (a bucket is fused on a copy until its write has succeeded)."""
+        return FusionState({i: replace(p) for i, p in self.people.items()}, dict(self.close_since),
+                           dict(self.aliases), self.last_bucket)
+
+    @classmethod
+    def from_record(cls, state: MapState, bucket: int) -> "FusionState":
+        """The state to continue after ``bucket`` from its entry in the record (the map stream),
+        when the state written beside it is missing (the current-map hash deleted or older).
+        Pairs of close ids start afresh; the bucket's own merges are kept."""
+        people = {p.id: FusedPerson(**p._asdict()) for p in state.people}
+        return cls(people, {}, {y: (e, state.t) for y, e in state.aliases.items()}, bucket)
+
     def resolve(self, pid: int) -> int:
         """The id ``pid`` is known by now (following merges)."""
         seen = set()
