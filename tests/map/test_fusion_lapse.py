@@ -163,14 +163,15 @@ def test_a_slow_step_renews_its_lease_between_buckets_and_stops_writing_once_it_
 @pytest.mark.slow
 def test_ctrl_c_on_a_fusion_holder_with_a_backlog_gives_the_role_back_within_the_drain_bound(redis_url, tmp_path):
     client, keys, cfg = connect(redis_url), MapKeys(), MapConfig()
+    # The backlog is in the streams before the fuser starts: 60 s of two cameras with 40 people each
+    # (capture times from 30 s ahead, so the fuser's cold start, 5 s before it takes the role, reads
+    # them all), ~10 s of fusing on an idle core.
+    b0, n = _floor(client, keys) + 300, 600
+    _publish(client, keys, range(b0, b0 + n), people=40)
     log = open(tmp_path / "fuser.log", "w")
     p = subprocess.Popen([*WORLDTRACK, "map", "fuse", redis_url], stdout=subprocess.DEVNULL, stderr=log)
     try:
-        wait_until(lambda: client.get(keys.fusion_lease), 120, what="the fuser to take the role")
-        b0 = _floor(client, keys)
-        n = 300                                     # 30 s of two cameras with 40 people each: a backlog
-        _publish(client, keys, range(b0, b0 + n), people=40)
-        wait_until(lambda: client.xlen(keys.map_stream) >= 1, 60, what="the fuser's first bucket")
+        wait_until(lambda: client.xlen(keys.map_stream) >= 1, 120, every=0.01, what="the fuser's first bucket")
         p.send_signal(signal.SIGINT)
         sent = time.monotonic()
         rc = p.wait(30)
@@ -181,15 +182,15 @@ def test_ctrl_c_on_a_fusion_holder_with_a_backlog_gives_the_role_back_within_the
     written = client.xlen(keys.map_stream)
     print(f"exit {rc} {took:.2f} s after SIGINT; {written} of {n} buckets written")
     assert rc == 130 and "interrupted" in text and "Traceback" not in text, text
-    assert took < DRAIN_S + 3.0 and written < n
+    assert took < DRAIN_S + 3.0 and written < n, text
     assert client.get(keys.fusion_lease) is None                    # given back, not left to expire
-    # What it wrote is whole; a next holder continues after it and completes the record.
+    # What it wrote is whole, and a next holder continues right after it.
     role = FusionRole(client, keys, cfg, "next")
     assert role.lease.acquire()
     role._take_over()
     assert role.state.last_bucket == b0 + written - 1
-    _steps(role, lambda: client.xlen(keys.map_stream) == n, limit=1000)
+    _steps(role, lambda: client.xlen(keys.map_stream) >= written + 20)
     states = _record(client, keys)
-    assert [bucket_index(s.t + 0.05, 0.1) for s in states] == list(range(b0, b0 + n))
+    assert [bucket_index(s.t + 0.05, 0.1) for s in states] == list(range(b0, b0 + len(states)))
     reported = Counter((c, round(t, 3)) for s in states for c, t, _ in s.reports)
-    assert len(reported) == 2 * n and max(reported.values()) == 1 and sum(s.late for s in states) == 0
+    assert len(reported) == 2 * len(states) and max(reported.values()) == 1 and sum(s.late for s in states) == 0

@@ -72,7 +72,7 @@ import numpy as np
 
 from worldtrack.map.config import MapConfig
 from worldtrack.map.evidence import floor_information, in_views, people_boxes, visible_share  # noqa: F401 (public here too)
-from worldtrack.map.messages import Estimate, MapPerson, MapState, Observation
+from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
 
 #: The least weight an estimate has (support 0 still says "a worker sees somebody here").
 MIN_WEIGHT = 0.05
@@ -99,6 +99,9 @@ class FusedPerson:
     mode: str = "tracking"
     workers: int = 0
     lead: str = ""
+    #: Buckets running in which another worker's clear view showed this person's place empty
+    #: while only views showing less than LEAD_SHARE of them reported them.
+    doubt: int = 0
 
     def public(self) -> MapPerson:
         return MapPerson(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
@@ -231,6 +234,8 @@ def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict
     for o in sorted(observations, key=lambda o: o.t):
         for e in o.people:
             pid = state.resolve(e.id)
+            if pid == REFUTED:                  # dropped on negative evidence: not brought back
+                continue
             mine = out.setdefault(pid, {})
             old = mine.get(o.worker)
             if old is None or e.seen or not old.seen:
@@ -262,6 +267,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
         if pid in ended or t - p.last_seen > cfg.forget_after_s:
             del state.people[pid]
     aliases = _merge_duplicates(state, workers_of, t, cfg)
+    if cfg.negative_evidence:
+        aliases.update(_refute(state, estimates, observations, t, cfg.refute_after))
     state.aliases = {y: (e, ts) for y, (e, ts) in state.aliases.items() if t - ts <= cfg.forget_after_s}
     state.last_bucket = bucket
     reports = tuple((o.camera, o.t, o.sent) for o in observations)
@@ -319,6 +326,33 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
     aliases = {young: elder for young, (elder, _) in state.aliases.items()}   # recent merges, again
     return MapState(t, public, reports, aliases, written)
+
+
+def _refute(state: FusionState, estimates: dict[int, dict[str, Estimate]], observations: list[Observation],
+            t: float, after: int) -> dict[int, int]:
+    """Negative evidence: drop a person only views showing less than :data:`LEAD_SHARE` of them
+    report (through a door, behind somebody) while another worker's camera shows their place
+    clearly, empty (``Observation.absent``), ``after`` buckets running: one worker's ghost (e.g. a
+    copy of somebody 1 m behind them on its line of sight) no single worker can tell from a person.
+    A person any worker shows well is kept. Returns ``{id: REFUTED}`` for those dropped now."""
+    against: dict[int, set[str]] = {}
+    for o in observations:
+        for i in o.absent:
+            against.setdefault(state.resolve(i), set()).add(o.worker)
+    refuted: dict[int, int] = {}
+    for pid, by_worker in estimates.items():
+        p = state.people.get(pid)
+        if p is None:
+            continue
+        well_seen = any(e.seen and e.visible >= LEAD_SHARE for e in by_worker.values())
+        seen_by = {k for k, e in by_worker.items() if e.seen}
+        doubted = bool(against.get(pid, set()) - seen_by) and not well_seen
+        p.doubt = p.doubt + 1 if doubted else 0
+        if p.doubt >= after:
+            del state.people[pid]
+            state.aliases[pid] = (REFUTED, t)
+            refuted[pid] = REFUTED
+    return refuted
 
 
 def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
