@@ -147,16 +147,21 @@ def looks_empty(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height: fl
     """
     if mask is None or mask.shape[:2] != (cam.height, cam.width):
         return False
-    if visible_share([cam], xy, height, [occlusion], [blockers]) < min_share:
-        return False
+    shown, open_share, foreground = emptiness(cam, mask, xy, height, width, occlusion, blockers)
+    return shown >= min_share and open_share >= 0.3 and foreground < EMPTY_SHARE
+
+
+def emptiness(cam: Camera, mask: np.ndarray, xy: np.ndarray, height: float, width: float,
+              occlusion: np.ndarray | None = None, blockers: np.ndarray | None = None) -> tuple[float, float, float]:
+    """What :func:`looks_empty` decides by: the share of the axis points that show, the share of
+    the box left open (inside the image, not behind an obstacle, not covered by ``blockers``) and
+    the foreground share of that open part (NaN when nothing is open)."""
+    shown = visible_share([cam], xy, height, [occlusion], [blockers])
     u0, v0, u1, v1, dist = people_boxes(cam, np.array([[xy[0], xy[1], height, width]]))[0]
-    if not u1 > u0 or not v1 > v0:
-        return False
-    area = (u1 - u0) * (v1 - v0)
     iu0, iv0 = max(0, int(math.floor(u0))), max(0, int(math.floor(v0)))
     iu1, iv1 = min(cam.width, int(math.ceil(u1))), min(cam.height, int(math.ceil(v1)))
-    if iu1 <= iu0 or iv1 <= iv0:
-        return False
+    if not (u1 > u0 and v1 > v0 and iu1 > iu0 and iv1 > iv0):
+        return shown, 0.0, float("nan")
     open_ = np.ones((iv1 - iv0, iu1 - iu0), bool)
     if occlusion is not None:
         open_ &= occlusion[iv0:iv1, iu0:iu1] > dist - 0.3
@@ -165,9 +170,9 @@ def looks_empty(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height: fl
         bu1, bv1 = min(iu1, int(math.ceil(b[2]))), min(iv1, int(math.ceil(b[3])))
         if bu1 > bu0 and bv1 > bv0:
             open_[bv0 - iv0:bv1 - iv0, bu0 - iu0:bu1 - iu0] = False
-    if open_.sum() < 0.3 * area:
-        return False
-    return float((mask[iv0:iv1, iu0:iu1] != 0)[open_].mean()) < EMPTY_SHARE
+    if not open_.any():
+        return shown, 0.0, float("nan")
+    return shown, float(open_.sum() / ((u1 - u0) * (v1 - v0))), float((mask[iv0:iv1, iu0:iu1] != 0)[open_].mean())
 
 
 #: The covariance fields of an estimate whose tracker measured none.

@@ -42,6 +42,8 @@ class Estimate(NamedTuple):
     (:func:`worldtrack.map.evidence.visible_share`). ``cxx, cxy, cyy`` (m²): the covariance of the
     estimate as the worker's tracker measured it this frame (the ellipsoid tracker's, from the
     curvature of its score: it knows what other people hide), NaN when the tracker gives none.
+    ``own``: the share of the person's body its best camera shows that no other person it holds
+    covers (the map's counterpart of the tracker's own share; 1 from older workers).
     """
 
     id: int
@@ -61,6 +63,7 @@ class Estimate(NamedTuple):
     cxx: float = float("nan")
     cxy: float = float("nan")
     cyy: float = float("nan")
+    own: float = 1.0
 
 
 #: An alias to this id means the map dropped the person on other workers' negative evidence
@@ -154,7 +157,8 @@ def encode_observation(o: Observation) -> dict[str, str]:
     reads thousands a second). NaN stays NaN (Python's JSON)."""
     people = [[int(e.id), round(e.x, 4), round(e.y, 4), round(e.height, 3), round(e.width, 3), round(e.vx, 3),
                round(e.vy, 3), round(float(e.score), 3), round(float(e.support), 3), int(bool(e.seen)), _sig(e.ixx),
-               _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2), _sig(e.cxx), _sig(e.cxy), _sig(e.cyy)]
+               _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2), _sig(e.cxx), _sig(e.cxy), _sig(e.cyy),
+               round(float(e.own), 2)]
               for e in o.people]
     body = [o.camera, o.worker, int(o.frame), float(o.sent), people, [int(i) for i in o.ended],
             [int(i) for i in o.absent]]

@@ -293,11 +293,12 @@ class MapLink:
                 self.placed.discard(tr.id)
             now_ids.add(tr.id)
             support = support_of(person, tr)
-            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ,
-                                     blockers=[np.delete(boxes[c], k, axis=0) for c in mine])
+            others = [np.delete(boxes[c], k, axis=0) for c in mine]
+            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ, blockers=others)
             cov = tracker_covariance(tracker, person, t) if seen else None
+            own = visible_share([self.cameras[c] for c in mine], where, tr.height, occ, others)
             e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info,
-                         share, *(NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])))
+                         share, *(NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])), own)
             for c, ok in zip(cams, views):
                 if ok:
                     per_cam[c].append(e)
