@@ -110,3 +110,21 @@ def test_a_worker_reports_a_map_person_its_camera_shows_nobody_at_and_drops_a_re
     link.read_map = lambda: link.state
     link.sync(SimpleNamespace(position_map=local), 0.15)
     assert 7 not in local
+
+
+def _covered(state, b, own, other_worker=True, cfg=MapConfig()):
+    """w1 reports person 7 with ``own`` of their body not covered by its other people; w2 reports 8."""
+    a = Observation("west", b / 10 + 0.05, "w1", b, 0.0,
+                    (Estimate(7, 4.0, 0.0, 1.7, 0.45, 0, 0, 0.8, 0.5, True, visible=0.9, own=own),))
+    n = Observation("east", b / 10 + 0.05, "w2", b, 0.0, (Estimate(8, 9.0, 2.0, 1.7, 0.45, 0, 0, 0.8, 0.5, True),))
+    return fuse_bucket(state, b, [a, n] if other_worker else [a], cfg)
+
+
+def test_a_person_one_worker_reports_inside_somebody_elses_silhouette_leaves_the_map_after_1_s():
+    state = FusionState()
+    out = [_covered(state, b, own=0.1) for b in range(12)]
+    assert [7 in {p.id for p in s.present()} for s in out] == [True] * 9 + [False] * 3       # 10 buckets = 1 s
+    assert out[9].aliases == {7: REFUTED} and {p.id for p in out[-1].present()} == {8}
+    for kept in (dict(own=0.5), dict(own=0.1, other_worker=False), dict(own=0.1, cfg=MapConfig(hidden_after_s=0))):
+        state = FusionState()
+        assert all(7 in {p.id for p in _covered(state, b, **kept).present()} for b in range(15)), kept
