@@ -25,6 +25,10 @@ import numpy as np
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Person, Track, Tracker
 
+#: The lead of a person is a worker whose cameras show at least this share of their body, if any
+#: does (a tracker fitting a head at the image's edge is no lead, however near the camera).
+LEAD_SHARE = 0.6
+
 
 def people_boxes(cam: Camera, people: np.ndarray) -> np.ndarray:
     """The image boxes of ``people`` (m, 4: x, y, height, width in metres) in ``cam``, as
@@ -201,5 +205,5 @@ def support_of(person: Person | None, tr: Track) -> float:
     return float("nan")
 
 
-__all__ = ["EMPTY_SHARE", "NO_COVARIANCE", "floor_information", "in_views", "looks_empty", "people_boxes", "support_of",
-           "tracker_covariance", "visible_share"]
+__all__ = ["EMPTY_SHARE", "LEAD_SHARE", "NO_COVARIANCE", "floor_information", "in_views", "looks_empty", "people_boxes",
+           "support_of", "tracker_covariance", "visible_share"]

@@ -71,17 +71,12 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from worldtrack.map.config import MapConfig
-from worldtrack.map.evidence import floor_information, in_views, people_boxes, visible_share  # noqa: F401 (public here too)
+from worldtrack.map.evidence import LEAD_SHARE, floor_information, in_views, people_boxes, visible_share  # noqa: F401
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
+from worldtrack.map.refute import refute
 
 #: The least weight an estimate has (support 0 still says "a worker sees somebody here").
 MIN_WEIGHT = 0.05
-#: Less than this share of a person's body their own (not covered by other people) in a view:
-#: that view may be showing somebody else (the ellipsoid tracker's ``min_own_share``).
-MIN_OWN_SHARE = 0.25
-#: The lead of a person is a worker whose cameras show at least this share of their body, if any
-#: does (a tracker fitting a head at the image's edge is no lead, however near the camera).
-LEAD_SHARE = 0.6
 
 
 @dataclass
@@ -273,7 +268,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
             del state.people[pid]
     aliases = _merge_duplicates(state, workers_of, t, cfg)
     if cfg.negative_evidence:
-        aliases.update(_refute(state, estimates, observations, t, cfg))
+        aliases.update(refute(state, estimates, observations, t, cfg))
     state.aliases = {y: (e, ts) for y, (e, ts) in state.aliases.items() if t - ts <= cfg.forget_after_s}
     state.last_bucket = bucket
     reports = tuple((o.camera, o.t, o.sent) for o in observations)
@@ -331,41 +326,6 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
     aliases = {young: elder for young, (elder, _) in state.aliases.items()}   # recent merges, again
     return MapState(t, public, reports, aliases, written)
-
-
-def _refute(state: FusionState, estimates: dict[int, dict[str, Estimate]], observations: list[Observation],
-            t: float, cfg: MapConfig) -> dict[int, int]:
-    """Drop a person no worker shows well, on the evidence against them (``{id: REFUTED}``):
-
-    * *negative*: only views showing less than :data:`LEAD_SHARE` of them report them (through a
-      door, behind somebody) while another worker's camera shows their place clearly and empty
-      (``Observation.absent``), ``cfg.refute_after`` buckets running;
-    * *hidden*: one worker reports them, covered by other people it holds (less than
-      :data:`MIN_OWN_SHARE` of the body its own: a copy of somebody behind them on its line of
-      sight), while other workers are on the map, for ``cfg.hidden_after_s`` — the one-process
-      tracker's rule for a person at most one of several cameras shows inside somebody else's
-      silhouette. A person any worker shows well is kept."""
-    against: dict[int, set[str]] = {}
-    for o in observations:
-        for i in o.absent:
-            against.setdefault(state.resolve(i), set()).add(o.worker)
-    several = len({o.worker for o in observations}) > 1
-    hidden_after = round(cfg.hidden_after_s / cfg.bucket_s) if cfg.hidden_after_s > 0 else math.inf
-    refuted: dict[int, int] = {}
-    for pid, by_worker in estimates.items():
-        p = state.people.get(pid)
-        if p is None:
-            continue
-        well_seen = any(e.seen and e.visible >= LEAD_SHARE for e in by_worker.values())
-        seen_by = {k for k, e in by_worker.items() if e.seen}
-        p.doubt = p.doubt + 1 if against.get(pid, set()) - seen_by and not well_seen else 0
-        covered = len(by_worker) == 1 and several and all(e.own < MIN_OWN_SHARE for e in by_worker.values())
-        p.hidden = p.hidden + 1 if covered else 0
-        if p.doubt >= cfg.refute_after or p.hidden >= hidden_after:
-            del state.people[pid]
-            state.aliases[pid] = (REFUTED, t)
-            refuted[pid] = REFUTED
-    return refuted
 
 
 def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
