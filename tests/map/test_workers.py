@@ -60,13 +60,15 @@ def test_two_workers_hand_a_person_over_and_score_as_well_as_one_process(two_roo
                  "--no-video"]) == 0
     one = evaluate(gt, read_tracks(tmp_path / "one" / "tracks.csv"))
     m = evaluate(gt, fused)
+    margin = f"fused − one process: MOTA {m['mota'] - one['mota']:+.3f}, IDF1 {m['idf1'] - one['idf1']:+.3f}"
     print(f"fused MOTA {m['mota']:.3f} IDF1 {m['idf1']:.3f} err {m['motp_m']:.3f} m; "
-          f"one process MOTA {one['mota']:.3f} IDF1 {one['idf1']:.3f} err {one['motp_m']:.3f} m")
+          f"one process MOTA {one['mota']:.3f} IDF1 {one['idf1']:.3f} err {one['motp_m']:.3f} m; {margin}")
     # Batch run (map.pace_files=false): each worker waits for the map to hold its previous frame, so
     # the result hardly depends on how loaded the machine is (in real time it does: at load 25 on 2
-    # cores MOTA 0.94-0.97). Here MOTA 1.000, IDF1 1.000 (one process 0.997 / 0.999), also with
+    # cores MOTA 0.94-0.97). Here MOTA 1.000, IDF1 1.000 (one process 0.997 / 0.999: a margin of
+    # +0.003 / +0.001, one missed frame; issue 39f, also in fresh clones under load), also with
     # map.share_rule=support-lead; how the share rules do on other seeds: benchmarks/map_two_workers.py.
-    assert m["mota"] >= one["mota"] and m["idf1"] >= one["idf1"]
+    assert m["mota"] >= one["mota"] and m["idf1"] >= one["idf1"], margin
     # Each walker crossed the door from one camera's view into the other's under one map id, put on
     # the receiving worker's map from the shared one before they entered its view (not born again
     # and given the id afterwards, which scores as well here: the logs tell the two apart).

@@ -60,25 +60,37 @@ def run_status(args: argparse.Namespace) -> int:
 
 
 def run_fuse(args: argparse.Namespace) -> int:
-    from worldtrack.map.fusion_role import FusionRole
+    from worldtrack.interrupts import StopRequests
+    from worldtrack.map.fusion_role import DRAIN_S, FusionRole
     from worldtrack.map.lease import worker_name
     cfg, client, keys, where = _open(args)
     name = worker_name()
     role = FusionRole(client, keys, cfg, name, log=lambda s: print(f"{name}: {s}", file=sys.stderr, flush=True))
-    stop = threading.Event()
-    th = threading.Thread(target=role.run, args=(stop,), name="fusion", daemon=True)
+    stop, done = threading.Event(), threading.Event()
+
+    def serve() -> None:
+        try:
+            role.run(stop)
+        finally:
+            done.set()
+    th = threading.Thread(target=serve, name="fusion", daemon=True)
     print(f"{name}: contending for the fusion role of {where}", file=sys.stderr, flush=True)
-    th.start()
     t_end = None if args.seconds is None else time.monotonic() + args.seconds
-    try:
-        while th.is_alive() and (t_end is None or time.monotonic() < t_end):
-            th.join(0.2)
-    finally:
+    # Ctrl-C / SIGTERM only set a flag (StopRequests): a KeyboardInterrupt landing in Thread.join
+    # makes Python 3.11 take the thread for finished while it still writes. The holder then writes
+    # what it has for at most DRAIN_S and gives the role back; the process exits (130 / 143) with the
+    # record intact up to its last bucket. A second signal stops at once.
+    with StopRequests() as requests:
+        th.start()
+        while not done.is_set() and not requests.requested and (t_end is None or time.monotonic() < t_end):
+            done.wait(0.1)
         stop.set()
-        th.join(cfg.max_wait_s + 2.0)
-        s = role.stats
-        print(f"{name}: {s.buckets} map states written, {s.observations} observations read, {s.late} late, "
-              f"{s.malformed} malformed", file=sys.stderr)
+        done.wait(DRAIN_S + 1.0)
+    s = role.stats
+    print(f"{name}: {s.buckets} map states written, {s.observations} observations read, {s.late} late, "
+          f"{s.malformed} malformed", file=sys.stderr)
+    if requests.requested:
+        raise requests.interrupt()
     return 0
 
 

@@ -135,7 +135,8 @@ class _Worker:
         self.stop.set()
         if self.keeper is not None:
             self.keeper.stop(release=True)
-        deadline = time.time() + self.cfg.max_wait_s + 1.0
+        from worldtrack.map.fusion_role import DRAIN_S
+        deadline = time.time() + DRAIN_S + 0.5
         while self.fusion.holding and time.time() < deadline:
             time.sleep(0.02)
         try:

@@ -44,6 +44,17 @@ class MapConfig(Section):
                                 "its cameras resolve the floor where the person stands, counting what obstacles "
                                 "and other people hide; 'tracker': the inverse of the covariance its tracker "
                                 "measured (the ellipsoid tracker's sigma), when every estimate has one")
+    negative_evidence: bool = Field(True, description="a worker whose camera shows the place of a map person "
+                                                      "clearly and nobody there says so, and the map drops a "
+                                                      "person that only views showing less than 60 % of the body "
+                                                      "report while another worker's clear view shows the place "
+                                                      "empty for refute_after buckets running")
+    refute_after: int = Field(3, ge=1, description="see negative_evidence (buckets)")
+    hidden_after_s: float = Field(1.0, ge=0, description="a person only one worker reports, covered by other people "
+                                                         "it holds (less than a quarter of the body its own) while "
+                                                         "other workers are on the map, leaves the map after this "
+                                                         "long (the one-process tracker's rule for a duplicate "
+                                                         "behind somebody; 0 = never)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

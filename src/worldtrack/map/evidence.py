@@ -25,6 +25,10 @@ import numpy as np
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Person, Track, Tracker
 
+#: The lead of a person is a worker whose cameras show at least this share of their body, if any
+#: does (a tracker fitting a head at the image's edge is no lead, however near the camera).
+LEAD_SHARE = 0.6
+
 
 def people_boxes(cam: Camera, people: np.ndarray) -> np.ndarray:
     """The image boxes of ``people`` (m, 4: x, y, height, width in metres) in ``cam``, as
@@ -118,6 +122,63 @@ def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, 
     return float(info[0, 0]), float(info[0, 1]), float(info[1, 1])
 
 
+#: A place looks empty when less than this share of the pixels of a person's box there that no
+#: other person explains is foreground (a person standing there fills ~half of their box).
+EMPTY_SHARE = 0.1
+
+
+def looks_empty(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height: float, width: float,
+                occlusion: np.ndarray | None = None, blockers: np.ndarray | None = None,
+                min_share: float = 0.6) -> bool:
+    """Negative evidence: does ``cam`` show floor point ``xy`` (m) clearly, with nobody there?
+
+    Yes when at least ``min_share`` of a person's axis points (``height``, ``width`` m) there
+    show in the image (not behind an obstacle of ``occlusion``, (H, W) floor distance, nor behind
+    a person of ``blockers``, :func:`people_boxes`), at least 30 % of their image box is neither
+    cut by the image border, nor behind an obstacle, nor covered by a box of ``blockers`` (their
+    foreground is explained), and less than :data:`EMPTY_SHARE` of that part is foreground in
+    ``mask`` (H, W, nonzero = foreground). No mask: False (nothing to tell).
+
+    >>> from worldtrack.geometry.camera import Camera
+    >>> cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
+    >>> empty = np.zeros((240, 320), np.uint8)
+    >>> looks_empty(cam, empty, np.array([4.0, 0.0]), 1.7, 0.45)
+    True
+    >>> u0, v0, u1, v1, _ = people_boxes(cam, np.array([[4.0, 0.0, 1.7, 0.45]]))[0].astype(int)
+    >>> empty[v0:v1, u0:u1] = 1                      # somebody there
+    >>> looks_empty(cam, empty, np.array([4.0, 0.0]), 1.7, 0.45)
+    False
+    """
+    if mask is None or mask.shape[:2] != (cam.height, cam.width):
+        return False
+    shown, open_share, foreground = emptiness(cam, mask, xy, height, width, occlusion, blockers)
+    return shown >= min_share and open_share >= 0.3 and foreground < EMPTY_SHARE
+
+
+def emptiness(cam: Camera, mask: np.ndarray, xy: np.ndarray, height: float, width: float,
+              occlusion: np.ndarray | None = None, blockers: np.ndarray | None = None) -> tuple[float, float, float]:
+    """What :func:`looks_empty` decides by: the share of the axis points that show, the share of
+    the box left open (inside the image, not behind an obstacle, not covered by ``blockers``) and
+    the foreground share of that open part (NaN when nothing is open)."""
+    shown = visible_share([cam], xy, height, [occlusion], [blockers])
+    u0, v0, u1, v1, dist = people_boxes(cam, np.array([[xy[0], xy[1], height, width]]))[0]
+    iu0, iv0 = max(0, int(math.floor(u0))), max(0, int(math.floor(v0)))
+    iu1, iv1 = min(cam.width, int(math.ceil(u1))), min(cam.height, int(math.ceil(v1)))
+    if not (u1 > u0 and v1 > v0 and iu1 > iu0 and iv1 > iv0):
+        return shown, 0.0, float("nan")
+    open_ = np.ones((iv1 - iv0, iu1 - iu0), bool)
+    if occlusion is not None:
+        open_ &= occlusion[iv0:iv1, iu0:iu1] > dist - 0.3
+    for b in (blockers if blockers is not None else ()):
+        bu0, bv0 = max(iu0, int(math.floor(b[0]))), max(iv0, int(math.floor(b[1])))
+        bu1, bv1 = min(iu1, int(math.ceil(b[2]))), min(iv1, int(math.ceil(b[3])))
+        if bu1 > bu0 and bv1 > bv0:
+            open_[bv0 - iv0:bv1 - iv0, bu0 - iu0:bu1 - iu0] = False
+    if not open_.any():
+        return shown, 0.0, float("nan")
+    return shown, float(open_.sum() / ((u1 - u0) * (v1 - v0))), float((mask[iv0:iv1, iu0:iu1] != 0)[open_].mean())
+
+
 #: The covariance fields of an estimate whose tracker measured none.
 NO_COVARIANCE = (float("nan"),) * 3
 
@@ -144,4 +205,5 @@ def support_of(person: Person | None, tr: Track) -> float:
     return float("nan")
 
 
-__all__ = ["NO_COVARIANCE", "floor_information", "in_views", "people_boxes", "support_of", "tracker_covariance", "visible_share"]
+__all__ = ["EMPTY_SHARE", "LEAD_SHARE", "NO_COVARIANCE", "floor_information", "in_views", "looks_empty", "people_boxes",
+           "support_of", "tracker_covariance", "visible_share"]

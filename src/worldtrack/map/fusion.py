@@ -71,14 +71,12 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from worldtrack.map.config import MapConfig
-from worldtrack.map.evidence import floor_information, in_views, people_boxes, visible_share  # noqa: F401 (public here too)
-from worldtrack.map.messages import Estimate, MapPerson, MapState, Observation
+from worldtrack.map.evidence import LEAD_SHARE, floor_information, in_views, people_boxes, visible_share  # noqa: F401
+from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
+from worldtrack.map.refute import refute
 
 #: The least weight an estimate has (support 0 still says "a worker sees somebody here").
 MIN_WEIGHT = 0.05
-#: The lead of a person is a worker whose cameras show at least this share of their body, if any
-#: does (a tracker fitting a head at the image's edge is no lead, however near the camera).
-LEAD_SHARE = 0.6
 
 
 @dataclass
@@ -99,6 +97,11 @@ class FusedPerson:
     mode: str = "tracking"
     workers: int = 0
     lead: str = ""
+    #: Buckets running in which another worker's clear view showed this person's place empty
+    #: while only views showing less than LEAD_SHARE of them reported them.
+    doubt: int = 0
+    #: Buckets running in which only one worker reported them, covered by other people there.
+    hidden: int = 0
 
     def public(self) -> MapPerson:
         return MapPerson(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
@@ -132,6 +135,19 @@ class FusionState:
         return cls({p.id: p for p in people},
                    {(int(a), int(b)): float(t) for a, b, t in d["close_since"]},
                    {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"])
+
+    def copy(self) -> "FusionState":
+        """An independent copy (a bucket is fused on a copy until its write has succeeded)."""
+        return FusionState({i: replace(p) for i, p in self.people.items()}, dict(self.close_since),
+                           dict(self.aliases), self.last_bucket)
+
+    @classmethod
+    def from_record(cls, state: MapState, bucket: int) -> "FusionState":
+        """The state to continue after ``bucket`` from its entry in the record (the map stream),
+        when the state written beside it is missing (the current-map hash deleted or older).
+        Pairs of close ids start afresh; the bucket's own merges are kept."""
+        people = {p.id: FusedPerson(**p._asdict()) for p in state.people}
+        return cls(people, {}, {y: (e, state.t) for y, e in state.aliases.items()}, bucket)
 
     def resolve(self, pid: int) -> int:
         """The id ``pid`` is known by now (following merges)."""
@@ -218,6 +234,8 @@ def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict
     for o in sorted(observations, key=lambda o: o.t):
         for e in o.people:
             pid = state.resolve(e.id)
+            if pid == REFUTED:                  # dropped on negative evidence: not brought back
+                continue
             mine = out.setdefault(pid, {})
             old = mine.get(o.worker)
             if old is None or e.seen or not old.seen:
@@ -249,6 +267,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
         if pid in ended or t - p.last_seen > cfg.forget_after_s:
             del state.people[pid]
     aliases = _merge_duplicates(state, workers_of, t, cfg)
+    if cfg.negative_evidence:
+        aliases.update(refute(state, estimates, observations, t, cfg))
     state.aliases = {y: (e, ts) for y, (e, ts) in state.aliases.items() if t - ts <= cfg.forget_after_s}
     state.last_bucket = bucket
     reports = tuple((o.camera, o.t, o.sent) for o in observations)

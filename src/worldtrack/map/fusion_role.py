@@ -16,11 +16,22 @@ script together with the state the next holder resumes from: a bucket is written
 holder of the lease, and a new holder continues from the bucket after the last one written,
 re-reading the observations from there (they stay in their streams until ``retention_s``), so
 nothing in the streams is skipped on a take-over.
+
+**Keeping the lease while working.** The lease is renewed by a thread of its own *and* between
+the buckets of a step, and a step does a bounded amount of work (:data:`MAX_READ_PER_STEP`
+observations read, :data:`MAX_BUCKETS_PER_STEP` buckets written), so a backlog (after a take-over,
+or a process that stalled) is worked off in many short steps instead of one long one that lets the
+lease lapse. A holder whose lease lapsed takes it again only if it is free, and then continues
+after the last bucket *in the record* (:meth:`FusionRole._take_over`): its own pending work if
+nobody wrote meanwhile, else the other holder's state — never from its first bucket. Every write
+is fenced by the lease, so a holder that lost it writes nothing more (no two writers), and a
+bucket somebody else wrote first is never written again.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import threading
 import time
 from dataclasses import dataclass, field
@@ -29,59 +40,21 @@ from typing import Any, Callable
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
 from worldtrack.map.fusion import FusionState, fuse_bucket, provisional_state
-from worldtrack.map.lease import Lease
-from worldtrack.map.messages import (MapState, Observation, bucket_index, decode_observation, encode_map_state,
-                                     stream_id_ms)
-
-#: KEYS = (lease, map stream, current hash); ARGV = (owner, id, minid, state, last bucket, written, t,
-#: people count, updates channel, update, field, value, …). 1 written, 0 not our lease, -1 bucket
-#: already written, 2 written but not published (an ACL user without the channel: ``&prefix:*``).
-_WRITE_MAP = """
-if redis.call('GET', KEYS[1]) ~= ARGV[1] then
-  return 0
-end
-local args = {KEYS[2]}
-if ARGV[3] ~= '' then
-  table.insert(args, 'MINID'); table.insert(args, '~'); table.insert(args, ARGV[3])
-end
-table.insert(args, ARGV[2])
-for i = 11, #ARGV do table.insert(args, ARGV[i]) end
-local ok = pcall(redis.call, 'XADD', unpack(args))
-if not ok then
-  return -1
-end
-redis.call('HSET', KEYS[3], 'state', ARGV[4], 'last_bucket', ARGV[5], 'written', ARGV[6], 't', ARGV[7],
-           'people', ARGV[8], 'holder', ARGV[1])
-for i = 11, #ARGV, 2 do
-  if ARGV[i] == 'people' or ARGV[i] == 'aliases' or ARGV[i] == 'reports' then
-    redis.call('HSET', KEYS[3], 'map_' .. ARGV[i], ARGV[i + 1])
-  end
-end
-local sent = redis.pcall('PUBLISH', ARGV[9], ARGV[10])
-if type(sent) == 'table' and sent.err then
-  return 2
-end
-return 1
-"""
-
-#: The live map between complete buckets. KEYS = (lease, current hash); ARGV = (owner, updates
-#: channel, update, written, t, people count, people, aliases, reports). 1 written, 0 not our lease,
-#: 2 written but not published.
-_UPDATE_MAP = """
-if redis.call('GET', KEYS[1]) ~= ARGV[1] then
-  return 0
-end
-redis.call('HSET', KEYS[2], 'written', ARGV[4], 't', ARGV[5], 'people', ARGV[6], 'map_people', ARGV[7],
-           'map_aliases', ARGV[8], 'map_reports', ARGV[9])
-local sent = redis.pcall('PUBLISH', ARGV[2], ARGV[3])
-if type(sent) == 'table' and sent.err then
-  return 2
-end
-return 1
-"""
+from worldtrack.map.lease import UPDATE_MAP, WRITE_MAP, Lease
+from worldtrack.map.messages import (MapState, Observation, bucket_index, decode_map_state, decode_observation,
+                                     encode_map_state, stream_id_ms)
 
 #: With no state to resume from, start this far back in the observation streams (s).
 COLD_START_S = 5.0
+#: Work per step: at most this many observations read (over all cameras) and buckets written.
+MAX_READ_PER_STEP = 200
+MAX_BUCKETS_PER_STEP = 10
+#: The live map is updated from the open buckets only while this few are open (a backlog is
+#: written to the record first; each record write updates the live map too).
+MAX_LIVE_OPEN = 10
+#: On Ctrl-C / SIGTERM the holder writes what it has for at most this long (s), then gives the
+#: lease back; what it did not write stays in the streams for the next holder.
+DRAIN_S = 1.5
 
 
 @dataclass
@@ -93,6 +66,7 @@ class FusionStats:
     late: int = 0
     malformed: int = 0
     takeovers: int = 0
+    retaken: int = 0          # the lease lapsed and this process took it again
     updates: int = 0
     last_written: float = 0.0
     lag_s: list[float] = field(default_factory=list)
@@ -117,8 +91,8 @@ class FusionRole:
                  log: Callable[[str], None] | None = None):
         self.client, self.keys, self.cfg, self.owner, self.clock = client, keys, cfg, owner, clock
         self.lease = Lease(client, keys.fusion_lease, owner, cfg.lease_s)
-        self._write = client.register_script(_WRITE_MAP)
-        self._update = client.register_script(_UPDATE_MAP)
+        self._write = client.register_script(WRITE_MAP)
+        self._update = client.register_script(UPDATE_MAP)
         self._fresh = False          # observations came that the live map does not hold yet
         self._said_unpublished = False
         self.on_state = on_state
@@ -126,20 +100,24 @@ class FusionRole:
         self.holding = False
         self.stats = FusionStats()
         self.state = FusionState()
+        self._started = False        # has this process held the role (state, cursors) before?
         self._cursors: dict[str, str] = {}
+        self._caught_up = False      # the last read reached the end of every stream
         self._buckets: dict[int, list[Observation]] = {}
         self._first_arrival: dict[int, float] = {}
         self._latest: dict[str, float] = {}
         self._cameras: dict[str, float] = {}
         self._cameras_read = 0.0
-        self._renewed = 0.0
+        self._renewed = 0.0          # time.monotonic() of the last renewal made by the step loop
         self._late_pending = 0
         self._start_ms = 0
+        self._deadline = math.inf    # time.monotonic() by which a drain stops writing
 
     # ------------------------------------------------------------------ the loop
     def run(self, stop: threading.Event) -> None:
-        """Contend and fuse until ``stop`` is set (then give the lease back). The lease is renewed by
-        a thread of its own, so a long step (a backlog after a take-over) does not let it lapse."""
+        """Contend and fuse until ``stop`` is set (then write what is due, at most :data:`DRAIN_S`,
+        and give the lease back). The lease is renewed by a thread of its own and between the
+        buckets of a step."""
         from worldtrack.map.lease import LeaseKeeper
         keeper = LeaseKeeper([], self.cfg.renew_s, self._lost)
         keeper.start()
@@ -152,49 +130,105 @@ class FusionRole:
                     else:
                         stop.wait(self.cfg.renew_s / 2)     # as a camera standby: take it soon after expiry
                     continue
-                self.step(block_ms=20, renew=False)
+                self.step(block_ms=20)
         finally:
-            keeper.stop(release=False)
-            if self.holding:
-                self.drain()
-                self.lease.release()
-                self.holding = False
-                self.log("fusion: given back")
+            try:
+                if self.holding:
+                    self.drain()                            # the keeper still renews meanwhile
+            finally:
+                keeper.stop(release=False)
+                if self.holding:
+                    self.lease.release()
+                    self.holding = False
+                    self.log("fusion: given back")
 
-    def drain(self) -> None:
-        """Before giving the role back: wait for the open buckets' last observations (``max_wait_s``),
-        then write them all."""
-        deadline = self.clock() + self.cfg.max_wait_s + 0.1
-        while self.holding and self._buckets and self.clock() < deadline:
-            self.step(block_ms=10)
-        while self.holding and self._buckets:
-            b = min(self._buckets)
-            if not self._write_bucket(b, self._buckets.pop(b)):
-                break
+    def drain(self, budget_s: float = DRAIN_S) -> None:
+        """Before giving the role back: wait a little for the open buckets' last observations, then
+        write those whose observations are all read — for at most ``budget_s`` seconds (checked
+        between buckets). What is left stays in the streams: the next holder continues after the
+        last bucket written."""
+        self._deadline = time.monotonic() + budget_s
+        try:
+            wait_end = time.monotonic() + min(self.cfg.max_wait_s + 0.1, budget_s / 2)
+            while self.holding and self._buckets and time.monotonic() < wait_end:
+                self.step(block_ms=10)
+            while self.holding and self._buckets and self._caught_up and time.monotonic() < self._deadline:
+                if not self._still_holding():
+                    break
+                b = min(self._buckets)
+                if not self._write_bucket(b, self._buckets.pop(b)):
+                    break
+                self._first_arrival.pop(b, None)
+        finally:
+            self._deadline = math.inf
+        if self.holding and self._buckets:
+            self.log(f"fusion: {len(self._buckets)} open buckets left in the streams for the next holder")
 
     def _lost(self, lease) -> None:
         self.holding = False
         self.log("fusion: lease taken by another process; contending again")
 
-    def _take_over(self) -> None:
+    def _still_holding(self) -> bool:
+        """Renew the lease when ``renew_s`` has passed since this loop last did; False (and stop
+        writing) when it has been taken. A lapsed lease nobody took is taken again."""
+        if not self.holding:
+            return False
+        now = time.monotonic()
+        if now - self._renewed < self.cfg.renew_s:
+            return True
+        if self.lease.renew():
+            self._renewed = now
+            return True
+        if self.lease.acquire():
+            self._take_over()
+            return self.holding
+        self.holding = False
+        self.log("fusion: lease lost (renewal came too late); contending again")
+        return False
+
+    def _record_end(self) -> tuple[int | None, MapState | None]:
+        """The last bucket in the record (the map stream) and its state; (None, None) if empty."""
+        last = self.client.xrevrange(self.keys.map_stream, count=1)
+        if not last:
+            return None, None
+        state = decode_map_state(last[0][1])
+        return bucket_index(state.t + 0.5 * self.cfg.bucket_s, self.cfg.bucket_s), state
+
+    def _take_over(self, reload: bool = False) -> None:
+        """Hold the role: continue after the last bucket written to the record. If that is this
+        process's own last bucket (its lease lapsed and nobody wrote meanwhile) it goes on with
+        what it has read; otherwise (or with ``reload``) it loads the state the last writer left
+        and re-reads the observations after that bucket."""
         self.holding = True
-        self.stats.takeovers += 1
+        self._renewed = time.monotonic()
         self.takeover_at = self.clock()
-        self._renewed = self.clock()
+        written, record = self._record_end()
+        if self._started and not reload and written == self.state.last_bucket:
+            self.stats.retaken += 1
+            self.log("fusion: lease taken again; nothing was written meanwhile, map continues " + self._where())
+            return
+        self.stats.takeovers += not reload
+        self._started = True
         raw = self.client.hgetall(self.keys.current)
-        self.state = FusionState.from_json(raw["state"]) if raw.get("state") else FusionState()
-        if self.state.last_bucket is not None:
-            start_ms = stream_id_ms((self.state.last_bucket + 1) * self.cfg.bucket_s) - 1
+        state = FusionState.from_json(raw["state"]) if raw.get("state") else FusionState()
+        if written is not None and (state.last_bucket is None or state.last_bucket < written):
+            state = FusionState.from_record(record, written)      # the hash is behind the record
+        self.state = state
+        if state.last_bucket is not None:
+            start_ms = stream_id_ms((state.last_bucket + 1) * self.cfg.bucket_s) - 1
         else:
             start_ms = stream_id_ms(self.clock() - COLD_START_S)
         self._buckets.clear()
         self._first_arrival.clear()
-        self._cursors = {}
+        self._latest.clear()
+        self._cursors, self._caught_up = {}, False
         self._start_ms = max(0, start_ms)
         self._refresh_cameras(force=True)
-        last = "from its first bucket" if self.state.last_bucket is None else \
-            f"after bucket t={self.state.last_bucket * self.cfg.bucket_s:.2f}"
-        self.log(f"fusion: taken by this worker; map continues {last}")
+        self.log("fusion: taken by this worker; map continues " + self._where())
+
+    def _where(self) -> str:
+        b = self.state.last_bucket
+        return "from its first bucket" if b is None else f"after bucket t={b * self.cfg.bucket_s:.2f}"
 
     def _refresh_cameras(self, force: bool = False) -> None:
         now = self.clock()
@@ -207,28 +241,22 @@ class FusionRole:
             self._cursors.setdefault(self.keys.observations(c), f"{self._start_ms}-0")
 
     def step(self, block_ms: int = 20, renew: bool = True) -> int:
-        """Read what has come, write the buckets that are due; returns buckets written. ``renew``:
-        renew the lease here (when no :class:`LeaseKeeper` does)."""
-        now = self.clock()
-        if renew and now - self._renewed >= self.cfg.renew_s:
-            if not self.lease.renew():
-                if self.lease.acquire():      # expired while this process stalled, but nobody took it
-                    self._take_over()         # somebody may have held it meanwhile: reload the state
-                    return 0
-                self.holding = False
-                self.log("fusion: lease lost (renewal came too late); contending again")
-                return 0
-            self._renewed = now
+        """Read what has come (at most :data:`MAX_READ_PER_STEP` observations), write the buckets
+        that are due (at most :data:`MAX_BUCKETS_PER_STEP`); returns buckets written. ``renew``:
+        renew the lease here too (every ``renew_s``) — whether or not a :class:`LeaseKeeper` does."""
+        if renew and not self._still_holding():
+            return 0
         self._refresh_cameras()
         if self._cursors:
-            # A bounded batch per step (a backlog after a take-over is read in several).
-            count = max(20, 4000 // len(self._cursors))
-            replies = self.client.xread(self._cursors, count=count, block=block_ms)
+            count = max(5, MAX_READ_PER_STEP // len(self._cursors))
+            replies = self.client.xread(self._cursors, count=count, block=block_ms or None)
+            self._caught_up = all(len(entries) < count for _, entries in replies or [])
             self._take(replies)
         else:
+            self._caught_up = True
             time.sleep(block_ms / 1000.0)
-        written = self._close_due()
-        if self._fresh and self._buckets and self.holding and self.cfg.live_updates:
+        written = self._close_due(renew)
+        if self._fresh and self.holding and self.cfg.live_updates and 0 < len(self._buckets) <= MAX_LIVE_OPEN:
             self._update_live()
         self._fresh = False
         return written
@@ -281,10 +309,12 @@ class FusionRole:
         held = self.client.mget([self.keys.camera_lease(c) for c in cams])
         return [c for c, h in zip(cams, held) if h]
 
-    def _close_due(self) -> int:
+    def _close_due(self, renew: bool = True) -> int:
+        """Write the complete (or ``max_wait_s`` old) buckets in order, at most
+        :data:`MAX_BUCKETS_PER_STEP`, renewing the lease between them (``renew``)."""
         written = 0
         live = None
-        while self._buckets:
+        while self._buckets and written < MAX_BUCKETS_PER_STEP and time.monotonic() < self._deadline:
             b = min(self._buckets)
             end = (b + 1) * self.cfg.bucket_s
             if self.clock() - self._first_arrival[b] < self.cfg.max_wait_s:
@@ -294,6 +324,8 @@ class FusionRole:
                 if not all(self._latest.get(c, -1e18) + 1.0 / self._cameras.get(c, 10.0) >= end - 1e-6
                            for c in live):
                     break
+            if renew and not self._still_holding():
+                break
             if not self._write_bucket(b, self._buckets.pop(b)):
                 break
             self._first_arrival.pop(b, None)
@@ -301,21 +333,36 @@ class FusionRole:
         return written
 
     def _write_bucket(self, b: int, observations: list[Observation]) -> bool:
+        """Fuse bucket ``b`` and write it, fenced by the lease. False when not written: the lease is
+        not ours (stop; the bucket stays pending), or somebody else wrote the bucket first (then
+        continue after the record's last bucket)."""
         now = self.clock()
-        state = fuse_bucket(self.state, b, observations, self.cfg, written=now)
+        fused = self.state.copy()          # self.state moves on only once the record holds the bucket
+        state = fuse_bucket(fused, b, observations, self.cfg, written=now)
         state = MapState(state.t, state.people, state.reports, state.aliases, now, self._late_pending)
-        self._late_pending = 0
         fields = encode_map_state(state)
         minid = str(stream_id_ms(state.t - self.cfg.retention_s))
-        args = [self.owner, f"{stream_id_ms(state.t)}-0", minid, self.state.to_json(), str(b), repr(now),
+        args = [self.owner, f"{stream_id_ms(state.t)}-0", minid, fused.to_json(), str(b), repr(now),
                 repr(state.t), str(len(state.present())), self.keys.updates, json.dumps(fields)]
         for k, v in fields.items():
             args += [k, v]
         res = self._write(keys=[self.keys.fusion_lease, self.keys.map_stream, self.keys.current], args=args)
         if res == 0:
+            # Not ours: write nothing more, keep the bucket. If this process takes the lease again
+            # and nobody wrote meanwhile, it goes on from here (_take_over).
+            self._buckets[b] = observations
             self.holding = False
+            self.log("fusion: lease lost before a write; contending again")
             return False
-        self.stats.buckets += res in (1, 2)
+        if res == -1:
+            # The record already holds this bucket (another holder wrote it while this process's
+            # lease had lapsed): never write it again, continue after the record's last bucket.
+            self.log(f"fusion: bucket t={state.t:.2f} already in the record; continuing after the record's last")
+            self._take_over(reload=True)
+            return False
+        self.state = fused
+        self._late_pending = 0
+        self.stats.buckets += 1
         self._published(res)
         self.stats.last_written = now
         self.stats.lag_s.append(now - (b + 1) * self.cfg.bucket_s)

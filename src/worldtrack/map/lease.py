@@ -46,6 +46,53 @@ end
 return res
 """
 
+#: The fusion's record of a bucket (:mod:`worldtrack.map.fusion_role`). KEYS = (lease, map stream, current hash); ARGV = (owner, id, minid, state, last bucket, written, t,
+#: people count, updates channel, update, field, value, …). 1 written, 0 not our lease, -1 bucket
+#: already written, 2 written but not published (an ACL user without the channel: ``&prefix:*``).
+WRITE_MAP = """
+if redis.call('GET', KEYS[1]) ~= ARGV[1] then
+  return 0
+end
+local args = {KEYS[2]}
+if ARGV[3] ~= '' then
+  table.insert(args, 'MINID'); table.insert(args, '~'); table.insert(args, ARGV[3])
+end
+table.insert(args, ARGV[2])
+for i = 11, #ARGV do table.insert(args, ARGV[i]) end
+local ok = pcall(redis.call, 'XADD', unpack(args))
+if not ok then
+  return -1
+end
+redis.call('HSET', KEYS[3], 'state', ARGV[4], 'last_bucket', ARGV[5], 'written', ARGV[6], 't', ARGV[7],
+           'people', ARGV[8], 'holder', ARGV[1])
+for i = 11, #ARGV, 2 do
+  if ARGV[i] == 'people' or ARGV[i] == 'aliases' or ARGV[i] == 'reports' then
+    redis.call('HSET', KEYS[3], 'map_' .. ARGV[i], ARGV[i + 1])
+  end
+end
+local sent = redis.pcall('PUBLISH', ARGV[9], ARGV[10])
+if type(sent) == 'table' and sent.err then
+  return 2
+end
+return 1
+"""
+
+#: The live map between complete buckets. KEYS = (lease, current hash); ARGV = (owner, updates
+#: channel, update, written, t, people count, people, aliases, reports). 1 written, 0 not our lease,
+#: 2 written but not published.
+UPDATE_MAP = """
+if redis.call('GET', KEYS[1]) ~= ARGV[1] then
+  return 0
+end
+redis.call('HSET', KEYS[2], 'written', ARGV[4], 't', ARGV[5], 'people', ARGV[6], 'map_people', ARGV[7],
+           'map_aliases', ARGV[8], 'map_reports', ARGV[9])
+local sent = redis.pcall('PUBLISH', ARGV[2], ARGV[3])
+if type(sent) == 'table' and sent.err then
+  return 2
+end
+return 1
+"""
+
 
 def worker_name() -> str:
     """A name for this process that no other process shares: ``host:pid:random``."""
@@ -139,4 +186,4 @@ class LeaseKeeper(threading.Thread):
                     pass
 
 
-__all__ = ["FENCED_XADD", "Lease", "LeaseKeeper", "acquire_all", "worker_name"]
+__all__ = ["FENCED_XADD", "UPDATE_MAP", "WRITE_MAP", "Lease", "LeaseKeeper", "acquire_all", "worker_name"]

@@ -13,7 +13,7 @@ Entry ids are capture times in ms (``<ms>-<seq>``), so streams can be read and t
 (``XRANGE``, ``MINID``) and a map bucket is written once: a second ``XADD`` of the same id fails.
 
 >>> e = Estimate(3, 1.5, 2.0, 1.7, 0.45, 0.2, 0.0, 0.8, 0.6, True, cxx=0.04, cxy=0.0, cyy=0.0025)
->>> o = Observation("cam1", 12.3, "w1", 123, 12.35, (e,), ended=(2,))
+>>> o = Observation("cam1", 12.3, "w1", 123, 12.35, (e,), ended=(2,), absent=(5,))
 >>> decode_observation(encode_observation(o)) == o
 True
 >>> bucket_index(12.34, 0.1), stream_id_ms(12.3)
@@ -42,6 +42,8 @@ class Estimate(NamedTuple):
     (:func:`worldtrack.map.evidence.visible_share`). ``cxx, cxy, cyy`` (m²): the covariance of the
     estimate as the worker's tracker measured it this frame (the ellipsoid tracker's, from the
     curvature of its score: it knows what other people hide), NaN when the tracker gives none.
+    ``own``: the share of the person's body its best camera shows that no other person it holds
+    covers (the map's counterpart of the tracker's own share; 1 from older workers).
     """
 
     id: int
@@ -61,11 +63,19 @@ class Estimate(NamedTuple):
     cxx: float = float("nan")
     cxy: float = float("nan")
     cyy: float = float("nan")
+    own: float = 1.0
+
+
+#: An alias to this id means the map dropped the person on other workers' negative evidence
+#: (their cameras show the place clearly, and nobody there): no elder, the id is gone.
+REFUTED = 0
 
 
 @dataclass(frozen=True)
 class Observation:
-    """One camera's frame as a worker saw it."""
+    """One camera's frame as a worker saw it. ``ended``: ids its tracker ended; ``absent``: ids of
+    the map's people this camera shows the place of, clearly, with nobody there (negative evidence,
+    :func:`worldtrack.map.evidence.looks_empty`)."""
 
     camera: str
     t: float
@@ -74,6 +84,7 @@ class Observation:
     sent: float
     people: tuple[Estimate, ...] = ()
     ended: tuple[int, ...] = ()
+    absent: tuple[int, ...] = ()
 
 
 class MapPerson(NamedTuple):
@@ -105,7 +116,8 @@ class MapState:
     """The fused map for the bucket starting at ``t`` (s).
 
     ``reports``: ``(camera, capture time, sent time)`` of every observation merged (for lag and
-    latency); ``aliases``: ``{younger id: elder id}`` merged in this bucket; ``written``: when the
+    latency); ``aliases``: ``{younger id: elder id}`` merged in this bucket (elder :data:`REFUTED`:
+    dropped on negative evidence); ``written``: when the
     fusion wrote it (wall clock, s); ``late``: observations that came after their bucket was written.
     """
 
@@ -141,13 +153,15 @@ def _float(v) -> float:
 
 def encode_observation(o: Observation) -> dict[str, str]:
     """The stream fields of an observation: ``v``, ``t`` (capture time) and ``o``, one JSON list
-    ``[camera, worker, frame, sent, people, ended]`` (one field to parse, not eight: the fusion
+    ``[camera, worker, frame, sent, people, ended, absent]`` (one field to parse, not eight: the fusion
     reads thousands a second). NaN stays NaN (Python's JSON)."""
     people = [[int(e.id), round(e.x, 4), round(e.y, 4), round(e.height, 3), round(e.width, 3), round(e.vx, 3),
                round(e.vy, 3), round(float(e.score), 3), round(float(e.support), 3), int(bool(e.seen)), _sig(e.ixx),
-               _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2), _sig(e.cxx), _sig(e.cxy), _sig(e.cyy)]
+               _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2), _sig(e.cxx), _sig(e.cxy), _sig(e.cyy),
+               round(float(e.own), 2)]
               for e in o.people]
-    body = [o.camera, o.worker, int(o.frame), float(o.sent), people, [int(i) for i in o.ended]]
+    body = [o.camera, o.worker, int(o.frame), float(o.sent), people, [int(i) for i in o.ended],
+            [int(i) for i in o.absent]]
     return {"v": FORMAT_VERSION, "t": repr(float(o.t)), "o": json.dumps(body, separators=(",", ":"))}
 
 
@@ -156,11 +170,11 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
     try:
         if fields.get("v") != FORMAT_VERSION:
             raise ValueError(f"format version {fields.get('v')!r}, expected {FORMAT_VERSION}")
-        camera, worker, frame, sent, people, ended = json.loads(fields["o"])
+        camera, worker, frame, sent, people, ended, *absent = json.loads(fields["o"])   # 6: before absent
         for p in people:
             p[9] = p[9] == 1
         return Observation(str(camera), float(fields["t"]), str(worker), int(frame), float(sent),
-                           tuple(Estimate(*p) for p in people), tuple(ended))
+                           tuple(Estimate(*p) for p in people), tuple(ended), tuple(absent[0]) if absent else ())
     except (KeyError, IndexError, TypeError, ValueError, json.JSONDecodeError) as e:
         if isinstance(e, ValueError) and str(e).startswith("format version"):
             raise
@@ -209,6 +223,6 @@ def time_of_id(entry_id: str) -> float:
     return int(str(entry_id).split("-", 1)[0]) / 1000.0
 
 
-__all__ = ["Estimate", "FORMAT_VERSION", "MapPerson", "MapState", "Observation", "bucket_index",
+__all__ = ["Estimate", "FORMAT_VERSION", "MapPerson", "MapState", "Observation", "REFUTED", "bucket_index",
            "decode_map_state", "decode_observation", "encode_map_state", "encode_observation", "stream_id_ms",
            "time_of_id"]

@@ -32,11 +32,11 @@ from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.evidence import (NO_COVARIANCE, floor_information, in_views, people_boxes, support_of,
-                                     tracker_covariance, visible_share)
+from worldtrack.map.evidence import (NO_COVARIANCE, floor_information, in_views, looks_empty, people_boxes,
+                                     support_of, tracker_covariance, visible_share)
 from worldtrack.map.fusion import LEAD_SHARE
 from worldtrack.map.lease import FENCED_XADD, Lease
-from worldtrack.map.messages import (FORMAT_VERSION, Estimate, MapState, Observation, decode_map_state,
+from worldtrack.map.messages import (FORMAT_VERSION, REFUTED, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
 from worldtrack.map.shared_ids import SharedPositionMap
 from worldtrack.trackers.base import Frame, PositionMap, Track, Tracker
@@ -192,7 +192,9 @@ class MapLink:
         for young, elder in state.aliases.items():
             if young not in local:
                 continue
-            if elder not in local and isinstance(local, SharedPositionMap):
+            if elder == REFUTED:
+                local.remove(young)                      # dropped by the map on negative evidence
+            elif elder not in local and isinstance(local, SharedPositionMap):
                 local.promote(young, known_id=elder)     # its copy goes on under the elder id, as tracked
                 for held in (self.mine_seen, self.ever_seen):
                     if young in held:
@@ -291,19 +293,45 @@ class MapLink:
                 self.placed.discard(tr.id)
             now_ids.add(tr.id)
             support = support_of(person, tr)
-            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ,
-                                     blockers=[np.delete(boxes[c], k, axis=0) for c in mine])
+            others = [np.delete(boxes[c], k, axis=0) for c in mine]
+            info = floor_information([self.cameras[c] for c in mine], where, tr.height, occlusion=occ, blockers=others)
             cov = tracker_covariance(tracker, person, t) if seen else None
+            own = visible_share([self.cameras[c] for c in mine], where, tr.height, occ, others)
             e = Estimate(tr.id, tr.x, tr.y, tr.height, tr.width, tr.vx, tr.vy, float(tr.score), support, seen, *info,
-                         share, *(NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])))
+                         share, *(NO_COVARIANCE if cov is None else (cov[0, 0], cov[0, 1], cov[1, 1])), own)
             for c, ok in zip(cams, views):
                 if ok:
                     per_cam[c].append(e)
         ended = tuple(sorted(i for i in self._reported if i not in local))
         self._reported = {i: () for i in now_ids}
         self.ever_seen &= {p.id for p in local}
-        return [Observation(c, float(frames[c].t), self.name, int(frames[c].index), sent, tuple(per_cam[c]), ended)
-                for c in cams]
+        seen_ids = {e.id for es in per_cam.values() for e in es if e.seen}
+        absent = self._absent(tracker, tracks, t, cams, boxes, seen_ids) if self.cfg.negative_evidence else {}
+        return [Observation(c, float(frames[c].t), self.name, int(frames[c].index), sent, tuple(per_cam[c]), ended,
+                            absent.get(c, ())) for c in cams]
+
+    def _absent(self, tracker: Tracker, tracks: Sequence[Track], t: float, cams: list[str],
+                boxes: Mapping[str, np.ndarray], seen_ids: set[int]) -> dict[str, tuple[int, ...]]:
+        """Per camera, the map's people (not seen by this worker now) whose place the camera shows
+        clearly with nobody there (:func:`~worldtrack.map.evidence.looks_empty`; the boxes of the
+        people this worker holds explain the foreground they cover)."""
+        if self.state is None:
+            return {}
+        out: dict[str, list[int]] = {}
+        dt = min(max(t - self.state.captured, 0.0), 0.5)
+        held = [tr.id for tr in tracks]
+        for p in self.state.present():
+            if p.id in seen_ids or not (math.isfinite(p.height) and math.isfinite(p.width)):
+                continue
+            xy = np.array([p.x + p.vx * dt, p.y + p.vy * dt])
+            others = np.array([k for k, i in enumerate(held) if i != p.id], int)
+            for c in cams:
+                overlay = tracker.overlay(c) if hasattr(tracker, "overlay") else None
+                mask = getattr(overlay, "mask", None)
+                if looks_empty(self.cameras[c], mask, xy, p.height, p.width, self.occlusion.get(c),
+                               boxes[c][others], min_share=LEAD_SHARE):
+                    out.setdefault(c, []).append(p.id)
+        return {c: tuple(ids) for c, ids in out.items()}
 
     def publish(self, observations: Sequence[Observation]) -> None:
         """Append the observations to their cameras' streams (only while this worker holds them)."""
