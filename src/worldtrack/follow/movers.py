@@ -5,10 +5,11 @@ ahead of it in its own direction (somebody cutting in between the robot and its 
 :func:`moving_speed_limit` tries every forward speed on a grid: the robot drives at that speed for
 one reaction ``delay``, then brakes at ``brake`` m/s² to a stop, along its arc at the commanded turn
 rate, while every person walks on at their velocity (constant-velocity prediction over ``horizon``
-seconds). A speed is admissible if, until the robot stands, its centre keeps ``clearance`` metres
-from every person's predicted centre — or, for somebody already nearer than that, does not come any
-nearer. What people do to a robot that stands is their doing, so the check ends when it stops. The
-limit is the fastest admissible speed; 0 when none is.
+seconds). A speed is admissible if, wherever the robot is still driving towards somebody, its
+centre keeps ``clearance`` metres from their predicted centre — or, for somebody already nearer
+than that, does not come any nearer. What people do to a robot that stands, or drives away from
+them, is their doing (the closed loop counts it apart), so it is not checked. The limit is the
+fastest admissible speed; 0 when none is.
 
 A standing person (velocity 0) gives the usual braking limit, ``v·delay + v²/(2·brake) ≤ gap``.
 
@@ -51,9 +52,12 @@ def moving_speed_limit(centre, yaw: float, turn_rate: float, people_xy: np.ndarr
     people = people_xy[None] + times[:, None, None] * velocity[None]                # (T, K, 2)
     d = np.linalg.norm(robot[:, :, None, :] - people[None], axis=-1)                # (S, T, K)
     allowed = np.minimum(clearance, d[0, 0] - 1e-6)                                 # (K,) nearer now: no nearer
-    # Only until the robot stands: what people do to a standing robot is theirs, not its.
-    moving = times[None] <= delay + speeds[:, None] / brake + step                  # (S, T)
-    ok = np.all((d >= allowed[None, None]) | ~moving[:, :, None], axis=(1, 2))
+    # Only where the robot drives towards them: what people do to a robot that stands or drives away
+    # (somebody walking up behind a braking robot) is theirs, not its.
+    along = np.stack([np.cos(heading), np.sin(heading)], -1)                        # (T, 2)
+    towards = np.einsum("tc,stkc->stk", along, people[None] - robot[:, :, None, :]) > 0
+    driving = (profile > 0)[:, :, None] & towards                                   # (S, T, K)
+    ok = np.all((d >= allowed[None, None]) | ~driving, axis=(1, 2))
     if not ok[0]:
         # Someone walks at the robot whatever it does: stand (their doing, not the robot's).
         return 0.0
