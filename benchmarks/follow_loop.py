@@ -99,6 +99,52 @@ def contact_episodes(causes: list) -> dict:
     return out
 
 
+def plot_seed(s: dict, seed: int, frames: int, path: Path) -> None:
+    """Plan view of one closed-loop run — the robot (colour: time), the target, the others, the frames
+    outside the band and every collision — over the distance error with the held / not-found frames."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    r = s["result"]
+    sc = make_scenario("follow-target", size=(160, 120), frames=frames, seed=seed, distance=DISTANCE, **SCENARIO)
+    t = r.times
+    err = r.distance - DISTANCE
+    fig = plt.figure(figsize=(13, 9))
+    ax, ax2 = fig.add_axes([0.05, 0.32, 0.9, 0.64]), fig.add_axes([0.05, 0.05, 0.9, 0.22])
+    df = sc.scene.distance_field(0.05)
+    gx, gy = np.meshgrid(np.linspace(0, 16, 321), np.linspace(0, 12, 241))
+    inside = df.sample(np.column_stack([gx.ravel(), gy.ravel()]), outside=-1.0).reshape(gx.shape) < 0.01
+    ax.contourf(gx, gy, inside, levels=[0.5, 1.5], colors=["#bbbbbb"])
+    ax.scatter(*r.robot_xy.T, c=t, cmap="viridis", s=3, label="robot (colour: time)")
+    ax.plot(*r.target_xy.T, "r-", lw=0.6, label="target (person 1)")
+    for p, colour in zip(sc.people[1:], ["tab:orange", "tab:purple", "tab:brown", "tab:pink"]):
+        ax.plot(*np.where(p.track.present[:, None], p.track.xy, np.nan).T, "-", color=colour, lw=0.6,
+                label=f"person {p.id}")
+    ax.plot(*r.robot_xy[np.abs(err) > TOLERANCE].T, "x", color="k", ms=3, label=f"robot, target outside ±{TOLERANCE} m")
+    for c in r.collision_causes:
+        if c.cause != "side by side":
+            ax.plot(*r.robot_xy[c.frame], "o", mfc="none", mec="red", ms=10)
+            ax.annotate(f"{c.frame} p{c.person}: {c.cause}", r.robot_xy[c.frame], fontsize=7, color="red")
+    for k in range(0, len(t), 100):
+        ax.annotate(f"{t[k]:.0f} s", r.robot_xy[k], fontsize=7)
+    ax.set_aspect("equal")
+    ax.legend(fontsize=7, loc="upper right")
+    ax.set_title(f"seed {seed}: within ±{TOLERANCE} m {np.mean(np.abs(err) <= TOLERANCE):.3f}, "
+                 f"collisions {r.collisions}, walked into {getattr(r, 'walked_into', 0)}")
+    ax2.plot(t, err, "k-", lw=0.7)
+    ax2.axhspan(-TOLERANCE, TOLERANCE, color="g", alpha=0.15)
+    ax2.fill_between(t, -1, 3, where=s["blocked"], color="orange", alpha=0.4, label="held by someone in the path")
+    ax2.fill_between(t, -1, 3, where=~r.found, color="blue", alpha=0.2, label="target not found")
+    for c in r.collision_causes:
+        if c.robot_fault:
+            ax2.axvline(t[c.frame], color="r", lw=0.5)
+    ax2.set(ylim=(-1, 2.5), xlim=(0, t[-1]), ylabel=f"distance − {DISTANCE} m", xlabel="time s")
+    ax2.legend(fontsize=7, loc="upper right")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", default="0-9")
@@ -108,11 +154,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="dev seed 100, 200 frames (prints only)")
     ap.add_argument("--cache", help="keep each seed's records in this folder (split seeds over processes)")
     ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")
+    ap.add_argument("--plot", action="store_true", help="also draw the seed with the least time within the band "
+                                                        "(results/follow_loop<TAG>_worst.png)")
     args = ap.parse_args(argv)
     seeds = [100] if args.quick else parse_seeds(args.seeds)
     frames = 200 if args.quick else args.frames
     t0 = time.perf_counter()
-    rows, all_within, all_free_within = [], [], []
+    rows, all_within, all_free_within, records = [], [], [], {}
     totals = {"contacts": 0, "collisions": 0, "walked_into": 0, "bumps": 0}
     episodes = {"robot": 0, "walked": 0}
     causes: dict = {}
@@ -123,6 +171,7 @@ def main(argv: list[str] | None = None) -> int:
         s = seed_cached(args.cache, f"loop-{args.follower}-{seed}-{frames}",
                         lambda: run_seed(seed, frames, (160, 120), args.follower))
         r = s["result"]
+        records[seed] = s
         err = np.abs(r.distance - DISTANCE)
         all_within.append(s["within"])
         all_free_within.append(s["within"][s["free"]])
@@ -170,6 +219,11 @@ def main(argv: list[str] | None = None) -> int:
                  "candidate or track of the follower within 0.5 m; held: the path check held the robot.\n\n"
                  + markdown_table(["seed", "frame", "person", "distance m", "robot speed", "person speed", "visible",
                                    "tracked", "held", "cause"], collision_rows) + "\n")
+    if args.plot and not args.quick:
+        worst = min(records, key=lambda k: records[k]["within"].mean())
+        png = Path(__file__).resolve().parent / "results" / f"follow_loop{args.tag}_worst.png"
+        plot_seed(records[worst], worst, frames, png)
+        text += f"\nPicture of the worst seed ({worst}): `{png.name}`.\n"
     print(text)
     save_tagged("follow_loop", args.tag, "The closed loop: a simulated robot follows (seed 001)", text, args.quick,
                 time.perf_counter() - t0)

@@ -71,11 +71,14 @@ def test_robot_kinematics_limits_and_bumper():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("follower, within, worst", [("planner", 0.70, 2.0), ("pid", 0.75, 1.4)])
+@pytest.mark.parametrize("follower, within, worst", [("planner", 0.70, 2.0), ("pid", 0.75, 1.4),
+                                                     ("pid+scan", 0.75, 1.4)])
 def test_closed_loop_keeps_the_distance_without_collisions(follower, within, worst):
     from worldtrack.synth import make_scenario
     sc = make_scenario("follow-target", size=(160, 120), frames=150, seed=5, others=1, clear_route=True)
-    result = run_closed_loop(sc, follower=PIDFollower() if follower == "pid" else LocalPlanner(sc.scene))
+    make = {"pid": PIDFollower, "planner": lambda: LocalPlanner(sc.scene),
+            "pid+scan": lambda: PIDFollower(depth_stop=True, walkers=True)}
+    result = run_closed_loop(sc, follower=make[follower](), side_scan=follower == "pid+scan")
     err = np.abs(result.distance - 1.8)
     assert result.found.mean() > 0.95
     # a person crosses 0.6-0.9 m in front of the robot: it waits (the PID used to pass them at 0.51 m,
