@@ -53,6 +53,8 @@ class PIDFollower:
     distance_gains, bearing_gains : (Kp, Ki, Kd) in 1/s, 1/s², 1 (distance) and 1/s, 1/s², 1 (bearing)
     depth_stop : also stop short of near depth points nobody detected (worldtrack's safety layer; False:
     the paper's PID)
+    search_look : seconds the lost target's predicted place is looked at before the robot turns on round
+    to look about (None: it only faces the prediction, the paper's and 35e's behaviour)
     walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
     (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
     the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
@@ -73,6 +75,7 @@ class PIDFollower:
     integral_limit: float = 0.5
     depth_stop: bool = False
     walkers: bool = False
+    search_look: float | None = 2.0
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -93,11 +96,7 @@ class PIDFollower:
         d = float(np.hypot(*rel))
         bearing = float(np.arctan2(rel @ left, rel @ fwd))
         if t - s.get("seen", -np.inf) > self.lost_timeout:
-            seen = s.get("seen", -np.inf)
-            self.reset()
-            s["seen"] = seen
-            # Lost: stand, and turn slowly towards where the target should be, to look for it.
-            return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
+            return self._search(t, bearing)
         e_d = d - self.distance
         dt = t - s["t"] if "t" in s else 0.0
         v_ff = w_ff = 0.0
@@ -105,6 +104,7 @@ class PIDFollower:
             vel = np.asarray(step.velocity, float)
             v_ff = float(vel @ rel) / max(d, 1e-6)
             w_ff = float(rel[0] * vel[1] - rel[1] * vel[0]) / max(d * d, 1e-6)
+        s["last_w"] = w_ff if step.found else s.get("last_w", 0.0)
         v = v_ff + self._pid("d", e_d, dt, self.distance_gains)
         w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
         s["t"] = t
@@ -117,6 +117,26 @@ class PIDFollower:
             limit = min(limit, self._depth_limit(frame, camera, w, dt if dt > 0 else 0.1, scan))
         s["blocked"] = bool(limit < v)
         return min(v, limit), w
+
+    def _search(self, t: float, bearing: float) -> tuple[float, float]:
+        """Lost: stand and turn slowly towards where the target should be; once that has been in view
+        for ``search_look`` seconds without finding it (it turned while hidden, its prediction walked
+        on), keep turning the same way round, a full look about (worldtrack; the paper stands)."""
+        s = self._state
+        keep = {k: s[k] for k in ("seen", "search_from", "search_turn", "search_last", "last_w") if k in s}
+        self.reset()
+        s.update(keep)
+        if s.get("search_last", -np.inf) < s["seen"]:                      # a new loss
+            s["search_from"], s["search_turn"] = np.inf, 0.0
+        s["search_last"] = t
+        if s["search_turn"]:
+            return 0.0, s["search_turn"]
+        if abs(bearing) < np.radians(15.0):
+            s["search_from"] = min(s["search_from"], t)
+            if self.search_look is not None and t - s["search_from"] > self.search_look:
+                # the way it was last seen going round the robot (left if not at all)
+                s["search_turn"] = float(np.copysign(self.search_turn_rate, s.get("last_w", 0.0) or 1.0))
+        return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
 
     @property
     def blocked(self) -> bool:
