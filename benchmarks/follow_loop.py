@@ -51,6 +51,7 @@ RECOVER_S = 3.0
 
 FOLLOWERS = {
     "pid+scan": "the PID with the depth safety layer, people's velocities (walkers) and a 270° range scanner (default)",
+    "pid+scan-nosearch": "pid+scan without the search turn (a lost target's prediction is only faced)",
     "pid+walkers": "the PID with the depth safety layer and people's velocities, camera only",
     "pid+depth": "the PID with the depth safety layer (35e's default), camera only",
     "pid": "the paper's PID",
@@ -61,7 +62,8 @@ FOLLOWERS = {
 def make_follower(name: str, scene):
     if name == "planner":
         return LocalPlanner(scene, distance=DISTANCE)
-    return PIDFollower(distance=DISTANCE, depth_stop=name != "pid", walkers=name in ("pid+walkers", "pid+scan"))
+    return PIDFollower(distance=DISTANCE, depth_stop=name != "pid", walkers=name.startswith(("pid+walkers", "pid+scan")),
+                       search_look=None if name.endswith("nosearch") else 2.0)
 
 
 def run_seed(seed: int, frames: int, size, follower: str = "pid+scan") -> dict:
@@ -69,7 +71,7 @@ def run_seed(seed: int, frames: int, size, follower: str = "pid+scan") -> dict:
     pid = make_follower(follower, sc.scene)
     blocked = []
     result = run_closed_loop(sc, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked),
-                             side_scan=follower == "pid+scan")
+                             side_scan=follower.startswith("pid+scan"))
     blocked = np.array(blocked)
     within = np.abs(result.distance - DISTANCE) <= TOLERANCE
     held = blocked.copy()
