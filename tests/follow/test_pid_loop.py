@@ -71,11 +71,14 @@ def test_robot_kinematics_limits_and_bumper():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("follower, within, worst", [("planner", 0.70, 2.0), ("pid", 0.75, 1.4)])
+@pytest.mark.parametrize("follower, within, worst", [("planner", 0.70, 2.0), ("pid", 0.75, 1.4),
+                                                     ("pid+scan", 0.75, 1.4)])
 def test_closed_loop_keeps_the_distance_without_collisions(follower, within, worst):
     from worldtrack.synth import make_scenario
     sc = make_scenario("follow-target", size=(160, 120), frames=150, seed=5, others=1, clear_route=True)
-    result = run_closed_loop(sc, follower=PIDFollower() if follower == "pid" else LocalPlanner(sc.scene))
+    make = {"pid": PIDFollower, "planner": lambda: LocalPlanner(sc.scene),
+            "pid+scan": lambda: PIDFollower(depth_stop=True, walkers=True)}
+    result = run_closed_loop(sc, follower=make[follower](), side_scan=follower == "pid+scan")
     err = np.abs(result.distance - 1.8)
     assert result.found.mean() > 0.95
     # a person crosses 0.6-0.9 m in front of the robot: it waits (the PID used to pass them at 0.51 m,
@@ -86,3 +89,18 @@ def test_closed_loop_keeps_the_distance_without_collisions(follower, within, wor
     assert result.collisions == 0 and result.bumps == 0 and result.nearest_person.min() > 0.65
     # the camera was where the robot put it: the frames were drawn from the closed loop
     assert np.linalg.norm(result.camera_xy[-1] - result.robot_xy[-1]) == pytest.approx(0.1, abs=1e-6)
+
+
+@pytest.mark.parametrize("look", [2.0, None])
+def test_a_lost_target_whose_predicted_place_shows_nobody_is_looked_for_all_round(look):
+    # the target was last seen walking left across the view; its prediction stays straight ahead
+    pid = PIDFollower(search_look=look)
+    pid.command(step((3.0, -0.2), velocity=(0.0, 0.5)), CAM, 0.0)
+    turns = [pid.command(step((3.0, 0.0), found=False), CAM, t)[1] for t in np.arange(0.1, 5.0, 0.1)]
+    assert max(abs(w) for w in turns[:25]) < 0.1                   # first it faces the predicted place
+    if look is None:
+        assert abs(turns[-1]) < 0.1                                 # the paper's robot keeps staring at it
+    else:
+        assert turns[-1] == pytest.approx(0.5)                      # then it turns left, the way the target went
+    v, w = pid.command(step((3.0, 0.0)), CAM, 5.0)                  # found again: following, not turning
+    assert v > 0 and abs(w) < 0.5

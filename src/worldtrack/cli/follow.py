@@ -46,10 +46,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--preset", default="default", help="default, paper, colour-only, position-only, paper+undo, "
                    "paper+undo+others (default: default)")
     p.add_argument("--distance", type=float, default=1.8, help="following distance for the commands, m (1.8)")
-    p.add_argument("--follower", choices=("pid+depth", "pid", "planner"), default="pid+depth",
+    p.add_argument("--follower", choices=("pid+depth", "pid+walkers", "pid", "planner"), default="pid+depth",
                    help="what turns the track into (v, ω): pid+depth (the paper's PID on distance and bearing with "
-                        "a stop for near depth points, default), pid (the paper's), planner (local planner round "
-                        "the scene's obstacles and people)")
+                        "a stop for near depth points, default), pid+walkers (the same, and the other people's "
+                        "velocities: someone walking out of the path does not hold it), pid (the paper's), planner "
+                        "(local planner round the scene's obstacles and people)")
     p.add_argument("--fps", type=float, help="frame rate when frames.csv gives no times (default: video, else 10)")
     p.add_argument("--frames", type=int, metavar="N", help="stop after N frames")
     p.add_argument("--no-video", action="store_true", help="do not write follow.mp4")
@@ -184,7 +185,8 @@ def run(args: argparse.Namespace) -> int:
                         args.fps, args.frames)
     tracker = FollowTracker(config, scene)
     follower = (LocalPlanner(scene, distance=args.distance) if args.follower == "planner"
-                else PIDFollower(distance=args.distance, depth_stop=args.follower == "pid+depth"))
+                else PIDFollower(distance=args.distance, depth_stop=args.follower != "pid",
+                                 walkers=args.follower == "pid+walkers"))
     out = _Outputs(Path(args.out), not args.no_video, source.fps)
     n = found = 0
     try:

@@ -27,6 +27,7 @@ import numpy as np
 from worldtrack.follow.pid import PIDFollower
 from worldtrack.follow.planner import LocalPlanner
 from worldtrack.follow.observation import frame_from_synth
+from worldtrack.follow.scan import simulate_scan
 from worldtrack.follow.tracker import FollowStep, FollowTracker
 from worldtrack.geometry.camera import look_at_rotation
 
@@ -92,9 +93,12 @@ class LoopResult:
     clearance (T,) robot centre to the nearest wall or obstacle, m; found (T,) bool;
     bumps : frames the bumper stopped the robot; contacts : frames with a person within
     ``robot.radius + 0.2`` m of the robot's centre; collisions : of those, frames where the robot
-    was driving towards that person (faster than 0.05 m/s) — the robot's doing, not a person
-    walking into it standing; collision_causes : one :class:`Collision` per collision frame;
-    steps : the FollowSteps (if kept)
+    drove into somebody — its speed towards them above 0.05 m/s and at least theirs towards it (the
+    robot's doing: "unseen" or "seen, not stopped"); walked_into : contact frames where a person
+    closed in faster than the robot (standing or not): the scripted people do not see the robot, and
+    that is their doing, counted apart; collision_causes : one :class:`Collision` per person in
+    contact per frame (cause "walked into the robot", "unseen", "seen, not stopped" or "side by side":
+    nobody closing in); steps : the FollowSteps (if kept)
     """
 
     times: np.ndarray
@@ -111,13 +115,16 @@ class LoopResult:
     collisions: int
     collision_causes: list = field(default_factory=list)
     steps: list = field(default_factory=list)
+    walked_into: int = 0
 
 
 @dataclass
 class Collision:
-    """One collision frame, and why (``cause``):
+    """One person in contact with the robot in one frame, and why (``cause``):
 
-    * ``"walked into the robot"`` — the person closed in faster than the robot drove at them;
+    * ``"walked into the robot"`` — the person closed in faster than the robot drove at them
+      (including a robot standing still);
+    * ``"side by side"`` — neither closes in faster than 0.05 m/s;
     * ``"unseen"`` — the person was not visible to the robot's camera in the last ``SEEN_S`` s
       (beside or behind it, or hidden): a forward camera cannot stop for them;
     * ``"seen, not stopped"`` — the robot saw them and still drove into them: the follower's fault.
@@ -138,6 +145,11 @@ class Collision:
     blocked: bool
     cause: str
 
+    @property
+    def robot_fault(self) -> bool:
+        """The robot drove into them (cause "unseen" or "seen, not stopped")."""
+        return self.cause in ("unseen", "seen, not stopped")
+
 
 SEEN_S = 1.0
 
@@ -152,8 +164,10 @@ def _collision(k: int, pid: int, rel: np.ndarray, robot, person_velocity: np.nda
     known = [a for a in (step.candidates.xy, step.others_xy, np.asarray(step.xy)[None]) if len(a)]
     person_xy = np.array([robot.x, robot.y]) + rel
     tracked = bool(np.hypot(*(np.vstack(known) - person_xy).T).min() < 0.5) if known else False
-    if person_speed > robot_speed:
+    if person_speed > robot_speed and person_speed > 0.05:
         cause = "walked into the robot"
+    elif robot_speed <= 0.05:
+        cause = "side by side"
     elif visible < 0.2:
         cause = "unseen"
     else:
@@ -163,10 +177,12 @@ def _collision(k: int, pid: int, rel: np.ndarray, robot, person_velocity: np.nda
 
 def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: LocalPlanner | PIDFollower | None = None,
                     camera_id: str = "robot", camera_height: float | None = None, keep_steps: bool = False,
-                    on_frame=None, **robot_limits) -> LoopResult:
+                    on_frame=None, side_scan: bool = False, **robot_limits) -> LoopResult:
     """Render ``scenario`` frame by frame from the robot that follows its person 1 (see the module docstring).
 
     ``on_frame(bundle, step, (v, ω))`` is called after every frame (e.g. to write a video).
+    ``side_scan``: the robot also carries a 270° planar range scanner (:func:`~worldtrack.follow.scan.simulate_scan`,
+    4 m, 1°, σ 2 cm), whose points go to the follower (``command(..., scan=)``; the PID only).
     """
     tracker = tracker or FollowTracker(scene=scenario.scene)
     follower = follower or PIDFollower(distance=float(scenario.params.get("distance", 1.8)), depth_stop=True)
@@ -181,12 +197,15 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
     n = scenario.n_frames
     rec = {k: np.zeros((n, 2)) for k in ("robot", "camera", "target", "cmd")}
     near, clear, found = np.full(n, np.inf), np.zeros(n), np.zeros(n, bool)
-    bumps = contacts = collisions = 0
+    bumps = contacts = collisions = walked_into = 0
     causes: list[Collision] = []
     previous: dict = {}
     visible: dict = {}
     steps: list[FollowStep] = []
     frames = scenario.frames()
+    radius = {p.id: 0.5 * float(p.shape.shoulder_width) for p in scenario.people}
+    scan_rng = np.random.default_rng([int(scenario.seed), 1])
+    extra = {}
     for k in range(n):
         poses[k] = camera_pose(robot, height)     # frame k is drawn from where the robot is now
         bundle = next(frames)
@@ -197,7 +216,11 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
         start = people.get(1) if k == 0 else None
         frame = frame_from_synth(bundle, camera_id)
         step = tracker.follow(frame, cam, start_xy=start)
-        v, w = follower.command(step, cam, bundle.time, frame=frame)
+        if side_scan:
+            ids = list(people)
+            extra["scan"] = simulate_scan((robot.x, robot.y), robot.yaw, np.array([people[i] for i in ids]).reshape(-1, 2),
+                                          np.array([radius.get(i, 0.2) for i in ids]), clearance_at, rng=scan_rng)
+        v, w = follower.command(step, cam, bundle.time, frame=frame, **extra)
         rec["robot"][k] = (robot.x, robot.y)
         rec["camera"][k] = cam.centre[:2]
         rec["target"][k] = people.get(1, np.full(2, np.nan))
@@ -210,13 +233,16 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
             near[k] = dist.min()
             touching = dist < robot.radius + 0.2
             contacts += int(touching.any())
-            towards = robot.v * (rel @ heading) / np.maximum(dist, 1e-9) > 0.05
-            collisions += int(np.any(touching & towards))
-            for j in np.flatnonzero(touching & towards):
+            frame_causes = []
+            for j in np.flatnonzero(touching):
                 pid = list(people)[j]
                 vel = (people[pid] - previous.get(pid, people[pid])) * scenario.fps
                 seen = max(visible[pid][-int(SEEN_S * scenario.fps) - 1:])
-                causes.append(_collision(k, pid, rel[j], robot, vel, seen, step, bool(getattr(follower, "blocked", False))))
+                frame_causes.append(_collision(k, pid, rel[j], robot, vel, seen, step,
+                                               bool(getattr(follower, "blocked", False))))
+            causes += frame_causes
+            collisions += int(any(c.robot_fault for c in frame_causes))
+            walked_into += int(any(c.cause == "walked into the robot" for c in frame_causes))
         previous = people
         clear[k] = clearance_at(rec["robot"][k][None])[0]
         if keep_steps:
@@ -227,4 +253,4 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
         bumps += int(not robot.drive(v, w, dt, clearance_at))
     distance = np.hypot(*(rec["target"] - rec["camera"]).T)
     return LoopResult(np.arange(n) / scenario.fps, rec["robot"], rec["camera"], rec["target"], distance, rec["cmd"],
-                      near, clear, found, bumps, contacts, collisions, causes, steps)
+                      near, clear, found, bumps, contacts, collisions, causes, steps, walked_into)

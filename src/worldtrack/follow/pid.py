@@ -40,7 +40,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from worldtrack.follow.movers import moving_speed_limit
 from worldtrack.follow.safety import free_path, near_points
+from worldtrack.follow.scan import ScanMovers, segments
 from worldtrack.geometry.camera import Camera
 
 
@@ -51,6 +53,11 @@ class PIDFollower:
     distance_gains, bearing_gains : (Kp, Ki, Kd) in 1/s, 1/s², 1 (distance) and 1/s, 1/s², 1 (bearing)
     depth_stop : also stop short of near depth points nobody detected (worldtrack's safety layer; False:
     the paper's PID)
+    search_look : seconds the lost target's predicted place is looked at before the robot turns on round
+    to look about (None: it only faces the prediction, the paper's and 35e's behaviour)
+    walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
+    (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
+    the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
     """
 
     distance: float = 1.8
@@ -67,14 +74,18 @@ class PIDFollower:
     search_turn_rate: float = 0.5
     integral_limit: float = 0.5
     depth_stop: bool = False
+    walkers: bool = False
+    search_look: float | None = 2.0
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
         self._state.clear()
 
-    def command(self, step, camera: Camera, t: float, frame=None) -> tuple[float, float]:
+    def command(self, step, camera: Camera, t: float, frame=None, scan=None) -> tuple[float, float]:
         """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep`; ``frame``'s
-        depth is read only with ``depth_stop`` (the paper's follower reads only the tracker's output)."""
+        depth is read only with ``depth_stop`` (the paper's follower reads only the tracker's output);
+        ``scan`` (M, 2): a range scanner's hit points round the robot (world, m, in ray order; see
+        :mod:`~worldtrack.follow.scan`), read with ``depth_stop`` (its points) and ``walkers`` (its movers)."""
         s = self._state
         if step.found:
             s["seen"] = t
@@ -85,11 +96,7 @@ class PIDFollower:
         d = float(np.hypot(*rel))
         bearing = float(np.arctan2(rel @ left, rel @ fwd))
         if t - s.get("seen", -np.inf) > self.lost_timeout:
-            seen = s.get("seen", -np.inf)
-            self.reset()
-            s["seen"] = seen
-            # Lost: stand, and turn slowly towards where the target should be, to look for it.
-            return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
+            return self._search(t, bearing)
         e_d = d - self.distance
         dt = t - s["t"] if "t" in s else 0.0
         v_ff = w_ff = 0.0
@@ -97,16 +104,39 @@ class PIDFollower:
             vel = np.asarray(step.velocity, float)
             v_ff = float(vel @ rel) / max(d, 1e-6)
             w_ff = float(rel[0] * vel[1] - rel[1] * vel[0]) / max(d * d, 1e-6)
+        s["last_w"] = w_ff if step.found else s.get("last_w", 0.0)
         v = v_ff + self._pid("d", e_d, dt, self.distance_gains)
         w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
         s["t"] = t
         v = float(np.clip(v, -self.max_reverse, self.max_speed))
         w = float(np.clip(w, -self.max_turn_rate, self.max_turn_rate))
         limit = self._speed_limit(step, pos, fwd, dt if dt > 0 else 0.1)
-        if self.depth_stop and frame is not None:
-            limit = min(limit, self._depth_limit(frame, camera, w, dt if dt > 0 else 0.1))
+        if self.walkers:
+            limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
+        if self.depth_stop and (frame is not None or scan is not None):
+            limit = min(limit, self._depth_limit(frame, camera, w, dt if dt > 0 else 0.1, scan))
         s["blocked"] = bool(limit < v)
         return min(v, limit), w
+
+    def _search(self, t: float, bearing: float) -> tuple[float, float]:
+        """Lost: stand and turn slowly towards where the target should be; once that has been in view
+        for ``search_look`` seconds without finding it (it turned while hidden, its prediction walked
+        on), keep turning the same way round, a full look about (worldtrack; the paper stands)."""
+        s = self._state
+        keep = {k: s[k] for k in ("seen", "search_from", "search_turn", "search_last", "last_w") if k in s}
+        self.reset()
+        s.update(keep)
+        if s.get("search_last", -np.inf) < s["seen"]:                      # a new loss
+            s["search_from"], s["search_turn"] = np.inf, 0.0
+        s["search_last"] = t
+        if s["search_turn"]:
+            return 0.0, s["search_turn"]
+        if abs(bearing) < np.radians(15.0):
+            s["search_from"] = min(s["search_from"], t)
+            if self.search_look is not None and t - s["search_from"] > self.search_look:
+                # the way it was last seen going round the robot (left if not at all)
+                s["search_turn"] = float(np.copysign(self.search_turn_rate, s.get("last_w", 0.0) or 1.0))
+        return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
 
     @property
     def blocked(self) -> bool:
@@ -124,10 +154,12 @@ class PIDFollower:
         s[name + "_i"], s[name + "_e"] = integral, error
         return kp * error + ki * integral + kd * deriv
 
-    def _depth_limit(self, frame, camera: Camera, w: float, dt: float) -> float:
+    def _depth_limit(self, frame, camera: Camera, w: float, dt: float, scan=None) -> float:
         """The local planner's safety layer (:mod:`~worldtrack.follow.safety`) on the PID: the speed that
-        stops 0.35 m (body) short of any near depth point along the next 1.5 s arc at ω."""
+        stops 0.35 m (body) short of any near depth point (or scan point) along the next 1.5 s arc at ω."""
         points = near_points(getattr(frame, "depth", None), camera)
+        if scan is not None and len(scan):
+            points = np.vstack([points, np.asarray(scan, float).reshape(-1, 2)])
         if len(points) == 0:
             return np.inf
         fwd = camera.floor_direction
@@ -138,15 +170,38 @@ class PIDFollower:
         gap = free_path(path, points, 0.35)
         return np.inf if not np.isfinite(gap) else float(max(0.0, np.sqrt(2 * self.brake * gap) - self.brake * dt))
 
+    def _walkers_limit(self, step, camera: Camera, w: float, t: float, scan) -> float:
+        """The speed from which the robot stops ``stop_distance`` clear of every other person walking on
+        (tracks with their Kalman velocities, the scan's movers with theirs; the target is left to the
+        distance control)."""
+        xy = [np.asarray(step.others_xy, float).reshape(-1, 2)]
+        vel = [np.asarray(getattr(step, "others_velocity", np.zeros((len(xy[0]), 2))), float).reshape(-1, 2)]
+        fwd = camera.floor_direction
+        centre = camera.centre[:2] - 0.1 * fwd
+        if scan is not None:
+            movers = self._state.setdefault("movers", ScanMovers())
+            found, velocity = movers.update(segments(scan, origin=centre), t)
+            away = np.hypot(*(found - np.asarray(step.xy, float)).T) > 0.5     # the target is not a mover
+            xy.append(found[away])
+            vel.append(velocity[away])
+        xy, vel = np.vstack(xy), np.vstack(vel)
+        return moving_speed_limit(centre, float(np.arctan2(fwd[1], fwd[0])), w, xy, vel,
+                                  clearance=self.stop_distance, brake=self.brake, max_speed=self.max_speed)
+
     def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float) -> float:
         """Largest forward speed (m/s) that stops ``stop_distance`` short of anybody in the path (the
-        target only by the stop distance: the distance control keeps the robot back from it)."""
+        target only by the stop distance: the distance control keeps the robot back from it). With
+        ``walkers`` the other tracks (and candidates they explain) are left to :meth:`_walkers_limit`."""
         people = [np.asarray(step.xy, float)[None]]
         cands = np.asarray(step.candidates.xy, float).reshape(-1, 2)
         chosen = getattr(step, "chosen", -1)
         if len(cands):
-            people.append(np.delete(cands, chosen, axis=0) if step.found and chosen >= 0 else cands)
-        if len(step.others_xy):
+            cands = np.delete(cands, chosen, axis=0) if step.found and chosen >= 0 else cands
+            if self.walkers and len(step.others_xy) and len(cands):
+                d = np.hypot(cands[:, None, 0] - step.others_xy[None, :, 0], cands[:, None, 1] - step.others_xy[None, :, 1])
+                cands = cands[d.min(axis=1) > 0.3]
+            people.append(cands)
+        if len(step.others_xy) and not self.walkers:
             people.append(step.others_xy)
         rel = np.vstack(people) - pos
         ahead = rel @ fwd
