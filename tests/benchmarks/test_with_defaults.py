@@ -20,9 +20,9 @@ def restored(monkeypatch):
 
 
 def test_only_the_ellipsoid_default_preset_changes(restored):
-    with_defaults.changed_defaults({"feet.anchor": True, "height.legs_min_share": 0.5}, "evidence")
+    with_defaults.changed_defaults({"feet.anchor": True, "height.prior_sigma_m": 0.1}, "evidence")
     cfg = trackers.method_config("ellipsoid")
-    assert cfg.feet.anchor and cfg.height.legs_min_share == 0.5
+    assert cfg.feet.anchor and cfg.height.prior_sigma_m == 0.1
     # A setting given by the run itself still wins over the changed default.
     assert not trackers.method_config("ellipsoid", "default", {"feet.anchor": False}).feet.anchor
     # make_tracker's path (method_config looked up in the module) sees the change too.

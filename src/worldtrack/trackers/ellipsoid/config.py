@@ -191,10 +191,6 @@ class HeightConfig(Section):
     prior_sigma_m: float = Field(
         0.0, ge=0, description="when > 0, replaces deadband_m: the height is the precision-weighted mean of the default "
         "(people's heights scatter by this much about it, m) and the measurements' median (its own standard error)")
-    legs_min_share: float = Field(
-        0.0, ge=0, le=1, description="in one view, measure only where at least this share of the labelled pixels "
-        "below the knees is foreground, not shadow-like (legs the floor's colour end the silhouette at the waist, "
-        "and the head's height above the waist is wrong but plausible); 0: no such test")
     ray_gap_m: float = Field(
         0.03, ge=0, description="head rays of several cameras give a height only when each passes this close to "
         "their nearest common point, m (else some view took another head for this one's)")

@@ -32,7 +32,6 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
 from worldtrack.trackers.ellipsoid.height_sigma import height_estimate
-from worldtrack.trackers.ellipsoid.legs import legs_foreground_share
 
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 MAX_COVERED_FOR_HEIGHT = 0.3
@@ -384,10 +383,6 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
             continue
         h = measure_height(cam, labels, view.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
                            max_depth_offset_m=config.depth_offset_m)
-        if h is not None and config.legs_min_share > 0:
-            ends = silhouette_ends(cam, labels, region, tuple(b), down)
-            if ends is None or legs_foreground_share(labels, region, tuple(b), *ends) < config.legs_min_share:
-                continue   # legs not foreground: the bottom may be the waist, not the feet
         if h is not None:
             samples_now.setdefault(k, []).append(h)
 
