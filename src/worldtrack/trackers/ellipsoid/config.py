@@ -254,7 +254,8 @@ class DepthConfig(Section):
         "knees is foreground (not shadow-like)")
     remeasure_after_encounter: bool = Field(
         False, description="drop a person's height samples once others stop covering them: the height is measured "
-        "afresh, not carried through a crossing")
+        "afresh, not carried through a crossing (with or without depth.fuse; with feet.anchor and height.prior_sigma_m "
+        "0.1, heights within 3 cm 67 -> 84 of 97 on held-out line-of-sight seeds, issue 37)")
 
 
 class IdentityConfig(Section):

@@ -50,6 +50,7 @@ import numpy as np
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
+from worldtrack.trackers.ellipsoid.encounters import covered_in_some_view
 from worldtrack.trackers.ellipsoid.feet import under_head
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
 from worldtrack.trackers.ellipsoid.height import MAX_COVERED_FOR_HEIGHT, head_ray, measure_feet, silhouette_ends
@@ -92,6 +93,9 @@ class DepthFusion:
         (see the module docstring), and those no camera shows by their prediction along the first
         camera's; returns how many were moved."""
         if not self.config.fuse or not people:
+            if self.config.remeasure_after_encounter and people:   # the encounters, without the fusion
+                for p, covered in zip(people, covered_in_some_view(people, views, self.height.range_m[1])):
+                    self.note_encounter(p, covered)
             return 0
         xy = np.array([[p.x, p.y] for p in people], dtype=float)
         shown = {cid: [v.visible_pixels(xy[k], p.height, p.width) >= MIN_OWN_PIXELS for k, p in enumerate(people)]
