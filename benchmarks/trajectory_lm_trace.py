@@ -13,7 +13,8 @@ Then the same run goes on with the tolerance 1e-13 (``--tight-iterations`` more 
 default stop (relative decrease 1e-5) is from the optimum its own path leads to, in objective and
 in metres.
 
-Run: ``.venv/bin/python benchmarks/trajectory_lm_trace.py [--sizes 1000,10000] [--seeds 3]``.
+Run: ``.venv/bin/python benchmarks/trajectory_lm_trace.py [--sizes 1000,10000] [--seeds 3]
+[--shrink-on-reject]`` (the option: a rejected step shortened as a trust region).
 Writes ``benchmarks/results/trajectory_lm_trace.md``. About a minute per (T, seed).
 """
 
@@ -22,6 +23,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -43,7 +45,7 @@ def floor_moves(delta: np.ndarray) -> np.ndarray:
     return np.hypot(delta[:, 0], delta[:, 2])
 
 
-def trace(T: int, seed: int, tight_iterations: int) -> tuple[list[list], dict]:
+def trace(T: int, seed: int, tight_iterations: int, shrink_on_reject: bool) -> tuple[list[list], dict]:
     """Rows of the per-iteration table and the summary of one (T, seed)."""
     scene, obs, height = problem_of(T, seed)
     field = scene.distance_field(0.05)
@@ -51,7 +53,7 @@ def trace(T: int, seed: int, tight_iterations: int) -> tuple[list[list], dict]:
     grid = TimeGrid.covering(obs.time, 0.1)
     problem = Problem.build(obs, grid, opts.motion, build_environment(opts, field, 0.1))
     X0 = shortest_path_start(problem.observations, grid, height, field, opts.clearance)
-    lm = LevenbergMarquardt(problem, X0, opts.solver)
+    lm = LevenbergMarquardt(problem, X0, replace(opts.solver, shrink_on_reject=shrink_on_reject))
     rows, limit = [], opts.solver.max_move
     while not lm.converged and lm.iterations < opts.solver.max_iterations:
         F, X, mu = lm.lin.costs.total, lm.X, lm.mu
@@ -77,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", default="3")
     ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
     ap.add_argument("--tight-iterations", type=int, default=100)
+    ap.add_argument("--shrink-on-reject", action="store_true", help="SolverOptions(shrink_on_reject=True)")
     ap.add_argument("--quick", action="store_true", help="T = 300, seed 3; prints only")
     args = ap.parse_args(argv)
     cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
@@ -88,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     parts, summaries = [f"({cpu})\n"], []
     for T in sizes:
         for seed in seeds:
-            rows, summary = trace(T, seed, args.tight_iterations)
+            rows, summary = trace(T, seed, args.tight_iterations, args.shrink_on_reject)
             summaries.append(summary)
             parts.append(f"### T = {T}, walk seed {seed}\n\n{markdown_table(head, rows)}\n")
             print(f"T = {T} seed {seed}: {summary['iterations']} iterations ({time.perf_counter() - t0:.0f} s)",

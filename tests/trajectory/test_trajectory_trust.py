@@ -1,5 +1,6 @@
-"""The barrier's step limit as a trust region: a rejected step halves the largest move allowed and keeps its
-Gauss–Newton step and its damping (no second solve, no runaway damping); good steps let it grow back."""
+"""The barrier's step limit as a trust region (``SolverOptions(shrink_on_reject=True)``, an option): a rejected
+step halves the largest move allowed and keeps its Gauss–Newton step and its damping (no second solve, no
+runaway damping); the default raises the damping instead."""
 
 from dataclasses import replace
 
@@ -42,7 +43,7 @@ def _first_rejection(lm: LevenbergMarquardt, most: int = 30):
 def test_a_rejected_step_halves_the_move_limit_and_keeps_its_step_and_damping(office_problem):
     problem, X0, options = office_problem
     # a limit of 20 m: the first full Gauss–Newton steps run the straight start's paths through the desks
-    lm = LevenbergMarquardt(problem, X0, replace(options.solver, max_move=20.0))
+    lm = LevenbergMarquardt(problem, X0, replace(options.solver, max_move=20.0, shrink_on_reject=True))
     rejected = _first_rejection(lm)
     assert rejected is not None
     mu, raw, tried = rejected
@@ -66,7 +67,7 @@ def test_without_the_trust_region_a_rejection_raises_the_damping_instead(office_
 def test_the_trust_region_reaches_the_same_optimum(office_problem):
     problem, X0, options = office_problem
     tight = replace(options.solver, barrier_relative_decrease=1e-12, max_iterations=300)
-    a = LevenbergMarquardt(problem, X0, tight).run()
+    a = LevenbergMarquardt(problem, X0, replace(tight, shrink_on_reject=True)).run()
     b = LevenbergMarquardt(problem, X0, replace(tight, shrink_on_reject=False)).run()
     assert a.converged and b.converged
     assert a.costs.total == pytest.approx(b.costs.total, rel=1e-9)
