@@ -280,22 +280,3 @@ def test_a_worker_renames_its_copy_of_a_merged_person_and_keeps_tracking_it():
     record.add(0, {9: 4})                            # the map folded this worker's 9 into 4
     link.sync(SimpleNamespace(position_map=local), 0.05)
     assert [p.id for p in local] == [4] and local[4] is mine and link.mine_seen == {4}
-
-
-def test_a_batch_worker_waits_for_the_map_of_its_first_frame_before_its_second():
-    """Batch runs repeat only if every step reads the map of the previous frame: the second frame
-    too (it once went on at once, reading whatever the fusion had written by then)."""
-    import threading
-    import time
-
-    from worldtrack.map.connection import MapKeys
-    from worldtrack.map.worker import MapLink
-    record = _Record()
-    link = MapLink(record, MapKeys(), MapConfig(), "w1", {})
-    link.lockstep, link.fps = True, 10.0
-    start = time.monotonic()
-    link._wait_for_map(0.05)                        # the first frame: no map yet, nothing to wait for
-    assert time.monotonic() - start < 0.1 and link.state is None
-    threading.Timer(0.3, record.add, args=(0, {})).start()
-    link._wait_for_map(0.15)                        # the second frame waits for the first frame's bucket
-    assert time.monotonic() - start >= 0.28 and link.state is not None and link.state.t == 0.0

@@ -172,7 +172,7 @@ class MapLink:
     def _wait_for_map(self, t: float) -> None:
         if self._first_t is None:
             self._first_t = t
-        if not self.lockstep or t - self._first_t < 0.5 / self.fps:   # from the second frame on
+        if not self.lockstep or t - self._first_t < 1.5 / self.fps:
             return
         deadline = time.monotonic() + self.lockstep_wait_s
         while time.monotonic() < deadline:
