@@ -68,8 +68,24 @@ def dump_run(client, cameras: list[str], seq: Path, run: int, out: Path) -> None
             s = decode_map_state(fields)
             for p in s.people:
                 f.write(f"{s.t:.3f}," + ",".join(str(v) for v in p) + "\n")
+    with open(out / "buckets.csv", "w") as f:
+        f.write("t,late,cameras\n")
+        for _, fields in client.xrange(keys.map_stream):
+            s = decode_map_state(fields)
+            f.write(f"{s.t:.3f},{s.late},{' '.join(sorted({c for c, _, _ in s.reports}))}\n")
     shutil.copy(seq / "gt.csv", out / "gt.csv")
     shutil.copy(seq / "one" / "tracks.csv", out / "one.csv")
+
+
+def incomplete_buckets(client, cameras: list[str]) -> tuple[int, int]:
+    """How many buckets of the record lack some camera's report, and how many observations came
+    after their bucket was written (dropped as late): a batch run that should repeat does not when
+    either is above 0 (the fusion wrote a bucket ``map.max_wait_s`` after its first report)."""
+    from worldtrack.map.messages import decode_map_state
+
+    states = [decode_map_state(fields) for _, fields in client.xrange(MapKeys().map_stream)]
+    missing = sum(1 for s in states[1:-1] if {c for c, _, _ in s.reports} != set(cameras))
+    return missing, sum(s.late for s in states)
 
 
 def main() -> None:
@@ -104,17 +120,19 @@ def main() -> None:
                                                                      seq / f"replay{k}").tracks_csv))
                     if args.dump:
                         dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
+                    missing, late = incomplete_buckets(connect(server.url), sc.camera_ids)
                     worse = worse_frames(one, fused)
                     m1, m2 = one.metrics, fused.metrics
                     rows.append([seed, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],
-                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—"])
+                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", missing, late])
                     for key in gaps:
                         gaps[key].append(m2[key] - m1[key])
                     print(rows[-1], file=sys.stderr)
         finally:
             server.stop()
     table = markdown_table(["seed", "run", "MOTA one", "MOTA workers", "IDF1 one", "IDF1 workers", "switches one",
-                            "switches workers", "worse frames", "from–to"], rows)
+                            "switches workers", "worse frames", "from–to", "buckets missing a camera",
+                           "late observations"], rows)
     text = (f"{table}\n\nWorkers − one process over all runs: MOTA mean {statistics.mean(gaps['mota']):+.3f} "
             f"(worse in {sum(g < 0 for g in gaps['mota'])} of {len(rows)}), IDF1 mean "
             f"{statistics.mean(gaps['idf1']):+.3f} (worse in {sum(g < 0 for g in gaps['idf1'])} of {len(rows)}). "
