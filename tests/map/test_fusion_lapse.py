@@ -169,10 +169,11 @@ def test_a_slow_step_renews_its_lease_between_buckets_and_stops_writing_once_it_
 @pytest.mark.slow
 def test_ctrl_c_on_a_fusion_holder_with_a_backlog_gives_the_role_back_within_the_drain_bound(redis_url, tmp_path):
     client, keys, cfg = connect(redis_url), MapKeys(), MapConfig()
-    # The backlog is in the streams before the fuser starts: 60 s of two cameras with 40 people each
+    # The backlog is in the streams before the fuser starts: 300 s of two cameras with 40 people each
     # (capture times from 30 s ahead, so the fuser's cold start, 5 s before it takes the role, reads
-    # them all), ~10 s of fusing on an idle core.
-    b0, n = _floor(client, keys) + 300, 600
+    # them all), far more than the drain bound lets it fuse (with 60 s an idle machine fused it all
+    # before the signal and left the next holder nothing to continue with).
+    b0, n = _floor(client, keys) + 300, 3000
     _publish(client, keys, range(b0, b0 + n), people=40)
     log = open(tmp_path / "fuser.log", "w")
     p = subprocess.Popen([*WORLDTRACK, "map", "fuse", redis_url], stdout=subprocess.DEVNULL, stderr=log)
