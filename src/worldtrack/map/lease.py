@@ -27,18 +27,22 @@ if redis.call('GET', KEYS[1]) == ARGV[1] then
 end
 return 0
 """
-#: XADD only while holding the lease: KEYS = (lease, stream), ARGV = (owner, id, minid, field, value, …).
-#: Returns the entry id, 0 when the lease is not ours, -1 when the id is not above the stream's last.
-FENCED_XADD = """
+#: The fence every holder-only write starts with: KEYS[1] is the lease, ARGV[1] its owner.
+_IF_NOT_OURS_RETURN_0 = """
 if redis.call('GET', KEYS[1]) ~= ARGV[1] then
   return 0
 end
-local args = {KEYS[2]}
+"""
+#: The fence, then XADD arguments for KEYS[2] capped at MINID ARGV[3] (if any), id ARGV[2].
+_FENCED_XADD_ARGS = _IF_NOT_OURS_RETURN_0 + """local args = {KEYS[2]}
 if ARGV[3] ~= '' then
   table.insert(args, 'MINID'); table.insert(args, '~'); table.insert(args, ARGV[3])
 end
 table.insert(args, ARGV[2])
-for i = 4, #ARGV do table.insert(args, ARGV[i]) end
+"""
+#: XADD only while holding the lease: KEYS = (lease, stream), ARGV = (owner, id, minid, field, value, …).
+#: Returns the entry id, 0 when the lease is not ours, -1 when the id is not above the stream's last.
+FENCED_XADD = _FENCED_XADD_ARGS + """for i = 4, #ARGV do table.insert(args, ARGV[i]) end
 local ok, res = pcall(redis.call, 'XADD', unpack(args))
 if not ok then
   return -1
@@ -49,16 +53,7 @@ return res
 #: The fusion's record of a bucket (:mod:`worldtrack.map.fusion_role`). KEYS = (lease, map stream, current hash); ARGV = (owner, id, minid, state, last bucket, written, t,
 #: people count, updates channel, update, field, value, …). 1 written, 0 not our lease, -1 bucket
 #: already written, 2 written but not published (an ACL user without the channel: ``&prefix:*``).
-WRITE_MAP = """
-if redis.call('GET', KEYS[1]) ~= ARGV[1] then
-  return 0
-end
-local args = {KEYS[2]}
-if ARGV[3] ~= '' then
-  table.insert(args, 'MINID'); table.insert(args, '~'); table.insert(args, ARGV[3])
-end
-table.insert(args, ARGV[2])
-for i = 11, #ARGV do table.insert(args, ARGV[i]) end
+WRITE_MAP = _FENCED_XADD_ARGS + """for i = 11, #ARGV do table.insert(args, ARGV[i]) end
 local ok = pcall(redis.call, 'XADD', unpack(args))
 if not ok then
   return -1
@@ -80,11 +75,7 @@ return 1
 #: The live map between complete buckets. KEYS = (lease, current hash); ARGV = (owner, updates
 #: channel, update, written, t, people count, people, aliases, reports). 1 written, 0 not our lease,
 #: 2 written but not published.
-UPDATE_MAP = """
-if redis.call('GET', KEYS[1]) ~= ARGV[1] then
-  return 0
-end
-redis.call('HSET', KEYS[2], 'written', ARGV[4], 't', ARGV[5], 'people', ARGV[6], 'map_people', ARGV[7],
+UPDATE_MAP = _IF_NOT_OURS_RETURN_0 + """redis.call('HSET', KEYS[2], 'written', ARGV[4], 't', ARGV[5], 'people', ARGV[6], 'map_people', ARGV[7],
            'map_aliases', ARGV[8], 'map_reports', ARGV[9])
 local sent = redis.pcall('PUBLISH', ARGV[2], ARGV[3])
 if type(sent) == 'table' and sent.err then
