@@ -26,6 +26,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import NamedTuple
 
+import cv2
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
@@ -127,3 +128,35 @@ def cube_truth_at_its_rows(board: RollingShutterBoard, cMo0: np.ndarray, K: np.n
         s = board.readout * (np.mean(p[:, 1] / p[:, 2]) - height / 2) / height
         at_rows.append(moved(pose, twist, np.array([s]))[0])
     return [M @ inv(at_rows[0]) @ cMo0 for M in at_rows]
+
+
+def board_tilt_against_depth(sequence: Path, depths: list, boards: dict) -> dict:
+    """A check from the other sensor: per frame, the plane fitted to the depth over the tags' convex
+    hull (robust, 3 MAD) against each board fit's plane. The tilt between them (rotation about the
+    camera's x and y, degrees) has a constant part — the depth sensor's own — and a frame-to-frame
+    part, which is the board fit's error where the depth is steady. Returns, per name in ``boards``
+    (name → T × 4×4 poses), the median and p90 (deg) of each frame's deviation from the median tilt."""
+    tags = load_tags(sequence)
+    K, (h, w) = tags.K, depths[0].shape
+    v, u = np.mgrid[0:h, 0:w]
+    normals = []
+    for t, Z in enumerate(depths):
+        hull = np.concatenate([tags.corners[(t, tag)] for tag in tags.names if (t, tag) in tags.corners])
+        mask = np.zeros((h, w), np.uint8)
+        cv2.fillConvexPoly(mask, cv2.convexHull(hull.astype(np.float32)).astype(np.int32), 1)
+        m = (mask > 0) & (Z > 0)
+        X = np.c_[(u[m] - K[0, 2]) / K[0, 0] * Z[m], (v[m] - K[1, 2]) / K[1, 1] * Z[m], Z[m]]
+        keep = np.ones(len(X), bool)
+        for _ in range(4):
+            c = X[keep].mean(0)
+            n = np.linalg.svd(X[keep] - c, full_matrices=False)[2][2]
+            r = (X - c) @ n
+            keep = np.abs(r - np.median(r)) < 3 * 1.4826 * np.median(np.abs(r - np.median(r)))
+        normals.append(n if n[2] < 0 else -n)
+    out = {}
+    for name, poses in boards.items():
+        nb = np.array([M[:3, 2] if M[2, 2] < 0 else -M[:3, 2] for M in poses])
+        tilt = np.degrees(np.cross(nb, np.array(normals)))[:, :2]
+        dev = np.linalg.norm(tilt - np.median(tilt, 0), axis=1)
+        out[name] = (float(np.median(dev)), float(np.percentile(dev, 90)))
+    return out
