@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -51,12 +52,20 @@ def _project(K: np.ndarray, M: np.ndarray, X: np.ndarray) -> np.ndarray:
     return p[:, :2] / p[:, 2:]
 
 
-def refit_board_poses(sequence: Path, rounds: int = 4) -> tuple[list[np.ndarray], float]:
-    """Board poses (T × 4×4, camera ← board, board = tag 2's frame) and the median per-frame RMS
-    corner reprojection error (pixels) of the fit.
+class TagData(NamedTuple):
+    """The tags of a ViSP sequence: intrinsics ``K`` (3×3), image height (px), one tag's corners in
+    its own frame (4×3, m), the detected corners per (frame, tag) as (u, v) pixels (4×2), the tag
+    names, the per-frame detections as stored."""
+    K: np.ndarray
+    height: int
+    square: np.ndarray
+    corners: dict
+    names: list
+    frames: list
 
-    >>> poses, rms = refit_board_poses(Path("visp_rbt/sequence"))   # doctest: +SKIP
-    """
+
+def load_tags(sequence: Path) -> TagData:
+    """Read ``apriltag_data.json`` and ``cam.json`` (corners stored (row, column): swapped here)."""
     tags_json = json.loads((sequence / "apriltag_data.json").read_text())
     cam = json.loads((sequence / "cam.json").read_text())
     K = np.array([[cam["px"], 0, cam["u0"]], [0, cam["py"], cam["v0"]], [0, 0, 1]])
@@ -65,6 +74,22 @@ def refit_board_poses(sequence: Path, rounds: int = 4) -> tuple[list[np.ndarray]
     frames = tags_json["detections"]
     corners = {(t, tag): np.array(x["tag_corners"])[:, ::-1] for t, f in enumerate(frames) for tag, x in f.items()}
     names = sorted({tag for f in frames for tag in f}, key=int)
+    return TagData(K, int(cam.get("h", 480)), square, corners, names, frames)
+
+
+def refit_board_poses(sequence: Path, rounds: int = 4) -> tuple[list[np.ndarray], float]:
+    """Board poses (T × 4×4, camera ← board, board = tag 2's frame) and the median per-frame RMS
+    corner reprojection error (pixels) of the fit.
+
+    >>> poses, rms = refit_board_poses(Path("visp_rbt/sequence"))   # doctest: +SKIP
+    """
+    board, _, rms = refit_board_and_layout(sequence, rounds)
+    return board, rms
+
+
+def refit_board_and_layout(sequence: Path, rounds: int = 4) -> tuple[list[np.ndarray], dict, float]:
+    """:func:`refit_board_poses`, also returning the tags' layout (tag name → 4×4, board ← tag)."""
+    K, _, square, corners, names, frames = load_tags(sequence)
     board = [np.array(f[REFERENCE_TAG]["cMo"]) for f in frames]
     layout = {tag: _pose(np.median([_vector(np.linalg.inv(board[t]) @ np.array(f[tag]["cMo"]))
                                     for t, f in enumerate(frames) if tag in f], axis=0)) for tag in names}
@@ -88,7 +113,7 @@ def refit_board_poses(sequence: Path, rounds: int = 4) -> tuple[list[np.ndarray]
             residual = lambda v, seen=seen, tag=tag: np.concatenate(
                 [(_project(K, board[t] @ _pose(v), square) - corners[(t, tag)]).ravel() for t in seen])
             layout[tag] = _pose(least_squares(residual, _vector(layout[tag]), loss="huber").x)
-    return board, float(np.median(rms))
+    return board, layout, float(np.median(rms))
 
 
 def box_surface_points(K: np.ndarray, cMo: np.ndarray, half: float, uv: np.ndarray, margin: float = 0.003):
@@ -140,3 +165,46 @@ def image_only_poses(sequence: Path, cMo0: np.ndarray, half: float) -> tuple[lis
         poses.append(M)
         counts.append(len(inliers))
     return poses, counts
+
+
+def _corners(half: float) -> np.ndarray:
+    return np.array([[x, y, z] for x in (-half, half) for y in (-half, half) for z in (-half, half)])
+
+
+def best_constant_transform(relative: np.ndarray, half: float) -> np.ndarray:
+    """The constant X (4×4) closest to every ``relative[t]`` (T × 4×4) over a cube's 8 corners, least
+    squares (Kabsch over all frames' corners): the one board ← cube transform that best explains
+    ``estimate(t) = cMg(t)·X`` when ``relative[t] = cMg(t)⁻¹·estimate(t)``."""
+    P = _corners(half)
+    Y = (np.einsum("nij,kj->nki", relative[:, :3, :3], P) + relative[:, None, :3, 3]).reshape(-1, 3)
+    mu = Y.mean(0)
+    U, _, Vt = np.linalg.svd(np.tile(P, (len(relative), 1)).T @ (Y - mu))
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
+    X = np.eye(4)
+    X[:3, :3], X[:3, 3] = Vt.T @ D @ U.T, mu
+    return X
+
+
+def constant_transform_check(grid: np.ndarray, cMo0: np.ndarray, estimate: np.ndarray, half: float) -> dict:
+    """Could one constant transform (or a frame shift) explain an estimate's gap to the board truth?
+    Gaps (mm, deg per frame 1…; NaN where the estimate is NaN) of ``estimate`` (T × 4×4) to
+    ``cMg(t)·X`` for: X = cMg(0)⁻¹·cMo(0) (the truth as read); X the mean of cMg(0)⁻¹·estimate(i) over
+    the first 10 frames (ViSP's own test of this data, ``catchRBTDataset.cpp``); the best X over all
+    frames; the best X with the board one frame earlier / later."""
+    inv = np.linalg.inv
+    ok = np.isfinite(estimate).all(axis=(1, 2))
+    frames = np.arange(1, len(grid))
+    truths = {"as read": grid @ inv(grid[0]) @ cMo0,
+              "ViSP's 10-frame anchor": grid @ best_constant_transform(inv(grid[0]) @ estimate[:10][ok[:10]], half),
+              "best constant": grid @ best_constant_transform(inv(grid[ok]) @ estimate[ok], half)}
+    for shift in (-1, 1):
+        j = np.clip(np.arange(len(grid)) + shift, 0, len(grid) - 1)
+        X = best_constant_transform(inv(grid[j[ok]]) @ estimate[ok], half)
+        truths[f"best constant, board {shift:+d} frame"] = grid[j] @ X
+    out = {}
+    for name, truth in truths.items():
+        mm = 1000 * np.linalg.norm(truth[frames, :3, 3] - estimate[frames, :3, 3], axis=1)
+        R = np.einsum("nij,nkj->nik", truth[frames, :3, :3], estimate[frames, :3, :3])
+        deg = np.degrees(np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1)))
+        out[name] = (mm, deg)
+    return out
