@@ -19,7 +19,7 @@ from worldtrack.trajectory.model import POS, VEL, MotionPrior, TimeGrid, frame_i
 from worldtrack.trajectory.objective import Problem
 from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import LevenbergMarquardt, SolveResult, SolverOptions, levenberg_marquardt
-from worldtrack.trajectory.starts import START_NAMES, shortest_path_start, straight_start
+from worldtrack.trajectory.starts import START_NAMES, anchor_points, shortest_path_start, straight_start
 from worldtrack.trajectory.uncertainty import marginal_covariances
 from worldtrack.trajectory.windows import race_by_gap
 
@@ -67,10 +67,14 @@ class TrajectoryOptions:
         (:mod:`.coarse`): the race on every step until one start is left (the same ranking as the default),
         then that leader on every ``coarse_steps``-th step of the grid (the same model re-derived for the
         longer step) until an iteration lowers F by less than ``coarse_tolerance``, brought back to every
-        step by the motion prior's interpolation and polished there by Levenberg–Marquardt with ``solver``. Off by default (None): 34h measured 6–17 % less time at
-        T = 10 000–100 000 and none at 1 000, but the polish settles in a neighbouring one of the shallow
-        minima (objective within ±3e-4 relative of the default's, lower as often as not; centimetres to
-        0.3 m apart in long gaps), not the same optimum
+        step by the motion prior's interpolation and polished there by Levenberg–Marquardt with ``solver``.
+        Off by default (None): 34h measured it (``benchmarks/trajectory_coarse.py``, CPU medians on walks of
+        T = 1 000 … 100 000) from 40 % slower (T = 1 000, m = 4) to 36 % faster (T = 100 000, m = 8) — the
+        polish still needs the slow last iterations that slide paths along obstacles — and the polish may
+        settle in a neighbouring one of the shallow minima: walks within −1.9e-4 … +2.2e-5 of the default's
+        objective, up to 0.45 m apart in long gaps; on ETH/UCY (1 153 people × 2 obstacle maps) the same
+        objective within 1e-6 for all but one zara01 person (camera seed 4, walls + free space), whose
+        other minimum moved that row's between-views RMSE 0.303 → 0.348 m
     coarse_tolerance : float — the relative decrease that ends the coarse solve
     solver : SolverOptions
     """
@@ -217,12 +221,13 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
     env = build_environment(options, field, dt)
     problem = Problem.build(obs, grid, options.motion, env, options.robust)
     free = problem.with_environment(env.without_barrier())
-    straight = straight_start(problem.observations, grid, options.height)
+    anchors = anchor_points(problem.observations, options.height)
+    straight = straight_start(problem.observations, grid, options.height, anchors)
     without = levenberg_marquardt(free, straight, options.solver)
     if env.barrier is None:          # "straight" and "map": the same problem from the same start
         results, wins = {name: without for name in options.starts if name != "shortest"} or {"map": without}, {}
     else:
-        results, wins = _barrier_starts(problem, straight, without, options)
+        results, wins = _barrier_starts(problem, straight, without, options, anchors)
     objectives = {name: r.costs.total for name, r in results.items()}
     best = min(objectives, key=objectives.get)
     win = results[best]
@@ -232,8 +237,8 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
                               win.linearisation.barrier_steps, without.X, results, options.height, wins)
 
 
-def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult,
-                    options: TrajectoryOptions) -> tuple[dict[str, SolveResult], dict[str, int]]:
+def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult, options: TrajectoryOptions,
+                    anchors: tuple[np.ndarray, np.ndarray]) -> tuple[dict[str, SolveResult], dict[str, int]]:
     """Levenberg–Marquardt with the barrier from each start: the race by gap, the race (every start
     ``options.race_iterations``, then only the leader to convergence) or every start to convergence.
     Returns the result per start (or per winning starts) and the windows each start won."""
@@ -249,7 +254,7 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
     barrier = problem.environment.barrier
     if "shortest" in options.starts:
         starts["shortest"] = shortest_path_start(problem.observations, problem.grid, options.height, barrier.field,
-                                                 options.clearance, max(barrier.field.resolution, 0.1))
+                                                 options.clearance, max(barrier.field.resolution, 0.1), anchors)
     if options.race_iterations is not None and options.race_by_gap:
         result, wins, _ = race_by_gap(problem, {name: starts[name] for name in options.starts}, without.X,
                                       options.solver)
