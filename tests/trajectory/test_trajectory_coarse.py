@@ -12,7 +12,6 @@ from worldtrack.trajectory.environment import hermite_weights, sample_field
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory
 from worldtrack.trajectory.model import MotionPrior, TimeGrid, frame_interval
 from worldtrack.trajectory.objective import Problem
-from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import levenberg_marquardt
 
 
@@ -70,14 +69,6 @@ def test_refine_keeps_the_coarse_states_and_subsample_takes_them_back():
     t = np.arange(21) * 0.1                                   # a walk at constant velocity stays on its line
     line = np.column_stack([1 + 0.8 * t, np.full(21, 0.8), 2 - 1.1 * t, np.full(21, -1.1), np.full(21, 1.7), 0 * t])
     np.testing.assert_allclose(refine(line[::4], MotionPrior(), 0.4, 4, 21), line, atol=1e-12)
-
-
-@pytest.fixture(scope="module")
-def office_person(office):
-    sc, tracks, pixels = office
-    person = pixels.of(1)
-    obs = Observations.from_rows(person.time, person.camera, person.uv, sc.scene.cameras, 2.0)
-    return obs, sc.scene.distance_field(0.05), tracks[1].height
 
 
 @pytest.mark.parametrize("factor", [4, 8])

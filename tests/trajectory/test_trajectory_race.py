@@ -10,17 +10,8 @@ from worldtrack.trajectory.environment import sample_field
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory
 from worldtrack.trajectory.model import TimeGrid, frame_interval
 from worldtrack.trajectory.objective import Problem
-from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import LevenbergMarquardt, solve_blocks
 from worldtrack.trajectory.starts import shortest_path_start, straight_start
-
-
-@pytest.fixture(scope="module")
-def office_person(office):
-    sc, tracks, pixels = office
-    person = pixels.of(1)
-    obs = Observations.from_rows(person.time, person.camera, person.uv, sc.scene.cameras, 2.0)
-    return obs, sc.scene.distance_field(0.05), tracks[1].height
 
 
 def _problem(obs, field, height):
