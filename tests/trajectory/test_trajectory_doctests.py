@@ -6,7 +6,8 @@ import importlib
 import pytest
 
 MODULES = ["worldtrack.trajectory.model", "worldtrack.trajectory.observation", "worldtrack.trajectory.estimate",
-           "worldtrack.trajectory.uncertainty", "worldtrack.trajectory.windows", "worldtrack.synth.observations"]
+           "worldtrack.trajectory.uncertainty", "worldtrack.trajectory.windows", "worldtrack.trajectory.coarse",
+           "worldtrack.synth.observations"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -10,17 +10,8 @@ from worldtrack.trajectory.environment import sample_field
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory
 from worldtrack.trajectory.model import TimeGrid, frame_interval
 from worldtrack.trajectory.objective import Problem
-from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import LevenbergMarquardt, solve_blocks
 from worldtrack.trajectory.starts import shortest_path_start, straight_start
-
-
-@pytest.fixture(scope="module")
-def office_person(office):
-    sc, tracks, pixels = office
-    person = pixels.of(1)
-    obs = Observations.from_rows(person.time, person.camera, person.uv, sc.scene.cameras, 2.0)
-    return obs, sc.scene.distance_field(0.05), tracks[1].height
 
 
 def _problem(obs, field, height):
@@ -93,6 +84,24 @@ def test_the_compiled_route_search_equals_scipys_dijkstra(office_person):
         if fast is not None:
             assert length(fast) == pytest.approx(length(ref), abs=1e-9)
             np.testing.assert_allclose(fast, ref)          # no ties on these rasters: the same cells
+
+
+def test_which_gaps_are_blocked_in_one_lookup_equals_the_gap_by_gap_reference(office_person):
+    _, field, _ = office_person
+    rng = np.random.default_rng(11)
+    a = rng.uniform([0, 0], [16, 8], size=(300, 2))
+    b = a + rng.normal(0.0, 1.5, size=(300, 2)) * rng.uniform(0, 1, size=(300, 1)) ** 3   # short and long gaps
+    b[:5] = a[:5]                                                                          # and zero-length ones
+    b[5:125] = a[5:125] + np.column_stack([0.025 * np.arange(1, 121), np.zeros(120)])     # 2 … 121 samples each
+    pts, first = starts._gap_samples(field, a, b)
+    reference = [a[g] + np.linspace(0.0, 1.0, max(2, int(np.ceil(np.linalg.norm(b[g] - a[g]) / 0.025)) + 1))[:, None]
+                 * (b[g] - a[g]) for g in range(len(a))]
+    np.testing.assert_array_equal(pts, np.vstack(reference))                               # the same points, bit for bit
+    np.testing.assert_array_equal(first, np.cumsum([0] + [len(r) for r in reference[:-1]]))
+    blocked = starts._blocked_gaps(field, a, b, 0.2)
+    assert blocked.tolist() == [starts._blocked(field, p, q, 0.2) for p, q in zip(a, b)]
+    assert 30 < blocked.sum() < 270                                                        # both answers occur
+    assert starts._blocked_gaps(field, a[:0], b[:0], 0.2).shape == (0,)
 
 
 def test_the_route_start_goes_round_what_blocks_the_straight_line(office_person):
