@@ -46,8 +46,9 @@ PAPER_LM50 = {1: [[2.627, 1.459, 2.313, 1.188], [1.501, 1.223, 1.254, 0.938], [2
                   [0.961, 0.817, 0.914, 0.927]]}
 
 
-def run(frames, model, intr, stages: int, lm: int, seed: int) -> dict:
-    tr = BodyTracker(model, intr, frames[0].params, BodyConfig(stages=stages, lm_iterations=lm, seed=seed))
+def run(frames, model, intr, stages: int, lm: int, seed: int, depth_weight: str = "fixed") -> dict:
+    tr = BodyTracker(model, intr, frames[0].params, BodyConfig(stages=stages, lm_iterations=lm, seed=seed,
+                                                               depth_weight=depth_weight))
     rules = {n: FailureRule(15.0, 5) for n in LIMB_ORDER}
     err, ms = [], []
     for f in frames[1:]:
@@ -69,6 +70,8 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=60)
     ap.add_argument("--configs", default="PF1LM0,PF1LM15,PF2LM0,PF2LM50")
     ap.add_argument("--tag", default="", help="suffix of the results file name (parallel runs)")
+    ap.add_argument("--depth-weight", default="fixed", choices=("fixed", "noise"),
+                    help="λ fixed (the paper's 0.9) or from the terms' measured noise")
     ap.add_argument("--quick", action="store_true")
     a = ap.parse_args()
     rng = lambda s: list(range(int(s.split("-")[0]), int(s.split("-")[1]) + 1)) if "-" in s else [int(s)]
@@ -85,7 +88,7 @@ def main() -> None:
         seq = body_sequence(s, n_frames=n)
         frames = [seq.render(k) for k in range(n)]
         for name, st, lm in configs:
-            res[(name, s)] = [run(frames, seq.true_model, seq.intr, st, lm, seed) for seed in seeds]
+            res[(name, s)] = [run(frames, seq.true_model, seq.intr, st, lm, seed, a.depth_weight) for seed in seeds]
             m = np.concatenate([r["err"] for r in res[(name, s)]]).mean(0)
             print(f"no{s} {name}: {np.round(m, 3)} fail {sum(r['fail'] for r in res[(name, s)])}",
                   file=sys.stderr, flush=True)

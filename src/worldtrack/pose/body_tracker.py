@@ -25,9 +25,11 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
+from worldtrack.errors import InputError
 from worldtrack.geometry.rotation import euler_zyx, rot_y, rot_z
 from worldtrack.pose.body import LEFT_ARM, RIGHT_ARM, TORSO, BodyModel, BodySpace, SubSpace, stacked_points
 from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, SparseTemplate
+from worldtrack.pose.noise_weight import NoiseWeightedLam, term_spreads
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics
@@ -42,7 +44,9 @@ class BodyConfig:
     sigma_mm : first-stage σ of the torso's tx, ty, tz (mm); sigma_deg : of θ, φ, ψ, then each
     arm's shoulder (θs, φs) and elbow (θe, φe), degrees; pf : "cascade" (torso → right arm → left
     arm, the paper's) or "joint" (all 14 at once); depth_sampling : "bilinear" (on one surface) or
-    "nearest" pixel (see :class:`~worldtrack.pose.cost.ColourDepthCost`)
+    "nearest" pixel (see :class:`~worldtrack.pose.cost.ColourDepthCost`); depth_weight : "fixed"
+    (λ = ``lam``, the paper's) or "noise" (λ from the two terms' measured spreads,
+    :mod:`~worldtrack.pose.noise_weight`, over the last ``noise_window`` frames)
     """
 
     stages: int = 1
@@ -55,6 +59,8 @@ class BodyConfig:
     sigma_deg: tuple = (1.0, 1.0, 1.0, 8.0, 8.0, 15.0, 15.0, 8.0, 8.0, 15.0, 15.0)
     c_depth_mm: float = 5.0
     lam: float = 0.9
+    depth_weight: str = "fixed"
+    noise_window: int = 10
     smooth_px: float = 1.0
     camera_blur_px: float = 0.6
     pf: str = "cascade"
@@ -141,6 +147,9 @@ class BodyTracker:
 
     def __init__(self, model: BodyModel, intr: Intrinsics, p0: np.ndarray, config: BodyConfig = BodyConfig()):
         self.model, self.intr, self.config = model, intr, config
+        if config.depth_weight not in ("fixed", "noise"):
+            raise InputError(f"depth_weight: expected fixed or noise, got {config.depth_weight!r}")
+        self.noise = NoiseWeightedLam(config.lam, config.noise_window)
         self.space = BodySpace(model=model, elbow_limit=None if config.elbow_limit_deg is None
                                else np.radians(config.elbow_limit_deg))
         self.sigma = self.space.increment_sigma(config.sigma_mm, config.sigma_deg)
@@ -176,7 +185,8 @@ class BodyTracker:
         order = np.argsort(self.part[tp.colour], kind="stable")
         colour = SparseTemplate(self.local[ci], self.part[ci], tp.value[order])
         dtemp = SparseTemplate(self.local[di], self.part[di], xyz[di, 2])
-        return ColourDepthCost(colour, dtemp, grey, depth, self.intr, None, cfg.c_depth_mm / 1000, cfg.lam,
+        lam = self.noise.lam if cfg.depth_weight == "noise" else cfg.lam
+        return ColourDepthCost(colour, dtemp, grey, depth, self.intr, None, cfg.c_depth_mm / 1000, lam,
                                DEPTH_SAMPLING[cfg.depth_sampling])
 
     def _pf(self, eps, start: np.ndarray):
@@ -204,4 +214,6 @@ class BodyTracker:
         res = levenberg_marquardt(self.space, residuals, kept.states, self.config.lm_iterations)
         self.state = representative_pose(res.states, eps, self.sigma * np.r_[[self.space.length] * 3, [1.0] * 11])
         self.kept = res.states
+        if self.config.depth_weight == "noise":
+            self.noise.add(*term_spreads(cost, self.space.transforms(self.state[None])))
         return BodyEstimate(self.state.copy(), float(eps(self.state[None])[0]) / cost.size, cost.size)

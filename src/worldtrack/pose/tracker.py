@@ -32,6 +32,7 @@ from worldtrack.errors import InputError
 from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, EigenTemplateCost, SparseTemplate
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
+from worldtrack.pose.noise_weight import NoiseWeightedLam, term_spreads
 from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics, posed_points
@@ -46,6 +47,9 @@ class TrackerConfig:
     sigma_mm : first-stage σ of tx, ty, tz (mm); sigma_deg : of rotations about x, y, z (degrees)
     c : Geman–McClure scale — grey levels for ``eigen``; None = 0.5/N for ``colour-depth``
     c_depth_mm : depth scale c′ (mm); lam : λ, share of the depth term
+    depth_weight : "fixed" — λ = ``lam`` (the paper's); "noise" — λ from the colour and depth
+        differences' measured spreads, inverse-variance (:mod:`~worldtrack.pose.noise_weight`;
+        ``lam`` until a frame is accepted, then the median spread over the last ``noise_window`` frames)
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
     pf_points : rank the particle filter's candidates on only the strongest ``pf_points`` template
         points (LM then uses them all; worldtrack's default 256, for speed); None: all, as the paper
@@ -82,6 +86,8 @@ class TrackerConfig:
     c: float | None = None
     c_depth_mm: float = 5.0
     lam: float = 0.9
+    depth_weight: str = "fixed"
+    noise_window: int = 10
     jacobian: str = "analytic"
     smooth_px: float = 1.0
     camera_blur_px: float = 0.6
@@ -137,6 +143,9 @@ class RigidTracker:
             raise InputError(f"motion: expected velocity or none, got {self.config.motion!r}")
         if self.cost not in ("eigen", "colour-depth"):
             raise InputError(f"cost: expected eigen or colour-depth, got {self.cost!r}")
+        if self.config.depth_weight not in ("fixed", "noise"):
+            raise InputError(f"depth_weight: expected fixed or noise, got {self.config.depth_weight!r}")
+        self.noise = NoiseWeightedLam(self.config.lam, self.config.noise_window)
         self.space = RigidSpace(length=max(self.model.radius, 1e-3))
         self.sigma = self.space.increment_sigma(self.config.sigma_mm, self.config.sigma_deg)
         self.basis = None
@@ -262,8 +271,9 @@ class RigidTracker:
         dt = SparseTemplate(m.points[tp.depth], np.zeros(len(tp.depth), int), zd)
         if depth is not None and self.depth_bias.any():
             depth = self.corrected_depth(np.asarray(depth), intr)
+        lam = self.noise.lam if self.config.depth_weight == "noise" else self.config.lam
         return ColourDepthCost(colour, dt, grey, depth, intr, self.config.c, self.config.c_depth_mm / 1000,
-                               self.config.lam, DEPTH_SAMPLING[self.config.depth_sampling])
+                               lam, DEPTH_SAMPLING[self.config.depth_sampling])
 
     def _lm(self, cost, states: np.ndarray, iterations: int):
         """Batched LM of the kept candidates on one cost (compiled normal equations for the face)."""
@@ -299,5 +309,7 @@ class RigidTracker:
             self.velocity = increment_between(self.state, new_state, self.space.length)
         self.state = new_state
         self.kept = res.states
+        if cfg.depth_weight == "noise" and self.cost == "colour-depth":
+            self.noise.add(*term_spreads(cost, self.space.transforms(self.state[None])))
         mean_cost = float(eps(self.state[None])[0]) / cost.size
         return PoseEstimate(Rm, tm, mean_cost, cost.size)
