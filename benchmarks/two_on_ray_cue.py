@@ -13,9 +13,8 @@ rest fall in two groups:
 
 For each group it prints the ratio :func:`worldtrack.trackers.ellipsoid.two_on_ray.head_scale` (the
 head band's width over a head's width at the feet's depth) and the share below the threshold
-(``ellipsoid.height.two_on_ray_ratio``, 0.8). The group "other's top, ≥ 5 cm wrong" is the one a
-height must not be taken from. The threshold was chosen on seeds 20–24; the default seeds 140–144 had
-never been used.
+(0.8, chosen on development seeds 20–24). The group "other's top, ≥ 5 cm wrong" is the one a
+height must not be taken from. The default seeds 140–144 had never been used.
 
 Usage::
 

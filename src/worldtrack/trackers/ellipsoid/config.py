@@ -197,10 +197,6 @@ class HeightConfig(Section):
     depth_offset_m: float = Field(
         1.0, ge=0, description="in one view, the feet found may be this far from the track along the line of "
         "sight, m (0.4 m across it)")
-    two_on_ray_ratio: float = Field(
-        0.0, ge=0, description="when > 0 (e.g. 0.8): in one view, no height from a silhouette whose head band is "
-        "narrower than this share of a head at its feet's depth (its top is likely somebody farther on the same line "
-        "of sight; two_on_ray.py). Measured neutral on the line-of-sight scenario (issue 37), so off")
 
     @model_validator(mode="after")
     def _range_in_order(self) -> "HeightConfig":

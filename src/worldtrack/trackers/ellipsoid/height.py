@@ -383,10 +383,6 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
             continue
         h = measure_height(cam, labels, view.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
                            max_depth_offset_m=config.depth_offset_m)
-        if h is not None and config.two_on_ray_ratio > 0:
-            from worldtrack.trackers.ellipsoid.two_on_ray import silhouette_ratio  # it imports this module
-            if silhouette_ratio(view, labels, region, tuple(b), down)[0] < config.two_on_ray_ratio:
-                h = None  # the top is somebody farther on the same ray
         if h is not None:
             samples_now.setdefault(k, []).append(h)
 

@@ -8,14 +8,17 @@ tall ellipse then explains the farther head, and that person is never born (issu
 A head has about the same size on everybody (``HEAD_WIDTH_M``, 15–18 cm with hair). The width of
 the silhouette's top, just under its highest point, measured in pixels, against the width a head
 would have at the depth the *feet* give: about 1 for one person, about ``d_near / d_far`` (0.5–0.8)
-when the top is somebody farther away. With ``ellipsoid.height.two_on_ray_ratio`` > 0, a
-silhouette whose ratio is below it gives no height (:mod:`.height`).
+when the top is somebody farther away.
 
-How well it separates (``benchmarks/two_on_ray_cue.py``, people in clear view read at their true
-place on the line-of-sight scenario): below 0.8 for about half of the readings whose top is
-somebody else's and 5 cm or more wrong, and for 2–3 % of those whose top is the person's own. That
-is not enough to decide alone: proposing a person along the top's ray wherever it fired (tried,
-issue 37) made phantoms that took over tracks, and is not here.
+How well it separates them (``benchmarks/two_on_ray_cue.py``: people in clear view read at their
+true place on the line-of-sight scenario, the renderer saying whose head tops the silhouette):
+below 0.8 for about half of the readings topped by somebody else's head and 5 cm or more wrong,
+and for 2–3 % of those topped by the person's own. Not enough to decide alone, measured in the
+tracker (issue 37): taking no height from a silhouette below 0.8 lost MOTA on the line-of-sight
+scenario (development seeds 20–39 0.740 → 0.717, never-used 140–149 0.738 → 0.686), and proposing a
+person along the top's ray made phantoms that took over tracks (0.666 on 20–39). So nothing in the
+tracker uses it yet; a model selection that also renders the two hypotheses (paper 000's analysis
+by synthesis) would.
 
 >>> import numpy as np
 >>> from worldtrack.geometry import Camera
