@@ -12,13 +12,13 @@ when the top is somebody farther away.
 
 How well it separates them (``benchmarks/two_on_ray_cue.py``: people in clear view read at their
 true place on the line-of-sight scenario, the renderer saying whose head tops the silhouette):
-below 0.8 for about half of the readings topped by somebody else's head and 5 cm or more wrong,
-and for 2–3 % of those topped by the person's own. Not enough to decide alone, measured in the
-tracker (issue 37): taking no height from a silhouette below 0.8 lost MOTA on the line-of-sight
-scenario (development seeds 20–39 0.740 → 0.717, never-used 140–149 0.738 → 0.686), and proposing a
-person along the top's ray made phantoms that took over tracks (0.666 on 20–39). So nothing in the
-tracker uses it yet; a model selection that also renders the two hypotheses (paper 000's analysis
-by synthesis) would.
+below 0.8 for 55–71 % of the readings topped by somebody else's head and 5 cm or more wrong, and
+for 1.4–2.3 % of those topped by the person's own. Not enough to decide alone, measured in the
+tracker (issue 37, line-of-sight scenario, development seeds 20–39 / never-used 140–149):
+taking no height from a silhouette below 0.8 lost MOTA (0.740 → 0.717 / 0.738 → 0.686), none
+from a birth blob below it was neutral (0.747 / 0.728), and proposing a person along the top's
+ray made phantoms that took over tracks (0.666 on 20–39). So nothing in the tracker uses it yet;
+a model selection that also renders the two hypotheses (paper 000's analysis by synthesis) would.
 
 >>> import numpy as np
 >>> from worldtrack.geometry import Camera
@@ -148,7 +148,7 @@ def head_scale(camera: Camera, labels: np.ndarray, region: np.ndarray, box: tupl
 def silhouette_ratio(view: CameraView, labels: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
                      down: np.ndarray) -> tuple[float, np.ndarray | None, np.ndarray | None]:
     """(:func:`head_scale`, the top pixel (2,), the feet's floor point (3,)) of the silhouette in
-    ``region``; (nan, None, None) where its ends are not both in clear view."""
+    ``region``; (nan, None, None) where the region touches the image border or shows too few pixels."""
     cam = view.camera
     u0, u1, v0, v1 = box
     if u0 <= 0 or v0 <= 0 or u1 >= cam.width or v1 >= cam.height:
