@@ -34,7 +34,7 @@ from worldtrack.eval.mot import evaluate_detailed  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.map.connection import MapKeys, connect  # noqa: E402
 from worldtrack.map.messages import Estimate, MapPerson  # noqa: E402
-from worldtrack.map.replay import replay  # noqa: E402
+from worldtrack.map.replay import record_digest, replay  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 
 
@@ -121,10 +121,11 @@ def main() -> None:
                     if args.dump:
                         dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
                     missing, late = incomplete_buckets(connect(server.url), sc.camera_ids)
+                    digest = record_digest(connect(server.url), MapKeys())
                     worse = worse_frames(one, fused)
                     m1, m2 = one.metrics, fused.metrics
                     rows.append([seed, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],
-                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", missing, late])
+                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", missing, late, digest])
                     for key in gaps:
                         gaps[key].append(m2[key] - m1[key])
                     print(rows[-1], file=sys.stderr)
@@ -132,7 +133,7 @@ def main() -> None:
             server.stop()
     table = markdown_table(["seed", "run", "MOTA one", "MOTA workers", "IDF1 one", "IDF1 workers", "switches one",
                             "switches workers", "worse frames", "from–to", "buckets missing a camera",
-                           "late observations"], rows)
+                           "late observations", "map digest"], rows)
     text = (f"{table}\n\nWorkers − one process over all runs: MOTA mean {statistics.mean(gaps['mota']):+.3f} "
             f"(worse in {sum(g < 0 for g in gaps['mota'])} of {len(rows)}), IDF1 mean "
             f"{statistics.mean(gaps['idf1']):+.3f} (worse in {sum(g < 0 for g in gaps['idf1'])} of {len(rows)}). "

@@ -231,7 +231,9 @@ def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict
     """Each person's estimates, one per worker (a worker's cameras share its tracker's estimate;
     the one seen, else the latest, is kept)."""
     out: dict[int, dict[str, Estimate]] = {}
-    for o in sorted(observations, key=lambda o: o.t):
+    # In an order that does not depend on arrival (worker names hold a pid): the sums of the
+    # weighted estimates, the people's order in the state and ties of the lead repeat run to run.
+    for o in sorted(observations, key=lambda o: (o.t, o.camera, o.frame)):
         for e in o.people:
             pid = state.resolve(e.id)
             if pid == REFUTED:                  # dropped on negative evidence: not brought back
@@ -256,6 +258,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     written : wall-clock time (s) recorded as the state's ``written``
     """
     t = bucket * cfg.bucket_s
+    observations = sorted(observations, key=lambda o: (o.t, o.camera, o.frame))
     estimates = _per_worker(state, observations)
     workers_of = _update_people(state.people, estimates, t, cfg.weigh_by)
     ended = {state.resolve(i) for o in observations for i in o.ended}
