@@ -235,7 +235,7 @@ class MapLink:
                 # Not where this worker already holds somebody under another id: the map merges
                 # those two ids (a copy here would make one worker hold the same person twice).
                 if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)) and \
-                        not self._holds_near(local, x, y):
+                        not self._holds_near(local, x, y) and not self._born_in_view(p, x, y, t):
                     self._place(tracker, p, x, y, t)
             elif self._follows_map(p):
                 # Not shown by this worker's cameras, or also by another worker's: from where the
@@ -262,6 +262,14 @@ class MapLink:
         if self.cfg.share_rule == "information":
             return p.workers > 1 or p.lead not in ("", self.name)
         return p.lead not in ("", self.name)
+
+    def _born_in_view(self, p, x: float, y: float, t: float) -> bool:
+        """Did another worker start ``p`` moments ago (``confirm_birth_s``) where this worker's
+        cameras already show them? Then this worker finds them in its own images (its new person
+        takes their id, :meth:`new_id`, or the map merges the two) rather than from a first
+        estimate another view made — at a run's start a far camera's, through a door."""
+        return t - p.born < self.cfg.confirm_birth_s and any(in_views(list(self.cameras.values()), np.array([x, y]),
+                                                                      p.height))
 
     def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
         return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m for q in local)
