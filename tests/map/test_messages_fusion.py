@@ -322,7 +322,7 @@ def test_the_worker_that_shows_a_person_as_their_own_weighs_more_and_leads():
     it holds (own 0.3, support 0.9). Weighed by support × own share w1 counts more and leads."""
     a = Observation("west", 5.02, "w1", 50, 5.03, (Estimate(7, 1.0, 2.0, 1.7, 0.45, 0, 0, 0.8, 0.4, True, own=1.0),))
     b = Observation("east", 5.04, "w2", 50, 5.05, (Estimate(7, 1.4, 2.0, 1.7, 0.45, 0, 0, 0.8, 0.9, True, own=0.3),))
-    p, = fuse_bucket(FusionState(), 50, [a, b], MapConfig()).people
+    p, = fuse_bucket(FusionState(), 50, [a, b], MapConfig(weigh_own=True)).people     # opt-in (issue-39h)
     assert p.lead == "w1" and p.x == pytest.approx((0.4 * 1.0 + 0.27 * 1.4) / 0.67)
-    q, = fuse_bucket(FusionState(), 50, [b, a], MapConfig(weigh_own=False)).people     # by support alone
+    q, = fuse_bucket(FusionState(), 50, [b, a], MapConfig()).people     # by support alone (default)
     assert q.lead == "w2" and q.x == pytest.approx((0.4 * 1.0 + 0.9 * 1.4) / 1.3)

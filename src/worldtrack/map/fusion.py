@@ -15,9 +15,11 @@ each with its own cameras, share one person map — who updates a person two of 
   two-rooms two people in line in one camera pulled the map between them —
   ``share_rule=support-lead`` keeps that rule. Letting every worker keep its own estimate
   instead lost up to 0.74 MOTA, ids swapping in one worker: issue 39d.)
-* **The shared map weighs each worker's estimate by support and by geometry** — the support is
-  the share of the person's own pixels that are foreground in that worker's views (the evidence
-  the estimate rests on; else the match score; at least 0.05), and the geometry is how finely the
+* **The shared map weighs each worker's estimate by support and by geometry** — the
+  support is the share of the person's own pixels that are foreground in that worker's views (the
+  evidence the estimate rests on; else the match score; at least 0.05) — with ``weigh_own``
+  (opt-in: it lost on held-out seeds 24-33, issue-39h) times the share of the body no other person
+  that worker holds covers — and the geometry is how finely the
   worker's cameras resolve the floor where the person stands: the information matrix ``I_k`` of
   a one-pixel error of the body points they show (:func:`~worldtrack.map.evidence.floor_information`; a camera 8 m away
   resolves depth ~6× worse than one 3 m away, and only along its line of sight; points hidden by
@@ -31,8 +33,10 @@ each with its own cameras, share one person map — who updates a person two of 
   estimates and does not tell the occluded view from the clear one (MOTA 0.83 / 0.90 against 1.00
   / 1.00 on seeds 1 and 3). Estimates of a person a worker holds without evidence (hidden behind a
   desk in its view) count only when no worker saw them.
-* **Ids are the map's.** A worker's tracker takes new ids from the map (one counter in Redis) and,
-  for a person walking in from a neighbour's view, finds them already on its map under their id.
+* **Ids are the map's.** A worker's tracker takes new ids from the map (each worker from its slot's
+  counter in Redis: the scene index of its first camera decides which ids it gives, so a batch run
+  gives the same ids whichever worker asks first) and, for a person walking in from a
+  neighbour's view, finds them already on its map under their id.
   If two workers still start the same person (both saw them first in the same frame), the two
   ids are close, and no worker sees both: the younger id is folded into the elder (``aliases``)
   after ``merge_after_s``, at once when both ids are that young, and the workers rename their

@@ -264,11 +264,11 @@ class MapLink:
         return p.lead not in ("", self.name)
 
     def _born_in_view(self, p, x: float, y: float, t: float) -> bool:
-        """Did another worker start ``p`` moments ago (``confirm_birth_s``) where this worker's
+        """Did another worker start ``p`` moments ago (``own_births_s``) where this worker's
         cameras already show them? Then this worker finds them in its own images (its new person
         takes their id, :meth:`new_id`, or the map merges the two) rather than from a first
         estimate another view made — at a run's start a far camera's, through a door."""
-        return t - p.born < self.cfg.confirm_birth_s and any(in_views(list(self.cameras.values()), np.array([x, y]),
+        return t - p.born < self.cfg.own_births_s and any(in_views(list(self.cameras.values()), np.array([x, y]),
                                                                       p.height))
 
     def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
