@@ -12,7 +12,8 @@ replay``. Per run: MOTA, IDF1, switches of both, and the frames in which the fus
 miss or a false positive the one process does not have (``worse frames``), with the first of them.
 
 Run: ``nice -n 10 .venv/bin/python benchmarks/map_two_workers.py [--seeds 2,5,6,7,8,9,10,11,12,13,1,3,4] [--repeats 1]``
-(batch runs mostly repeat, but not always: seed 6 gave 0.817 and 0.974 in two runs of one commit).
+(since issue 39h batch runs repeat byte for byte: the ``map digest`` column; ``--also map.X=Y,…`` adds
+a variant run per seed, e.g. ``--also map.weigh_own=true``).
 Writes ``benchmarks/results/map_two_workers.md``.
 """
 
