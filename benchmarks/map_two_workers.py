@@ -12,7 +12,8 @@ replay``. Per run: MOTA, IDF1, switches of both, and the frames in which the fus
 miss or a false positive the one process does not have (``worse frames``), with the first of them.
 
 Run: ``nice -n 10 .venv/bin/python benchmarks/map_two_workers.py [--seeds 2,5,6,7,8,9,10,11,12,13,1,3,4] [--repeats 1]``
-(batch runs mostly repeat, but not always: seed 6 gave 0.817 and 0.974 in two runs of one commit).
+(since issue 39h batch runs repeat byte for byte: the ``map digest`` column; ``--also map.X=Y,…`` adds
+a variant run per seed, e.g. ``--also map.weigh_own=true``).
 Writes ``benchmarks/results/map_two_workers.md``.
 """
 
@@ -34,7 +35,7 @@ from worldtrack.eval.mot import evaluate_detailed  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.map.connection import MapKeys, connect  # noqa: E402
 from worldtrack.map.messages import Estimate, MapPerson  # noqa: E402
-from worldtrack.map.replay import replay  # noqa: E402
+from worldtrack.map.replay import record_digest, replay  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 
 
@@ -95,11 +96,14 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="seed 2, one run; prints only")
     ap.add_argument("--set", action="append", default=[], metavar="map.NAME=VALUE",
                     help="a map setting for the workers (e.g. map.share_rule=support-lead)")
+    ap.add_argument("--also", action="append", default=[], metavar="map.A=X,map.B=Y",
+                    help="a variant run once more per seed with these settings (repeatable; runs are deterministic)")
     ap.add_argument("--dump", type=Path, help="write per run the workers' published estimates, the map and the "
                                              "one process's tracks as CSV files in this folder (to find out why)")
     args = ap.parse_args()
     seeds, repeats = ([2], 1) if args.quick else ([int(s) for s in args.seeds.split(",")], args.repeats)
-    start, rows, gaps = time.time(), [], {"mota": [], "idf1": []}
+    variants = [("default", args.set, repeats)] + [(v, [*args.set, *v.split(",")], 1) for v in args.also]
+    start, rows, gaps = time.time(), [], {(v, key): [] for v, _, _ in variants for key in ("mota", "idf1")}
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         server = Server(tmp)
@@ -113,29 +117,32 @@ def main() -> None:
                                 *[a for c in sc.camera_ids for a in ("--video", f"{c}={seq / (c + '.mp4')}")],
                                 "--out", str(seq / "one"), "--quiet", "--no-video"], check=True, capture_output=True)
                 one = evaluate_detailed(gt, read_tracks(seq / "one" / "tracks.csv"))
-                for k in range(repeats):
+                for variant, sets, k in ((v, sets, k) for v, sets, n in variants for k in range(n)):
                     server.flush()
-                    run_workers(seq, server.url, sc.camera_ids, seq / f"workers{k}", sets=["map.pace_files=false", *args.set])
+                    run_workers(seq, server.url, sc.camera_ids, seq / f"workers{k}", sets=["map.pace_files=false", *sets])
                     fused = evaluate_detailed(gt, read_tracks(replay(connect(server.url), MapKeys(),
                                                                      seq / f"replay{k}").tracks_csv))
                     if args.dump:
                         dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
                     missing, late = incomplete_buckets(connect(server.url), sc.camera_ids)
+                    digest = record_digest(connect(server.url), MapKeys())
                     worse = worse_frames(one, fused)
                     m1, m2 = one.metrics, fused.metrics
-                    rows.append([seed, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],
-                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", missing, late])
-                    for key in gaps:
-                        gaps[key].append(m2[key] - m1[key])
+                    rows.append([seed, variant, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],
+                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", missing, late, digest])
+                    for key in ("mota", "idf1"):
+                        gaps[variant, key].append(m2[key] - m1[key])
                     print(rows[-1], file=sys.stderr)
         finally:
             server.stop()
-    table = markdown_table(["seed", "run", "MOTA one", "MOTA workers", "IDF1 one", "IDF1 workers", "switches one",
+    table = markdown_table(["seed", "variant", "run", "MOTA one", "MOTA workers", "IDF1 one", "IDF1 workers", "switches one",
                             "switches workers", "worse frames", "from–to", "buckets missing a camera",
-                           "late observations"], rows)
-    text = (f"{table}\n\nWorkers − one process over all runs: MOTA mean {statistics.mean(gaps['mota']):+.3f} "
-            f"(worse in {sum(g < 0 for g in gaps['mota'])} of {len(rows)}), IDF1 mean "
-            f"{statistics.mean(gaps['idf1']):+.3f} (worse in {sum(g < 0 for g in gaps['idf1'])} of {len(rows)}). "
+                           "late observations", "map digest"], rows)
+    summary = "; ".join(
+        f"{v}: MOTA mean {statistics.mean(gaps[v, 'mota']):+.3f} (worse in {sum(g < 0 for g in gaps[v, 'mota'])} of "
+        f"{len(gaps[v, 'mota'])}), IDF1 mean {statistics.mean(gaps[v, 'idf1']):+.3f} (worse in "
+        f"{sum(g < 0 for g in gaps[v, 'idf1'])})" for v, _, _ in variants)
+    text = (f"{table}\n\nWorkers − one process over all runs: {summary}. "
             f"Load average at the end: {load_average()} (2 cores shared with other work).\n")
     print(text)
     save_result("map_two_workers", "Two workers on the shared map against one process (two-rooms, held-out seeds)",

@@ -1,6 +1,7 @@
 """Message formats and the fusion rule, without a server (pure functions)."""
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -280,3 +281,48 @@ def test_a_worker_renames_its_copy_of_a_merged_person_and_keeps_tracking_it():
     record.add(0, {9: 4})                            # the map folded this worker's 9 into 4
     link.sync(SimpleNamespace(position_map=local), 0.05)
     assert [p.id for p in local] == [4] and local[4] is mine and link.mine_seen == {4}
+
+
+def test_new_ids_do_not_depend_on_which_worker_asks_first(redis_url):
+    """Ids from each worker's slot (the scene index of its first camera): the same in any order of
+    asking, never one id twice, and a standby for the same cameras continues the slot's counter."""
+    from worldtrack.map.connection import MapKeys, connect
+    from worldtrack.map.worker import MapLink
+    client, scene = connect(redis_url), ["west", "east", "north"]
+
+    def run(order):
+        client.flushdb()
+        links = {"a": MapLink(client, MapKeys(), MapConfig(), "a", {"west": None}, scene_cameras=scene),
+                 "b": MapLink(client, MapKeys(), MapConfig(), "b", {"north": None, "east": None}, scene_cameras=scene)}
+        got = {"a": [], "b": []}
+        for who in order:
+            got[who].append(links[who].new_id(0.0, 0.0))
+        return got
+    first, second = run("ababb"), run("bbaab")
+    assert first == second == {"a": [1, 4], "b": [2, 5, 8]}
+    standby = MapLink(client, MapKeys(), MapConfig(), "c", {"east": None}, scene_cameras=scene)
+    assert standby.new_id(0.0, 0.0) == 11                       # b's slot, after b's 8
+    assert MapLink(client, MapKeys(), MapConfig(), "d", {"west": None}).new_id(0.0, 0.0) == 1  # no scene: one counter
+
+
+def test_a_batch_worker_waits_for_the_map_of_its_first_frame_before_its_second():
+    from worldtrack.map.connection import MapKeys
+    from worldtrack.map.worker import MapLink
+    link = MapLink(_Record(), MapKeys(), MapConfig(), "w1", {}, fps=10.0)
+    link.lockstep, link.lockstep_wait_s = True, 0.3
+    t0 = time.monotonic()
+    link._wait_for_map(100.05)                 # frame 0: nothing to wait for
+    assert time.monotonic() - t0 < 0.1
+    link._wait_for_map(100.15)                 # frame 1: bucket 0 is not in the record, so it waits
+    assert time.monotonic() - t0 >= 0.3
+
+
+def test_the_worker_that_shows_a_person_as_their_own_weighs_more_and_leads():
+    """Two workers see person 7: w1 whole (own share 1.0, support 0.4), w2 mostly behind somebody
+    it holds (own 0.3, support 0.9). Weighed by support × own share w1 counts more and leads."""
+    a = Observation("west", 5.02, "w1", 50, 5.03, (Estimate(7, 1.0, 2.0, 1.7, 0.45, 0, 0, 0.8, 0.4, True, own=1.0),))
+    b = Observation("east", 5.04, "w2", 50, 5.05, (Estimate(7, 1.4, 2.0, 1.7, 0.45, 0, 0, 0.8, 0.9, True, own=0.3),))
+    p, = fuse_bucket(FusionState(), 50, [a, b], MapConfig(weigh_own=True)).people     # opt-in (issue-39h)
+    assert p.lead == "w1" and p.x == pytest.approx((0.4 * 1.0 + 0.27 * 1.4) / 0.67)
+    q, = fuse_bucket(FusionState(), 50, [b, a], MapConfig()).people     # by support alone (default)
+    assert q.lead == "w2" and q.x == pytest.approx((0.4 * 1.0 + 0.9 * 1.4) / 1.3)

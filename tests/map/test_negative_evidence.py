@@ -42,13 +42,23 @@ def test_a_person_only_a_poor_view_reports_is_dropped_when_a_clear_view_shows_th
 
 
 def test_a_person_a_worker_shows_well_or_whose_place_is_not_shown_empty_every_bucket_is_kept():
-    well = FusionState()
-    assert all(len(_bucket(well, b, visible=0.9).present()) == 1 for b in range(6))
+    well = FusionState()                         # shown well for 1 s before the other view says empty
+    assert all(len(_bucket(well, b, visible=0.9, absent=b >= 10).present()) == 1 for b in range(16))
     broken = FusionState()                       # the empty view is interrupted: its count starts again
     assert all(len(_bucket(broken, b, visible=0.4, absent=b % 3 != 2).present()) == 1 for b in range(8))
     off = FusionState()
     cfg = MapConfig(negative_evidence=False)
     assert all(len(_bucket(off, b, visible=0.4, cfg=cfg).present()) == 1 for b in range(6))
+
+
+def test_a_birth_another_workers_clear_view_shows_empty_is_dropped_even_when_shown_well():
+    young = FusionState()
+    on = MapConfig(confirm_birth_s=1.0)          # opt-in: held-out seeds 24-33 lose with it (issue-39h)
+    out = [_bucket(young, b, visible=0.9, cfg=on) for b in range(4)]
+    assert [len(s.present()) for s in out] == [1, 1, 0, 0] and out[2].aliases == {7: REFUTED}
+    off = FusionState()                          # confirm_birth_s = 0 (default): a person shown well is kept
+    cfg = MapConfig()
+    assert all(len(_bucket(off, b, visible=0.9, cfg=cfg).present()) == 1 for b in range(6))
 
 
 def test_the_absent_ids_travel_in_the_observation_and_older_messages_still_decode():

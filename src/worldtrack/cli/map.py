@@ -95,7 +95,7 @@ def run_fuse(args: argparse.Namespace) -> int:
 
 
 def run_start(args: argparse.Namespace) -> int:
-    from worldtrack.map.worker import set_epoch
+    from worldtrack.map.timings import set_epoch
     cfg, client, keys, where = _open(args)
     epoch = set_epoch(client, keys, args.lead, cfg.bucket_s)
     print(f"{where}: video files play from {epoch:.3f} (in {args.lead:g} s)", file=sys.stderr)

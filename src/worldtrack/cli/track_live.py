@@ -87,7 +87,8 @@ class _Worker:
         claim_scene(self.client, self.keys, scene_digest(args.scene), scene.name, args.map)
         self.name = worker_name()
         self.link = MapLink(self.client, self.keys, self.cfg, self.name, {c: scene.camera(c) for c in cameras}, fps,
-                            occlusion={c: scene.occlusion(c).floor_distance for c in cameras})
+                            occlusion={c: scene.occlusion(c).floor_distance for c in cameras},
+                            scene_cameras=list(scene.cameras))
         self.link.register()
         self.fusion = FusionRole(self.client, self.keys, self.cfg, self.name, log=lambda s: _say(f"{self.name}: {s}"))
         self.stop = threading.Event()

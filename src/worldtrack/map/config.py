@@ -50,6 +50,19 @@ class MapConfig(Section):
                                                       "report while another worker's clear view shows the place "
                                                       "empty for refute_after buckets running")
     refute_after: int = Field(3, ge=1, description="see negative_evidence (buckets)")
+    own_births_s: float = Field(0.0, ge=0, description="a person another worker started less than this long ago "
+                                                       "(s) inside this worker's views is not taken from the map: "
+                                                       "this worker finds them in its own images (its new person "
+                                                       "takes their id or the map merges the two); 0 = take them "
+                                                       "(default: 1 s lost on held-out seeds)")
+    confirm_birth_s: float = Field(0.0, ge=0, description="with negative_evidence, a person younger than this "
+                                                          "(s) is dropped on another worker's clear empty view "
+                                                          "even when the worker that started them shows them well "
+                                                          "(a birth one view does not confirm; 0 = off)")
+    weigh_own: bool = Field(False, description="weigh each worker's estimate (and choose the lead) by support x "
+                                              "the share of the body no other person it holds covers in its "
+                                              "views, not by support alone: a worker that sees a person behind "
+                                              "somebody else does not lead them over one that sees them whole")
     hidden_after_s: float = Field(1.0, ge=0, description="a person only one worker reports, covered by other people "
                                                          "it holds (less than a quarter of the body its own) while "
                                                          "other workers are on the map, leaves the map after this "

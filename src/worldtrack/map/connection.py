@@ -143,8 +143,13 @@ class MapKeys:
 
     @property
     def ids(self) -> str:
-        """Counter: the last person id given out."""
+        """Counter: the last person id given out (workers that do not know the scene's cameras)."""
         return self._k("ids")
+
+    def ids_of(self, camera: str) -> str:
+        """Counter: how many ids the workers whose first camera is ``camera`` gave out
+        (:meth:`worldtrack.map.worker.MapLink.new_id`)."""
+        return self._k("ids", camera)
 
     def observations(self, camera: str) -> str:
         """Stream: one camera's observations, entry ids from capture times (ms)."""

@@ -15,9 +15,11 @@ each with its own cameras, share one person map — who updates a person two of 
   two-rooms two people in line in one camera pulled the map between them —
   ``share_rule=support-lead`` keeps that rule. Letting every worker keep its own estimate
   instead lost up to 0.74 MOTA, ids swapping in one worker: issue 39d.)
-* **The shared map weighs each worker's estimate by support and by geometry** — the support is
-  the share of the person's own pixels that are foreground in that worker's views (the evidence
-  the estimate rests on; else the match score; at least 0.05), and the geometry is how finely the
+* **The shared map weighs each worker's estimate by support and by geometry** — the
+  support is the share of the person's own pixels that are foreground in that worker's views (the
+  evidence the estimate rests on; else the match score; at least 0.05) — with ``weigh_own``
+  (opt-in: it lost on held-out seeds 24-33, issue-39h) times the share of the body no other person
+  that worker holds covers — and the geometry is how finely the
   worker's cameras resolve the floor where the person stands: the information matrix ``I_k`` of
   a one-pixel error of the body points they show (:func:`~worldtrack.map.evidence.floor_information`; a camera 8 m away
   resolves depth ~6× worse than one 3 m away, and only along its line of sight; points hidden by
@@ -31,8 +33,10 @@ each with its own cameras, share one person map — who updates a person two of 
   estimates and does not tell the occluded view from the clear one (MOTA 0.83 / 0.90 against 1.00
   / 1.00 on seeds 1 and 3). Estimates of a person a worker holds without evidence (hidden behind a
   desk in its view) count only when no worker saw them.
-* **Ids are the map's.** A worker's tracker takes new ids from the map (one counter in Redis) and,
-  for a person walking in from a neighbour's view, finds them already on its map under their id.
+* **Ids are the map's.** A worker's tracker takes new ids from the map (each worker from its slot's
+  counter in Redis: the scene index of its first camera decides which ids it gives, so a batch run
+  gives the same ids whichever worker asks first) and, for a person walking in from a
+  neighbour's view, finds them already on its map under their id.
   If two workers still start the same person (both saw them first in the same frame), the two
   ids are close, and no worker sees both: the younger id is folded into the elder (``aliases``)
   after ``merge_after_s``, at once when both ids are that young, and the workers rename their
@@ -166,6 +170,14 @@ def estimate_weight(e: Estimate) -> float:
     return MIN_WEIGHT
 
 
+def own_weight(e: Estimate, weigh_own: bool = True) -> float:
+    """:func:`estimate_weight` × the share of the body the worker's views show as this person's own
+    (``Estimate.own``: not covered by other people it holds; at least :data:`MIN_WEIGHT`): a worker
+    that sees a person behind somebody else measures the one in front as much as them."""
+    own = e.own if weigh_own and math.isfinite(e.own) else 1.0
+    return estimate_weight(e) * max(MIN_WEIGHT, min(1.0, own))
+
+
 def _information(e: Estimate) -> np.ndarray:
     m = np.array([[e.ixx, e.ixy], [e.ixy, e.iyy]], float)
     return m if np.isfinite(m).all() and np.linalg.det(m) > 0 else np.eye(2)
@@ -180,25 +192,26 @@ def measured_information(e: Estimate) -> np.ndarray | None:
     return np.linalg.inv(c)
 
 
-def _weights(estimates: list[Estimate], weigh_by: str) -> tuple[list[np.ndarray], bool]:
+def _weights(estimates: list[Estimate], weigh_by: str, weigh_own: bool = True) -> tuple[list[np.ndarray], bool]:
     """Each estimate's weight matrix, and whether they are the trackers' measured information
-    (``weigh_by="tracker"`` and every estimate has one) rather than support × floor geometry."""
+    (``weigh_by="tracker"`` and every estimate has one) rather than support (× own share, see
+    :func:`own_weight`) × floor geometry."""
     measured = [measured_information(e) for e in estimates] if weigh_by == "tracker" else [None]
     if all(m is not None for m in measured):
         return measured, True
-    w = [estimate_weight(e) for e in estimates]
+    w = [own_weight(e, weigh_own) for e in estimates]
     infos = [wi * _information(e) for wi, e in zip(w, estimates)]
     scale = np.mean([np.trace(m) for m in infos])
     return [m / scale for m in infos], False         # relative weights: keeps the solve well scaled
 
 
-def _weighted(estimates: list[Estimate], weigh_by: str = "geometry") -> tuple[float, ...]:
+def _weighted(estimates: list[Estimate], weigh_by: str = "geometry", weigh_own: bool = True) -> tuple[float, ...]:
     if len(estimates) == 1:           # most people, most of the time: one worker sees them
         e = estimates[0]
         return e.x, e.y, e.height, e.width, e.vx, e.vy, e.score, e.support
     w = [estimate_weight(e) for e in estimates]
     total = sum(w)
-    infos, _ = _weights(estimates, weigh_by)
+    infos, _ = _weights(estimates, weigh_by, weigh_own)
     total_info = sum(infos)
     xy = np.linalg.solve(total_info, sum(m @ np.array([e.x, e.y]) for m, e in zip(infos, estimates)))
     v_ok = [(m, e) for m, e in zip(infos, estimates) if math.isfinite(e.vx) and math.isfinite(e.vy)]
@@ -215,15 +228,17 @@ def _weighted(estimates: list[Estimate], weigh_by: str = "geometry") -> tuple[fl
             sum(wi * e.score for wi, e in zip(w, estimates)) / total, max(supports) if supports else float("nan"))
 
 
-def _lead(by_worker: Mapping[str, Estimate], use: list[Estimate], weigh_by: str) -> str:
+def _lead(by_worker: Mapping[str, Estimate], use: list[Estimate], weigh_by: str, weigh_own: bool = True) -> str:
     """The worker whose estimate of a person weighs most: with the trackers' covariances
     (``weigh_by="tracker"``) the smallest (trace); else a worker showing at least
-    :data:`LEAD_SHARE` of the body, then the largest support × trace of floor information."""
+    :data:`LEAD_SHARE` of the body (with ``weigh_own``: as their own, not covered by other people),
+    then the largest support (× own share) × trace of floor information."""
     if len(by_worker) == 1:
         return next(iter(by_worker))
     if _weights(use, weigh_by)[1]:
         return min((e.cxx + e.cyy, k) for k, e in by_worker.items() if e in use)[1]
-    return max(((e.visible >= LEAD_SHARE, estimate_weight(e) * np.trace(_information(e)), k)
+    return max(((min(e.visible, e.own if weigh_own else 1.0) >= LEAD_SHARE,
+                 own_weight(e, weigh_own) * np.trace(_information(e)), k)
                 for k, e in by_worker.items() if e in use), default=(False, 0.0, ""))[2]
 
 
@@ -231,7 +246,9 @@ def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict
     """Each person's estimates, one per worker (a worker's cameras share its tracker's estimate;
     the one seen, else the latest, is kept)."""
     out: dict[int, dict[str, Estimate]] = {}
-    for o in sorted(observations, key=lambda o: o.t):
+    # In an order that does not depend on arrival (worker names hold a pid): the sums of the
+    # weighted estimates, the people's order in the state and ties of the lead repeat run to run.
+    for o in sorted(observations, key=lambda o: (o.t, o.camera, o.frame)):
         for e in o.people:
             pid = state.resolve(e.id)
             if pid == REFUTED:                  # dropped on negative evidence: not brought back
@@ -256,8 +273,9 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     written : wall-clock time (s) recorded as the state's ``written``
     """
     t = bucket * cfg.bucket_s
+    observations = sorted(observations, key=lambda o: (o.t, o.camera, o.frame))
     estimates = _per_worker(state, observations)
-    workers_of = _update_people(state.people, estimates, t, cfg.weigh_by)
+    workers_of = _update_people(state.people, estimates, t, cfg.weigh_by, weigh_own=cfg.weigh_own)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -277,7 +295,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 
 
 def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
-                   weigh_by: str = "geometry", copy: bool = False) -> dict[int, set[str]]:
+                   weigh_by: str = "geometry", copy: bool = False, weigh_own: bool = True) -> dict[int, set[str]]:
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
     committed state stay as they are). Returns, per person, the workers that see them."""
@@ -285,7 +303,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
     for pid, by_worker in estimates.items():
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
-        x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by)
+        x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by, weigh_own)
         p = people.get(pid)
         if p is None:
             p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
@@ -295,7 +313,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
-        p.lead = _lead(by_worker, use, weigh_by)
+        p.lead = _lead(by_worker, use, weigh_by, weigh_own)
         workers_of[pid] = {k for k, e in by_worker.items() if e.seen}
     return workers_of
 
@@ -320,7 +338,8 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     """
     people = dict(state.people)
     for b in sorted(buckets):
-        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True)
+        _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True,
+                       weigh_own=cfg.weigh_own)
     t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
     reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))

@@ -24,7 +24,8 @@ def refute(state: "FusionState", estimates: dict[int, dict[str, Estimate]], obse
 
     * *negative*: only views showing less than :data:`LEAD_SHARE` of them report them (through a
       door, behind somebody) while another worker's camera shows their place clearly and empty
-      (``Observation.absent``), ``cfg.refute_after`` buckets running;
+      (``Observation.absent``), ``cfg.refute_after`` buckets running; also when they are shown
+      well but younger than ``cfg.confirm_birth_s`` (a birth the other view does not confirm);
     * *hidden*: one worker reports them, covered by other people it holds (less than
       :data:`MIN_OWN_SHARE` of the body its own: a copy of somebody behind them on its line of
       sight), while other workers are on the map, for ``cfg.hidden_after_s`` — the one-process
@@ -43,7 +44,8 @@ def refute(state: "FusionState", estimates: dict[int, dict[str, Estimate]], obse
             continue
         well_seen = any(e.seen and e.visible >= LEAD_SHARE for e in by_worker.values())
         seen_by = {k for k, e in by_worker.items() if e.seen}
-        p.doubt = p.doubt + 1 if against.get(pid, set()) - seen_by and not well_seen else 0
+        young = t - p.born < cfg.confirm_birth_s           # a birth another worker's view does not confirm
+        p.doubt = p.doubt + 1 if against.get(pid, set()) - seen_by and (young or not well_seen) else 0
         covered = len(by_worker) == 1 and several and all(e.own < MIN_OWN_SHARE for e in by_worker.values())
         p.hidden = p.hidden + 1 if covered else 0
         if p.doubt >= cfg.refute_after or p.hidden >= hidden_after:

@@ -135,6 +135,28 @@ def replay(client: Any, keys: MapKeys, out_dir: str | Path, t_from: float | None
     return result
 
 
+def record_digest(client: Any, keys: MapKeys, buckets: int | None = None) -> str:
+    """A digest (hex, 16 digits) of the map record: per bucket its people and merges, as stored, with
+    times counted in ms from the first bucket and each lead's worker name (``host:pid:random``) replaced
+    by the cameras it published — equal for two batch runs of the same videos that wrote the same
+    map. ``buckets``: only the first so many."""
+    import hashlib
+    import json
+    workers: dict[str, list[str]] = {}
+    for cam, info in sorted(client.hgetall(keys.cameras).items()):
+        workers.setdefault(json.loads(info).get("worker", ""), []).append(cam)
+    h, t0 = hashlib.sha256(), None
+    for k, state in enumerate(read_states(client, keys)):
+        if buckets is not None and k >= buckets:
+            break
+        t0 = state.t if t0 is None else t0
+        ms = lambda t: round((t - t0) * 1000)     # noqa: E731
+        people = [p._replace(last_seen=ms(p.last_seen), born=ms(p.born), lead="+".join(workers.get(p.lead, [p.lead])))
+                  for p in state.people]
+        h.update(f"{ms(state.t)} {people!r} {sorted(state.aliases.items())}\n".encode())
+    return h.hexdigest()[:16]
+
+
 class PlanVideo:
     """A floor-plan video: the scene drawn once (matplotlib), the people drawn on it per state."""
 
@@ -182,4 +204,4 @@ def _colour(pid: int) -> tuple[float, float, float]:
     return b, g, r
 
 
-__all__ = ["PlanVideo", "ReplayResult", "parse_time", "read_states", "replay"]
+__all__ = ["PlanVideo", "ReplayResult", "parse_time", "read_states", "record_digest", "replay"]

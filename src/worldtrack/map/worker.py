@@ -39,6 +39,7 @@ from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, REFUTED, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
 from worldtrack.map.shared_ids import SharedPositionMap
+from worldtrack.map.timings import set_epoch
 from worldtrack.trackers.base import Frame, PositionMap, Track, Tracker
 
 
@@ -56,16 +57,22 @@ class MapLink:
     clock : wall clock, seconds
     occlusion : {camera_id: (H, W) floor distance of the obstacles} — the scene's occlusion maps
         (:func:`~worldtrack.map.evidence.floor_information` leaves hidden body points out)
+    scene_cameras : every camera of the scene, in the scene's order: new ids then follow a rule
+        that does not depend on which worker asks first (:meth:`new_id`); empty: one counter for all
     """
 
     def __init__(self, client: Any, keys: MapKeys, cfg: MapConfig, name: str, cameras: Mapping[str, Camera],
                  fps: float = 10.0, clock: Callable[[], float] = time.time,
-                 occlusion: Mapping[str, np.ndarray] | None = None):
+                 occlusion: Mapping[str, np.ndarray] | None = None, scene_cameras: Sequence[str] = ()):
         self.client, self.keys, self.cfg, self.name, self.clock = client, keys, cfg, name, clock
         self.cameras = dict(cameras)
         self.occlusion = dict(occlusion or {})
         self.fps = fps
         self.leases = {c: Lease(client, keys.camera_lease(c), name, cfg.lease_s) for c in self.cameras}
+        order = [c for c in scene_cameras if c in self.cameras]
+        #: Ids this worker gives out: ``slot + 1 + k * stride`` (k = 0, 1, ...), slot = the scene
+        #: index of its first camera (None: the map's one counter, first come first served).
+        self.id_slot = (order[0], list(scene_cameras).index(order[0]), len(scene_cameras)) if order else None
         self._xadd = client.register_script(FENCED_XADD)
         self.state: MapState | None = None
         self._state_t: float | None = None
@@ -107,12 +114,21 @@ class MapLink:
 
     def new_id(self, x: float, y: float) -> int:
         """An id for a person the tracker confirms at (x, y): a lost person's of the map nearby, else
-        the next of the map's counter."""
+        a new one.
+
+        New ids do not depend on which worker asks first (a batch run gives the same ids every
+        time): the workers whose first camera has scene index ``slot`` (of ``stride`` cameras)
+        give out ``slot + 1``, ``slot + 1 + stride``, ... from their own counter on the map (a
+        standby that takes those cameras over continues it), so no two workers give one id.
+        """
         claimed = self._claim(x, y)
         if claimed is not None:
             self.claimed += 1
             return claimed
-        return int(self.client.incr(self.keys.ids))
+        if self.id_slot is None:
+            return int(self.client.incr(self.keys.ids))
+        camera, slot, stride = self.id_slot
+        return (int(self.client.incr(self.keys.ids_of(camera))) - 1) * stride + slot + 1
 
     def _claim(self, x: float, y: float) -> int | None:
         if self.state is None:
@@ -172,8 +188,8 @@ class MapLink:
     def _wait_for_map(self, t: float) -> None:
         if self._first_t is None:
             self._first_t = t
-        if not self.lockstep or t - self._first_t < 1.5 / self.fps:
-            return
+        if not self.lockstep or t - self._first_t < 0.5 / self.fps:
+            return                  # frame 0: no map yet; from frame 1 on, the previous frame's
         deadline = time.monotonic() + self.lockstep_wait_s
         while time.monotonic() < deadline:
             # The bucket of the previous frame complete: every worker's report of it is in.
@@ -219,7 +235,7 @@ class MapLink:
                 # Not where this worker already holds somebody under another id: the map merges
                 # those two ids (a copy here would make one worker hold the same person twice).
                 if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)) and \
-                        not self._holds_near(local, x, y):
+                        not self._holds_near(local, x, y) and not self._born_in_view(p, x, y, t):
                     self._place(tracker, p, x, y, t)
             elif self._follows_map(p):
                 # Not shown by this worker's cameras, or also by another worker's: from where the
@@ -246,6 +262,14 @@ class MapLink:
         if self.cfg.share_rule == "information":
             return p.workers > 1 or p.lead not in ("", self.name)
         return p.lead not in ("", self.name)
+
+    def _born_in_view(self, p, x: float, y: float, t: float) -> bool:
+        """Did another worker start ``p`` moments ago (``own_births_s``) where this worker's
+        cameras already show them? Then this worker finds them in its own images (its new person
+        takes their id, :meth:`new_id`, or the map merges the two) rather than from a first
+        estimate another view made — at a run's start a far camera's, through a door."""
+        return t - p.born < self.cfg.own_births_s and any(in_views(list(self.cameras.values()), np.array([x, y]),
+                                                                      p.height))
 
     def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
         return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m for q in local)
@@ -359,15 +383,6 @@ class MapLink:
         for k, v in fields.items():
             args += [k, v]
         return self._xadd(keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)], args=args) != 0
-
-
-def set_epoch(client: Any, keys: MapKeys, lead_s: float, bucket_s: float, clock: Callable[[], float] = time.time,
-              only_if_unset: bool = False) -> float:
-    """Set the map's epoch ``lead_s`` from now, in the middle of a time bucket (frame ``i`` of every
-    file, at ``epoch + i / fps``, then falls in bucket ``i`` when fps is ``1 / bucket_s``)."""
-    epoch = (math.floor((clock() + lead_s) / bucket_s) + 0.5) * bucket_s
-    client.set(keys.epoch, repr(epoch), nx=only_if_unset)
-    return float(client.get(keys.epoch))
 
 
 __all__ = ["MapLink", "in_views", "set_epoch"]
