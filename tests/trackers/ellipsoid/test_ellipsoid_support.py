@@ -26,7 +26,7 @@ def test_track_support_equals_the_reference(cam_id):
             want = track_support_reference(args, mask, forms, target, covers)
             for a, b in zip(got, want):
                 np.testing.assert_array_equal(a, b)
-    visible, own, own_fg, area = got
+    visible, own, own_fg, area, hidden = got
     assert (own <= visible).all() and (own_fg <= own).all() and (visible > 0).any()
 
 
@@ -38,7 +38,7 @@ def test_a_ghost_beside_a_person_has_no_support_and_one_inside_them_no_own_pixel
     mask = person_mask(cam, person, 1.65, 0.4)
     forms = person_forms(args, np.array([person, beside, inside]), np.full(3, 1.65), np.full(3, 0.4),
                          DrawArgs(0.1, 0.0))
-    visible, own, own_fg, _ = track_support(args, mask, forms, 0, np.array([True, False, False]))
+    visible, own, own_fg, _, _ = track_support(args, mask, forms, 0, np.array([True, False, False]))
     assert own_fg[0] / own[0] > 0.99                  # the person: all their own pixels foreground
     assert own_fg[1] / own[1] < 0.05                  # the ghost beside: its own pixels are floor
     assert own[2] / visible[2] < 0.3                  # the duplicate inside: covered by the person

@@ -54,6 +54,7 @@ def track_support(cam, mask, forms, target_pixels, covers):
     own : (N,) float64 — of those, the ones covered by nobody else (not counting unsure pixels)
     own_fg : (N,) float64 — of those, the foreground ones
     area : (N,) float64 — the whole ellipse's area in pixels, image border and obstacles ignored
+    hidden : (N,) float64 — pixels of the ellipse inside the image that obstacles hide
     """
     inner, box, dist, valid = forms.inner, forms.box, forms.dist, forms.valid
     occ = cam.occ
@@ -62,6 +63,7 @@ def track_support(cam, mask, forms, target_pixels, covers):
     own = np.zeros(n)
     own_fg = np.zeros(n)
     area = np.zeros(n)
+    hidden = np.zeros(n)
     for k in range(n):
         if not valid[k]:
             continue
@@ -76,7 +78,10 @@ def track_support(cam, mask, forms, target_pixels, covers):
             for uu in range(u0, u1, stride):
                 x, y = ideal_position(cam.grid, cam.has_dist, v, uu)
                 o = occ[v, uu]
-                if o < dist[k] or not inside(inner[k], x, y):
+                if not inside(inner[k], x, y):
+                    continue
+                if o < dist[k]:
+                    hidden[k] += stride * stride
                     continue
                 visible[k] += stride * stride
                 covered = False
@@ -92,14 +97,14 @@ def track_support(cam, mask, forms, target_pixels, covers):
                     own[k] += stride * stride
                     if mask[v, uu] == 1:
                         own_fg[k] += stride * stride
-    return visible, own, own_fg, area
+    return visible, own, own_fg, area, hidden
 
 
 def track_support_reference(cam: CameraArgs, mask: np.ndarray, forms: Forms, target_pixels: int,
-                            covers: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                            covers: np.ndarray) -> tuple[np.ndarray, ...]:
     """:func:`track_support` with whole-box masks in NumPy: the version it is tested against."""
     n = len(forms.valid)
-    visible, own, own_fg, area = (np.zeros(n) for _ in range(4))
+    visible, own, own_fg, area, hidden = (np.zeros(n) for _ in range(5))
     for k in np.flatnonzero(forms.valid):
         a11, a12, a22 = forms.inner[k, 2:]
         area[k] = math.pi / math.sqrt(max(a11 * a22 - a12 ** 2, 1e-300))
@@ -110,7 +115,8 @@ def track_support_reference(cam: CameraArgs, mask: np.ndarray, forms: Forms, tar
         vv, uu = np.meshgrid(np.arange(v0, v1, stride), np.arange(u0, u1, stride), indexing="ij")
         x, y = _ideal(cam, vv, uu)
         occ = cam.occ[vv, uu]
-        mine = (occ >= forms.dist[k]) & _inside(forms.inner[k], x, y)
+        ellipse = _inside(forms.inner[k], x, y)
+        mine = (occ >= forms.dist[k]) & ellipse
         covered = np.zeros_like(mine)
         for m in np.flatnonzero(forms.valid & covers):
             if m != k:
@@ -123,7 +129,8 @@ def track_support_reference(cam: CameraArgs, mask: np.ndarray, forms: Forms, tar
         visible[k] = weight * np.count_nonzero(mine)
         own[k] = weight * np.count_nonzero(alone)
         own_fg[k] = weight * np.count_nonzero(alone & (labels == 1))
-    return visible, own, own_fg, area
+        hidden[k] = weight * np.count_nonzero(ellipse & ~mine)
+    return visible, own, own_fg, area, hidden
 
 
 def _ideal(cam: CameraArgs, vv: np.ndarray, uu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -151,7 +158,8 @@ class Support(NamedTuple):
     own_share : float — fraction of the visible pixels that nobody else covers
     seen_share : float — the largest fraction of the whole ellipse some camera shows
     evidence : float — the largest fraction of the whole ellipse that is own foreground or
-        explained by others (low for a track past the image border or on empty floor)
+        explained by others (low for a track past the image border or on empty floor) — or, with
+        ``obstacles_explain``, by the obstacles that hide it
     views : int — cameras that show at least :data:`MIN_OWN_PIXELS` own pixels
     seen_by : tuple of tuple of str — per person, the cameras whose view holds some of it
     """
@@ -166,7 +174,7 @@ class Support(NamedTuple):
 
 
 def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mapping[str, np.ndarray],
-                    target_pixels: int, covers: np.ndarray) -> Support:
+                    target_pixels: int, covers: np.ndarray, obstacles_explain: bool = False) -> Support:
     """:class:`Support` of N people from their ellipses in each camera.
 
     Parameters
@@ -175,6 +183,10 @@ def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mappin
     labels : {camera_id: (H, W) uint8} — the cameras' foreground labels (1 fg, 0 bg, 2 unsure)
     target_pixels : int — samples per person (0: every pixel)
     covers : (N,) bool — who takes pixels away from the others (tracked people)
+    obstacles_explain : bool — pixels an obstacle hides count as explained in the evidence, as
+        those somebody else covers do, and the seen share is of what the obstacles leave in view:
+        a person standing behind a sign is neither failing nor unconfirmable for showing only
+        their head and legs (``support.obstacles_explain``)
     """
     n = len(covers)
     visible, own_total, seen_share, evidence = (np.zeros(n) for _ in range(4))
@@ -183,12 +195,16 @@ def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mappin
     seen: list[list[str]] = [[] for _ in range(n)]
     for cid, mask in labels.items():
         args, forms = cams[cid]
-        vis, own, own_fg, area = track_support(args, mask, forms, target_pixels, covers)
+        vis, own, own_fg, area, hidden = track_support(args, mask, forms, target_pixels, covers)
         visible += vis
         own_total += own
-        seen_share = np.maximum(seen_share, np.where(area > 0, vis / np.maximum(area, 1), 0.0))
-        # Evidence: foreground of its own plus what others explain, over the whole ellipse.
-        evidence = np.maximum(evidence, np.where(area > 0, (own_fg + vis - own) / np.maximum(area, 1), 0.0))
+        # Seen: of the ellipse, or with ``obstacles_explain`` of what the obstacles leave to see.
+        can_see = area - hidden if obstacles_explain else area
+        seen_share = np.maximum(seen_share, np.where(can_see > 0, vis / np.maximum(can_see, 1), 0.0))
+        # Evidence: foreground of its own plus what others (and, as an option, obstacles) explain,
+        # over the whole ellipse.
+        explained = vis - own + (hidden if obstacles_explain else 0.0)
+        evidence = np.maximum(evidence, np.where(area > 0, (own_fg + explained) / np.maximum(area, 1), 0.0))
         with np.errstate(invalid="ignore", divide="ignore"):
             here = np.where(own >= MIN_OWN_PIXELS, own_fg / np.maximum(own, 1), np.nan)
         support = np.fmin(support, here)
