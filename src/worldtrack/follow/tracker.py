@@ -271,6 +271,8 @@ class FollowTracker:
             others.update(matched, c.xy[cand], obs.hists[cand], t, dt)
             owner[cand] = others.ids[matched]
         others.expire(t)
+        if chosen >= 0 and t - self.last_seen >= REACQUIRED_AFTER and self._pieces_of_others(c.xy, owner > 1)[chosen]:
+            owner[chosen], chosen = 0, -1       # found again beside somebody tracked: a piece of them
         if chosen < 0:
             chosen = self._reidentify(obs, owner, D, hiding, t)
         free = np.flatnonzero(owner == 0)
