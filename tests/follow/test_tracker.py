@@ -227,7 +227,7 @@ def test_a_lost_target_is_not_taken_for_a_taller_person_or_one_whose_colours_dif
         obs = _seen(cam, cfg, people, colours, tops, rng)
         step = tracker.start_with(obs, t, people[0]) if k == 0 else tracker.step_with(obs, t)
         labels.append(names[step.chosen] if step.found else ".")
-    assert abs(tracker.height - 1.65) < 1e-6
+    assert abs(tracker.height.value - 1.65) < 1e-6
     assert labels[:10] == ["T"] * 10 and "X" not in labels, "".join(labels)
     assert labels[41:] == ["T"] * 9, "".join(labels)
 

@@ -48,6 +48,7 @@ from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
 from worldtrack.follow.silhouette import covering, person_box, silhouettes
 from worldtrack.follow.templates import Templates
+from worldtrack.follow.vetoes import TargetHeight, pieces_of_others
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
 from worldtrack.scene.model import Scene
@@ -65,14 +66,6 @@ STOPPED_RADIUS = 0.3
 COAST_S = 1.5
 #: Found again after being unseen this long (s), the target's identity is on probation.
 REACQUIRED_AFTER = 0.3
-#: A candidate this near (m) one of another tracked person's is a piece of that person (a body split in
-#: two near the camera), not the lost target.
-FRAGMENT_RADIUS = 0.5
-#: The target's height is learnt only from frames where a point this far (m) above its top is in the image
-#: (the head is not cut off by the image's upper edge).
-HEAD_ROOM = 0.15
-#: Time constant (s) of the target's learnt height.
-HEIGHT_TAU = 3.0
 
 
 @dataclass
@@ -136,7 +129,7 @@ class FollowTracker:
         self._alpha = 0.0
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
-        self.height = np.nan
+        self.height = TargetHeight()
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -175,7 +168,8 @@ class FollowTracker:
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
         self.last_xy = c.xy[i].copy()
-        self.height = float(c.top[i]) if self._head_in_view(obs, i) else np.nan
+        self.height = TargetHeight()
+        self.height.learn(obs.camera, c.xy[i], float(c.top[i]), 0.0)
         self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
                              self.config.others_max_coast)
         rest = np.arange(len(c)) != i
@@ -223,8 +217,8 @@ class FollowTracker:
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
         hiding = self._hiding(obs)
         allowed = (E / cfg.k <= gate) & ~hiding
-        if t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until:
-            allowed &= ~self._too_tall(obs)     # found again: a taller person is somebody else
+        if t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until:   # found again: a taller
+            allowed &= ~self.height.too_tall(obs.candidates.top, cfg.height_margin)   # person is somebody else
         if t - self.last_seen > COAST_S:
             allowed &= rb < cfg.reid_rbhat      # the prediction no longer tells: colour must agree
         if cfg.track_others:
@@ -271,12 +265,12 @@ class FollowTracker:
             others.update(matched, c.xy[cand], obs.hists[cand], t, dt)
             owner[cand] = others.ids[matched]
         others.expire(t)
-        if chosen >= 0 and t - self.last_seen >= REACQUIRED_AFTER and self._pieces_of_others(c.xy, owner > 1)[chosen]:
+        if chosen >= 0 and t - self.last_seen >= REACQUIRED_AFTER and pieces_of_others(c.xy, owner > 1)[chosen]:
             owner[chosen], chosen = 0, -1       # found again beside somebody tracked: a piece of them
         if chosen < 0:
             chosen = self._reidentify(obs, owner, D, hiding, t)
         free = np.flatnonzero(owner == 0)
-        maybe = self._within_reach(c.xy[free], t) & ~self._pieces_of_others(c.xy, owner > 1)[free]
+        maybe = self._within_reach(c.xy[free], t) & ~pieces_of_others(c.xy, owner > 1)[free]
         owner[free] = others.add(c.xy[free], obs.hists[free], t, maybe)
         return chosen, owner
 
@@ -288,7 +282,7 @@ class FollowTracker:
         (a person who reappears half hidden is often first taken for somebody new; one who appeared
         beyond where the target could have got to is somebody else), qualify, and not one who may be
         hiding the target, not a piece of a person another track holds in this frame (a body split in
-        two near the camera), and not taller than the target (:meth:`_too_tall`). They must look like
+        two near the camera), and not taller than the target (:mod:`~worldtrack.follow.vetoes`). They must look like
         it (RBhat < ``reid_rbhat``) or, while it is coasting (unseen up to ``COAST_S``), score like it
         (D < ``threshold``: after that, with E discounted as below, D under the threshold would take
         anybody near whose RBhat is under 1), and be no farther from it than a walker could have gone
@@ -300,8 +294,9 @@ class FollowTracker:
         cfg = self.config
         others = self.others
         young_ids = others.ids[(others.born > self.last_seen) & others.maybe_target]
-        eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding & ~self._too_tall(obs)
-        eligible &= ~self._pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, young_ids))
+        eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
+        eligible &= ~self.height.too_tall(obs.candidates.top, cfg.height_margin)
+        eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, young_ids))
         eligible = np.flatnonzero(eligible)
         if len(eligible) == 0:
             return -1
@@ -351,50 +346,12 @@ class FollowTracker:
             self.templates.short, self.templates.short_wb = self.templates.long.copy(), self.templates.long_wb
         return new
 
-    def _reach(self, t: float) -> float:
-        """How far (m) from its constant-velocity prediction the target may be after being unseen since
-        ``last_seen``: ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
-        cfg, unseen = self.config, t - self.last_seen
-        return cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
-
     def _within_reach(self, xy: np.ndarray, t: float) -> np.ndarray:
-        """(N,) positions (N, 2) the lost target could have reached (:meth:`_reach`)."""
-        return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= self._reach(t)
-
-    def _way_distance(self, xy: np.ndarray) -> np.ndarray:
-        """(N,) distance (m) of positions (N, 2) from the target's way since it was last measured: the
-        segment from there to its prediction (it may have walked on or stopped)."""
-        xy = np.asarray(xy, float).reshape(-1, 2)
-        way = self.x[:2] - self.last_xy
-        along = np.clip((xy - self.last_xy) @ way / max(way @ way, 1e-12), 0.0, 1.0)
-        return np.hypot(*(xy - self.last_xy - along[:, None] * way).T)
-
-    def _pieces_of_others(self, xy: np.ndarray, others_mask: np.ndarray) -> np.ndarray:
-        """(N,) candidates within ``FRAGMENT_RADIUS`` of a candidate (``others_mask``) that another
-        person's track holds in this frame: a piece of that person, seen while the target was not."""
-        if not others_mask.any():
-            return np.zeros(len(xy), dtype=bool)
-        d = np.hypot(*(xy[:, None] - xy[others_mask][None]).transpose(2, 0, 1))
-        return (d <= FRAGMENT_RADIUS).any(axis=1) & ~others_mask
-
-    def _head_in_view(self, obs: Observation, i: int) -> bool:
-        """Whether candidate ``i``'s measured top is its height: a point ``HEAD_ROOM`` above it projects
-        into the image (else the image's upper edge may have cut the head off)."""
-        cam = obs.camera
-        if cam is None:
-            return False
-        c = obs.candidates
-        uv, z = cam.project(np.array([*c.xy[i], c.top[i] + HEAD_ROOM]), return_depth=True)
-        return bool(z > 0 and cam.in_image(uv, margin=1.0))
-
-    def _too_tall(self, obs: Observation) -> np.ndarray:
-        """(N,) candidates whose highest measured point is more than ``height_margin`` above the target's
-        learnt height: a taller person (the top of somebody partly hidden or cut off by the image's edge
-        is lower than their height, never higher, so only taller is a veto)."""
-        margin = self.config.height_margin
-        if not (margin > 0 and np.isfinite(self.height)):
-            return np.zeros(len(obs.candidates), dtype=bool)
-        return obs.candidates.top > self.height + margin
+        """(N,) positions (N, 2) the lost target could have reached: no farther from its constant-velocity
+        prediction than ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
+        cfg, unseen = self.config, t - self.last_seen
+        reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
+        return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
 
     def _hiding(self, obs: Observation) -> np.ndarray:
         """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
@@ -409,7 +366,9 @@ class FollowTracker:
         cover = covering(obs.silhouettes, n, person_box(obs.camera, self.x[:2]))
         centre = obs.camera.centre[:2]
         nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
-        stopped = self._way_distance(obs.candidates.xy) <= STOPPED_RADIUS
+        way = self.x[:2] - self.last_xy
+        along = np.clip((obs.candidates.xy - self.last_xy) @ way / max(way @ way, 1e-12), 0.0, 1.0)
+        stopped = np.hypot(*(obs.candidates.xy - self.last_xy - along[:, None] * way).T) <= STOPPED_RADIUS
         return nearer & (cover >= HIDE_SHARE) & ~stopped
 
     def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, rb: np.ndarray, alpha: float,
@@ -429,10 +388,7 @@ class FollowTracker:
         close = np.hypot(*(c.xy[chosen] - self.x[:2])) * cfg.k < cfg.update_max_d
         if near.sum() == 1 and close:
             self.templates.learn(hist, obs.wb, dt)
-            if self._head_in_view(obs, chosen):
-                w = 1.0 - np.exp(-max(dt, 0.0) / HEIGHT_TAU)
-                top = float(c.top[chosen])
-                self.height = top if not np.isfinite(self.height) else (1 - w) * self.height + w * top
+            self.height.learn(obs.camera, c.xy[chosen], float(c.top[chosen]), dt)
 
     def _result(self, t: float, obs: Observation, chosen: int, D, rb, E, alpha: float, w: float,
                 owner: np.ndarray, gate: float = 0.0) -> FollowStep:
