@@ -48,7 +48,7 @@ from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
 from worldtrack.follow.silhouette import covering, person_box, silhouettes
 from worldtrack.follow.templates import Templates
-from worldtrack.follow.vetoes import TargetHeight, pieces_of_others
+from worldtrack.follow.vetoes import TargetHeight, heads_seen, pieces_of_others
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
 from worldtrack.scene.model import Scene
@@ -123,8 +123,7 @@ class FollowTracker:
         self.templates: Templates | None = None
         self.x = np.zeros(4)
         self.P = np.eye(4)
-        self.t = 0.0
-        self.last_seen = 0.0
+        self.t = self.last_seen = 0.0
         self.last_xy = np.full(2, np.nan)
         self._alpha = 0.0
         self.identity = IdentityEvidence(self.config.identity_tau)
@@ -169,7 +168,8 @@ class FollowTracker:
         self.probation_until = -np.inf
         self.last_xy = c.xy[i].copy()
         self.height = TargetHeight()
-        self.height.learn(obs.camera, c.xy[i], float(c.top[i]), 0.0)
+        if heads_seen(c, obs.silhouettes, obs.camera)[i]:
+            self.height.learn(float(c.top[i]), 0.0)
         self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
                              self.config.others_max_coast)
         rest = np.arange(len(c)) != i
@@ -217,12 +217,13 @@ class FollowTracker:
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
         hiding = self._hiding(obs)
         allowed = (E / cfg.k <= gate) & ~hiding
-        if t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until:   # found again: a taller
-            allowed &= ~self.height.too_tall(obs.candidates.top, cfg.height_margin)   # person is somebody else
+        self._heads = heads_seen(c, obs.silhouettes, obs.camera)     # found again: somebody of another
+        mismatch = self.height.mismatch(c.top, self._heads, cfg.height_margin)   # height is somebody else
+        allowed &= ~mismatch if t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until else True
         if t - self.last_seen > COAST_S:
             allowed &= rb < cfg.reid_rbhat      # the prediction no longer tells: colour must agree
         if cfg.track_others:
-            chosen, owner = self._assign_all(obs, D, allowed, hiding, t, dt)
+            chosen, owner = self._assign_all(obs, D, allowed, hiding | mismatch, t, dt)
             chosen = self._weigh_identity(obs, rb, chosen, owner, t, dt)
         else:
             chosen = decide(D, cfg.threshold, allowed)
@@ -280,22 +281,20 @@ class FollowTracker:
         Somebody seen at the same time as the target cannot be the target, so only candidates
         nobody owns and those of tracks born after the target's last sighting, within its reach
         (a person who reappears half hidden is often first taken for somebody new; one who appeared
-        beyond where the target could have got to is somebody else), qualify, and not one who may be
-        hiding the target, not a piece of a person another track holds in this frame (a body split in
-        two near the camera), and not taller than the target (:mod:`~worldtrack.follow.vetoes`). They must look like
-        it (RBhat < ``reid_rbhat``) or, while it is coasting (unseen up to ``COAST_S``), score like it
-        (D < ``threshold``: after that, with E discounted as below, D under the threshold would take
-        anybody near whose RBhat is under 1), and be no farther from it than a walker could have gone
-        (``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)`` from the velocity-consistent
-        prediction); the smallest D wins (E counting only the distance beyond half of what a walker
-        could have strayed from the prediction while unseen). A track taken over ends. Changes
+        beyond where the target could have got to is somebody else), qualify; not one who may be
+        hiding the target or is of another height (``hiding``), nor a piece of somebody another track
+        holds now (:mod:`~worldtrack.follow.vetoes`). They must look like it (RBhat < ``reid_rbhat``)
+        or, while it coasts (unseen up to ``COAST_S``), score like it (D < ``threshold``; later, with E
+        discounted, that would take anybody near with RBhat under 1), and be no farther from its
+        velocity-consistent prediction than a walker could have gone (:meth:`_within_reach`); the
+        smallest D wins (E counting only the distance beyond half of what a walker could have strayed
+        from the prediction while unseen). A track taken over ends. Changes
         ``owner`` in place; returns the candidate's index or −1.
         """
         cfg = self.config
         others = self.others
         young_ids = others.ids[(others.born > self.last_seen) & others.maybe_target]
         eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
-        eligible &= ~self.height.too_tall(obs.candidates.top, cfg.height_margin)
         eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, young_ids))
         eligible = np.flatnonzero(eligible)
         if len(eligible) == 0:
@@ -347,8 +346,8 @@ class FollowTracker:
         return new
 
     def _within_reach(self, xy: np.ndarray, t: float) -> np.ndarray:
-        """(N,) positions (N, 2) the lost target could have reached: no farther from its constant-velocity
-        prediction than ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
+        """(N,) positions (N, 2) no farther from the lost target's constant-velocity prediction than
+        ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
         cfg, unseen = self.config, t - self.last_seen
         reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
         return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
@@ -388,7 +387,8 @@ class FollowTracker:
         close = np.hypot(*(c.xy[chosen] - self.x[:2])) * cfg.k < cfg.update_max_d
         if near.sum() == 1 and close:
             self.templates.learn(hist, obs.wb, dt)
-            self.height.learn(obs.camera, c.xy[chosen], float(c.top[chosen]), dt)
+            if self._heads[chosen]:
+                self.height.learn(float(c.top[chosen]), dt)
 
     def _result(self, t: float, obs: Observation, chosen: int, D, rb, E, alpha: float, w: float,
                 owner: np.ndarray, gate: float = 0.0) -> FollowStep:
