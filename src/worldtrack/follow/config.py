@@ -81,10 +81,11 @@ class FollowConfig:
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
         height_margin : the target's height is learnt from depth (the highest point of its candidate,
-        from frames that show its head); a candidate whose highest point is more than this above it
-        is not taken for the target when it is found again after being unseen or while its identity
-        is on probation (0.1 m: the measured top of one person varies by ±0.05 m; 0 = off; the paper
-        has none).
+        from frames that show its head, as an upper envelope, used after 2 s of such frames; see
+        :mod:`~worldtrack.follow.vetoes`); when the target is found again after being unseen, or while
+        its identity is on probation, a candidate more than this taller, or this shorter with its own
+        head seen, is not taken for it (0.1 m: the measured top of one person varies by ±0.05 m;
+        0 = off; the paper has none).
     Identity kept open (:mod:`~worldtrack.follow.identity`; ours, the paper has none)
         identity_margin : another track whose running RBhat against the target's templates is
         lower than the followed one's by this much takes the target's place (0.4; 0 = never; 0.2
