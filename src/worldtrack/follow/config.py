@@ -80,6 +80,12 @@ class FollowConfig:
         away 0.3 s after the target vanished is not the target).
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
+        height_margin : the target's height is learnt from depth (the highest point of its candidate,
+        from frames that show its head, as an upper envelope, used after 2 s of such frames; see
+        :mod:`~worldtrack.follow.vetoes`); when the target is found again after being unseen, or while
+        its identity is on probation, a candidate more than this taller, or this shorter with its own
+        head seen, is not taken for it (0.1 m: the measured top of one person varies by ±0.05 m;
+        0 = off; the paper has none).
     Identity kept open (:mod:`~worldtrack.follow.identity`; ours, the paper has none)
         identity_margin : another track whose running RBhat against the target's templates is
         lower than the followed one's by this much takes the target's place (0.4; 0 = never; 0.2
@@ -133,6 +139,7 @@ class FollowConfig:
     reid_near: float = 0.5
     reid_accel: float = 3.0
     occluders: bool = True
+    height_margin: float = 0.1
     identity_margin: float = 0.4
     identity_tau: float = 0.5
     probation: float = 1.0
@@ -168,7 +175,7 @@ class FollowConfig:
         """
         paper = dict(normalise="none", grey_bins=0, alpha_floor=0.0, gate=1e6, max_gate=1e6, gate_growth=0.0,
                      short_term_tau=0.0, track_others=False, occluders=False,
-                     identity_margin=0.0, probation=0.0)
+                     identity_margin=0.0, probation=0.0, height_margin=0.0)
         undo = dict(paper, normalise="gains+greyworld")
         table = {
             "default": {},

@@ -48,6 +48,7 @@ from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
 from worldtrack.follow.silhouette import covering, person_box, silhouettes
 from worldtrack.follow.templates import Templates
+from worldtrack.follow.vetoes import TargetHeight, heads_seen, pieces_of_others
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
 from worldtrack.scene.model import Scene
@@ -122,12 +123,12 @@ class FollowTracker:
         self.templates: Templates | None = None
         self.x = np.zeros(4)
         self.P = np.eye(4)
-        self.t = 0.0
-        self.last_seen = 0.0
+        self.t = self.last_seen = 0.0
         self.last_xy = np.full(2, np.nan)
         self._alpha = 0.0
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
+        self.height = TargetHeight()
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -166,6 +167,9 @@ class FollowTracker:
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
         self.last_xy = c.xy[i].copy()
+        self.height = TargetHeight()
+        if heads_seen(c, obs.silhouettes, obs.camera)[i]:
+            self.height.learn(float(c.top[i]), 0.0)
         self.others = Others(n_bins(self.config), self.config.accel_sigma, self.config.measurement_sigma,
                              self.config.others_max_coast)
         rest = np.arange(len(c)) != i
@@ -213,8 +217,13 @@ class FollowTracker:
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
         hiding = self._hiding(obs)
         allowed = (E / cfg.k <= gate) & ~hiding
+        self._heads = heads_seen(c, obs.silhouettes, obs.camera)     # found again: somebody of another
+        mismatch = self.height.mismatch(c.top, self._heads, cfg.height_margin)   # height is somebody else
+        allowed &= ~mismatch if t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until else True
+        if t - self.last_seen > COAST_S:
+            allowed &= rb < cfg.reid_rbhat      # the prediction no longer tells: colour must agree
         if cfg.track_others:
-            chosen, owner = self._assign_all(obs, D, allowed, hiding, t, dt)
+            chosen, owner = self._assign_all(obs, D, allowed, hiding | mismatch, t, dt)
             chosen = self._weigh_identity(obs, rb, chosen, owner, t, dt)
         else:
             chosen = decide(D, cfg.threshold, allowed)
@@ -257,10 +266,13 @@ class FollowTracker:
             others.update(matched, c.xy[cand], obs.hists[cand], t, dt)
             owner[cand] = others.ids[matched]
         others.expire(t)
+        if chosen >= 0 and t - self.last_seen >= REACQUIRED_AFTER and pieces_of_others(c.xy, owner > 1)[chosen]:
+            owner[chosen], chosen = 0, -1       # found again beside somebody tracked: a piece of them
         if chosen < 0:
             chosen = self._reidentify(obs, owner, D, hiding, t)
         free = np.flatnonzero(owner == 0)
-        owner[free] = others.add(c.xy[free], obs.hists[free], t, self._within_reach(c.xy[free], t))
+        maybe = self._within_reach(c.xy[free], t) & ~pieces_of_others(c.xy, owner > 1)[free]
+        owner[free] = others.add(c.xy[free], obs.hists[free], t, maybe)
         return chosen, owner
 
     def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, hiding: np.ndarray, t: float) -> int:
@@ -269,18 +281,21 @@ class FollowTracker:
         Somebody seen at the same time as the target cannot be the target, so only candidates
         nobody owns and those of tracks born after the target's last sighting, within its reach
         (a person who reappears half hidden is often first taken for somebody new; one who appeared
-        beyond where the target could have got to is somebody else), qualify, and not one who may be
-        hiding the target. They must look like it (RBhat < ``reid_rbhat``) or score like it (D <
-        ``threshold``, E counting only the distance beyond half of what a walker could have strayed
-        from the prediction while unseen), and be no farther from it than a walker could have gone
-        (``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)`` from the velocity-consistent
-        prediction); the smallest D wins. A track taken over ends. Changes
+        beyond where the target could have got to is somebody else), qualify; not one who may be
+        hiding the target or is of another height (``hiding``), nor a piece of somebody another track
+        holds now (:mod:`~worldtrack.follow.vetoes`). They must look like it (RBhat < ``reid_rbhat``)
+        or, while it coasts (unseen up to ``COAST_S``), score like it (D < ``threshold``; later, with E
+        discounted, that would take anybody near with RBhat under 1), and be no farther from its
+        velocity-consistent prediction than a walker could have gone (:meth:`_within_reach`); the
+        smallest D wins (E counting only the distance beyond half of what a walker could have strayed
+        from the prediction while unseen). A track taken over ends. Changes
         ``owner`` in place; returns the candidate's index or −1.
         """
         cfg = self.config
         others = self.others
         young_ids = others.ids[(others.born > self.last_seen) & others.maybe_target]
         eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
+        eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, young_ids))
         eligible = np.flatnonzero(eligible)
         if len(eligible) == 0:
             return -1
@@ -291,7 +306,11 @@ class FollowTracker:
         # Position counts only beyond half of what a walker could have strayed from the prediction.
         e = cfg.k * np.maximum(0.0, dist - 0.5 * cfg.reid_speed * unseen)
         d = dissimilarity(rb, e, self._alpha, cfg.alpha_th)
-        ok = ((rb < cfg.reid_rbhat) | (d < cfg.threshold)) & self._within_reach(c.xy[eligible], t)
+        # Position speaks while the prediction is trusted (coasting, up to COAST_S: a change of light may
+        # have changed every colour meanwhile); after that, with E discounted, D under the threshold would
+        # take anybody near whose RBhat is under 1, so colour must agree.
+        looks = (rb < cfg.reid_rbhat) | ((d < cfg.threshold) & (unseen <= COAST_S))
+        ok = looks & self._within_reach(c.xy[eligible], t)
         if not ok.any():
             return -1
         pick = int(eligible[np.flatnonzero(ok)[np.argmin(d[ok])]])
@@ -327,8 +346,8 @@ class FollowTracker:
         return new
 
     def _within_reach(self, xy: np.ndarray, t: float) -> np.ndarray:
-        """(N,) positions (N, 2) the lost target could have reached: no farther from its constant-velocity
-        prediction than ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
+        """(N,) positions (N, 2) no farther from the lost target's constant-velocity prediction than
+        ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
         cfg, unseen = self.config, t - self.last_seen
         reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
         return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
@@ -368,6 +387,8 @@ class FollowTracker:
         close = np.hypot(*(c.xy[chosen] - self.x[:2])) * cfg.k < cfg.update_max_d
         if near.sum() == 1 and close:
             self.templates.learn(hist, obs.wb, dt)
+            if self._heads[chosen]:
+                self.height.learn(float(c.top[chosen]), dt)
 
     def _result(self, t: float, obs: Observation, chosen: int, D, rb, E, alpha: float, w: float,
                 owner: np.ndarray, gate: float = 0.0) -> FollowStep:
