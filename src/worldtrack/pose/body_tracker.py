@@ -25,11 +25,10 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from worldtrack.errors import InputError
 from worldtrack.geometry.rotation import euler_zyx, rot_y, rot_z
 from worldtrack.pose.body import LEFT_ARM, RIGHT_ARM, TORSO, BodyModel, BodySpace, SubSpace, stacked_points
 from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, SparseTemplate
-from worldtrack.pose.noise_weight import NoiseWeightedLam, term_spreads
+from worldtrack.pose.noise_weight import depth_share
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics
@@ -147,9 +146,7 @@ class BodyTracker:
 
     def __init__(self, model: BodyModel, intr: Intrinsics, p0: np.ndarray, config: BodyConfig = BodyConfig()):
         self.model, self.intr, self.config = model, intr, config
-        if config.depth_weight not in ("fixed", "noise"):
-            raise InputError(f"depth_weight: expected fixed or noise, got {config.depth_weight!r}")
-        self.noise = NoiseWeightedLam(config.lam, config.noise_window)
+        self.noise = depth_share(config.depth_weight, config.lam, config.noise_window)
         self.space = BodySpace(model=model, elbow_limit=None if config.elbow_limit_deg is None
                                else np.radians(config.elbow_limit_deg))
         self.sigma = self.space.increment_sigma(config.sigma_mm, config.sigma_deg)
@@ -185,8 +182,7 @@ class BodyTracker:
         order = np.argsort(self.part[tp.colour], kind="stable")
         colour = SparseTemplate(self.local[ci], self.part[ci], tp.value[order])
         dtemp = SparseTemplate(self.local[di], self.part[di], xyz[di, 2])
-        lam = self.noise.lam if cfg.depth_weight == "noise" else cfg.lam
-        return ColourDepthCost(colour, dtemp, grey, depth, self.intr, None, cfg.c_depth_mm / 1000, lam,
+        return ColourDepthCost(colour, dtemp, grey, depth, self.intr, None, cfg.c_depth_mm / 1000, self.noise.lam,
                                DEPTH_SAMPLING[cfg.depth_sampling])
 
     def _pf(self, eps, start: np.ndarray):
@@ -214,6 +210,5 @@ class BodyTracker:
         res = levenberg_marquardt(self.space, residuals, kept.states, self.config.lm_iterations)
         self.state = representative_pose(res.states, eps, self.sigma * np.r_[[self.space.length] * 3, [1.0] * 11])
         self.kept = res.states
-        if self.config.depth_weight == "noise":
-            self.noise.add(*term_spreads(cost, self.space.transforms(self.state[None])))
+        self.noise.observe(cost, self.space.transforms(self.state[None]))
         return BodyEstimate(self.state.copy(), float(eps(self.state[None])[0]) / cost.size, cost.size)

@@ -32,6 +32,7 @@ from collections import deque
 
 import numpy as np
 
+from worldtrack.errors import InputError
 from worldtrack.pose.cost import ColourDepthCost, project_sample
 
 MAD_TO_SIGMA = 1.4826      # σ of a Gaussian = 1.4826 × its median absolute deviation
@@ -77,6 +78,10 @@ class NoiseWeightedLam:
         self.lam0 = float(lam0)
         self.spreads: deque = deque(maxlen=int(window))
 
+    def observe(self, cost: ColourDepthCost, T: np.ndarray) -> None:
+        """Record the spreads of ``cost`` at an accepted pose (``T``: (1, P, 3, 4) part transforms)."""
+        self.add(*term_spreads(cost, T))
+
     def add(self, s_colour: float, s_depth: float) -> None:
         """Record one accepted frame's spreads (ignored unless both terms were measured)."""
         if np.isfinite(s_colour) and np.isfinite(s_depth) and s_colour + s_depth > 0:
@@ -88,3 +93,30 @@ class NoiseWeightedLam:
             return self.lam0
         s = np.median(np.asarray(self.spreads), axis=0)
         return inverse_variance_lam(s[0], s[1])
+
+
+class FixedLam:
+    """λ = the configured share, whatever is observed (the paper's fixed weight)."""
+
+    def __init__(self, lam: float):
+        self.lam = float(lam)
+
+    def observe(self, cost: ColourDepthCost, T: np.ndarray) -> None:
+        """Nothing to learn: a fixed λ."""
+
+
+def depth_share(mode: str, lam: float, window: int) -> FixedLam | NoiseWeightedLam:
+    """The trackers' λ source for ``depth_weight`` ``mode``: "fixed" (``lam``) or "noise" (measured).
+
+    >>> depth_share("fixed", 0.9, 10).lam
+    0.9
+    >>> depth_share("learnt", 0.9, 10)
+    Traceback (most recent call last):
+    ...
+    worldtrack.errors.InputError: depth_weight: expected fixed or noise, got 'learnt'
+    """
+    if mode == "fixed":
+        return FixedLam(lam)
+    if mode == "noise":
+        return NoiseWeightedLam(lam, window)
+    raise InputError(f"depth_weight: expected fixed or noise, got {mode!r}")

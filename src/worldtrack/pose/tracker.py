@@ -32,7 +32,7 @@ from worldtrack.errors import InputError
 from worldtrack.pose.cost import DEPTH_SAMPLING, ColourDepthCost, EigenTemplateCost, SparseTemplate
 from worldtrack.pose.lm import levenberg_marquardt
 from worldtrack.pose.measures import rotation_error_deg  # noqa: F401  (doctest)
-from worldtrack.pose.noise_weight import NoiseWeightedLam, term_spreads
+from worldtrack.pose.noise_weight import depth_share
 from worldtrack.pose.models import PointModel, increment_between, rigid_state, state_pose
 from worldtrack.pose.particle import candidate_weights, coarse_to_fine, mean_rotation
 from worldtrack.pose.render import Intrinsics, posed_points
@@ -143,9 +143,7 @@ class RigidTracker:
             raise InputError(f"motion: expected velocity or none, got {self.config.motion!r}")
         if self.cost not in ("eigen", "colour-depth"):
             raise InputError(f"cost: expected eigen or colour-depth, got {self.cost!r}")
-        if self.config.depth_weight not in ("fixed", "noise"):
-            raise InputError(f"depth_weight: expected fixed or noise, got {self.config.depth_weight!r}")
-        self.noise = NoiseWeightedLam(self.config.lam, self.config.noise_window)
+        self.noise = depth_share(self.config.depth_weight, self.config.lam, self.config.noise_window)
         self.space = RigidSpace(length=max(self.model.radius, 1e-3))
         self.sigma = self.space.increment_sigma(self.config.sigma_mm, self.config.sigma_deg)
         self.basis = None
@@ -271,9 +269,8 @@ class RigidTracker:
         dt = SparseTemplate(m.points[tp.depth], np.zeros(len(tp.depth), int), zd)
         if depth is not None and self.depth_bias.any():
             depth = self.corrected_depth(np.asarray(depth), intr)
-        lam = self.noise.lam if self.config.depth_weight == "noise" else self.config.lam
         return ColourDepthCost(colour, dt, grey, depth, intr, self.config.c, self.config.c_depth_mm / 1000,
-                               lam, DEPTH_SAMPLING[self.config.depth_sampling])
+                               self.noise.lam, DEPTH_SAMPLING[self.config.depth_sampling])
 
     def _lm(self, cost, states: np.ndarray, iterations: int):
         """Batched LM of the kept candidates on one cost (compiled normal equations for the face)."""
@@ -309,7 +306,7 @@ class RigidTracker:
             self.velocity = increment_between(self.state, new_state, self.space.length)
         self.state = new_state
         self.kept = res.states
-        if cfg.depth_weight == "noise" and self.cost == "colour-depth":
-            self.noise.add(*term_spreads(cost, self.space.transforms(self.state[None])))
+        if self.cost == "colour-depth":
+            self.noise.observe(cost, self.space.transforms(self.state[None]))
         mean_cost = float(eps(self.state[None])[0]) / cost.size
         return PoseEstimate(Rm, tm, mean_cost, cost.size)
