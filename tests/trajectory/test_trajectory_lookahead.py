@@ -141,3 +141,33 @@ def test_a_shaped_step_that_is_no_descent_falls_back_to_the_move_limit(office_pr
     lm = LevenbergMarquardt(problem, X0, options.solver)
     lm.run(1)
     assert limited == [1] and lm.lin.costs.total < LevenbergMarquardt(problem, X0, options.solver).lin.costs.total
+
+
+def test_the_objective_settles_only_where_the_next_steps_model_agrees(office_problem, monkeypatch):
+    problem, X0, options = office_problem
+    loose = replace(options.solver, barrier_relative_decrease=0.05, max_iterations=30)
+
+    def run(confirm, promise):
+        lm = LevenbergMarquardt(problem, X0, replace(loose, confirm_stop=confirm))
+        monkeypatch.setattr(lm, "_floor", lambda: lm.lin.costs.total * (1.0 - promise))   # what the model promises
+        lm.run()
+        return lm
+
+    plain = run(False, 0.5)
+    assert plain.converged and plain.message == "objective settled" and plain.iterations < 10
+    agrees = run(True, 0.0)                                   # the model promises nothing more: the same stop
+    assert agrees.iterations == plain.iterations and agrees.message == "objective settled"
+    more = run(True, 0.5)                                     # the model promises half of F: it goes on
+    assert more.iterations > plain.iterations and more.message != "objective settled"
+
+
+def test_a_state_takes_the_least_share_of_the_samples_on_both_its_curves():
+    field = _field(lambda x: 3.0 - x)
+    X = np.array([[1.0, 0, 1.0, 0, 1.7, 0], [1.5, 0, 1.0, 0, 1.7, 0], [1.0, 0, 2.0, 0, 1.7, 0]])
+    delta = np.zeros_like(X)
+    delta[:2, 0] = 1.9                                         # both towards the wall; the third stays
+    own = trace_reference(field, X[:, [0, 2]], delta[:, [0, 2]], 0.2)
+    assert own[0] > own[1] + 0.2 and own[2] == 1.0
+    shares = state_shares(X, delta, Barrier(field, clearance=0.2), 0.5)   # samples: the states only
+    # the curve 1 → 2 is sampled at state 1 (its start) and state 2 (the last state): both take the least
+    np.testing.assert_allclose(shares, [own[0], own[1], own[1]], atol=1e-12)
