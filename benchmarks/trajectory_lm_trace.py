@@ -8,7 +8,8 @@ Problem: the walk of ``trajectory_speed.py`` (``problem_of(T, seed)``), Levenber
 barrier from the shortest-path start (the start that wins the race on these walks), the default
 ``SolverOptions``. Per iteration: objective F, its relative decrease, the damping μ (relative to
 diag H), the largest floor move of the undamped-limit step (the Gauss–Newton step before the
-``max_move`` limit), how many states the limit shortened, the largest move taken, the barrier cost.
+``max_move`` limit), how many states the limit shortened (since 34i: how many moved beyond it, the step
+then shaped by the look-ahead, ``SolverOptions.look_ahead``), the largest move taken, the barrier cost.
 Then the same run goes on with the tolerance 1e-13 (``--tight-iterations`` more at most): how far the
 default stop (relative decrease 1e-5) is from the optimum its own path leads to, in objective and
 in metres.

@@ -299,27 +299,30 @@ def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: floa
 
 
 @njit(cache=True)
-def field_values(values: np.ndarray, origin: np.ndarray, res: float, xy: np.ndarray) -> np.ndarray:  # pragma: no cover
-    """The value d (N,) of ``environment.sample_field`` at floor points xy (N, 2) without its gradient:
-    bilinear on the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus
-    the distance to it. The same arithmetic in the same order (the free-space routes' rasters)."""
+def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float) -> float:  # pragma: no cover
+    """The value d of ``environment.sample_field`` at one floor point (x, y) without its gradient: bilinear on
+    the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus the distance to it.
+    The same arithmetic in the same order."""
     ny, nx = values.shape
-    hi_x = origin[0] + res * (nx - 1)
-    hi_y = origin[1] + res * (ny - 1)
+    cx = min(max(x, origin[0]), origin[0] + res * (nx - 1))
+    cy = min(max(y, origin[1]), origin[1] + res * (ny - 1))
+    fi = (cx - origin[0]) / res
+    fj = (cy - origin[1]) / res
+    i0 = min(int(fi), nx - 2)
+    j0 = min(int(fj), ny - 2)
+    a, b = fi - i0, fj - j0
+    d = ((1 - a) * (1 - b) * values[j0, i0] + a * (1 - b) * values[j0, i0 + 1]
+         + (1 - a) * b * values[j0 + 1, i0] + a * b * values[j0 + 1, i0 + 1])
+    gap = np.hypot(cx - x, cy - y)
+    return d - gap if gap > 0 else d
+
+
+@njit(cache=True)
+def field_values(values: np.ndarray, origin: np.ndarray, res: float, xy: np.ndarray) -> np.ndarray:  # pragma: no cover
+    """:func:`field_value` at floor points xy (N, 2): d (N,) (the free-space routes' rasters)."""
     d = np.empty(xy.shape[0])
     for k in range(xy.shape[0]):
-        cx = min(max(xy[k, 0], origin[0]), hi_x)
-        cy = min(max(xy[k, 1], origin[1]), hi_y)
-        fi = (cx - origin[0]) / res
-        fj = (cy - origin[1]) / res
-        i0 = min(int(fi), nx - 2)
-        j0 = min(int(fj), ny - 2)
-        a, b = fi - i0, fj - j0
-        d[k] = ((1 - a) * (1 - b) * values[j0, i0] + a * (1 - b) * values[j0, i0 + 1]
-                + (1 - a) * b * values[j0 + 1, i0] + a * b * values[j0 + 1, i0 + 1])
-        gap = np.hypot(cx - xy[k, 0], cy - xy[k, 1])
-        if gap > 0:
-            d[k] -= gap
+        d[k] = field_value(values, origin, res, xy[k, 0], xy[k, 1])
     return d
 
 
