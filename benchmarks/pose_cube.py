@@ -192,6 +192,7 @@ def main() -> None:
         gaps[name] = (*np.percentile(g[:, 0], [50, 90]), *np.percentile(g[:, 1], [50, 90]))
     methods = {"PF1LM10 colour+depth λ=0.9": TrackerConfig(), "PF1LM10 colour+depth λ=0.3": TrackerConfig(lam=0.3),
                "PF1LM10 colour+depth λ from noise": TrackerConfig(depth_weight="noise"),
+               "PF1LM10 colour+depth λ kernel-weighted": TrackerConfig(depth_weight="kernel"),
                "PF1LM10 colour only": TrackerConfig(lam=0.0), "PF1LM0 colour+depth λ=0.9": TrackerConfig(lm_iterations=0),
                "KLT+PnP": None}
     rows, first, seed0 = [], None, {}

@@ -44,8 +44,9 @@ class BodyConfig:
     arm's shoulder (θs, φs) and elbow (θe, φe), degrees; pf : "cascade" (torso → right arm → left
     arm, the paper's) or "joint" (all 14 at once); depth_sampling : "bilinear" (on one surface) or
     "nearest" pixel (see :class:`~worldtrack.pose.cost.ColourDepthCost`); depth_weight : "fixed"
-    (λ = ``lam``, the paper's) or "noise" (λ from the two terms' measured spreads,
-    :mod:`~worldtrack.pose.noise_weight`, over the last ``noise_window`` frames)
+    (λ = ``lam``, the paper's), "noise" (λ from the two terms' measured spreads) or "kernel" (from
+    each term's robust-kernel weight; :mod:`~worldtrack.pose.noise_weight`, over the last
+    ``noise_window`` frames)
     """
 
     stages: int = 1

@@ -11,13 +11,28 @@ The spread of each term is the median over the last ``window`` accepted frames (
 frame); until a frame is accepted the configured λ is used (a first frame's colour template read
 from that very image would otherwise look noise-free).
 
-Measured (opt-in, not the default): on synthetic RGB-D faces with 1 mm depth steps λ rises to
-0.99 and the rotation error falls (faces 0/1/5/8: 0.18–0.19° vs 0.24–0.26° at λ = 0.9); with 3 mm
-noise λ ≈ 0.6–0.8, better on three faces of four; with 10 mm noise λ → 0.0–0.05 and it is worse
-(one face lost): the depth differences then sit in Geman–McClure's flat part (σ > c′), where the
-kernel already discounts them, and the quadratic-regime weight discounts them again. Real cube
-(``benchmarks/pose_cube.py``): λ → 0.003–0.006, closer to the image-only and rolling-shutter checks,
-further from the data's board truth in median millimetres. Body (held-out seed 3): level.
+Inverse variance is the ML weight only where the robust kernel is quadratic. ``"kernel"``
+(:func:`kernel_weight`) uses each term's Godambe weight instead, ``E[ρ″]/E[ρ′²]`` of its own
+differences — the expected curvature of the term at the right pose over its gradient's variance,
+the weight that minimises an M-estimator's sandwich variance for independent residuals. It equals
+inverse variance for small differences and gives a term whose differences reach Geman–McClure's
+flat part several times more (it is discounted there already); no Gaussian assumption, no constant.
+
+Measured (opt-in, not the default), synthetic RGB-D faces (faces 0/1/5/8, one sequence each),
+mean rotation error: with 1 mm depth steps inverse variance (λ → 0.99) gives 0.16–0.19° vs
+0.24–0.26° at λ = 0.9, the kernel weight (λ → 0.98) 0.16–0.19° as well; with 3 mm noise inverse variance (λ ≈ 0.6–0.8)
+is better on three faces of four and worse on face 1 (1.34° vs 0.72°), the kernel weight (λ ≈ 0.62–0.75) is
+better on all four (0.45–0.55° vs 0.72–1.25°); with 10 mm noise inverse variance (λ → 0.0–0.05)
+is worse on all four and loses face 1, the kernel weight (λ ≈ 0.05–0.21) is better on three
+(2.45–3.05° vs 2.92–3.76°) and worse on face 1 (7.0° vs 2.5°: its λ fell to 0.055). On held-out
+faces 2/3/4/6/7 it is better at 3 mm on three of five (the other two within 0.07°) but at 10 mm it
+is better on one only and loses faces 2 and 4 (λ → 0.04–0.05; face 7: λ → 0, 8.8°): the colour
+differences of a face under changing light are not independent noise (one smooth shading error),
+so the weight over-trusts colour; and a drifting pose inflates the depth differences it is
+measured on, which lowers λ further. Real cube
+(``benchmarks/pose_cube.py``, 5 seeds): inverse variance λ → 0.003–0.006, worse than λ = 0.9 in
+median mm against the data's board truth; the kernel weight λ → 0.015–0.02, better than λ = 0.9
+against every truth of the benchmark. Body (held-out seed 3): both level with λ = 0.9.
 
 >>> w = NoiseWeightedLam(0.9)
 >>> w.lam                                     # nothing measured yet: the configured λ
@@ -52,47 +67,101 @@ def inverse_variance_lam(s_colour: float, s_depth: float) -> float:
     return vc / (vc + vd) if vc + vd > 0 else 0.5
 
 
+def term_differences(cost: ColourDepthCost, T: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """The colour and depth differences of ``cost`` at one pose, in units of ``c`` and ``c′``.
+
+    ``T``: (1, P, 3, 4) part transforms of the pose. Returns the read points' ``d_i / c`` (eq. 16)
+    and ``d′_i / c′`` (eq. 17; None without a depth term), unread points dropped.
+    """
+    vals, _ = project_sample(cost.images, cost.intr, T, cost.colour)
+    d = cost.colour_differences(vals[:, 0].astype(float))[0]
+    x_c = d[np.isfinite(d)] / cost.c
+    if cost.depth is None:
+        return x_c, None
+    zhat, z = project_sample(cost.depth_image, cost.intr, T, cost.depth, cost.depth_sampling)
+    dd = (zhat[0, 0] - z).astype(float)
+    return x_c, dd[np.isfinite(dd)] / cost.c_depth
+
+
 def term_spreads(cost: ColourDepthCost, T: np.ndarray) -> tuple[float, float]:
     """Robust spreads ``(s_C, s_D)`` of the colour and depth differences of ``cost`` at one pose.
 
     ``T``: (1, P, 3, 4) part transforms of the pose. Each spread is ``1.4826·median|d| / c`` over
     the points read (``c′`` for depth); NaN when a term has fewer than ``MIN_POINTS`` read points.
     """
-    vals, _ = project_sample(cost.images, cost.intr, T, cost.colour)
-    d = cost.colour_differences(vals[:, 0].astype(float))[0]
-    d = d[np.isfinite(d)]
-    s_c = MAD_TO_SIGMA * float(np.median(np.abs(d))) / cost.c if len(d) >= MIN_POINTS else np.nan
-    if cost.depth is None:
-        return s_c, np.nan
-    zhat, z = project_sample(cost.depth_image, cost.intr, T, cost.depth, cost.depth_sampling)
-    dd = (zhat[0, 0] - z).astype(float)
-    dd = dd[np.isfinite(dd)]
-    s_d = MAD_TO_SIGMA * float(np.median(np.abs(dd))) / cost.c_depth if len(dd) >= MIN_POINTS else np.nan
-    return s_c, s_d
+    return tuple(robust_spread(x) if x is not None and len(x) >= MIN_POINTS else np.nan
+                 for x in term_differences(cost, T))
 
 
-class NoiseWeightedLam:
-    """λ from the spreads measured on the last ``window`` accepted frames (module docstring)."""
+def robust_spread(x: np.ndarray) -> float:
+    """``1.4826·median|x|``: the spread of differences about zero (a Gaussian's σ)."""
+    return MAD_TO_SIGMA * float(np.median(np.abs(x)))
 
-    def __init__(self, lam0: float, window: int = 10):
-        self.lam0 = float(lam0)
-        self.spreads: deque = deque(maxlen=int(window))
+
+def kernel_weight(x: np.ndarray) -> float:
+    """``E[ρ″(x)] / E[ρ′(x)²]`` of Geman–McClure ``ρ(x) = x²/(1 + x²)`` over differences ``x`` (units of c).
+
+    The Godambe (sandwich) weight of one M-estimator term: the cost's expected curvature at the
+    right pose over the variance of its gradient. In ``c``'s units the scale cancels, so terms
+    measured in grey levels and in metres compare directly. For small Gaussian noise of spread
+    ``s`` it is ``1/(2s²)`` (inverse variance); for ``s ≫ 1`` it is ~``4/s²``, not ``1/(2s²)``:
+    the kernel's flat part already discounts the large differences, and the weight says so.
+    0 when the expected curvature is not positive (a term that does not pin the pose).
+
+    >>> round(kernel_weight(np.array([-0.1, 0.1])), 1)   # two points at ±0.1: ≈ 1/(2·0.1²)
+    49.0
+    """
+    x2 = np.asarray(x, float) ** 2
+    q = 1.0 + x2
+    curvature = float(np.mean(2.0 * (1.0 - 3.0 * x2) / q ** 3))
+    variance = float(np.mean(4.0 * x2 / q ** 4))
+    return max(curvature, 0.0) / variance if variance > 0 else np.inf
+
+
+def kernel_share(w_colour: float, w_depth: float) -> float:
+    """λ = w_D / (w_C + w_D) from the two terms' :func:`kernel_weight` (0.5 if both are 0)."""
+    return w_depth / (w_colour + w_depth) if w_colour + w_depth > 0 else 0.5
+
+
+class MeasuredLam:
+    """λ from one number per term measured at each accepted pose (``per_term`` of its differences
+    in units of its scale), the median over the last ``window`` frames turned into λ by ``share``;
+    the configured ``lam0`` until a frame is accepted."""
+
+    def __init__(self, lam0: float, window: int, per_term, share):
+        self.lam0, self.per_term, self.share = float(lam0), per_term, share
+        self.measured: deque = deque(maxlen=int(window))
 
     def observe(self, cost: ColourDepthCost, T: np.ndarray) -> None:
-        """Record the spreads of ``cost`` at an accepted pose (``T``: (1, P, 3, 4) part transforms)."""
-        self.add(*term_spreads(cost, T))
+        """Measure both terms of ``cost`` at an accepted pose (``T``: (1, P, 3, 4) part transforms)."""
+        x_c, x_d = term_differences(cost, T)
+        if x_d is not None and min(len(x_c), len(x_d)) >= MIN_POINTS:
+            self.add(self.per_term(x_c), self.per_term(x_d))
 
-    def add(self, s_colour: float, s_depth: float) -> None:
-        """Record one accepted frame's spreads (ignored unless both terms were measured)."""
-        if np.isfinite(s_colour) and np.isfinite(s_depth) and s_colour + s_depth > 0:
-            self.spreads.append((float(s_colour), float(s_depth)))
+    def add(self, colour: float, depth: float) -> None:
+        """Record one accepted frame's two numbers (ignored unless both are finite and one is positive)."""
+        if np.isfinite(colour) and np.isfinite(depth) and colour + depth > 0:
+            self.measured.append((float(colour), float(depth)))
 
     @property
     def lam(self) -> float:
-        if not self.spreads:
+        if not self.measured:
             return self.lam0
-        s = np.median(np.asarray(self.spreads), axis=0)
-        return inverse_variance_lam(s[0], s[1])
+        return float(self.share(*np.median(np.asarray(self.measured), axis=0)))
+
+
+class NoiseWeightedLam(MeasuredLam):
+    """λ by inverse variance of the terms' robust spreads (:func:`term_spreads`, module docstring)."""
+
+    def __init__(self, lam0: float, window: int = 10):
+        super().__init__(lam0, window, robust_spread, inverse_variance_lam)
+
+
+class KernelWeightedLam(MeasuredLam):
+    """λ from each term's Godambe weight (:func:`kernel_weight`, :func:`kernel_share`)."""
+
+    def __init__(self, lam0: float, window: int = 10):
+        super().__init__(lam0, window, kernel_weight, kernel_share)
 
 
 class FixedLam:
@@ -105,18 +174,21 @@ class FixedLam:
         """Nothing to learn: a fixed λ."""
 
 
-def depth_share(mode: str, lam: float, window: int) -> FixedLam | NoiseWeightedLam:
-    """The trackers' λ source for ``depth_weight`` ``mode``: "fixed" (``lam``) or "noise" (measured).
+def depth_share(mode: str, lam: float, window: int) -> FixedLam | NoiseWeightedLam | KernelWeightedLam:
+    """The trackers' λ source for ``depth_weight`` ``mode``: "fixed" (``lam``), "noise" (inverse
+    variance) or "kernel" (:func:`kernel_weight`).
 
     >>> depth_share("fixed", 0.9, 10).lam
     0.9
     >>> depth_share("learnt", 0.9, 10)
     Traceback (most recent call last):
     ...
-    worldtrack.errors.InputError: depth_weight: expected fixed or noise, got 'learnt'
+    worldtrack.errors.InputError: depth_weight: expected fixed, noise or kernel, got 'learnt'
     """
     if mode == "fixed":
         return FixedLam(lam)
     if mode == "noise":
         return NoiseWeightedLam(lam, window)
-    raise InputError(f"depth_weight: expected fixed or noise, got {mode!r}")
+    if mode == "kernel":
+        return KernelWeightedLam(lam, window)
+    raise InputError(f"depth_weight: expected fixed, noise or kernel, got {mode!r}")

@@ -49,7 +49,9 @@ class TrackerConfig:
     c_depth_mm : depth scale c′ (mm); lam : λ, share of the depth term
     depth_weight : "fixed" — λ = ``lam`` (the paper's); "noise" — λ from the colour and depth
         differences' measured spreads, inverse-variance (:mod:`~worldtrack.pose.noise_weight`;
-        ``lam`` until a frame is accepted, then the median spread over the last ``noise_window`` frames)
+        ``lam`` until a frame is accepted, then the median spread over the last ``noise_window`` frames);
+        "kernel" — λ from each term's Geman–McClure curvature over its gradient's variance, measured
+        on the same differences (:func:`~worldtrack.pose.noise_weight.kernel_weight`)
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
     pf_points : rank the particle filter's candidates on only the strongest ``pf_points`` template
         points (LM then uses them all; worldtrack's default 256, for speed); None: all, as the paper
