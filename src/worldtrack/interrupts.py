@@ -11,6 +11,10 @@ result with an exception set`` with the interrupt as its cause, and a frame half
   ``KeyboardInterrupt``) as SIGINT does, and :func:`interrupt_in` finds an interrupt hidden in an
   exception's cause chain, so the command line can say ``interrupted`` and exit with 128 + the
   signal number (130 for SIGINT, 143 for SIGTERM) whatever was running.
+* Those handlers also remember the signal (:func:`received_signal`): an interrupt raised inside a
+  library that swallows it (a bare ``except:``, an exception "ignored" in a ``__del__``) is not
+  lost. The next :class:`StopRequests` starts with it already requested, and the command line
+  ends with its status even if the command itself finished.
 
 >>> interrupt_in(SystemError("wrapped")) is None
 True
@@ -53,14 +57,34 @@ def interrupt_in(exc: BaseException | None) -> KeyboardInterrupt | None:
     return None
 
 
-def _raise_terminated(signum: int, frame: FrameType | None) -> None:
-    raise Terminated()
+_received: int | None = None        # the first signal the raising handlers saw since installed
+
+
+def _raise_interrupt(signum: int, frame: FrameType | None) -> None:
+    global _received
+    if _received is None:
+        _received = signum
+    raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
 
 
 def install_terminate_handler() -> None:
-    """Make SIGTERM raise :class:`Terminated` (main thread only; a no-op elsewhere)."""
+    """Make SIGTERM raise :class:`Terminated` and SIGINT ``KeyboardInterrupt``, both remembered
+    (:func:`received_signal`); forget any signal seen before. Main thread only; a no-op elsewhere."""
+    global _received
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _raise_terminated)
+        _received = None
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, _raise_interrupt)
+
+
+def received_signal(forget: bool = False) -> int | None:
+    """The first SIGINT/SIGTERM raised since :func:`install_terminate_handler`, even if whatever
+    it interrupted swallowed the exception; None if none. ``forget``: it is being dealt with."""
+    global _received
+    signum = _received
+    if forget:
+        _received = None
+    return signum
 
 
 class StopRequests:
@@ -96,6 +120,7 @@ class StopRequests:
         raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
 
     def __enter__(self) -> "StopRequests":
+        self.signal = received_signal(forget=True)     # one that something before the loop swallowed
         if threading.current_thread() is threading.main_thread():
             for s in self._SIGNALS:
                 self._previous[s] = signal.signal(s, self._handle)
@@ -112,4 +137,4 @@ class StopRequests:
 
 
 __all__ = ["StopRequests", "Terminated", "exit_status", "install_terminate_handler", "interrupt_in",
-           "signal_of"]
+           "received_signal", "signal_of"]

@@ -19,7 +19,8 @@ import sys
 
 from worldtrack import __version__
 from worldtrack.errors import InputError
-from worldtrack.interrupts import exit_status, install_terminate_handler, interrupt_in, signal_of
+from worldtrack.interrupts import (exit_status, install_terminate_handler, interrupt_in, received_signal,
+                                   signal_of)
 
 # Verb modules, in the order ``worldtrack --help`` lists them, with the one line it shows for each
 # (each module's own ``register`` repeats it; tests/cli/test_cli_startup.py checks they agree).
@@ -87,6 +88,10 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         status = int(args.func(args) or 0)
         sys.stdout.flush()          # a reader that went away (| head) is met here, not at exit
+        swallowed = received_signal(forget=True)     # raised where a library dropped it: still honoured
+        if swallowed is not None and status == 0:
+            print("terminated" if swallowed == 15 else "interrupted", file=sys.stderr)
+            return 128 + swallowed
         return status
     except InputError as e:
         print(f"error: {e}", file=sys.stderr)
