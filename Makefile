@@ -24,12 +24,17 @@ demo: $(STAMP)
 test: $(STAMP) services
 	$(PY) -m pytest
 
-# The shared-map and live-stream tests start their own redis-server and ffmpeg (Debian packages); the
+# The shared-map and live-stream tests start their own redis-server, ffmpeg and an RTSP server
+# (GStreamer's, through the system Python's PyGObject: tests/map/rtsp_server.py) (Debian packages); the
 # tests of worldtrack serve drive Debian's chromium through Playwright (no browser download).
 services:
 	@command -v redis-server >/dev/null && command -v ffmpeg >/dev/null || \
 	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq redis-server ffmpeg >/dev/null; } || \
 	  echo "redis-server/ffmpeg could not be installed: the shared-map and live-stream tests will be skipped"
+	@dpkg -s gir1.2-gst-rtsp-server-1.0 gstreamer1.0-plugins-good python3-gi >/dev/null 2>&1 || \
+	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq gir1.2-gst-rtsp-server-1.0 \
+	    gstreamer1.0-plugins-good python3-gi >/dev/null; } || \
+	  echo "GStreamer's RTSP server could not be installed: the RTSP camera test will be skipped"
 	@command -v chromium >/dev/null || \
 	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; } || \
 	  echo "chromium could not be installed: the browser tests of worldtrack serve will be skipped"

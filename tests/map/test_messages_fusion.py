@@ -326,3 +326,27 @@ def test_the_worker_that_shows_a_person_as_their_own_weighs_more_and_leads():
     assert p.lead == "w1" and p.x == pytest.approx((0.4 * 1.0 + 0.27 * 1.4) / 0.67)
     q, = fuse_bucket(FusionState(), 50, [b, a], MapConfig()).people     # by support alone (default)
     assert q.lead == "w2" and q.x == pytest.approx((0.4 * 1.0 + 0.9 * 1.4) / 1.3)
+
+
+def test_a_far_views_first_estimate_merges_with_a_near_views_within_their_covariances():
+    # Frame 0: the west worker starts a person 2 m from its camera (sigma_x 0.07 m), the east worker
+    # the same person through the door 10 m away, 0.56 m off along its line of sight (sigma_x 0.24 m):
+    # beyond merge_distance_m, within the 99 % gate of their covariances -> one person at once.
+    near = est(1, 2.02, 3.34)._replace(cxx=0.0053, cxy=0.0, cyy=0.0019)
+    far = est(2, 1.46, 3.37)._replace(cxx=0.057, cxy=0.0, cyy=0.0029)
+    s = fuse_bucket(FusionState(), 0, [obs("west", 0.0, "w1", [near]), obs("east", 0.0, "w2", [far])], MapConfig())
+    assert s.aliases == {2: 1} and [p.id for p in s.people] == [1]
+    # Two sure estimates 0.56 m apart are two people; so are these with the gate off, with a
+    # worker holding both, with no covariance, or once they are older than merge_after_s.
+    sure = far._replace(cxx=0.0053, cyy=0.0019)
+    cases = [([obs("west", 0.0, "w1", [near]), obs("east", 0.0, "w2", [sure])], MapConfig(), FusionState()),
+             ([obs("west", 0.0, "w1", [near]), obs("east", 0.0, "w2", [far])], MapConfig(newborn_gate=0), FusionState()),
+             ([obs("west", 0.0, "w1", [near, far]), obs("east", 0.0, "w2", [far])], MapConfig(), FusionState()),
+             ([obs("west", 0.0, "w1", [near]), obs("east", 0.0, "w2", [est(2, 1.46, 3.37)])], MapConfig(), FusionState())]
+    old = FusionState()
+    fuse_bucket(old, 0, [obs("west", 0.0, "w1", [near])], MapConfig())
+    fuse_bucket(old, 1, [obs("east", 0.1, "w2", [far._replace(id=2)])], MapConfig())
+    cases.append(([obs("west", 0.5, "w1", [near]), obs("east", 0.5, "w2", [far])], MapConfig(), old))
+    for k, (observations, cfg, st) in enumerate(cases):
+        s = fuse_bucket(st, 5 if st is old else 0, observations, cfg)
+        assert not s.aliases and sorted(p.id for p in s.people) == [1, 2], k

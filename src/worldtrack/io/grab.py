@@ -71,9 +71,17 @@ def _open_capture(source: int | str, open_timeout_s: float, read_timeout_s: floa
 
 
 def check_source(camera_id: str, source: int | str) -> None:
-    """:class:`InputError` if a file source is neither a video file nor a folder of images."""
+    """:class:`InputError` if a file source is neither a video file nor a folder of images, or a
+    stream URL's scheme needs an FFmpeg backend this OpenCV build does not have."""
     from worldtrack.io.sources import _IMAGE_SUFFIXES
+    if isinstance(source, int):
+        return
     if is_live(source):
+        import cv2
+        if not cv2.videoio_registry.hasBackend(cv2.CAP_FFMPEG):
+            raise InputError(f"{camera_id}: {source}: this OpenCV ({cv2.__version__}) was built without FFmpeg, "
+                             "which reads stream URLs (see cv2.getBuildInformation(); the opencv-python wheel "
+                             "from PyPI has it)")
         return
     p = Path(str(source))
     if p.is_dir() and not any(q.suffix.lower() in _IMAGE_SUFFIXES for q in p.iterdir()):
@@ -146,8 +154,8 @@ class Grabber(threading.Thread):
         self._taken = -1
         self._queue: queue.Queue = queue.Queue(maxsize=buffer_frames)   # files: every frame
         self.ended = False
+        check_source(camera_id, source)
         if not self.live:
-            check_source(camera_id, source)
             cap = _FolderReader(Path(source)) if Path(source).is_dir() else \
                 _open_capture(source, open_timeout_s, read_timeout_s)
             if not cap.isOpened():

@@ -72,6 +72,11 @@ class MapConfig(Section):
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")
     merge_after_s: float = Field(0.2, ge=0, description="see merge_distance_m")
+    newborn_gate: float = Field(9.21, ge=0, description="two ids from different workers both younger than "
+                                                        "merge_after_s merge at once also beyond merge_distance_m "
+                                                        "(up to twice it) when their squared Mahalanobis distance "
+                                                        "under their trackers' covariances is below this (9.21: "
+                                                        "99 % of two degrees of freedom; 0 = off)")
     forget_after_s: float = Field(3.0, gt=0, description="a person no worker reports for this long leaves the "
                                                          "map (their id may be reclaimed until then)")
     claim_radius_m: float = Field(1.0, gt=0, description="a worker's new person within this distance of a "

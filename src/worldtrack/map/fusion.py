@@ -77,10 +77,8 @@ import numpy as np
 from worldtrack.map.config import MapConfig
 from worldtrack.map.evidence import LEAD_SHARE, floor_information, in_views, people_boxes, visible_share  # noqa: F401
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
+from worldtrack.map.merges import MIN_WEIGHT, merge_duplicates
 from worldtrack.map.refute import refute
-
-#: The least weight an estimate has (support 0 still says "a worker sees somebody here").
-MIN_WEIGHT = 0.05
 
 
 @dataclass
@@ -284,7 +282,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
         p.mode = "lost"
         if pid in ended or t - p.last_seen > cfg.forget_after_s:
             del state.people[pid]
-    aliases = _merge_duplicates(state, workers_of, t, cfg)
+    aliases = merge_duplicates(state, workers_of, t, cfg, estimates)
     if cfg.negative_evidence:
         aliases.update(refute(state, estimates, observations, t, cfg))
     state.aliases = {y: (e, ts) for y, (e, ts) in state.aliases.items() if t - ts <= cfg.forget_after_s}
@@ -345,47 +343,6 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
     aliases = {young: elder for young, (elder, _) in state.aliases.items()}   # recent merges, again
     return MapState(t, public, reports, aliases, written)
-
-
-def _merge_duplicates(state: FusionState, workers_of: dict[int, set[str]], t: float,
-                      cfg: MapConfig) -> dict[int, int]:
-    """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
-    the elder, unless a worker sees both (then they are two people that worker tells apart: two
-    people crossing in one worker's view while another worker sees only one of them are not
-    merged). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
-    the same frames: no history could tell them apart) are merged at once. Returns
-    ``{younger: elder}``."""
-    from scipy.spatial import cKDTree
-    ids = sorted(workers_of)
-    close_now = set()
-    if len(ids) >= 2:
-        xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
-        for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
-            a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
-            if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
-                continue      # a worker that sees both holds them apart: two people
-            close_now.add((a, b))
-    state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
-    merged: dict[int, int] = {}
-    for (a, b), since in sorted(state.close_since.items()):
-        pa, pb = state.people[a], state.people[b]
-        newborn = t - min(pa.born, pb.born) < cfg.merge_after_s    # both just started: nothing to wait for
-        if (t - since < cfg.merge_after_s and not newborn) or a in merged or b in merged:
-            continue
-        elder, younger = (pa, pb) if (pa.born, pa.id) <= (pb.born, pb.id) else (pb, pa)
-        wa, wb = max(MIN_WEIGHT, _finite(elder.support)), max(MIN_WEIGHT, _finite(younger.support))
-        elder.x = (wa * elder.x + wb * younger.x) / (wa + wb)
-        elder.y = (wa * elder.y + wb * younger.y) / (wa + wb)
-        elder.workers += younger.workers
-        del state.people[younger.id]
-        state.aliases[younger.id] = (elder.id, t)
-        merged[younger.id] = elder.id
-    state.close_since = {k: v for k, v in state.close_since.items() if k[0] not in merged and k[1] not in merged}
-    return merged
-
-
-def _finite(v: float) -> float:
-    return v if v is not None and math.isfinite(v) else 0.0
 
 
 __all__ = ["FusedPerson", "FusionState", "MIN_WEIGHT", "estimate_weight", "floor_information", "fuse_bucket",

@@ -1,0 +1,105 @@
+"""Ids the shared map finds to be one person (:func:`merge_duplicates`): two workers that started
+the same person, or one worker's first estimate of somebody it sees from afar. Pure, called by
+:func:`worldtrack.map.fusion.fuse_bucket`."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Mapping
+
+import numpy as np
+
+from worldtrack.map.config import MapConfig
+from worldtrack.map.messages import Estimate
+
+if TYPE_CHECKING:
+    from worldtrack.map.fusion import FusionState
+
+#: The least weight an estimate has (support 0 still says "a worker sees somebody here").
+MIN_WEIGHT = 0.05
+
+
+def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: float,
+                      cfg: MapConfig, estimates: Mapping[int, Mapping[str, Estimate]] | None = None) -> dict[int, int]:
+    """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
+    the elder, unless a worker sees both (then they are two people that worker tells apart: two
+    people crossing in one worker's view while another worker sees only one of them are not
+    merged). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
+    the same frames: no history could tell them apart) are merged at once — also farther apart than
+    ``merge_distance_m`` when the workers' tracker covariances (``estimates``) put them within
+    ``newborn_gate`` (a far view's first estimate through a door is off by more than 0.5 m in depth,
+    and says so). Returns ``{younger: elder}``."""
+    from scipy.spatial import cKDTree
+    ids = sorted(workers_of)
+    close_now = set()
+    if len(ids) >= 2:
+        xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
+        for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
+            a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
+            if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
+                continue      # a worker that sees both holds them apart: two people
+            close_now.add((a, b))
+        close_now |= _newborns_within_gate(state, workers_of, t, cfg, estimates or {}, xy, ids)
+    state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
+    merged: dict[int, int] = {}
+    for (a, b), since in sorted(state.close_since.items()):
+        pa, pb = state.people[a], state.people[b]
+        newborn = t - min(pa.born, pb.born) < cfg.merge_after_s    # both just started: nothing to wait for
+        if (t - since < cfg.merge_after_s and not newborn) or a in merged or b in merged:
+            continue
+        elder, younger = (pa, pb) if (pa.born, pa.id) <= (pb.born, pb.id) else (pb, pa)
+        wa, wb = max(MIN_WEIGHT, _finite(elder.support)), max(MIN_WEIGHT, _finite(younger.support))
+        elder.x = (wa * elder.x + wb * younger.x) / (wa + wb)
+        elder.y = (wa * elder.y + wb * younger.y) / (wa + wb)
+        elder.workers += younger.workers
+        del state.people[younger.id]
+        state.aliases[younger.id] = (elder.id, t)
+        merged[younger.id] = elder.id
+    state.close_since = {k: v for k, v in state.close_since.items() if k[0] not in merged and k[1] not in merged}
+    return merged
+
+
+def _newborns_within_gate(state: "FusionState", workers_of: dict[int, set[str]], t: float, cfg: MapConfig,
+                          estimates: Mapping[int, Mapping[str, Estimate]], xy: np.ndarray,
+                          ids: list[int]) -> set[tuple[int, int]]:
+    """Pairs of ids both younger than ``merge_after_s``, from different workers, at most
+    ``2 · merge_distance_m`` apart, whose squared Mahalanobis distance under the sum of their
+    estimates' covariances is below ``newborn_gate``."""
+    from scipy.spatial import cKDTree
+    if cfg.newborn_gate <= 0:
+        return set()
+    out = set()
+    for i, j in cKDTree(xy).query_pairs(2 * cfg.merge_distance_m):
+        a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
+        pa, pb = state.people[a], state.people[b]
+        if not workers_of[a] or not workers_of[b] or workers_of[a] & workers_of[b] or \
+                t - min(pa.born, pb.born) >= cfg.merge_after_s:
+            continue
+        ca, cb = _covariance(estimates.get(a, {})), _covariance(estimates.get(b, {}))
+        if ca is None or cb is None:
+            continue
+        d = np.array([pa.x - pb.x, pa.y - pb.y])
+        if float(d @ np.linalg.solve(ca + cb, d)) < cfg.newborn_gate:
+            out.add((a, b))
+    return out
+
+
+def _covariance(estimates_of: Mapping[str, Estimate]) -> np.ndarray | None:
+    """The covariance (m²) of a person's fused position: its workers' seen estimates' tracker
+    covariances, their information added; None when one of them has none."""
+    infos = []
+    for e in estimates_of.values():
+        c = np.array([[e.cxx, e.cxy], [e.cxy, e.cyy]])
+        if not e.seen:
+            continue
+        if not np.all(np.isfinite(c)) or np.linalg.det(c) <= 0:
+            return None
+        infos.append(np.linalg.inv(c))
+    return np.linalg.inv(sum(infos)) if infos else None
+
+
+def _finite(v: float) -> float:
+    return v if v is not None and math.isfinite(v) else 0.0
+
+
+__all__ = ["MIN_WEIGHT", "merge_duplicates"]
