@@ -28,7 +28,7 @@ def _sign_scene(size=(160, 120), low=0.7, high=1.6, y=2.5):
     })
 
 
-def _support(obstacles_explain: bool, xy: np.ndarray, mask: np.ndarray | None = None):
+def _support(obstacles_explain: bool, xy: np.ndarray, mask: np.ndarray | None = None, obstacles_confirm: bool = True):
     scene = _sign_scene()
     cam = scene.cameras["cam"]
     occ = scene.occlusion("cam").floor_distance
@@ -38,7 +38,7 @@ def _support(obstacles_explain: bool, xy: np.ndarray, mask: np.ndarray | None = 
         mask = person_mask(cam, person, 1.75, 0.45) & ~np.isfinite(occ)
     forms = person_forms(args, np.asarray(xy, float)[None], np.array([1.75]), np.array([0.45]), DrawArgs(0.1, 0.0))
     return measure_support({"cam": (args, forms)}, {"cam": mask.astype(np.uint8)}, 0, np.array([True]),
-                           obstacles_explain), track_support(args, mask.astype(np.uint8), forms, 0, np.array([True]))
+                           obstacles_explain, obstacles_confirm), track_support(args, mask.astype(np.uint8), forms, 0, np.array([True]))
 
 
 def test_the_hidden_pixels_are_counted_and_the_reference_agrees():
@@ -64,6 +64,11 @@ def test_a_person_behind_the_sign_is_not_failing_with_the_option():
     # pixels that are foreground) does not change.
     assert without.seen_share[0] < 0.5 and with_.seen_share[0] > 0.95
     assert with_.support[0] == without.support[0] > 0.95
+    # With ``obstacles_confirm`` off the board explains its pixels in the evidence only: the seen
+    # share is of the whole ellipse, as without the option.
+    evidence_only, _ = _support(True, [0.0, 4.0], obstacles_confirm=False)
+    assert evidence_only.evidence[0] == with_.evidence[0]
+    assert evidence_only.seen_share[0] == without.seen_share[0] < 0.5
 
 
 def test_a_ghost_behind_the_sign_still_has_no_support():

@@ -159,6 +159,9 @@ class SupportConfig(Section):
         "person covers do, and min_seen_share is of what the obstacles leave in view (a person behind a sign "
         "shows only head and legs; PETS 2009 MOTA +0.019 over 8 start frames, crowd 10 and paper_kato unchanged; "
         "false: before issue 37)")
+    obstacles_confirm: bool = Field(
+        True, description="with obstacles_explain, min_seen_share is of what the obstacles leave in view rather "
+        "than of the whole ellipse (false: obstacles explain pixels in min_evidence only)")
 
 
 class EndConfig(Section):

@@ -287,7 +287,7 @@ class EllipsoidTracker(TrackerBase):
             cams = {cid: (self.views[cid].args, self.views[cid].forms(*people)) for cid in self.last_labels}
             covers = np.array([p.mode == "tracking" for p in everyone])
             support = measure_support(cams, self.last_labels, int(cfg.score.target_pixels), covers,
-                                      cfg.support.obstacles_explain)
+                                      cfg.support.obstacles_explain, cfg.support.obstacles_confirm)
             judged = self.life.update(judged, scores, support, n_before, t, dt, interval)
         flag_unmeasurable(judged, [v.camera for v in self.views.values()], self.scene.occlusion, t)
         if cfg.height.measure:
