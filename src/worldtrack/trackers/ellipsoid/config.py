@@ -205,6 +205,9 @@ class HeightConfig(Section):
     depth_offset_m: float = Field(
         1.0, ge=0, description="in one view, the feet found may be this far from the track along the line of "
         "sight, m (0.4 m across it)")
+    keep_with_id: bool = Field(
+        False, description="a person given a lost id back keeps the height samples measured under it (the "
+        "kept_heights module; false: measured again from scratch)")
 
     @model_validator(mode="after")
     def _range_in_order(self) -> "HeightConfig":
