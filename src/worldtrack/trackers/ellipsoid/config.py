@@ -205,6 +205,9 @@ class HeightConfig(Section):
     depth_offset_m: float = Field(
         1.0, ge=0, description="in one view, the feet found may be this far from the track along the line of "
         "sight, m (0.4 m across it)")
+    prefer_large: bool = Field(
+        False, description="once samples are in, keep measuring and keep the samples from the views that show the "
+        "person largest (a pixel of a far view is centimetres of height; false: the first samples are final)")
     keep_with_id: bool = Field(
         False, description="a person given a lost id back keeps the height samples measured under it (the "
         "kept_heights module; false: measured again from scratch)")

@@ -32,6 +32,7 @@ from typing import Iterable
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.height_sigma import height_estimate
+from worldtrack.trackers.ellipsoid.height_views import add_samples
 
 
 class KeptHeights:
@@ -44,29 +45,36 @@ class KeptHeights:
 
     def __init__(self, config: HeightConfig) -> None:
         self.config = config
-        self._by_id: dict[int, list[float]] = {}
+        self._by_id: dict[int, tuple[list[float], list[float]]] = {}
 
     def remember(self, people: Iterable[Person]) -> None:
         """After a step: note the samples of every confirmed person (positive id) on the map."""
         for p in people:
             if p.id > 0 and p.height_samples:
-                self._by_id[p.id] = p.height_samples
+                self._by_id[p.id] = (p.height_samples, p.height_px)
 
     def give_back(self, p: Person, default_height: float) -> None:
         """``p`` was just given a known id: the samples kept for it come first, ``p``'s own after
         them; the last ``samples`` are kept and ``p.height`` is their estimate
         (:func:`.height_sigma.height_estimate` against ``default_height``, m)."""
-        old = self._by_id.get(p.id)
+        old, old_px = self._by_id.get(p.id, ([], []))
         if not old or old is p.height_samples:
             return
-        merged = list(old) + list(p.height_samples)
-        # The oldest go first, as when a person's own samples exceed ``samples``; measuring stops
-        # once that many are in (:func:`.height.heights_due`), so the returning person's height is
-        # the one measured before, plus what was measured since.
-        merged = merged[len(merged) - self.config.samples:] if len(merged) > self.config.samples else merged
-        p.height_samples = merged
-        if len(merged) >= 3:
-            p.height = height_estimate(merged, default_height, self.config)
+        px = [*_sizes(old, old_px), *_sizes(p.height_samples, p.height_px)]
+        samples = list(old) + list(p.height_samples)
+        p.height_samples, p.height_px = [], []
+        # As if measured in that order: the oldest go first when there are more than ``samples``
+        # (or, with ``prefer_large``, those from the smallest views, :mod:`.height_views`); measuring
+        # stops once that many are in (:func:`.height.heights_due`), so the returning person's height
+        # is the one measured before, plus what was measured since.
+        add_samples(p, list(zip(samples, px)), self.config)
+        if len(p.height_samples) >= 3:
+            p.height = height_estimate(p.height_samples, default_height, self.config)
+
+
+def _sizes(samples: list[float], px: list[float]) -> list[float]:
+    """The view sizes of ``samples``: ``px``, or 0 (unknown) for each when the lists disagree."""
+    return list(px) if len(px) == len(samples) else [0.0] * len(samples)
 
 
 __all__ = ["KeptHeights"]
