@@ -78,7 +78,7 @@ def test_a_ghost_behind_the_sign_still_has_no_support():
     assert ghost.evidence[0] < 0.8                    # and the evidence is what the board hides, no more
 
 
-def _frames_held_behind_board(obstacles_explain: bool, started: bool = True) -> int:
+def _frames_held_behind_board(obstacles_explain: bool, started: bool = True, obstacles_confirm: bool = True) -> int:
     """Frames (of 30, 3 s) with a track on a person standing just behind a board from the knees
     to the shoulders (320x240; a fifth of their ellipse in view, as behind the PETS sign), started
     on them (``started``) or found by the tracker."""
@@ -86,7 +86,8 @@ def _frames_held_behind_board(obstacles_explain: bool, started: bool = True) -> 
     occ = scene.occlusion("cam").floor_distance
     rng = np.random.default_rng(5)
     bg = noise_backgrounds(scene, rng)["cam"]
-    cfg = with_overrides(EllipsoidConfig(), {"support.obstacles_explain": obstacles_explain})
+    cfg = with_overrides(EllipsoidConfig(), {"support.obstacles_explain": obstacles_explain,
+                                             "support.obstacles_confirm": obstacles_confirm})
     tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"), cfg)
     if started:
         tr.init_track(0.0, 4.0, track_id=1)
@@ -107,3 +108,7 @@ def test_the_tracker_keeps_a_person_behind_a_board_only_with_the_option():
 def test_a_person_found_behind_a_board_is_confirmed_only_with_the_option():
     assert _frames_held_behind_board(True, started=False) >= 25
     assert _frames_held_behind_board(False, started=False) == 0   # a fifth in view: never confirmed
+    # With the evidence half alone (``obstacles_confirm`` off) a fifth in view is not confirmed either,
+    # and a track started on them is kept.
+    assert _frames_held_behind_board(True, started=False, obstacles_confirm=False) == 0
+    assert _frames_held_behind_board(True, obstacles_confirm=False) == 30
