@@ -144,3 +144,14 @@ def test_two_people_side_by_side_have_met_and_neither_is_clearly_isolated(frames
     seen = see_colours(tracker.views["c1"], image, labels, people, 30, lambda i, j: met.append((i, j)))
     assert met == [(1, 2), (1, 2)]  # each of them met the other (smaller id first)
     assert not any(c.alone for c in seen.values())
+
+
+def test_two_lost_entries_of_one_id_are_told_apart_by_identity_not_by_their_arrays():
+    # An id given back by the lost state (not by colour) stays in this list; lost again, it is
+    # kept a second time, and giving one entry back (``list.remove``) compared the two field by
+    # field: numpy places raised "truth value of an array is ambiguous" (crowd 10 seed 188).
+    from worldtrack.trackers.ellipsoid.identity import Lost
+    first, second = Lost(3, {}, np.zeros(2), 1.0), Lost(3, {}, np.ones(2), 2.0)
+    entries = [first, second]
+    entries.remove(second)
+    assert entries == [first] and entries[0] is first

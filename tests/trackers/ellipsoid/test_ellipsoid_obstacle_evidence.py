@@ -28,7 +28,7 @@ def _sign_scene(size=(160, 120), low=0.7, high=1.6, y=2.5):
     })
 
 
-def _support(obstacles_explain: bool, xy: np.ndarray, mask: np.ndarray | None = None):
+def _support(obstacles_explain: bool, xy: np.ndarray, mask: np.ndarray | None = None, obstacles_confirm: bool = True):
     scene = _sign_scene()
     cam = scene.cameras["cam"]
     occ = scene.occlusion("cam").floor_distance
@@ -38,7 +38,7 @@ def _support(obstacles_explain: bool, xy: np.ndarray, mask: np.ndarray | None = 
         mask = person_mask(cam, person, 1.75, 0.45) & ~np.isfinite(occ)
     forms = person_forms(args, np.asarray(xy, float)[None], np.array([1.75]), np.array([0.45]), DrawArgs(0.1, 0.0))
     return measure_support({"cam": (args, forms)}, {"cam": mask.astype(np.uint8)}, 0, np.array([True]),
-                           obstacles_explain), track_support(args, mask.astype(np.uint8), forms, 0, np.array([True]))
+                           obstacles_explain, obstacles_confirm), track_support(args, mask.astype(np.uint8), forms, 0, np.array([True]))
 
 
 def test_the_hidden_pixels_are_counted_and_the_reference_agrees():
@@ -64,6 +64,11 @@ def test_a_person_behind_the_sign_is_not_failing_with_the_option():
     # pixels that are foreground) does not change.
     assert without.seen_share[0] < 0.5 and with_.seen_share[0] > 0.95
     assert with_.support[0] == without.support[0] > 0.95
+    # With ``obstacles_confirm`` off the board explains its pixels in the evidence only: the seen
+    # share is of the whole ellipse, as without the option.
+    evidence_only, _ = _support(True, [0.0, 4.0], obstacles_confirm=False)
+    assert evidence_only.evidence[0] == with_.evidence[0]
+    assert evidence_only.seen_share[0] == without.seen_share[0] < 0.5
 
 
 def test_a_ghost_behind_the_sign_still_has_no_support():
@@ -73,7 +78,7 @@ def test_a_ghost_behind_the_sign_still_has_no_support():
     assert ghost.evidence[0] < 0.8                    # and the evidence is what the board hides, no more
 
 
-def _frames_held_behind_board(obstacles_explain: bool, started: bool = True) -> int:
+def _frames_held_behind_board(obstacles_explain: bool, started: bool = True, obstacles_confirm: bool = True) -> int:
     """Frames (of 30, 3 s) with a track on a person standing just behind a board from the knees
     to the shoulders (320x240; a fifth of their ellipse in view, as behind the PETS sign), started
     on them (``started``) or found by the tracker."""
@@ -81,7 +86,8 @@ def _frames_held_behind_board(obstacles_explain: bool, started: bool = True) -> 
     occ = scene.occlusion("cam").floor_distance
     rng = np.random.default_rng(5)
     bg = noise_backgrounds(scene, rng)["cam"]
-    cfg = with_overrides(EllipsoidConfig(), {"support.obstacles_explain": obstacles_explain})
+    cfg = with_overrides(EllipsoidConfig(), {"support.obstacles_explain": obstacles_explain,
+                                             "support.obstacles_confirm": obstacles_confirm})
     tr = EllipsoidTracker(scene, make_foregrounds(scene, {"cam": bg}, "colour"), cfg)
     if started:
         tr.init_track(0.0, 4.0, track_id=1)
@@ -102,3 +108,7 @@ def test_the_tracker_keeps_a_person_behind_a_board_only_with_the_option():
 def test_a_person_found_behind_a_board_is_confirmed_only_with_the_option():
     assert _frames_held_behind_board(True, started=False) >= 25
     assert _frames_held_behind_board(False, started=False) == 0   # a fifth in view: never confirmed
+    # With the evidence half alone (``obstacles_confirm`` off) a fifth in view is not confirmed either,
+    # and a track started on them is kept.
+    assert _frames_held_behind_board(True, started=False, obstacles_confirm=False) == 0
+    assert _frames_held_behind_board(True, obstacles_confirm=False) == 30

@@ -94,3 +94,14 @@ def test_watch_files_confirmed_tracks_that_lived_long_enough_and_forgets_them_af
     assert lost.lost[0].t == pytest.approx(1.5) and np.allclose(lost.lost[0].xy, [0.0, 0.0])
     lost.watch(m, 3.6, alive)
     assert lost.lost == []                            # forgotten 2.1 s after
+
+
+def test_an_id_lost_twice_is_given_back_without_comparing_arrays():
+    # An id given back by colour re-identification stays in this list; lost again, it is filed a
+    # second time. Giving back the second entry must not compare it with the first field by field
+    # (numpy places: "truth value of an array is ambiguous"; crowd 10 seed 188 crashed on it).
+    lost = _lost()
+    lost.file(4, xy=(0.0, 0.0), v=(0.0, 0.0), t=0.0)
+    lost.file(4, xy=(5.0, 0.0), v=(0.0, 0.0), t=0.5)
+    assert lost.claim((5.1, 0.0), t=0.6, taken=lambda pid: False) == 4
+    assert [g.xy.tolist() for g in lost.lost] == [[0.0, 0.0]]

@@ -32,6 +32,7 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
 from worldtrack.trackers.ellipsoid.height_sigma import height_estimate
+from worldtrack.trackers.ellipsoid.height_views import add_samples
 
 #: A person's height is measured in a view where others' ellipses cover at most this share of its region.
 MAX_COVERED_FOR_HEIGHT = 0.3
@@ -279,10 +280,12 @@ def heights_due(people: Sequence[Person], config: HeightConfig, frame: int) -> l
 
     Every frame until a person has 10 measurements (or 20 frames were tried: someone always in a
     group rarely gives one), then one frame in five until ``config.samples`` are in: a person's
-    height does not change, and the median of that many is final.
+    height does not change, and the median of that many is final — unless ``config.prefer_large``:
+    then one frame in five for as long as they are tracked, so that nearer views can replace far
+    ones (:mod:`.height_views`).
     """
     return [k for k, p in enumerate(people) if p.mode == "tracking"
-            and len(p.height_samples) < config.samples
+            and (len(p.height_samples) < config.samples or config.prefer_large)
             and ((len(p.height_samples) < 10 and p.height_tries < 20) or (frame + p.id) % 5 == 0)]
 
 
@@ -313,7 +316,7 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
     xy = np.array([[p.x, p.y] for p in people], dtype=float).reshape(-1, 2)
     hs = np.array([p.height for p in people], dtype=float)
     ws = np.array([p.width for p in people], dtype=float)
-    samples_now: dict[int, list[float]] = {}
+    samples_now: dict[int, list[tuple[float, float]]] = {}
     rays: dict[int, list] = {}
     for cid, image_labels in labels.items():
         _measure_in_view(views[cid], image_labels, (xy, hs, ws), due, config, len(labels) >= 2, (samples_now, rays))
@@ -323,7 +326,7 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
         head_rays = rays.get(k, [])
         h3 = triangulate_height(head_rays, xy[k], height_range_m=(lo, hi), max_ray_gap_m=config.ray_gap_m)
         if h3 is not None:
-            new = [h3]
+            new = [(h3, np.inf)]
         elif len(head_rays) >= 2:
             # Head rays from two views or more that give no height (they miss each other, or meet
             # off the person or outside the plausible range): some view's "head" is most likely
@@ -333,17 +336,15 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
             new = samples_now.get(k, [])
         if not new:
             continue
-        samples = p.height_samples
-        samples.extend(new)
-        del samples[:-config.samples]
-        if len(samples) >= 3:
-            p.height = height_estimate(samples, default_height(p.id), config)
+        add_samples(p, new, config)
+        if len(p.height_samples) >= 3:
+            p.height = height_estimate(p.height_samples, default_height(p.id), config)
 
 
 def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
                      due: Sequence[int], config: HeightConfig, triangulate: bool,
-                     out: tuple[dict[int, list[float]], dict[int, list]]) -> None:
-    """One camera's height measurements (into ``out[0]``) and head rays (``out[1]``, with
+                     out: tuple[dict[int, list[tuple[float, float]]], dict[int, list]]) -> None:
+    """One camera's height measurements (height m, the view's size px, into ``out[0]``) and head rays (``out[1]``, with
     ``triangulate``) of the people ``due``, by index; ``people`` = (xy (N, 2), heights, widths)."""
     samples_now, rays = out
     xy, hs, ws = people
@@ -384,7 +385,7 @@ def _measure_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndar
         h = measure_height(cam, labels, view.occ, xy[k], region, tuple(b), height_range_m=(lo, hi), down=down,
                            max_depth_offset_m=config.depth_offset_m)
         if h is not None:
-            samples_now.setdefault(k, []).append(h)
+            samples_now.setdefault(k, []).append((h, float(v1 - v0)))
 
 
 __all__ = ["MAX_COVERED_FOR_HEIGHT", "extreme_ends", "extreme_ends_reference", "head_ray", "heights_due",

@@ -39,9 +39,10 @@ from worldtrack.trackers.ellipsoid.colours import (HIST_BINS, PARTS, Colours, Si
                                                     look)
 
 
-@dataclass
+@dataclass(eq=False)
 class Lost:
-    """A confirmed person whose track ended: kept for re-identification."""
+    """A confirmed person whose track ended: kept for re-identification. Entries are told apart by
+    identity (one id can be lost twice, and ``list.remove`` must not compare numpy places)."""
 
     id: int
     colours: dict[str, Colours]

@@ -38,9 +38,11 @@ from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.config import LostConfig
 
 
-@dataclass
+@dataclass(eq=False)
 class Vanished:
-    """A confirmed person whose track ended: id, last place (2,) m, velocity (2,) m/s, time s."""
+    """A confirmed person whose track ended: id, last place (2,) m, velocity (2,) m/s, time s.
+    Entries are told apart by identity (one id can be filed twice: given back by colour, lost
+    again; ``list.remove`` must not compare numpy places)."""
 
     id: int
     xy: np.ndarray

@@ -174,7 +174,8 @@ class Support(NamedTuple):
 
 
 def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mapping[str, np.ndarray],
-                    target_pixels: int, covers: np.ndarray, obstacles_explain: bool = False) -> Support:
+                    target_pixels: int, covers: np.ndarray, obstacles_explain: bool = False,
+                    obstacles_confirm: bool = True) -> Support:
     """:class:`Support` of N people from their ellipses in each camera.
 
     Parameters
@@ -187,6 +188,8 @@ def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mappin
         those somebody else covers do, and the seen share is of what the obstacles leave in view:
         a person standing behind a sign is neither failing nor unconfirmable for showing only
         their head and legs (``support.obstacles_explain``)
+    obstacles_confirm : bool — with ``obstacles_explain``, the seen share is of what the obstacles
+        leave in view; false: of the whole ellipse, as without it (``support.obstacles_confirm``)
     """
     n = len(covers)
     visible, own_total, seen_share, evidence = (np.zeros(n) for _ in range(4))
@@ -199,7 +202,7 @@ def measure_support(cams: Mapping[str, tuple[CameraArgs, Forms]], labels: Mappin
         visible += vis
         own_total += own
         # Seen: of the ellipse, or with ``obstacles_explain`` of what the obstacles leave to see.
-        can_see = area - hidden if obstacles_explain else area
+        can_see = area - hidden if obstacles_explain and obstacles_confirm else area
         seen_share = np.maximum(seen_share, np.where(can_see > 0, vis / np.maximum(can_see, 1), 0.0))
         # Evidence: foreground of its own plus what others (and, as an option, obstacles) explain,
         # over the whole ellipse.

@@ -41,6 +41,7 @@ from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 from worldtrack.trackers.ellipsoid.height import heights_due, update_heights
 from worldtrack.trackers.ellipsoid.identity import Identities
 from worldtrack.trackers.ellipsoid.joint import JointImage
+from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
 from worldtrack.trackers.ellipsoid.real import ternary_real
@@ -109,6 +110,8 @@ class EllipsoidTracker(TrackerBase):
         self.reentry = LostTracks(cfg.lost)
         #: Depth along one camera's line of sight from every cue (:mod:`.depth`; ``depth.fuse``).
         self.depth = DepthFusion(cfg.depth, cfg.feet, cfg.height)
+        #: Each confirmed id's height samples, for a person given the id back (:mod:`.kept_heights`).
+        self.kept_heights = KeptHeights(cfg.height)
         self._now = 0.0
 
     # ------------------------------------------------------------------ the Tracker protocol
@@ -168,6 +171,8 @@ class EllipsoidTracker(TrackerBase):
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
             self.reentry.watch(self.position_map, t, lambda p: self.position_map.get(p.id) is p)
+        if self.config.height.keep_with_id:
+            self.kept_heights.remember(self.position_map)
         self._last_t = t
         self.frames_stepped += 1
         return self.uncertainty.tracks(self.position_map, t)
@@ -287,7 +292,7 @@ class EllipsoidTracker(TrackerBase):
             cams = {cid: (self.views[cid].args, self.views[cid].forms(*people)) for cid in self.last_labels}
             covers = np.array([p.mode == "tracking" for p in everyone])
             support = measure_support(cams, self.last_labels, int(cfg.score.target_pixels), covers,
-                                      cfg.support.obstacles_explain)
+                                      cfg.support.obstacles_explain, cfg.support.obstacles_confirm)
             judged = self.life.update(judged, scores, support, n_before, t, dt, interval)
         flag_unmeasurable(judged, [v.camera for v in self.views.values()], self.scene.occlusion, t)
         if cfg.height.measure:
@@ -308,6 +313,8 @@ class EllipsoidTracker(TrackerBase):
                                       lambda pid: colours(p, pid))
         new = self.position_map.promote(p.id, back)
         height, p.width = self.scene.people.size_of(new)
+        if back is not None and self.config.height.keep_with_id:
+            self.kept_heights.give_back(p, height)
         if not p.height_samples:  # else keep what was measured (at birth, or since)
             p.height = height
 
