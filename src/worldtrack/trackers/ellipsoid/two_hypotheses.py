@@ -34,6 +34,7 @@ description and the issue's notes).
 
 from __future__ import annotations
 
+from collections import deque
 from typing import Callable, Mapping, NamedTuple, Sequence
 
 import numpy as np
@@ -50,6 +51,8 @@ from worldtrack.trackers.ellipsoid.two_on_ray import silhouette_ratio
 WINDOW_PIXELS = 3000
 #: Heights tried above the one whose head top is the silhouette's top pixel, m.
 TOP_SLACK_M = (0.0, 0.03, 0.06)
+#: Tests kept in :attr:`RaySplitter.log`.
+LOG_TESTS = 10000
 #: Widths tried for the first person, as shares of the width the tracker draws them with.
 NEAR_WIDTHS = (0.6, 0.8, 1.0)
 #: Flag of a person put on the map by the two-hypothesis test (not a young duplicate; :mod:`.life`).
@@ -195,8 +198,9 @@ class RaySplitter:
         self.width_m = width_m
         #: Person id → (frames in a row "two" won, the second person's place at the last win).
         self.wins: dict[int, tuple[int, np.ndarray]] = {}
-        #: Every test made: (time, person id, their place (2,), Verdict), for benchmarks and pictures.
-        self.log: list[tuple[float, int, np.ndarray, Verdict]] = []
+        #: The last ``LOG_TESTS`` tests made: (time, person id, their place (2,), Verdict), for benchmarks
+        #: and pictures (bounded: a long video must not grow it).
+        self.log: deque[tuple[float, int, np.ndarray, Verdict]] = deque(maxlen=LOG_TESTS)
         #: The tests that put a second person on the map (same rows).
         self.splits: list[tuple[float, int, np.ndarray, Verdict]] = []
 
