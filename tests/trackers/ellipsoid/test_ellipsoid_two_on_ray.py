@@ -95,3 +95,87 @@ def test_one_person_reads_as_one_and_two_on_one_ray_as_two(room):
     # The top is the far person's head: read as one person the near one would be ~1.9 m tall.
     assert head_height(cam, top, feet) > NEAR_H + 0.15
     assert 0.5 < ratio < 0.75          # ~ 5 m / 8 m
+
+
+# ---------------------------------------------------------------- rendering both (two_hypotheses)
+
+def _verdict(tracker, labels, xy, height):
+    """The two-hypothesis test (:mod:`.two_hypotheses`) of one tracked person at ``xy`` of ``height``,
+    nobody else on the map, on foreground ``labels``: (Verdict or None when no second person fits)."""
+    from worldtrack.trackers.ellipsoid.real import ternary_real
+    from worldtrack.trackers.ellipsoid.two_hypotheses import compare_on_ray
+
+    view = tracker.views["cam"]
+    t = tracker.fresh()
+    p = t.position_map.add(xy[0], xy[1], height, 0.4, mode="tracking")
+    joint = t.joint_image({"cam": ternary_real(labels, view.ring_px)}, [p])
+    far = t.splitter.candidates(joint, {"cam": labels}, 0)
+    if not len(far):
+        return None
+    cfg = t.config.split
+    near = np.arange(height, 1.3, -cfg.shorter_step_m)
+    return compare_on_ray(joint, 0, near, far, cfg.band_m)
+
+
+def test_two_on_one_ray_win_when_both_are_rendered(room):
+    cam = room.scene.cameras["cam"]
+    near, far = _pair(cam, 5.0, 7.0)
+    merged = _labels(cam, [(near, NEAR_H), (far, FAR_H)])
+    _, top, feet = _ratio(room, merged, near)
+    read = head_height(cam, top, feet)           # what one person's height measure reads: too tall
+    assert read > NEAR_H + 0.1
+    v = _verdict(room, merged, near, read)
+    assert v is not None and v.gain > room.config.split.margin
+    assert abs(v.near_height - NEAR_H) < 0.12
+    assert np.hypot(*(v.far_xy - far)) < 0.6 and abs(v.far_height - FAR_H) < 0.12
+
+
+@pytest.mark.parametrize("height", [1.6, 1.9])
+def test_one_person_stays_one_when_both_are_rendered(room, height):
+    cam = room.scene.cameras["cam"]
+    near, _ = _pair(cam, 5.0, 7.0)
+    v = _verdict(room, _labels(cam, [(near, height)]), near, height)
+    assert v is None or v.gain < room.config.split.margin
+
+
+def test_the_splitter_puts_the_second_person_behind(room):
+    from worldtrack.trackers.ellipsoid.real import ternary_real
+    from worldtrack.trackers.ellipsoid.two_hypotheses import BEHIND
+
+    cam = room.scene.cameras["cam"]
+    near, far = _pair(cam, 5.0, 7.0)
+    merged = _labels(cam, [(near, NEAR_H), (far, FAR_H)])
+    _, top, feet = _ratio(room, merged, near)
+    t = room.fresh()
+    read = head_height(cam, top, feet)
+    p = t.position_map.add(near[0], near[1], read, 0.4, mode="tracking")
+    real = {"cam": ternary_real(merged, t.views["cam"].ring_px)}
+    born = []
+    for k in range(t.config.split.held):       # "two" must win held frames in a row
+        assert not born
+        born = t.splitter.split(t.joint_image(real, [p]), {"cam": merged}, [p], t.position_map, 0.1 * k,
+                                lambda q: t.life._confirm(q, 0.1 * k))
+    assert len(born) == 1
+    q = born[0]
+    assert q.confirmed and q.id > 0 and BEHIND in q.flags and t.position_map.get(q.id) is q
+    assert np.hypot(q.x - far[0], q.y - far[1]) < 0.6
+    assert p.height < read - 0.05 and abs(p.height - NEAR_H) < 0.08 and not p.height_samples
+
+
+def test_a_person_put_behind_is_not_a_young_duplicate():
+    from worldtrack.trackers.base import PositionMap
+    from worldtrack.trackers.ellipsoid import EllipsoidConfig
+    from worldtrack.trackers.ellipsoid.life import LifeCycle, Measures
+    from worldtrack.trackers.ellipsoid.two_hypotheses import BEHIND
+
+    # A young track whose visible pixels are nearly all another person's: a duplicate, unless the
+    # two-hypothesis test put it there (then it is hidden by the one in front).
+    hidden = Measures(0.5, 200.0, float("nan"), 0.05, 0.5, 0.9, 0)
+    kept = []
+    for flag in (False, True):
+        life = LifeCycle(EllipsoidConfig(), PositionMap(), False, lambda p: None)
+        p = life.position_map.add(5.0, 7.0, 1.6, 0.4, mode="tracking")
+        if flag:
+            p.flags.add(BEHIND)
+        kept.append(all(life._judge(p, hidden, 0.1 * i, (3, 10, 3)) for i in range(5)))
+    assert kept == [False, True]

@@ -276,6 +276,32 @@ class DepthConfig(Section):
         "0.1, heights within 3 cm 67 -> 84 of 97 on held-out line-of-sight seeds, issue 37)")
 
 
+class SplitConfig(Section):
+    """One person or two on one line of sight, decided by rendering both (:mod:`.two_hypotheses`)."""
+
+    path: ClassVar[str] = "ellipsoid.split"
+
+    enabled: bool = Field(
+        False, description="score each confirmed person alone against them shorter plus a second person behind on "
+        "the camera's ray; map the second when two wins (issue 37; off: it lost, line of sight 0.740 -> 0.652 on "
+        "seeds 20-39, 0.767 -> 0.649 on 150-169, PETS 0.919 -> 0.765)")
+    margin: float = Field(0.05, ge=0, description="E the two must beat the best one by")
+    head_ratio: float = Field(0.0, ge=0, description="test only people whose silhouette's top is a head this much "
+                              "narrower than theirs would be (the two_on_ray cue; 0 = everybody)")
+    held: int = Field(2, ge=1, description="frames in a row two must win, at about the same place")
+    same_place_m: float = Field(0.5, gt=0, description="... the second person's places within this distance, m")
+    behind_min_m: float = Field(1.2, ge=0, description="the second person (head on top) at least this much farther, m ...")
+    behind_max_m: float = Field(4.0, ge=0, description="... and at most this much, m")
+    step_m: float = Field(0.03, gt=0, description="... tried at heights on this step along the top's ray, m")
+    far_min_m: float = Field(1.45, gt=0, description="the second person is this tall at least, m ...")
+    far_max_m: float = Field(1.95, gt=0, description="... and at most, m")
+    clear_m: float = Field(1.0, ge=0, description="no second person this close to anybody tracked, m")
+    shorter_step_m: float = Field(0.05, gt=0, description="the first person's heights tried below theirs on this step, m")
+    band_m: float = Field(
+        0.25, ge=0, description="both are scored on the rows above this far below the first person's top, m: the "
+        "heads tell one from two, the body's shape does not (0 = the whole silhouette)")
+
+
 class IdentityConfig(Section):
     """Identity by colour: per-person colour models that undo swaps and re-identify people who come
     back (:mod:`worldtrack.trackers.ellipsoid.identity`)."""
@@ -356,6 +382,7 @@ class EllipsoidConfig(Section):
     depth: DepthConfig = Field(DepthConfig(), description="depth along one camera's line of sight from every cue")
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
     lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
+    split: SplitConfig = Field(SplitConfig(), description="one person or two on one line of sight")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -370,4 +397,4 @@ class EllipsoidConfig(Section):
 
 
 __all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig",
-           "RescueConfig", "ScoreConfig", "SupportConfig", "WarmStartConfig"]
+           "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]

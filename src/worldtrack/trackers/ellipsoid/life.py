@@ -197,7 +197,9 @@ class LifeCycle:
                 self.end(p)
                 return False
         else:
-            low, by = self.evidence.failing(m, t - p.born < self.config.end.young_s, self.several_cameras)
+            # A person the two-hypothesis test put behind another is hidden by them, not their duplicate.
+            young = t - p.born < self.config.end.young_s and "behind" not in p.flags
+            low, by = self.evidence.failing(m, young, self.several_cameras)
             if counts_for(p, "low", t, low, by) >= lost_after:
                 self.end(p)
                 return False

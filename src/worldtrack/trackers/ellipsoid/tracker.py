@@ -48,6 +48,7 @@ from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS, flag_unmeasurable, measure_support
+from worldtrack.trackers.ellipsoid.two_hypotheses import RaySplitter
 from worldtrack.trackers.ellipsoid.uncertainty import PositionUncertainty
 from worldtrack.trackers.ellipsoid.warm_start import frames_wanted, warm_start
 from worldtrack.trackers.lifecycle import frames_for
@@ -112,6 +113,9 @@ class EllipsoidTracker(TrackerBase):
         self.depth = DepthFusion(cfg.depth, cfg.feet, cfg.height)
         #: Each confirmed id's height samples, for a person given the id back (:mod:`.kept_heights`).
         self.kept_heights = KeptHeights(cfg.height)
+        #: One person or two on one line of sight (:mod:`.two_hypotheses`; ``split.enabled``).
+        self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
+                                    tuple(cfg.height.range_m))
         self._now = 0.0
 
     # ------------------------------------------------------------------ the Tracker protocol
@@ -161,6 +165,9 @@ class EllipsoidTracker(TrackerBase):
         born = self._births(real, t)
         if born:
             scores += self._match(born, real, t, judged + bystanders)
+        if self.config.split.enabled and real:
+            split = self._split(real, judged + bystanders + born, t)
+            born, scores = born + split, scores + [(0.0, 0.0)] * len(split)
         anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet,
                        self.config.height)
         self.depth.apply(judged + born, self.views, self.last_labels, self.walkable, dt if dt > 0 else self.frame_interval)
@@ -279,6 +286,12 @@ class EllipsoidTracker(TrackerBase):
                 p.height_samples.append(shown)
             born.append(p)
         return born
+
+    def _split(self, real: Mapping[str, np.ndarray], people: list[Person], t: float) -> list[Person]:
+        """Second people behind confirmed ones, where rendering two explains the image better
+        (:mod:`.two_hypotheses`); they are put on the map confirmed."""
+        return self.splitter.split(self.joint_image(real, people), self.last_labels, people, self.position_map, t,
+                                   lambda q: self.life._confirm(q, t))
 
     def _update(self, judged: list[Person], bystanders: list[Person], scores: list[tuple[float, float]],
                 n_before: int, t: float, dt: float) -> None:
