@@ -10,8 +10,8 @@ with the real time step. ``v_ff`` (the target's speed along the line of sight) a
 angular rate about the robot), both from the Kalman filter's velocity, are worldtrack's
 feed-forward terms (``feed_forward=False`` is the paper's plain PID): without them a PID lags a
 walking target by ``v/Kp``. Derivatives are of the errors computed from the filtered state, so a
-noisy detection does not kick the output. Limits: ``−max_reverse ≤ v ≤ max_speed`` (the robot backs
-off when the target walks at it), ``|ω| ≤ max_turn_rate``; the integrals are clamped (anti-windup)
+noisy detection does not kick the output. Limits (``robot``, :class:`~worldtrack.follow.robot.RobotLimits`):
+``−max_reverse ≤ v ≤ max_speed`` (the robot backs off when the target walks at it), ``|ω| ≤ max_turn_rate``; the integrals are clamped (anti-windup)
 and reset when the target is lost.
 
 Safety: everybody the follower knows of (the target, every candidate, every other person's track,
@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from worldtrack.follow.movers import moving_speed_limit
+from worldtrack.follow.robot import RobotLimits
 from worldtrack.follow.safety import free_path, near_points
 from worldtrack.follow.scan import ScanMovers, segments
 from worldtrack.geometry.camera import Camera
@@ -71,9 +72,7 @@ class PIDFollower:
     distance: float = 1.8
     distance_gains: tuple = (1.2, 0.1, 0.1)
     bearing_gains: tuple = (2.5, 0.1, 0.1)
-    max_speed: float = 1.6
-    max_reverse: float = 0.5
-    max_turn_rate: float = 1.5
+    robot: RobotLimits = RobotLimits()
     feed_forward: bool = True
     stop_distance: float = 0.7
     corridor: float = 0.6
@@ -126,8 +125,8 @@ class PIDFollower:
         v = v_ff + self._pid("d", e_d, dt, self.distance_gains)
         w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
         s["t"] = t
-        v = float(np.clip(v, -self.max_reverse, self.max_speed))
-        w = float(np.clip(w, -self.max_turn_rate, self.max_turn_rate))
+        v = float(np.clip(v, -self.robot.max_reverse, self.robot.max_speed))
+        w = float(np.clip(w, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         limit = self._speed_limit(step, pos, fwd, dt if dt > 0 else 0.1)
         if self.walkers:
             limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
@@ -162,7 +161,7 @@ class PIDFollower:
         pos, fwd = camera.centre[:2], camera.floor_direction
         rel = goal - pos
         bearing = float(np.arctan2(rel @ np.array([-fwd[1], fwd[0]]), rel @ fwd))
-        w = float(np.clip(self.bearing_gains[0] * bearing, -self.max_turn_rate, self.max_turn_rate))
+        w = float(np.clip(self.bearing_gains[0] * bearing, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         v, limit = 0.0, np.inf
         if abs(bearing) < np.radians(20.0):      # facing it (the camera sees the way): drive
             v = float(np.clip(self.distance_gains[0] * (np.hypot(*rel) - self.arrive), 0.0, self.pursue_speed))
@@ -215,7 +214,7 @@ class PIDFollower:
         fwd = camera.floor_direction
         yaw = np.arctan2(fwd[1], fwd[0]) + w * np.linspace(0.0, 1.5, 16)
         centre = camera.centre[:2] - 0.1 * fwd
-        step_xy = (self.max_speed * 0.1) * np.column_stack([np.cos(yaw), np.sin(yaw)])
+        step_xy = (self.robot.max_speed * 0.1) * np.column_stack([np.cos(yaw), np.sin(yaw)])
         path = centre + np.vstack([np.zeros(2), np.cumsum(step_xy[1:], axis=0)])
         gap = free_path(path, points, 0.35)
         return np.inf if not np.isfinite(gap) else float(max(0.0, np.sqrt(2 * self.brake * gap) - self.brake * dt))
@@ -236,7 +235,7 @@ class PIDFollower:
             vel.append(velocity[away])
         xy, vel = np.vstack(xy), np.vstack(vel)
         return moving_speed_limit(centre, float(np.arctan2(fwd[1], fwd[0])), w, xy, vel,
-                                  clearance=self.stop_distance, brake=self.brake, max_speed=self.max_speed)
+                                  clearance=self.stop_distance, brake=self.brake, max_speed=self.robot.max_speed)
 
     def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float, with_target: bool = True) -> float:
         """Largest forward speed (m/s) that stops ``stop_distance`` short of anybody in the path (the
