@@ -218,8 +218,11 @@ class FollowTracker:
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
         hiding = hiding_target(obs, self.x[:2], self.last_xy) if cfg.occluders else np.zeros(len(c), bool)
         allowed = (E / cfg.k <= gate) & ~hiding
-        self._heads = heads_seen(c, obs.silhouettes, obs.camera)     # somebody of another height is
-        mismatch = self.height.mismatch(c.top, self._heads, cfg.height_margin)   # somebody else, seen or not
+        # Somebody of another height is somebody else. While the target is seen, only taller: a top is never
+        # measured above the head, but one hidden by somebody the depth missed looks shorter, its head "seen".
+        self._heads = heads_seen(c, obs.silhouettes, obs.camera)
+        found_again = t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until
+        mismatch = self.height.mismatch(c.top, self._heads & found_again, cfg.height_margin)
         allowed &= ~mismatch
         if t - self.last_seen > COAST_S:
             allowed &= rb < cfg.reid_rbhat      # the prediction no longer tells: colour must agree
