@@ -23,8 +23,9 @@ as it nears anybody in its way instead of stopping late. The target hidden behin
 (the tracker's ``hidden``: depth puts them in front of its prediction) is followed by its prediction
 for up to ``hidden_coast`` seconds. Otherwise, not seen for ``lost_timeout`` seconds, the target is
 lost: the robot goes to where it was last seen (``pursue`` seconds at most: it turns to face the
-place first, then drives, under the same speed limits) — a target that turned a corner out of view
-is seen again from there —, and then only turns (at most ``search_turn_rate``) towards where the
+place first, then drives, under the same speed limits; with the room's map, ``nav``, along the
+shortest way round its obstacles) — a target that turned a corner out of view is seen again from
+there —, and then only turns (at most ``search_turn_rate``) towards where the
 target should be, to look for it.
 
 >>> import numpy as np
@@ -45,10 +46,24 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from worldtrack.follow.movers import moving_speed_limit
+from worldtrack.follow.navigation import NavigationGrid
 from worldtrack.follow.robot import RobotLimits
 from worldtrack.follow.safety import free_path, near_points
 from worldtrack.follow.scan import ScanMovers, segments
 from worldtrack.geometry.camera import Camera
+
+
+#: The pursuit's carrot on the way round obstacles: this far (m) ahead, in steps of 0.1 m over 16 headings.
+LOOKAHEAD = 0.6
+RING = np.column_stack([np.cos(np.arange(16) * np.pi / 8), np.sin(np.arange(16) * np.pi / 8)])
+#: The pursuit's way keeps this much (m) more than the robot's radius from obstacles (the carrot cuts corners).
+NAV_MARGIN = 0.2
+
+
+def pursuit_map(scene, robot: RobotLimits = RobotLimits()) -> NavigationGrid:
+    """The room's :class:`NavigationGrid` for :attr:`PIDFollower.nav`: drivable ``NAV_MARGIN`` clear of the
+    robot's radius."""
+    return NavigationGrid(scene, radius=robot.radius + NAV_MARGIN)
 
 
 @dataclass
@@ -62,6 +77,8 @@ class PIDFollower:
     to look about (None: it only faces the prediction, the paper's and 35e's behaviour)
     pursue : seconds after the loss during which the robot drives to where the target was last seen
     (None: it stands, 35g and before)
+    nav : the room (:func:`pursuit_map`): the pursuit drives towards a
+    point ``LOOKAHEAD`` m down the shortest way round its obstacles (None: straight at the place)
     hidden_coast : seconds since last seen that a target hidden behind somebody nearer is followed by
     its prediction (0: lost after ``lost_timeout`` like any other)
     walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
@@ -87,6 +104,7 @@ class PIDFollower:
     pursue_speed: float = 1.0
     arrive: float = 0.4
     hidden_coast: float = 3.0
+    nav: NavigationGrid | None = None
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -139,7 +157,7 @@ class PIDFollower:
         """Clear the PID's state (integrals, derivatives) but what the search needs."""
         s = self._state
         keep = {k: s[k] for k in ("seen", "followed", "search_from", "search_turn", "search_last", "last_w",
-                                  "arrived", "movers") if k in s}
+                                  "arrived", "movers", "way", "way_to") if k in s}
         self.reset()
         s.update(keep)
         if s.get("search_last", -np.inf) < s.get("seen", -np.inf):         # a new loss
@@ -157,14 +175,16 @@ class PIDFollower:
         return last
 
     def _drive_to(self, goal: np.ndarray, step, camera: Camera, t: float, frame, scan) -> tuple[float, float]:
-        """Turn to face ``goal`` (m), then drive to it, under the same speed limits as the PID."""
+        """Turn to face ``goal`` (m) — or the point on the way there round the obstacles (``nav``) —, then
+        drive to it, under the same speed limits as the PID."""
         pos, fwd = camera.centre[:2], camera.floor_direction
-        rel = goal - pos
+        rel = self._waypoint(goal, pos - self.robot.camera_forward * fwd) - pos
         bearing = float(np.arctan2(rel @ np.array([-fwd[1], fwd[0]]), rel @ fwd))
         w = float(np.clip(self.bearing_gains[0] * bearing, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         v, limit = 0.0, np.inf
         if abs(bearing) < np.radians(20.0):      # facing it (the camera sees the way): drive
-            v = float(np.clip(self.distance_gains[0] * (np.hypot(*rel) - self.arrive), 0.0, self.pursue_speed))
+            ahead = np.hypot(*(goal - pos)) - 0.5 * self.arrive       # slowing down to stop inside ``arrive``
+            v = float(np.clip(self.distance_gains[0] * ahead, 0.0, self.pursue_speed))
             limit = self._speed_limit(step, pos, fwd, 0.1, with_target=False)
             if self.walkers:
                 limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
@@ -172,6 +192,24 @@ class PIDFollower:
                 limit = min(limit, self._depth_limit(frame, camera, w, 0.1, scan))
         self._state["blocked"] = bool(limit < v)
         return min(v, limit), w
+
+    def _waypoint(self, goal: np.ndarray, pos: np.ndarray) -> np.ndarray:
+        """``goal`` without a map; else the point reached from ``pos`` going ``LOOKAHEAD`` m downhill on the
+        shortest-way length to it (:meth:`NavigationGrid.geodesic`, computed once per goal)."""
+        if self.nav is None:
+            return goal
+        s = self._state
+        if s.get("way_to") is None or not np.allclose(s["way_to"], goal):
+            s["way"], s["way_to"] = self.nav.geodesic(goal), np.array(goal, float)
+        p, here = np.array(pos, float), float(s["way"].sample(pos[None], outside=1e3)[0])
+        for _ in range(int(round(LOOKAHEAD / 0.1))):
+            near = p + 0.1 * RING
+            left = s["way"].sample(near, outside=1e3)
+            k = int(np.argmin(left))
+            if left[k] >= here:
+                break
+            p, here = near[k], float(left[k])
+        return p if np.hypot(*(p - pos)) > 0.05 else goal
 
     def _search(self, t: float, bearing: float) -> tuple[float, float]:
         """Lost: stand and turn slowly towards where the target should be; once that has been in view
