@@ -170,16 +170,3 @@ def test_with_the_map_the_pursuit_goes_round_an_obstacle():
                         0.1, clearance)
         ends[name] = np.hypot(robot.x - 8.0, robot.y - 7.0)
     assert ends["straight"] > 1.0 and ends["map"] < 0.6, ends
-
-
-def test_nobody_in_contact_ahead_of_the_centre_is_driven_towards_even_walking_away():
-    # the robot's centre at the origin heading east, its camera 0.1 m ahead; the target far ahead (the PID
-    # wants 1.6 m/s); somebody 0.07 m ahead of the centre — inside the body, behind the camera — walking on
-    robot = Robot(0.0, 0.0, 0.0)
-    cam = CAM.moved(*camera_pose(robot, 1.1))
-    for walkers in (False, True):
-        inside = PIDFollower(walkers=walkers)
-        v, _ = inside.command(step((6.0, 0.0), others=[(0.07, 0.0)]), cam, 0.0)
-        assert v == 0.0 and inside.blocked, walkers
-        behind, _ = PIDFollower(walkers=walkers).command(step((6.0, 0.0), others=[(-0.2, 0.0)]), cam, 0.0)
-        assert behind > 1.0, walkers                      # in contact but behind the centre: driving away is fine

@@ -26,7 +26,7 @@ import numpy as np
 
 from worldtrack.follow.pid import PIDFollower
 from worldtrack.follow.planner import LocalPlanner
-from worldtrack.follow.robot import CONTACT_MARGIN, Robot, RobotLimits, camera_pose
+from worldtrack.follow.robot import Robot, RobotLimits, camera_pose
 from worldtrack.follow.observation import frame_from_synth
 from worldtrack.follow.scan import simulate_scan
 from worldtrack.follow.tracker import FollowStep, FollowTracker
@@ -40,7 +40,7 @@ class LoopResult:
     nearest_person (T,) distance from the robot's centre to the nearest person, m;
     clearance (T,) robot centre to the nearest wall or obstacle, m; found (T,) bool;
     bumps : frames the bumper stopped the robot; contacts : frames with a person within
-    ``robot.limits.radius + CONTACT_MARGIN`` (0.2) m of the robot's centre; collisions : of those, frames where the robot
+    ``robot.limits.radius + 0.2`` m of the robot's centre; collisions : of those, frames where the robot
     drove into somebody — its speed towards them above 0.05 m/s and at least theirs towards it (the
     robot's doing: "unseen" or "seen, not stopped"); walked_into : contact frames where a person
     closed in faster than the robot (standing or not): the scripted people do not see the robot, and
@@ -180,7 +180,7 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
             rel = np.array(list(people.values())) - rec["robot"][k]
             dist = np.hypot(rel[:, 0], rel[:, 1])
             near[k] = dist.min()
-            touching = dist < robot.limits.radius + CONTACT_MARGIN
+            touching = dist < robot.limits.radius + 0.2
             contacts += int(touching.any())
             frame_causes = []
             for j in np.flatnonzero(touching):

@@ -47,7 +47,7 @@ import numpy as np
 
 from worldtrack.follow.movers import moving_speed_limit
 from worldtrack.follow.navigation import NavigationGrid
-from worldtrack.follow.robot import CONTACT_MARGIN, RobotLimits
+from worldtrack.follow.robot import RobotLimits
 from worldtrack.follow.safety import free_path, near_points
 from worldtrack.follow.scan import ScanMovers, segments
 from worldtrack.geometry.camera import Camera
@@ -275,18 +275,6 @@ class PIDFollower:
         return moving_speed_limit(centre, float(np.arctan2(fwd[1], fwd[0])), w, xy, vel,
                                   clearance=self.stop_distance, brake=self.brake, max_speed=self.robot.max_speed)
 
-    def _touching_ahead(self, step, pos: np.ndarray, fwd: np.ndarray, with_target: bool) -> bool:
-        """Whether anybody known (target, candidates, other tracks, whichever rule limits them) stands in
-        contact with the body — within ``radius + CONTACT_MARGIN`` m of the robot's centre — in front of
-        the centre. Nobody is driven towards from there, even walking away: it is already a contact, and a
-        person inside the body is behind the camera, where the path check does not look."""
-        known = [np.asarray(step.candidates.xy, float).reshape(-1, 2),
-                 np.asarray(step.others_xy, float).reshape(-1, 2)]
-        if with_target:
-            known.append(np.asarray(step.xy, float).reshape(-1, 2))
-        rel = np.vstack(known) - (pos - self.robot.camera_forward * fwd)
-        return bool(np.any((rel @ fwd > 0) & (np.hypot(rel[:, 0], rel[:, 1]) < self.robot.radius + CONTACT_MARGIN)))
-
     def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float, with_target: bool = True) -> float:
         """Largest forward speed (m/s) that stops ``stop_distance`` short of anybody in the path (the
         target only by the stop distance: the distance control keeps the robot back from it). With
@@ -303,8 +291,6 @@ class PIDFollower:
             people.append(cands)
         if len(step.others_xy) and not self.walkers:
             people.append(step.others_xy)
-        if self._touching_ahead(step, pos, fwd, with_target):
-            return 0.0
         rel = np.vstack(people) - pos
         ahead = rel @ fwd
         side = np.abs(rel @ np.array([-fwd[1], fwd[0]]))

@@ -25,10 +25,6 @@ from worldtrack.geometry.camera import look_at_rotation
 
 CAMERA_TILT_DEG = 4.0
 
-#: m beyond the body: a person this near it is in contact with the robot (the closed loop counts these
-#: frames; the PID drives towards nobody in contact).
-CONTACT_MARGIN = 0.2
-
 
 @dataclass(frozen=True)
 class RobotLimits:
