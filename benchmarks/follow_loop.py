@@ -40,6 +40,7 @@ from follow_common import SCENARIO, save_tagged, seed_cached  # noqa: E402
 from follow_synth import parse_seeds  # noqa: E402
 
 from worldtrack.follow import PIDFollower  # noqa: E402
+from worldtrack.follow.pid import pursuit_map  # noqa: E402
 from worldtrack.follow.planner import LocalPlanner  # noqa: E402
 from worldtrack.follow.loop import run_closed_loop  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
@@ -63,7 +64,7 @@ def make_follower(name: str, scene):
     if name == "planner":
         return LocalPlanner(scene, distance=DISTANCE)
     return PIDFollower(distance=DISTANCE, depth_stop=name != "pid", walkers=name.startswith(("pid+walkers", "pid+scan")),
-                       search_look=None if name.endswith("nosearch") else 2.0)
+                       search_look=None if name.endswith("nosearch") else 2.0, nav=pursuit_map(scene))
 
 
 def run_seed(seed: int, frames: int, size, follower: str = "pid+scan") -> dict:

@@ -104,3 +104,69 @@ def test_a_lost_target_whose_predicted_place_shows_nobody_is_looked_for_all_roun
         assert turns[-1] == pytest.approx(0.5)                      # then it turns left, the way the target went
     v, w = pid.command(step((3.0, 0.0)), CAM, 5.0)                  # found again: following, not turning
     assert v > 0 and abs(w) < 0.5
+
+
+def lost_step(predicted, last_seen, hidden=False):
+    s = step(predicted, found=False)
+    s.candidates, s.hidden, s.last_xy = SimpleNamespace(xy=np.zeros((0, 2))), hidden, np.array(last_seen, float)
+    return s
+
+
+@pytest.mark.parametrize("pursue", [10.0, None])
+def test_a_lost_target_is_pursued_to_where_it_was_last_seen_turning_first(pursue):
+    # the target walked left round a corner 2 m ahead and vanished at (2.0, 1.2); its prediction
+    # walks on to the left, (2.0, 3.0). The robot turns to face the place first, then drives there.
+    pid, robot = PIDFollower(pursue=pursue, depth_stop=True), Robot(-0.1, 0.0, 0.0)
+    free = lambda xy: np.full(len(xy), 5.0)                               # noqa: E731
+    pid.command(step((2.0, 1.2), velocity=(0.0, 1.0)), CAM.moved(*camera_pose(robot, 1.1)), 0.0)
+    cmds, nearest = [], np.inf
+    for t in np.arange(1.2, 9.0, 0.1):
+        cam = CAM.moved(*camera_pose(robot, 1.1))
+        nearest = min(nearest, np.hypot(*(cam.centre[:2] - (2.0, 1.2))))
+        cmds.append(pid.command(lost_step((2.0, 3.0), (2.0, 1.2)), cam, t))
+        robot.drive(*cmds[-1], 0.1, free)
+    if pursue is None:                                              # 35g: it stands and looks
+        assert np.hypot(robot.x + 0.1, robot.y) < 0.01
+        return
+    assert cmds[0][0] == 0.0 and cmds[0][1] > 0.5                   # 31° to the left: turn, do not drive yet
+    assert nearest < 0.41                                           # then there (within arrive), then it looks about
+    assert max(v for v, _ in cmds) <= 1.0                           # at most pursue_speed
+
+
+def test_a_hidden_target_is_followed_by_its_prediction_and_the_pursuit_stops_short_of_people():
+    pid = PIDFollower(depth_stop=True)
+    pid.command(step((3.0, 0.0), velocity=(1.0, 0.0)), CAM, 0.0)
+    v, _ = pid.command(lost_step((4.5, 0.0), (3.0, 0.0), hidden=True), CAM, 1.5)
+    assert v > 1.1                                                  # behind somebody: still followed, 2.7 m off
+    pid = PIDFollower(depth_stop=True, hidden_coast=0.0)
+    pid.command(step((3.0, 0.0), velocity=(1.0, 0.0)), CAM, 0.0)
+    v, _ = pid.command(lost_step((4.5, 0.0), (3.0, 0.0), hidden=True), CAM, 1.5)
+    assert v <= 1.0                                                 # lost: the pursuit's speed, at most 1 m/s
+    # a person standing 0.9 m ahead slows the pursuit like the PID: to stop 0.7 m short of them
+    pid = PIDFollower(depth_stop=True)
+    pid.command(step((3.0, 0.0)), CAM, 0.0)
+    s = lost_step((4.5, 0.0), (3.0, 0.0))
+    s.candidates = SimpleNamespace(xy=np.array([[0.9, 0.05]]))
+    v, _ = pid.command(s, CAM, 1.5)
+    assert v == pytest.approx(np.sqrt(2 * 1.2 * 0.2) - 1.2 * 0.1) and pid.blocked
+
+
+def test_with_the_map_the_pursuit_goes_round_an_obstacle():
+    # the target was last seen just north of the courtyard's bench (8 ± 0.9, 6 ± 0.25); the robot stands
+    # south of it, facing north. Straight at the place, the bumper stops it at the bench; with the map
+    # it drives round the bench's end and gets there.
+    from worldtrack.follow.navigation import NavigationGrid
+    from worldtrack.synth import make_scenario
+
+    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
+    field = scene.distance_field(0.05)
+    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    ends = {}
+    for name, nav in (("straight", None), ("map", NavigationGrid(scene, radius=0.5))):     # 0.2 m to spare
+        pid, robot = PIDFollower(nav=nav), Robot(8.0, 4.9, np.pi / 2)
+        pid.command(step((8.0, 7.0)), CAM.moved(*camera_pose(robot, 1.1)), 0.0)
+        for t in np.arange(1.2, 14.0, 0.1):
+            robot.drive(*pid.command(lost_step((8.0, 8.0), (8.0, 7.0)), CAM.moved(*camera_pose(robot, 1.1)), t),
+                        0.1, clearance)
+        ends[name] = np.hypot(robot.x - 8.0, robot.y - 7.0)
+    assert ends["straight"] > 1.0 and ends["map"] < 0.6, ends

@@ -160,6 +160,7 @@ class _Outputs:
 
 def run(args: argparse.Namespace) -> int:
     from worldtrack.follow import FollowConfig, FollowTracker, PIDFollower
+    from worldtrack.follow.pid import pursuit_map
     from worldtrack.follow.planner import LocalPlanner
     from worldtrack.io.rgbd import RGBDSource, read_gains, read_poses
     from worldtrack.scene import load_scene
@@ -186,7 +187,7 @@ def run(args: argparse.Namespace) -> int:
     tracker = FollowTracker(config, scene)
     follower = (LocalPlanner(scene, distance=args.distance) if args.follower == "planner"
                 else PIDFollower(distance=args.distance, depth_stop=args.follower != "pid",
-                                 walkers=args.follower == "pid+walkers"))
+                                 walkers=args.follower == "pid+walkers", nav=pursuit_map(scene)))
     out = _Outputs(Path(args.out), not args.no_video, source.fps)
     n = found = 0
     try:

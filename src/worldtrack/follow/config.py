@@ -82,10 +82,10 @@ class FollowConfig:
         stand may be hiding it, and is never taken for it (True; False in the paper).
         height_margin : the target's height is learnt from depth (the highest point of its candidate,
         from frames that show its head, as an upper envelope, used after 2 s of such frames; see
-        :mod:`~worldtrack.follow.vetoes`); when the target is found again after being unseen, or while
-        its identity is on probation, a candidate more than this taller, or this shorter with its own
-        head seen, is not taken for it (0.1 m: the measured top of one person varies by ±0.05 m;
-        0 = off; the paper has none).
+        :mod:`~worldtrack.follow.vetoes`); a candidate more than this taller is never taken for it,
+        seen or not, and when the target is found again after being unseen, or while its identity
+        is on probation, neither is one this shorter with its own head seen (0.1 m: the measured top
+        of one person varies by ±0.05 m; 0 = off; the paper has none).
     Identity kept open (:mod:`~worldtrack.follow.identity`; ours, the paper has none)
         identity_margin : another track whose running RBhat against the target's templates is
         lower than the followed one's by this much takes the target's place (0.4; 0 = never; 0.2

@@ -8,8 +8,8 @@ PID (:mod:`~worldtrack.follow.pid`) with worldtrack's depth safety layer, or the
 the robot drives by them for one frame time — a unicycle with limited speed, turn rate
 and acceleration that stops rather than drive into a wall or an obstacle (a bumper, counted).
 
-The camera sits on the robot as in the scenario: ``camera_height`` m up, 0.1 m ahead of the
-robot's centre, looking along its heading, tilted 4° down.
+The robot and its camera are :mod:`~worldtrack.follow.robot`'s: the camera ``camera_height`` m up
+(as in the scenario), 0.1 m ahead of the robot's centre, looking along its heading, tilted 4° down.
 
 >>> from worldtrack.synth import make_scenario
 >>> sc = make_scenario("follow-target", size=(160, 120), frames=20, seed=3, others=0)
@@ -26,62 +26,10 @@ import numpy as np
 
 from worldtrack.follow.pid import PIDFollower
 from worldtrack.follow.planner import LocalPlanner
+from worldtrack.follow.robot import Robot, RobotLimits, camera_pose
 from worldtrack.follow.observation import frame_from_synth
 from worldtrack.follow.scan import simulate_scan
 from worldtrack.follow.tracker import FollowStep, FollowTracker
-from worldtrack.geometry.camera import look_at_rotation
-
-CAMERA_FORWARD = 0.1       # m, camera ahead of the robot's centre
-CAMERA_TILT_DEG = 4.0
-
-
-@dataclass
-class Robot:
-    """A unicycle robot: pose (m, rad), speeds (m/s, rad/s) and their limits."""
-
-    x: float
-    y: float
-    yaw: float
-    v: float = 0.0
-    w: float = 0.0
-    max_speed: float = 1.6
-    max_turn_rate: float = 1.5
-    accel: float = 1.5
-    turn_accel: float = 4.0
-    radius: float = 0.3
-
-    def drive(self, v_cmd: float, w_cmd: float, dt: float, clearance_at) -> bool:
-        """Move for ``dt`` s towards the commanded speeds; False when the bumper stopped it.
-
-        ``clearance_at(xy (1, 2)) -> (1,)`` is the distance (m) to walls and obstacles.
-        """
-        v_cmd = float(np.clip(v_cmd, -self.max_speed, self.max_speed))
-        w_cmd = float(np.clip(w_cmd, -self.max_turn_rate, self.max_turn_rate))
-        self.v += float(np.clip(v_cmd - self.v, -self.accel * dt, self.accel * dt))
-        self.w += float(np.clip(w_cmd - self.w, -self.turn_accel * dt, self.turn_accel * dt))
-        self.yaw = float((self.yaw + self.w * dt + np.pi) % (2 * np.pi) - np.pi)
-        new = np.array([self.x, self.y]) + self.v * dt * np.array([np.cos(self.yaw), np.sin(self.yaw)])
-        if clearance_at(new[None])[0] < self.radius:
-            self.v = 0.0
-            return False
-        self.x, self.y = float(new[0]), float(new[1])
-        return True
-
-    @classmethod
-    def from_camera(cls, camera, **limits) -> "Robot":
-        """The robot that carries ``camera`` (its centre 0.1 m behind the camera, same heading)."""
-        fwd = camera.floor_direction
-        x, y = camera.centre[:2] - CAMERA_FORWARD * fwd
-        return cls(float(x), float(y), float(np.arctan2(fwd[1], fwd[0])), **limits)
-
-
-def camera_pose(robot: Robot, camera_height: float) -> tuple[np.ndarray, np.ndarray]:
-    """(R, t) world → camera of the robot's camera."""
-    fwd = np.array([np.cos(robot.yaw), np.sin(robot.yaw), 0.0])
-    pos = np.array([robot.x, robot.y, camera_height]) + CAMERA_FORWARD * fwd
-    R = look_at_rotation(pos, pos + fwd + np.array([0.0, 0.0, -np.tan(np.radians(CAMERA_TILT_DEG))]))
-    return R, -R @ pos
-
 
 @dataclass
 class LoopResult:
@@ -92,7 +40,7 @@ class LoopResult:
     nearest_person (T,) distance from the robot's centre to the nearest person, m;
     clearance (T,) robot centre to the nearest wall or obstacle, m; found (T,) bool;
     bumps : frames the bumper stopped the robot; contacts : frames with a person within
-    ``robot.radius + 0.2`` m of the robot's centre; collisions : of those, frames where the robot
+    ``robot.limits.radius + 0.2`` m of the robot's centre; collisions : of those, frames where the robot
     drove into somebody — its speed towards them above 0.05 m/s and at least theirs towards it (the
     robot's doing: "unseen" or "seen, not stopped"); walked_into : contact frames where a person
     closed in faster than the robot (standing or not): the scripted people do not see the robot, and
@@ -177,12 +125,13 @@ def _collision(k: int, pid: int, rel: np.ndarray, robot, person_velocity: np.nda
 
 def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: LocalPlanner | PIDFollower | None = None,
                     camera_id: str = "robot", camera_height: float | None = None, keep_steps: bool = False,
-                    on_frame=None, side_scan: bool = False, **robot_limits) -> LoopResult:
+                    on_frame=None, side_scan: bool = False, limits: RobotLimits | None = None) -> LoopResult:
     """Render ``scenario`` frame by frame from the robot that follows its person 1 (see the module docstring).
 
     ``on_frame(bundle, step, (v, ω))`` is called after every frame (e.g. to write a video).
     ``side_scan``: the robot also carries a 270° planar range scanner (:func:`~worldtrack.follow.scan.simulate_scan`,
     4 m, 1°, σ 2 cm), whose points go to the follower (``command(..., scan=)``; the PID only).
+    ``limits``: the robot's (:class:`~worldtrack.follow.robot.RobotLimits`; the default robot).
     """
     tracker = tracker or FollowTracker(scene=scenario.scene)
     follower = follower or PIDFollower(distance=float(scenario.params.get("distance", 1.8)), depth_stop=True)
@@ -191,7 +140,7 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
         raise ValueError(f"camera {camera_id!r} of scenario {scenario.name!r} does not move")
     first = scenario.camera_at(camera_id, 0)
     height = float(first.centre[2]) if camera_height is None else camera_height
-    robot = Robot.from_camera(first, **robot_limits)
+    robot = Robot.from_camera(first, limits)
     df = scenario.scene.distance_field(0.05)
     clearance_at = lambda xy: df.sample(xy, outside=-1.0)  # noqa: E731
     n = scenario.n_frames
@@ -231,7 +180,7 @@ def run_closed_loop(scenario, tracker: FollowTracker | None = None, follower: Lo
             rel = np.array(list(people.values())) - rec["robot"][k]
             dist = np.hypot(rel[:, 0], rel[:, 1])
             near[k] = dist.min()
-            touching = dist < robot.radius + 0.2
+            touching = dist < robot.limits.radius + 0.2
             contacts += int(touching.any())
             frame_causes = []
             for j in np.flatnonzero(touching):

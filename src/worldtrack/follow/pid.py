@@ -10,8 +10,8 @@ with the real time step. ``v_ff`` (the target's speed along the line of sight) a
 angular rate about the robot), both from the Kalman filter's velocity, are worldtrack's
 feed-forward terms (``feed_forward=False`` is the paper's plain PID): without them a PID lags a
 walking target by ``v/Kp``. Derivatives are of the errors computed from the filtered state, so a
-noisy detection does not kick the output. Limits: ``−max_reverse ≤ v ≤ max_speed`` (the robot backs
-off when the target walks at it), ``|ω| ≤ max_turn_rate``; the integrals are clamped (anti-windup)
+noisy detection does not kick the output. Limits (``robot``, :class:`~worldtrack.follow.robot.RobotLimits`):
+``−max_reverse ≤ v ≤ max_speed`` (the robot backs off when the target walks at it), ``|ω| ≤ max_turn_rate``; the integrals are clamped (anti-windup)
 and reset when the target is lost.
 
 Safety: everybody the follower knows of (the target, every candidate, every other person's track,
@@ -19,9 +19,14 @@ including those coasting out of view) who stands in the robot's path — ahead, 
 metres to either side — limits the forward speed to what lets it stop ``stop_distance`` metres
 short of them braking at ``brake`` m/s² after one frame's delay, ``v ≤ √(2·brake·gap) − brake·dt``;
 nobody within ``stop_distance`` ahead at all (path or not) lets it move forward. So the robot slows
-as it nears anybody in its way instead of stopping late. It stops driving when the target has not
-been seen for ``lost_timeout`` seconds; then it only turns (at most ``search_turn_rate``) towards
-where the target should be, to look for it.
+as it nears anybody in its way instead of stopping late. The target hidden behind somebody nearer
+(the tracker's ``hidden``: depth puts them in front of its prediction) is followed by its prediction
+for up to ``hidden_coast`` seconds. Otherwise, not seen for ``lost_timeout`` seconds, the target is
+lost: the robot goes to where it was last seen (``pursue`` seconds at most: it turns to face the
+place first, then drives, under the same speed limits; with the room's map, ``nav``, along the
+shortest way round its obstacles) — a target that turned a corner out of view is seen again from
+there —, and then only turns (at most ``search_turn_rate``) towards where the
+target should be, to look for it.
 
 >>> import numpy as np
 >>> from types import SimpleNamespace
@@ -41,9 +46,24 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from worldtrack.follow.movers import moving_speed_limit
+from worldtrack.follow.navigation import NavigationGrid
+from worldtrack.follow.robot import RobotLimits
 from worldtrack.follow.safety import free_path, near_points
 from worldtrack.follow.scan import ScanMovers, segments
 from worldtrack.geometry.camera import Camera
+
+
+#: The pursuit's carrot on the way round obstacles: this far (m) ahead, in steps of 0.1 m over 16 headings.
+LOOKAHEAD = 0.6
+RING = np.column_stack([np.cos(np.arange(16) * np.pi / 8), np.sin(np.arange(16) * np.pi / 8)])
+#: The pursuit's way keeps this much (m) more than the robot's radius from obstacles (the carrot cuts corners).
+NAV_MARGIN = 0.2
+
+
+def pursuit_map(scene, robot: RobotLimits = RobotLimits()) -> NavigationGrid:
+    """The room's :class:`NavigationGrid` for :attr:`PIDFollower.nav`: drivable ``NAV_MARGIN`` clear of the
+    robot's radius."""
+    return NavigationGrid(scene, radius=robot.radius + NAV_MARGIN)
 
 
 @dataclass
@@ -55,6 +75,12 @@ class PIDFollower:
     the paper's PID)
     search_look : seconds the lost target's predicted place is looked at before the robot turns on round
     to look about (None: it only faces the prediction, the paper's and 35e's behaviour)
+    pursue : seconds after the loss during which the robot drives to where the target was last seen
+    (None: it stands, 35g and before)
+    nav : the room (:func:`pursuit_map`): the pursuit drives towards a
+    point ``LOOKAHEAD`` m down the shortest way round its obstacles (None: straight at the place)
+    hidden_coast : seconds since last seen that a target hidden behind somebody nearer is followed by
+    its prediction (0: lost after ``lost_timeout`` like any other)
     walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
     (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
     the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
@@ -63,9 +89,7 @@ class PIDFollower:
     distance: float = 1.8
     distance_gains: tuple = (1.2, 0.1, 0.1)
     bearing_gains: tuple = (2.5, 0.1, 0.1)
-    max_speed: float = 1.6
-    max_reverse: float = 0.5
-    max_turn_rate: float = 1.5
+    robot: RobotLimits = RobotLimits()
     feed_forward: bool = True
     stop_distance: float = 0.7
     corridor: float = 0.6
@@ -76,6 +100,11 @@ class PIDFollower:
     depth_stop: bool = False
     walkers: bool = False
     search_look: float | None = 2.0
+    pursue: float | None = 10.0
+    pursue_speed: float = 1.0
+    arrive: float = 0.4
+    hidden_coast: float = 3.0
+    nav: NavigationGrid | None = None
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -88,14 +117,20 @@ class PIDFollower:
         :mod:`~worldtrack.follow.scan`), read with ``depth_stop`` (its points) and ``walkers`` (its movers)."""
         s = self._state
         if step.found:
-            s["seen"] = t
+            s["seen"] = s["followed"] = t
+        elif getattr(step, "hidden", False) and t - s.get("seen", -np.inf) <= self.hidden_coast:
+            s["followed"] = t                   # behind somebody nearer: keep to its prediction
         pos = camera.centre[:2]
         fwd = camera.floor_direction
         left = np.array([-fwd[1], fwd[0]])
         rel = np.asarray(step.xy, float) - pos
         d = float(np.hypot(*rel))
         bearing = float(np.arctan2(rel @ left, rel @ fwd))
-        if t - s.get("seen", -np.inf) > self.lost_timeout:
+        if t - s.get("followed", -np.inf) > self.lost_timeout:
+            self._lost_reset(t)
+            goal = self._pursuit_goal(step, pos, t)
+            if goal is not None:
+                return self._drive_to(goal, step, camera, t, frame, scan)
             return self._search(t, bearing)
         e_d = d - self.distance
         dt = t - s["t"] if "t" in s else 0.0
@@ -108,8 +143,8 @@ class PIDFollower:
         v = v_ff + self._pid("d", e_d, dt, self.distance_gains)
         w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
         s["t"] = t
-        v = float(np.clip(v, -self.max_reverse, self.max_speed))
-        w = float(np.clip(w, -self.max_turn_rate, self.max_turn_rate))
+        v = float(np.clip(v, -self.robot.max_reverse, self.robot.max_speed))
+        w = float(np.clip(w, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         limit = self._speed_limit(step, pos, fwd, dt if dt > 0 else 0.1)
         if self.walkers:
             limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
@@ -118,17 +153,69 @@ class PIDFollower:
         s["blocked"] = bool(limit < v)
         return min(v, limit), w
 
+    def _lost_reset(self, t: float) -> None:
+        """Clear the PID's state (integrals, derivatives) but what the search needs."""
+        s = self._state
+        keep = {k: s[k] for k in ("seen", "followed", "search_from", "search_turn", "search_last", "last_w",
+                                  "arrived", "movers", "way", "way_to") if k in s}
+        self.reset()
+        s.update(keep)
+        if s.get("search_last", -np.inf) < s.get("seen", -np.inf):         # a new loss
+            s["search_from"], s["search_turn"], s["arrived"] = np.inf, 0.0, False
+        s["search_last"] = t
+
+    def _pursuit_goal(self, step, pos: np.ndarray, t: float):
+        """Where the lost target was last seen (2,) m, while it is to be pursued, or None."""
+        last = np.asarray(getattr(step, "last_xy", np.full(2, np.nan)), float)
+        if self.pursue is None or not np.all(np.isfinite(last)) or t - self._state.get("seen", -np.inf) > self.pursue:
+            return None
+        if self._state["arrived"] or np.hypot(*(last - pos)) < self.arrive:
+            self._state["arrived"] = True
+            return None
+        return last
+
+    def _drive_to(self, goal: np.ndarray, step, camera: Camera, t: float, frame, scan) -> tuple[float, float]:
+        """Turn to face ``goal`` (m) — or the point on the way there round the obstacles (``nav``) —, then
+        drive to it, under the same speed limits as the PID."""
+        pos, fwd = camera.centre[:2], camera.floor_direction
+        rel = self._waypoint(goal, pos - self.robot.camera_forward * fwd) - pos
+        bearing = float(np.arctan2(rel @ np.array([-fwd[1], fwd[0]]), rel @ fwd))
+        w = float(np.clip(self.bearing_gains[0] * bearing, -self.robot.max_turn_rate, self.robot.max_turn_rate))
+        v, limit = 0.0, np.inf
+        if abs(bearing) < np.radians(20.0):      # facing it (the camera sees the way): drive
+            ahead = np.hypot(*(goal - pos)) - 0.5 * self.arrive       # slowing down to stop inside ``arrive``
+            v = float(np.clip(self.distance_gains[0] * ahead, 0.0, self.pursue_speed))
+            limit = self._speed_limit(step, pos, fwd, 0.1, with_target=False)
+            if self.walkers:
+                limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
+            if self.depth_stop and (frame is not None or scan is not None):
+                limit = min(limit, self._depth_limit(frame, camera, w, 0.1, scan))
+        self._state["blocked"] = bool(limit < v)
+        return min(v, limit), w
+
+    def _waypoint(self, goal: np.ndarray, pos: np.ndarray) -> np.ndarray:
+        """``goal`` without a map; else the point reached from ``pos`` going ``LOOKAHEAD`` m downhill on the
+        shortest-way length to it (:meth:`NavigationGrid.geodesic`, computed once per goal)."""
+        if self.nav is None:
+            return goal
+        s = self._state
+        if s.get("way_to") is None or not np.allclose(s["way_to"], goal):
+            s["way"], s["way_to"] = self.nav.geodesic(goal), np.array(goal, float)
+        p, here = np.array(pos, float), float(s["way"].sample(pos[None], outside=1e3)[0])
+        for _ in range(int(round(LOOKAHEAD / 0.1))):
+            near = p + 0.1 * RING
+            left = s["way"].sample(near, outside=1e3)
+            k = int(np.argmin(left))
+            if left[k] >= here:
+                break
+            p, here = near[k], float(left[k])
+        return p if np.hypot(*(p - pos)) > 0.05 else goal
+
     def _search(self, t: float, bearing: float) -> tuple[float, float]:
         """Lost: stand and turn slowly towards where the target should be; once that has been in view
         for ``search_look`` seconds without finding it (it turned while hidden, its prediction walked
         on), keep turning the same way round, a full look about (worldtrack; the paper stands)."""
         s = self._state
-        keep = {k: s[k] for k in ("seen", "search_from", "search_turn", "search_last", "last_w") if k in s}
-        self.reset()
-        s.update(keep)
-        if s.get("search_last", -np.inf) < s["seen"]:                      # a new loss
-            s["search_from"], s["search_turn"] = np.inf, 0.0
-        s["search_last"] = t
         if s["search_turn"]:
             return 0.0, s["search_turn"]
         if abs(bearing) < np.radians(15.0):
@@ -165,7 +252,7 @@ class PIDFollower:
         fwd = camera.floor_direction
         yaw = np.arctan2(fwd[1], fwd[0]) + w * np.linspace(0.0, 1.5, 16)
         centre = camera.centre[:2] - 0.1 * fwd
-        step_xy = (self.max_speed * 0.1) * np.column_stack([np.cos(yaw), np.sin(yaw)])
+        step_xy = (self.robot.max_speed * 0.1) * np.column_stack([np.cos(yaw), np.sin(yaw)])
         path = centre + np.vstack([np.zeros(2), np.cumsum(step_xy[1:], axis=0)])
         gap = free_path(path, points, 0.35)
         return np.inf if not np.isfinite(gap) else float(max(0.0, np.sqrt(2 * self.brake * gap) - self.brake * dt))
@@ -186,13 +273,14 @@ class PIDFollower:
             vel.append(velocity[away])
         xy, vel = np.vstack(xy), np.vstack(vel)
         return moving_speed_limit(centre, float(np.arctan2(fwd[1], fwd[0])), w, xy, vel,
-                                  clearance=self.stop_distance, brake=self.brake, max_speed=self.max_speed)
+                                  clearance=self.stop_distance, brake=self.brake, max_speed=self.robot.max_speed)
 
-    def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float) -> float:
+    def _speed_limit(self, step, pos: np.ndarray, fwd: np.ndarray, dt: float, with_target: bool = True) -> float:
         """Largest forward speed (m/s) that stops ``stop_distance`` short of anybody in the path (the
         target only by the stop distance: the distance control keeps the robot back from it). With
         ``walkers`` the other tracks (and candidates they explain) are left to :meth:`_walkers_limit`."""
-        people = [np.asarray(step.xy, float)[None]]
+        # a lost target's prediction limits nothing (put behind the robot)
+        people = [np.asarray(step.xy, float)[None] if with_target else (pos - 10.0 * fwd)[None]]
         cands = np.asarray(step.candidates.xy, float).reshape(-1, 2)
         chosen = getattr(step, "chosen", -1)
         if len(cands):

@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from worldtrack.follow.robot import RobotLimits
 from worldtrack.follow.navigation import NavigationGrid
 from worldtrack.follow.safety import free_path, near_points, unexplained
 from worldtrack.geometry.camera import Camera
@@ -121,8 +122,8 @@ class LocalPlanner:
     """Dynamic-window follower; see the module docstring. Lengths in m, times in s, angles in rad.
 
     scene : the Scene (walls and obstacles); distance : set following distance, camera to target;
-    max_speed, max_reverse, max_turn_rate, accel, turn_accel, radius : the robot (as in
-    :class:`~worldtrack.follow.loop.Robot`); camera_forward : the camera ahead of the robot's centre;
+    robot : its limits and the camera ahead of its centre (:class:`~worldtrack.follow.robot.RobotLimits`,
+    the simulated robot's);
     horizon, step : rollout length and step; speeds, turns : number of commands sampled;
     obstacle_clearance, person_clearance, point_clearance : closest admissible approach of the
     robot's centre to a wall, a person's centre, an unexplained depth point;
@@ -139,13 +140,7 @@ class LocalPlanner:
 
     scene: object
     distance: float = 1.8
-    max_speed: float = 1.6
-    max_reverse: float = 0.5
-    max_turn_rate: float = 1.5
-    accel: float = 1.5
-    turn_accel: float = 4.0
-    radius: float = 0.3
-    camera_forward: float = 0.1
+    robot: RobotLimits = RobotLimits()
     horizon: float = 1.5
     step: float = 0.1
     speeds: int = 12
@@ -165,9 +160,9 @@ class LocalPlanner:
     _state: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
-        self.nav = NavigationGrid(self.scene, radius=self.radius)
-        v = np.linspace(-self.max_reverse, self.max_speed, self.speeds)
-        w = np.linspace(-self.max_turn_rate, self.max_turn_rate, self.turns)
+        self.nav = NavigationGrid(self.scene, radius=self.robot.radius)
+        v = np.linspace(-self.robot.max_reverse, self.robot.max_speed, self.speeds)
+        w = np.linspace(-self.robot.max_turn_rate, self.robot.max_turn_rate, self.turns)
         self._commands = np.stack(np.meshgrid(v, w, indexing="ij"), axis=-1).reshape(-1, 2)
 
     def reset(self) -> None:
@@ -182,9 +177,10 @@ class LocalPlanner:
         """(v m/s, ω rad/s) for this frame's :class:`~worldtrack.follow.tracker.FollowStep`, the
         camera's pose and (optionally) the frame, whose depth feeds the safety layer."""
         fwd = camera.floor_direction
-        pose = np.array([*(camera.centre[:2] - self.camera_forward * fwd), np.arctan2(fwd[1], fwd[0])])
+        pose = np.array([*(camera.centre[:2] - self.robot.camera_forward * fwd), np.arctan2(fwd[1], fwd[0])])
         velocity = self._odometry(pose, t)
-        roll = roll_out(pose, velocity, self._commands, self.horizon, self.step, self.accel, self.turn_accel)
+        roll = roll_out(pose, velocity, self._commands, self.horizon, self.step, self.robot.accel,
+                        self.robot.turn_accel)
         points = near_points(getattr(frame, "depth", None), camera)
         cost, admissible, margin, free_cost = self._score(roll, step, points, camera)
         if admissible.any():
@@ -218,7 +214,7 @@ class LocalPlanner:
         without people and unexplained points (to tell when they held the robot back)."""
         wv, wh, wo, wp, wq, ws = self.weights
         xy, ts = roll.xy, roll.times
-        cam = xy + self.camera_forward * np.stack([np.cos(roll.yaw), np.sin(roll.yaw)], axis=-1)
+        cam = xy + self.robot.camera_forward * np.stack([np.cos(roll.yaw), np.sin(roll.yaw)], axis=-1)
         if step.found:
             self._state["seen"], self._state["last_xy"] = float(step.t), np.asarray(step.measured, float)
         lost = float(step.t) - self._state.get("seen", float(step.t)) > self.lost_timeout

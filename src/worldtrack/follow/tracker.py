@@ -46,9 +46,9 @@ from worldtrack.follow.identity import IdentityEvidence
 from worldtrack.follow.observation import Observation
 from worldtrack.follow.others import Others, assign
 from worldtrack.follow.planview import Candidates, detect
-from worldtrack.follow.silhouette import covering, person_box, silhouettes
+from worldtrack.follow.silhouette import silhouettes
 from worldtrack.follow.templates import Templates
-from worldtrack.follow.vetoes import TargetHeight, heads_seen, pieces_of_others
+from worldtrack.follow.vetoes import TargetHeight, heads_seen, hiding_target, pieces_of_others
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Frame
 from worldtrack.scene.model import Scene
@@ -57,11 +57,6 @@ from worldtrack.scene.model import Scene
 OTHERS_MIN_ALPHA = 0.5
 #: A person within this distance (m) of the target makes its silhouette unsafe to learn from.
 CLEAR_RADIUS = 1.0
-#: A person this much nearer the camera (m) covering this share of the target's expected image box
-#: may be hiding it.
-HIDE_MARGIN, HIDE_SHARE = 0.25, 0.3
-#: ... unless it stands this close (m) to the target's way since it was last measured (the target, stopped).
-STOPPED_RADIUS = 0.3
 #: Unseen longer than this (s), the target's predicted velocity decays with this time constant.
 COAST_S = 1.5
 #: Found again after being unseen this long (s), the target's identity is on probation.
@@ -84,6 +79,9 @@ class FollowStep:
     owner : (N,) int — who each candidate was given to: 1 the target, ≥ 2 another person, 0 nobody
     others_ids : (K,) int; others_xy : (K, 2) — the other people tracked (predicted when unseen);
     others_velocity : (K, 2) m/s — their Kalman velocities (a planner predicts where they walk)
+    hidden : bool — not found, and somebody nearer the camera covers where the target should stand
+    (depth says it is behind them: a follower keeps to its prediction); last_xy : (2,) m, where it
+    was last measured
     """
 
     t: float
@@ -104,6 +102,8 @@ class FollowStep:
     others_ids: np.ndarray
     others_xy: np.ndarray
     others_velocity: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    hidden: bool = False
+    last_xy: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
 
 
 class FollowTracker:
@@ -129,6 +129,7 @@ class FollowTracker:
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
         self.height = TargetHeight()
+        self.hidden = False
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -203,8 +204,8 @@ class FollowTracker:
         if dt > 0:
             x, P = kalman.predict(self.x[None], self.P[None], dt, cfg.accel_sigma)
             self.x, self.P = x[0], P[0]
-            if t - self.last_seen > COAST_S:      # long unseen: the walk slows down (not off the map)
-                self.x[2:] *= np.exp(-dt / COAST_S)
+            if t - self.last_seen > COAST_S and not self.hidden:   # long unseen (and not known to be
+                self.x[2:] *= np.exp(-dt / COAST_S)                # behind somebody): the walk slows down
             self.others.predict(dt)
         self.t = t
         c = obs.candidates
@@ -215,11 +216,14 @@ class FollowTracker:
         D = dissimilarity(rb, E, alpha, cfg.alpha_th)
         self._alpha = alpha
         gate = min(cfg.gate + cfg.gate_growth * (t - self.last_seen), cfg.max_gate)
-        hiding = self._hiding(obs)
+        hiding = hiding_target(obs, self.x[:2], self.last_xy) if cfg.occluders else np.zeros(len(c), bool)
         allowed = (E / cfg.k <= gate) & ~hiding
-        self._heads = heads_seen(c, obs.silhouettes, obs.camera)     # found again: somebody of another
-        mismatch = self.height.mismatch(c.top, self._heads, cfg.height_margin)   # height is somebody else
-        allowed &= ~mismatch if t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until else True
+        # Somebody of another height is somebody else. While the target is seen, only taller: a top is never
+        # measured above the head, but one hidden by somebody the depth missed looks shorter, its head "seen".
+        self._heads = heads_seen(c, obs.silhouettes, obs.camera)
+        found_again = t - self.last_seen >= REACQUIRED_AFTER or t < self.probation_until
+        mismatch = self.height.mismatch(c.top, self._heads & found_again, cfg.height_margin)
+        allowed &= ~mismatch
         if t - self.last_seen > COAST_S:
             allowed &= rb < cfg.reid_rbhat      # the prediction no longer tells: colour must agree
         if cfg.track_others:
@@ -236,6 +240,7 @@ class FollowTracker:
             if t - self.last_seen >= REACQUIRED_AFTER:
                 self.probation_until = t + cfg.probation
             self.last_seen, self.last_xy = t, c.xy[chosen].copy()
+        self.hidden = chosen < 0 and bool(hiding.any())
         self._update_templates(obs, chosen, D, rb, alpha, dt)
         return self._result(t, obs, chosen, D, rb, E, alpha, w, owner, gate)
 
@@ -352,24 +357,6 @@ class FollowTracker:
         reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
         return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
 
-    def _hiding(self, obs: Observation) -> np.ndarray:
-        """(N,) candidates that may be hiding the target: more than ``HIDE_MARGIN`` nearer the camera
-        than its prediction and covering at least ``HIDE_SHARE`` of the image box where it should
-        stand. Such a person appears just as the target vanishes, where it vanishes; they are not
-        taken for it (``occluders``; the paper has no such rule). Except one standing on the target's
-        way from where it was last measured to its prediction (within ``STOPPED_RADIUS``): that is
-        the target, stopped while its constant-velocity prediction walked on."""
-        n = len(obs.candidates)
-        if not self.config.occluders or obs.camera is None or n == 0:
-            return np.zeros(n, dtype=bool)
-        cover = covering(obs.silhouettes, n, person_box(obs.camera, self.x[:2]))
-        centre = obs.camera.centre[:2]
-        nearer = np.hypot(*(obs.candidates.xy - centre).T) < np.hypot(*(self.x[:2] - centre)) - HIDE_MARGIN
-        way = self.x[:2] - self.last_xy
-        along = np.clip((obs.candidates.xy - self.last_xy) @ way / max(way @ way, 1e-12), 0.0, 1.0)
-        stopped = np.hypot(*(obs.candidates.xy - self.last_xy - along[:, None] * way).T) <= STOPPED_RADIUS
-        return nearer & (cover >= HIDE_SHARE) & ~stopped
-
     def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, rb: np.ndarray, alpha: float,
                           dt: float) -> None:
         cfg = self.config
@@ -397,4 +384,5 @@ class FollowTracker:
         return FollowStep(t, chosen >= 0, self.x[:2].copy(), self.x[2:].copy(), measured, int(chosen), c,
                           obs.silhouettes, np.asarray(D, float), np.asarray(rb, float), np.asarray(E, float),
                           float(alpha), float(w), float(gate), owner, self.others.ids.copy(),
-                          self.others.x[:, :2].copy(), self.others.x[:, 2:].copy())
+                          self.others.x[:, :2].copy(), self.others.x[:, 2:].copy(), self.hidden and chosen < 0,
+                          self.last_xy.copy())

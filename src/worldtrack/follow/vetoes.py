@@ -11,6 +11,8 @@ the target is found again, whatever its D.
   head lower than the height is more likely than one higher), and used only once it has been
   learnt for ``CONFIRM_S`` seconds — a single frame with the head hidden must not set a height
   that would veto the target itself.
+* **Somebody hiding it** (:func:`hiding_target`) — a person who appears just as the target vanishes,
+  where it vanishes, nearer the camera and covering where it should stand, is in front of it.
 * **Pieces of somebody else** (:func:`pieces_of_others`) — near the camera one body is often seen
   as two candidates. A candidate within ``FRAGMENT_RADIUS`` of one that another person's track holds
   in the same frame is a piece of that person, seen while the target was not.
@@ -32,6 +34,11 @@ import numpy as np
 from worldtrack.follow.silhouette import covering, person_box
 from worldtrack.geometry.camera import Camera
 
+#: A person this much nearer the camera (m) covering this share of the target's expected image box
+#: may be hiding it.
+HIDE_MARGIN, HIDE_SHARE = 0.25, 0.3
+#: ... unless it stands this close (m) to the target's way since it was last measured (the target, stopped).
+STOPPED_RADIUS = 0.3
 #: A candidate this near (m) one of another tracked person's is a piece of that person.
 FRAGMENT_RADIUS = 0.5
 #: The target's height is learnt only from frames where a point this far (m) above its top is in the
@@ -51,6 +58,25 @@ def pieces_of_others(xy: np.ndarray, held: np.ndarray) -> np.ndarray:
         return np.zeros(len(xy), dtype=bool)
     d = np.hypot(*(xy[:, None] - xy[held][None]).transpose(2, 0, 1))
     return (d <= FRAGMENT_RADIUS).any(axis=1) & ~held
+
+
+def hiding_target(obs, predicted_xy: np.ndarray, last_xy: np.ndarray) -> np.ndarray:
+    """(N,) candidates of ``obs`` (an :class:`~worldtrack.follow.observation.Observation`) that may be
+    hiding the target: more than ``HIDE_MARGIN`` nearer the camera than its prediction
+    ``predicted_xy`` (2,) m and covering at least ``HIDE_SHARE`` of the image box where it should
+    stand; except one standing on the target's way from where it was last measured (``last_xy``) to
+    its prediction (within ``STOPPED_RADIUS``): that is the target, stopped while its
+    constant-velocity prediction walked on. None without a camera."""
+    c, n = obs.candidates, len(obs.candidates)
+    if obs.camera is None or n == 0:
+        return np.zeros(n, dtype=bool)
+    cover = covering(obs.silhouettes, n, person_box(obs.camera, predicted_xy))
+    centre = obs.camera.centre[:2]
+    nearer = np.hypot(*(c.xy - centre).T) < np.hypot(*(predicted_xy - centre)) - HIDE_MARGIN
+    way = predicted_xy - last_xy
+    along = np.clip((c.xy - last_xy) @ way / max(way @ way, 1e-12), 0.0, 1.0)
+    stopped = np.hypot(*(c.xy - last_xy - along[:, None] * way).T) <= STOPPED_RADIUS
+    return nearer & (cover >= HIDE_SHARE) & ~stopped
 
 
 def head_in_view(camera: Camera | None, xy, top: float) -> bool:
