@@ -12,6 +12,7 @@ from worldtrack.map.connection import MapKeys, connect
 from worldtrack.map.fusion_role import FusionRole, run_fusion_thread
 from worldtrack.map.messages import (Estimate, Observation, bucket_index, decode_map_state, encode_observation,
                                      stream_id_ms)
+from worldtrack.map.worker import MapLink
 
 
 def _publish(client, keys, camera: str, t: float, pid: int, x: float) -> None:
@@ -66,3 +67,44 @@ def test_a_slow_worker_delays_only_its_own_people(redis_url):
         thread.join(10)
     print(f"the fast worker's report was on the live map {took * 1000:.0f} ms after it was published")
     assert took < 1.0
+
+
+def test_a_bucket_waits_for_a_batch_workers_report_past_max_wait_s(redis_url):
+    """A batch worker (video files read as fast as it can, registered with ``lockstep``) is waited
+    for however late its report comes while its lease lives: the record of a batch run must not
+    depend on the machine's load (issue-39j). A live camera is not (a slow worker delays only its
+    own people), and a batch camera whose lease lapsed (its worker died) is not either."""
+    client = connect(redis_url)
+    keys, cfg = MapKeys(), MapConfig(max_wait_s=0.2)
+    for cam, batch in (("first", True), ("late", True), ("live", False)):
+        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
+        link.lockstep = batch                   # as `worldtrack track` sets it (map.pace_files=false, files)
+        link.register()
+        client.set(keys.camera_lease(cam), f"w-{cam}", px=30000)
+    role = FusionRole(client, keys, cfg, "fuser")
+    thread, stop = run_fusion_thread(role)
+    try:
+        wait_until(lambda: role.holding, 10, what="the fusion role")
+        t0 = (bucket_index(time.time(), cfg.bucket_s) + 0.5) * cfg.bucket_s
+        _publish(client, keys, "first", t0, 1, 2.0)
+        _publish(client, keys, "live", t0, 3, 9.0)
+        time.sleep(5 * cfg.max_wait_s)
+        assert client.xlen(keys.map_stream) == 0            # still waiting for the late batch camera
+        _publish(client, keys, "late", t0, 2, 6.0)
+        wait_until(lambda: client.xlen(keys.map_stream) == 1, 5.0, what="the bucket with the late report")
+        first = decode_map_state(client.xrange(keys.map_stream)[0][1])
+        assert sorted(c for c, _, _ in first.reports) == ["first", "late", "live"] and first.late == 0
+        # The next bucket: the batch cameras report, the live one does not: written after max_wait_s.
+        _publish(client, keys, "first", t0 + 0.1, 1, 2.1)
+        _publish(client, keys, "late", t0 + 0.1, 2, 6.1)
+        wait_until(lambda: client.xlen(keys.map_stream) == 2, 5.0, what="the bucket without the live camera")
+        # The next: the late batch worker's lease lapses (it died): written without it.
+        _publish(client, keys, "first", t0 + 0.2, 1, 2.2)
+        _publish(client, keys, "live", t0 + 0.2, 3, 9.2)
+        time.sleep(5 * cfg.max_wait_s)
+        assert client.xlen(keys.map_stream) == 2
+        client.delete(keys.camera_lease("late"))
+        wait_until(lambda: client.xlen(keys.map_stream) == 3, 5.0, what="the bucket after the lease lapsed")
+    finally:
+        stop.set()
+        thread.join(10)

@@ -22,7 +22,9 @@ class MapConfig(Section):
     bucket_s: float = Field(0.1, gt=0, le=5, description="fusion time bucket: observations whose capture times "
                                                           "fall in one bucket are merged into one map state")
     max_wait_s: float = Field(0.5, gt=0, le=60, description="a bucket is written once every live camera has "
-                                                              "reported it, or this long after its first observation")
+                                                              "reported it, or this long after its first observation "
+                                                              "(a batch worker's camera is waited for while "
+                                                              "its lease lives)")
     live_updates: bool = Field(True, description="update the live map (map:current, map:updates) as soon as any "
                                                  "worker's observation of a bucket comes, not only when the "
                                                  "bucket is complete (the record, the map stream, waits)")

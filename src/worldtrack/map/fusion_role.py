@@ -10,7 +10,10 @@ refines it, and a worker that has not reported yet delays only its own people (`
 
 **The record** (the stream ``map``, one entry per time bucket, what ``replay`` reads) holds each
 bucket's final state, written when every camera with a live lease has reported past it, or
-``max_wait_s`` after its first observation came (a slow or dead worker does not hold it up).
+``max_wait_s`` after its first observation came (a slow or dead worker does not hold it up) —
+except for a batch worker's cameras (files read as fast as it can, registered with ``lockstep``):
+their reports are waited for as long as their leases live, so that a batch run writes the same
+record however loaded the machine is.
 That entry's id is the bucket's start in ms, and the write is fenced by the lease in one Lua
 script together with the state the next holder resumes from: a bucket is written once, by the
 holder of the lease, and a new holder continues from the bucket after the last one written,
@@ -107,6 +110,7 @@ class FusionRole:
         self._first_arrival: dict[int, float] = {}
         self._latest: dict[str, float] = {}
         self._cameras: dict[str, float] = {}
+        self._batch: set[str] = set()    # cameras of batch workers (lockstep): waited for, however long
         self._cameras_read = 0.0
         self._renewed = 0.0          # time.monotonic() of the last renewal made by the step loop
         self._late_pending = 0
@@ -235,8 +239,9 @@ class FusionRole:
         if not force and now - self._cameras_read < 1.0:
             return
         self._cameras_read = now
-        raw = self.client.hgetall(self.keys.cameras)
-        self._cameras = {c: float(json.loads(v).get("fps") or 10.0) for c, v in raw.items()}
+        raw = {c: json.loads(v) for c, v in self.client.hgetall(self.keys.cameras).items()}
+        self._cameras = {c: float(v.get("fps") or 10.0) for c, v in raw.items()}
+        self._batch = {c for c, v in raw.items() if v.get("lockstep")}
         for c in self._cameras:
             self._cursors.setdefault(self.keys.observations(c), f"{self._start_ms}-0")
 
@@ -317,13 +322,14 @@ class FusionRole:
         while self._buckets and written < MAX_BUCKETS_PER_STEP and time.monotonic() < self._deadline:
             b = min(self._buckets)
             end = (b + 1) * self.cfg.bucket_s
-            if self.clock() - self._first_arrival[b] < self.cfg.max_wait_s:
-                if live is None:
-                    live = self._live_cameras()
-                # Complete when each live camera's next frame falls after the bucket.
-                if not all(self._latest.get(c, -1e18) + 1.0 / self._cameras.get(c, 10.0) >= end - 1e-6
-                           for c in live):
-                    break
+            if self.state.last_bucket is None and self._cameras_read < self._first_arrival[b]:
+                self._refresh_cameras(force=True)    # the map's first bucket: every camera registered by now
+            if live is None:
+                live = self._live_cameras()
+            # Complete when each live camera's next frame falls after the bucket.
+            missing = [c for c in live if self._latest.get(c, -1e18) + 1.0 / self._cameras.get(c, 10.0) < end - 1e-6]
+            if missing and (self.clock() - self._first_arrival[b] < self.cfg.max_wait_s or self._waits_for(missing)):
+                break
             if renew and not self._still_holding():
                 break
             if not self._write_bucket(b, self._buckets.pop(b)):
@@ -331,6 +337,15 @@ class FusionRole:
             self._first_arrival.pop(b, None)
             written += 1
         return written
+
+    def _waits_for(self, missing: list[str]) -> bool:
+        """Past ``max_wait_s``: does the bucket still wait for these cameras? Yes for a batch worker's
+        (files read as fast as it can, :attr:`MapLink.lockstep`) while its lease lives: a bucket
+        written without its report would make the record depend on the machine's load (the report
+        dropped as late, the other workers reading a map without it); a dead worker's lease lapses
+        within ``lease_s``. A live camera is not waited for (a slow worker delays only itself)."""
+        self._refresh_cameras(force=True)       # a batch flag registered since the last read
+        return any(c in self._batch for c in missing)
 
     def _write_bucket(self, b: int, observations: list[Observation]) -> bool:
         """Fuse bucket ``b`` and write it, fenced by the lease. False when not written: the lease is

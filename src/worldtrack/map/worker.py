@@ -87,8 +87,11 @@ class MapLink:
         #: Batch runs (files not played in real time): before each step wait (at most
         #: ``lockstep_wait_s``) until the map holds the previous frame, so that workers going at
         #: different speeds stay in step and none reads a map from its own future.
+        #: The fusion waits for a batch worker's report of each bucket however late it comes (while
+        #: its lease lives, :meth:`FusionRole._waits_for`), so the wait here is long too: a worker
+        #: that went on without the bucket would read a map that depends on the machine's load.
         self.lockstep = False
-        self.lockstep_wait_s = 2.0
+        self.lockstep_wait_s = 60.0
         self._first_t: float | None = None
         self._prev_t: float | None = None
         #: The end (s) of the last complete bucket of the map (every live camera's report in).
@@ -97,9 +100,10 @@ class MapLink:
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
-        """Tell the fusion about this worker's cameras (and their frame rate)."""
-        self.client.hset(self.keys.cameras, mapping={c: json.dumps({"fps": self.fps, "worker": self.name})
-                                                    for c in self.cameras})
+        """Tell the fusion about this worker's cameras (their frame rate; ``lockstep``: a batch run,
+        whose reports the fusion waits for however late they come)."""
+        info = {"fps": self.fps, "worker": self.name} | ({"lockstep": True} if self.lockstep else {})
+        self.client.hset(self.keys.cameras, mapping={c: json.dumps(info) for c in self.cameras})
 
     def epoch(self, lead_s: float = 0.5, wait: bool = False, poll_s: float = 0.05) -> float:
         """The map's epoch: when video files played as cameras have their frame 0. Set by the first
