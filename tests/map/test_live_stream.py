@@ -93,16 +93,8 @@ def test_an_http_stream_is_read_live_and_reconnected_after_the_server_restarts(t
     url = f"http://127.0.0.1:{port}/west.ts"
     server = _serve_http(two_rooms / "west.mp4", port, 0.0, 3.0)
     grabber = Grabber("west", url, backoff_s=(0.25, 1.0))
-    frames, taken = [], -1
-
-    def take(seconds: float) -> None:
-        nonlocal taken
-        end = time.time() + seconds
-        while time.time() < end:
-            item = grabber.newest(taken, timeout=0.2)
-            if item is not None:
-                taken = item[1]
-                frames.append((time.time(), *item))
+    frames: list = []
+    take = _taker(grabber, frames)
     try:
         time.sleep(0.5)                                           # the server listens
         grabber.start()
@@ -165,16 +157,8 @@ def test_an_rtsp_camera_is_read_live_and_reconnected_after_the_server_restarts(t
     port = _tcp_port()
     server = _serve_rtsp(python, movie, port, tmp_path)
     grabber = Grabber("west", f"rtsp://127.0.0.1:{port}/west", backoff_s=(0.25, 1.0))
-    frames, taken = [], -1
-
-    def take(seconds: float) -> None:
-        nonlocal taken
-        end = time.time() + seconds
-        while time.time() < end:
-            item = grabber.newest(taken, timeout=0.2)
-            if item is not None:
-                taken = item[1]
-                frames.append((time.time(), *item))
+    frames: list = []
+    take = _taker(grabber, frames)
     try:
         grabber.start()
         take(3.0)
@@ -212,3 +196,19 @@ def test_a_stream_url_without_ffmpeg_in_opencv_is_one_clear_error(monkeypatch):
     with pytest.raises(InputError, match=r"^cam1: rtsp://127.0.0.1:8554/x: this OpenCV .* without FFmpeg"):
         Grabber("cam1", "rtsp://127.0.0.1:8554/x")
     Grabber("cam2", 0)         # a device index does not need FFmpeg (not started: no camera here)
+
+
+def _taker(grabber, frames: list):
+    """``take(seconds)``: append every new frame ``grabber`` hands over for that long to ``frames``, as
+    (arrival time, *the grabber's item)."""
+    taken = -1
+
+    def take(seconds: float) -> None:
+        nonlocal taken
+        end = time.time() + seconds
+        while time.time() < end:
+            item = grabber.newest(taken, timeout=0.2)
+            if item is not None:
+                taken = item[1]
+                frames.append((time.time(), *item))
+    return take
