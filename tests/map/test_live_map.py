@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import time
+from contextlib import contextmanager
 
 from _mapkit import wait_until
 from worldtrack.map.config import MapConfig
@@ -29,6 +30,20 @@ def _live_people(client, keys) -> dict[int, tuple[float, str]]:
     return {p.id: (p.x, p.mode) for p in state.people}
 
 
+@contextmanager
+def _fusing(client, keys, cfg):
+    """The fusion role running in a thread of this process (stopped on leaving); yields the middle
+    of the bucket now beginning (s), the time to publish the first observations at."""
+    role = FusionRole(client, keys, cfg, "fuser")
+    thread, stop = run_fusion_thread(role)
+    try:
+        wait_until(lambda: role.holding, 10, what="the fusion role")
+        yield (bucket_index(time.time(), cfg.bucket_s) + 0.5) * cfg.bucket_s
+    finally:
+        stop.set()
+        thread.join(10)
+
+
 def test_a_slow_worker_delays_only_its_own_people(redis_url):
     client = connect(redis_url)
     keys, cfg = MapKeys(), MapConfig(max_wait_s=3.0)
@@ -37,11 +52,7 @@ def test_a_slow_worker_delays_only_its_own_people(redis_url):
         client.set(keys.camera_lease(cam), f"w-{cam}", px=30000)
     updates = client.pubsub(ignore_subscribe_messages=True)
     updates.subscribe(keys.updates)
-    role = FusionRole(client, keys, cfg, "fuser")
-    thread, stop = run_fusion_thread(role)
-    try:
-        wait_until(lambda: role.holding, 10, what="the fusion role")
-        t0 = (bucket_index(time.time(), cfg.bucket_s) + 0.5) * cfg.bucket_s
+    with _fusing(client, keys, cfg) as t0:
         _publish(client, keys, "fast", t0, 1, 2.0)
         _publish(client, keys, "slow", t0, 2, 6.0)
         wait_until(lambda: client.xlen(keys.map_stream) == 1, 10, what="the first complete bucket")
@@ -62,9 +73,6 @@ def test_a_slow_worker_delays_only_its_own_people(redis_url):
         wait_until(lambda: client.xlen(keys.map_stream) == 2, 2.0, what="the second complete bucket")
         last = decode_map_state(client.xrevrange(keys.map_stream, count=1)[0][1])
         assert {p.id: p.x for p in last.present()} == {1: 2.1, 2: 6.1}
-    finally:
-        stop.set()
-        thread.join(10)
     print(f"the fast worker's report was on the live map {took * 1000:.0f} ms after it was published")
     assert took < 1.0
 
@@ -81,11 +89,7 @@ def test_a_bucket_waits_for_a_batch_workers_report_past_max_wait_s(redis_url):
         link.lockstep = batch                   # as `worldtrack track` sets it (map.pace_files=false, files)
         link.register()
         client.set(keys.camera_lease(cam), f"w-{cam}", px=30000)
-    role = FusionRole(client, keys, cfg, "fuser")
-    thread, stop = run_fusion_thread(role)
-    try:
-        wait_until(lambda: role.holding, 10, what="the fusion role")
-        t0 = (bucket_index(time.time(), cfg.bucket_s) + 0.5) * cfg.bucket_s
+    with _fusing(client, keys, cfg) as t0:
         _publish(client, keys, "first", t0, 1, 2.0)
         _publish(client, keys, "live", t0, 3, 9.0)
         time.sleep(5 * cfg.max_wait_s)
@@ -105,6 +109,3 @@ def test_a_bucket_waits_for_a_batch_workers_report_past_max_wait_s(redis_url):
         assert client.xlen(keys.map_stream) == 2
         client.delete(keys.camera_lease("late"))
         wait_until(lambda: client.xlen(keys.map_stream) == 3, 5.0, what="the bucket after the lease lapsed")
-    finally:
-        stop.set()
-        thread.join(10)

@@ -145,13 +145,20 @@ class PIDFollower:
         s["t"] = t
         v = float(np.clip(v, -self.robot.max_reverse, self.robot.max_speed))
         w = float(np.clip(w, -self.robot.max_turn_rate, self.robot.max_turn_rate))
-        limit = self._speed_limit(step, pos, fwd, dt if dt > 0 else 0.1)
+        limit = self._forward_limit(step, camera, w, t, dt if dt > 0 else 0.1, frame, scan)
+        s["blocked"] = bool(limit < v)
+        return min(v, limit), w
+
+    def _forward_limit(self, step, camera: Camera, w: float, t: float, dt: float, frame, scan,
+                       with_target: bool = True) -> float:
+        """The largest forward speed (m/s) every safety rule allows: the path check, then people's
+        velocities (``walkers``) and near depth points or scan points (``depth_stop``)."""
+        limit = self._speed_limit(step, camera.centre[:2], camera.floor_direction, dt, with_target=with_target)
         if self.walkers:
             limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
         if self.depth_stop and (frame is not None or scan is not None):
-            limit = min(limit, self._depth_limit(frame, camera, w, dt if dt > 0 else 0.1, scan))
-        s["blocked"] = bool(limit < v)
-        return min(v, limit), w
+            limit = min(limit, self._depth_limit(frame, camera, w, dt, scan))
+        return limit
 
     def _lost_reset(self, t: float) -> None:
         """Clear the PID's state (integrals, derivatives) but what the search needs."""
@@ -185,11 +192,7 @@ class PIDFollower:
         if abs(bearing) < np.radians(20.0):      # facing it (the camera sees the way): drive
             ahead = np.hypot(*(goal - pos)) - 0.5 * self.arrive       # slowing down to stop inside ``arrive``
             v = float(np.clip(self.distance_gains[0] * ahead, 0.0, self.pursue_speed))
-            limit = self._speed_limit(step, pos, fwd, 0.1, with_target=False)
-            if self.walkers:
-                limit = min(limit, self._walkers_limit(step, camera, w, t, scan))
-            if self.depth_stop and (frame is not None or scan is not None):
-                limit = min(limit, self._depth_limit(frame, camera, w, 0.1, scan))
+            limit = self._forward_limit(step, camera, w, t, 0.1, frame, scan, with_target=False)
         self._state["blocked"] = bool(limit < v)
         return min(v, limit), w
 
