@@ -214,6 +214,7 @@ def main() -> None:
     methods = {"PF1LM10 colour+depth λ=0.9": TrackerConfig(), "PF1LM10 colour+depth λ=0.3": TrackerConfig(lam=0.3),
                "PF1LM10 colour+depth λ from noise": TrackerConfig(depth_weight="noise"),
                "PF1LM10 colour+depth λ kernel-weighted": TrackerConfig(depth_weight="kernel"),
+               "PF1LM10 colour+depth λ sandwich-weighted": TrackerConfig(depth_weight="sandwich"),
                "PF1LM10 colour only": TrackerConfig(lam=0.0), "PF1LM0 colour+depth λ=0.9": TrackerConfig(lm_iterations=0),
                "KLT+PnP": None}
     rows, first, seed0 = [], None, {}
