@@ -70,7 +70,7 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=60)
     ap.add_argument("--configs", default="PF1LM0,PF1LM15,PF2LM0,PF2LM50")
     ap.add_argument("--tag", default="", help="suffix of the results file name (parallel runs)")
-    ap.add_argument("--depth-weight", default="fixed", choices=("fixed", "noise", "kernel"),
+    ap.add_argument("--depth-weight", default="fixed", choices=("fixed", "noise", "kernel", "sandwich"),
                     help="λ fixed (the paper's 0.9) or from the terms' measured noise")
     ap.add_argument("--quick", action="store_true")
     a = ap.parse_args()

@@ -208,3 +208,39 @@ def constant_transform_check(grid: np.ndarray, cMo0: np.ndarray, estimate: np.nd
         deg = np.degrees(np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1)))
         out[name] = (mm, deg)
     return out
+
+
+def visible_face_points(half: float, per_side: int = 15) -> tuple[np.ndarray, np.ndarray]:
+    """A grid of ``per_side``² points on each of a cube's six faces (object frame, m; 80 % of each
+    face, away from the edges where depth mixes cube and table) and their outward normals."""
+    g = np.linspace(-0.8, 0.8, per_side) * half
+    a, b = (v.ravel() for v in np.meshgrid(g, g))
+    pts, nrm = [], []
+    for axis in range(3):
+        others = [i for i in range(3) if i != axis]
+        for sign in (-1.0, 1.0):
+            X = np.zeros((len(a), 3))
+            X[:, axis], X[:, others[0]], X[:, others[1]] = sign * half, a, b
+            pts.append(X)
+            nrm.append(np.tile(np.eye(3)[axis] * sign, (len(a), 1)))
+    return np.concatenate(pts), np.concatenate(nrm)
+
+
+def depth_disagreement(K: np.ndarray, poses: np.ndarray, depths: list, half: float) -> np.ndarray:
+    """How far each cube pose is from what the depth sensor measures — a check that sees no tag and
+    no colour. Per frame (T,): the median |measured − predicted depth| (mm) over points on the
+    faces the pose shows the camera, after removing the sensor's offset at the cube (the median
+    difference at frame 0's pose, as the tracker learns it). NaN where the pose is NaN."""
+    X, N = visible_face_points(half)
+
+    def differences(M, depth):
+        P, n = X @ M[:3, :3].T + M[:3, 3], N @ M[:3, :3].T
+        P = P[np.einsum("ij,ij->i", n, -P) > 0]
+        uv = np.round(P @ K.T[:, :2] / P[:, 2:]).astype(int)
+        ok = (uv[:, 0] >= 0) & (uv[:, 0] < depth.shape[1]) & (uv[:, 1] >= 0) & (uv[:, 1] < depth.shape[0])
+        z = depth[uv[ok, 1], uv[ok, 0]]
+        return (z - P[ok, 2])[z > 0]
+
+    offset = float(np.median(differences(poses[0], depths[0])))
+    return np.array([1000 * np.median(np.abs(differences(M, d) - offset)) if np.isfinite(M).all() else np.nan
+                     for M, d in zip(poses, depths)])

@@ -4,25 +4,14 @@ import numpy as np
 import pytest
 
 from worldtrack.errors import InputError
-from worldtrack.pose.measures import rotation_error_deg
 from scipy import integrate
 
 from worldtrack.pose.noise_weight import (KernelWeightedLam, NoiseWeightedLam, inverse_variance_lam, kernel_weight,
                                           term_spreads)
 from worldtrack.pose.tracker import RigidTracker, TrackerConfig
-from worldtrack.synth.faces import face_model, face_sequence, make_face
+from worldtrack.synth.faces import face_model
 
 
-@pytest.fixture(scope="module")
-def rgbd_face():
-    face = make_face(3)
-    seq = face_sequence(face, "sim1", seed=5, n_frames=10)
-    return face, seq, list(seq.frames())
-
-
-def noisy(depth: np.ndarray, sigma_m: float, seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    return np.where(depth > 0, depth + rng.normal(0, sigma_m, depth.shape), 0).astype(np.float32)
 
 
 def test_inverse_variance_lam_and_its_running_median():
@@ -62,7 +51,7 @@ def test_kernel_weight_is_the_godambe_weight_of_geman_mcclure():
     assert w.lam == pytest.approx(2.0 / 3.0)
 
 
-def test_measured_depth_spread_follows_the_noise_set(rgbd_face):
+def test_measured_depth_spread_follows_the_noise_set(rgbd_face, noisy):
     """At the true pose, the depth spread in units of c′ is the depth noise σ / c′ (read at the
     nearest pixel: bilinear reading would average the pixels' independent noise)."""
     face, seq, frames = rgbd_face
@@ -80,20 +69,15 @@ def test_measured_depth_spread_follows_the_noise_set(rgbd_face):
     assert lams[0] > lams[1] > lams[2]                                    # noisier depth, less weight
 
 
-def test_noise_weighted_tracking_is_no_worse_at_the_fixed_weights_noise(rgbd_face):
+def test_noise_weighted_tracking_is_no_worse_at_the_fixed_weights_noise(track_rgbd_face):
     """Depth as in the paper's simulation (quantised, no added noise — what λ = 0.9 was chosen for):
     λ from the noise, and from the kernel weight, rises above 0.85 and tracks at least as well. With
     10 mm noise the inverse-variance λ gives the depth little weight and the kernel weight more
     (Geman–McClure's flat part already discounts large differences), and it tracks better than the
     inverse-variance λ there."""
-    face, seq, frames = rgbd_face
-    errors, lam = {}, {}
-    for mode in ("fixed", "noise", "kernel"):
-        for sigma in (0.0, 0.010):
-            tr = RigidTracker(face_model(face), seq.intr, frames[0].R, frames[0].t,
-                              TrackerConfig(depth_weight=mode, seed=1), cost="colour-depth")
-            e = [rotation_error_deg(f.R, tr.step(f.image, noisy(f.depth, sigma, k)).R) for k, f in enumerate(frames[1:])]
-            errors[mode, sigma], lam[mode, sigma] = float(np.mean(e)), tr.noise.lam
+    runs = {(mode, sigma): track_rgbd_face(mode, sigma) for mode in ("fixed", "noise", "kernel") for sigma in (0.0, 0.010)}
+    errors = {k: v[0] for k, v in runs.items()}
+    lam = {k: v[1].lam for k, v in runs.items()}
     assert lam["noise", 0.0] > 0.85 and lam["noise", 0.010] < 0.3
     assert lam["kernel", 0.0] > 0.85 and 2 * lam["noise", 0.010] < lam["kernel", 0.010] < 0.5
     for mode in ("noise", "kernel"):

@@ -44,9 +44,10 @@ class BodyConfig:
     arm's shoulder (θs, φs) and elbow (θe, φe), degrees; pf : "cascade" (torso → right arm → left
     arm, the paper's) or "joint" (all 14 at once); depth_sampling : "bilinear" (on one surface) or
     "nearest" pixel (see :class:`~worldtrack.pose.cost.ColourDepthCost`); depth_weight : "fixed"
-    (λ = ``lam``, the paper's), "noise" (λ from the two terms' measured spreads) or "kernel" (from
+    (λ = ``lam``, the paper's), "noise" (λ from the two terms' measured spreads), "kernel" (from
     each term's robust-kernel weight; :mod:`~worldtrack.pose.noise_weight`, over the last
-    ``noise_window`` frames)
+    ``noise_window`` frames) or "sandwich" (that weight over the score's design effect, each term
+    at its own fit; :mod:`~worldtrack.pose.sandwich_weight`)
     """
 
     stages: int = 1

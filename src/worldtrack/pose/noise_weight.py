@@ -29,7 +29,8 @@ faces 2/3/4/6/7 it is better at 3 mm on three of five (the other two within 0.07
 is better on one only and loses faces 2 and 4 (λ → 0.04–0.05; face 7: λ → 0, 8.8°): the colour
 differences of a face under changing light are not independent noise (one smooth shading error),
 so the weight over-trusts colour; and a drifting pose inflates the depth differences it is
-measured on, which lowers λ further. Real cube
+measured on, which lowers λ further (``"sandwich"``, :mod:`~worldtrack.pose.sandwich_weight`,
+answers both: a design effect for correlated differences, each term measured at its own fit). Real cube
 (``benchmarks/pose_cube.py``, 5 seeds): inverse variance λ → 0.003–0.006, worse than λ = 0.9 in
 median mm against the data's board truth; the kernel weight λ → 0.015–0.02, better than λ = 0.9
 against every truth of the benchmark. Body (held-out seed 3): both level with λ = 0.9.
@@ -174,16 +175,17 @@ class FixedLam:
         """Nothing to learn: a fixed λ."""
 
 
-def depth_share(mode: str, lam: float, window: int) -> FixedLam | NoiseWeightedLam | KernelWeightedLam:
+def depth_share(mode: str, lam: float, window: int) -> FixedLam | MeasuredLam:
     """The trackers' λ source for ``depth_weight`` ``mode``: "fixed" (``lam``), "noise" (inverse
-    variance) or "kernel" (:func:`kernel_weight`).
+    variance), "kernel" (:func:`kernel_weight`) or "sandwich" (the kernel weight over the score's
+    design effect, each term at its own fit: :mod:`worldtrack.pose.sandwich_weight`).
 
     >>> depth_share("fixed", 0.9, 10).lam
     0.9
     >>> depth_share("learnt", 0.9, 10)
     Traceback (most recent call last):
     ...
-    worldtrack.errors.InputError: depth_weight: expected fixed, noise or kernel, got 'learnt'
+    worldtrack.errors.InputError: depth_weight: expected fixed, noise, kernel or sandwich, got 'learnt'
     """
     if mode == "fixed":
         return FixedLam(lam)
@@ -191,4 +193,7 @@ def depth_share(mode: str, lam: float, window: int) -> FixedLam | NoiseWeightedL
         return NoiseWeightedLam(lam, window)
     if mode == "kernel":
         return KernelWeightedLam(lam, window)
-    raise InputError(f"depth_weight: expected fixed, noise or kernel, got {mode!r}")
+    if mode == "sandwich":
+        from worldtrack.pose.sandwich_weight import SandwichWeightedLam   # it builds on this module
+        return SandwichWeightedLam(lam, window)
+    raise InputError(f"depth_weight: expected fixed, noise, kernel or sandwich, got {mode!r}")

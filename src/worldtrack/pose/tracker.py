@@ -51,7 +51,9 @@ class TrackerConfig:
         differences' measured spreads, inverse-variance (:mod:`~worldtrack.pose.noise_weight`;
         ``lam`` until a frame is accepted, then the median spread over the last ``noise_window`` frames);
         "kernel" — λ from each term's Geman–McClure curvature over its gradient's variance, measured
-        on the same differences (:func:`~worldtrack.pose.noise_weight.kernel_weight`)
+        on the same differences (:func:`~worldtrack.pose.noise_weight.kernel_weight`); "sandwich" — the
+        kernel weight over the pose score's design effect (correlated differences), each term
+        measured at its own fit (:mod:`~worldtrack.pose.sandwich_weight`)
     jacobian : "analytic" (eq. 10, eigen cost only) or "numeric" (central differences, eq. 20)
     pf_points : rank the particle filter's candidates on only the strongest ``pf_points`` template
         points (LM then uses them all; worldtrack's default 256, for speed); None: all, as the paper
