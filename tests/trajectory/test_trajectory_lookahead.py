@@ -171,3 +171,20 @@ def test_a_state_takes_the_least_share_of_the_samples_on_both_its_curves():
     shares = state_shares(X, delta, Barrier(field, clearance=0.2), 0.5)   # samples: the states only
     # the curve 1 → 2 is sampled at state 1 (its start) and state 2 (the last state): both take the least
     np.testing.assert_allclose(shares, [own[0], own[1], own[1]], atol=1e-12)
+
+
+def test_traces_from_the_linearisations_distances_equal_traces_that_look_them_up(office_person):
+    """The solver hands the look-ahead the distances its linearisation has at the samples: the same shares."""
+    from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment
+    from worldtrack.trajectory.model import TimeGrid
+    from worldtrack.trajectory.objective import Problem, linearise
+    from worldtrack.trajectory.starts import straight_start
+    obs, field, height = office_person
+    grid = TimeGrid.covering(obs.time, 0.1)
+    problem = Problem.build(obs, grid, TrajectoryOptions().motion, build_environment(TrajectoryOptions(), field, 0.1))
+    X = straight_start(problem.observations, grid, height)
+    delta = np.random.default_rng(3).normal(scale=0.8, size=X.shape)
+    barrier = problem.environment.barrier
+    looked_up = state_shares(X, delta, barrier, 0.1)
+    assert 0.1 < np.mean(looked_up < 1) < 0.9
+    np.testing.assert_array_equal(state_shares(X, delta, barrier, 0.1, linearise(problem, X).barrier_d), looked_up)
