@@ -49,6 +49,16 @@ def test_a_move_stops_short_of_the_clearance_of_a_wall():
     np.testing.assert_allclose(alpha[1:], [1.0, 1.0, 0.0, 1.0], atol=1e-12)
 
 
+def test_a_move_the_first_stride_covers_is_whole_only_if_the_steepest_field_keeps_it_clear():
+    """The end of a move within 0.7·(d − floor) is not looked up: still right where the field falls at 1.4 m/m
+    (a bilinear distance field's steepest, √2, along a diagonal), and a move beyond that is traced."""
+    field = _field(lambda x: 1.4 * (3.0 - x))                  # d = 2.8 at x = 1, floor 0.2 at x = 2.857 m
+    xy = np.array([[1.0, 1.0], [1.0, 1.0]])
+    alpha = _shares(field, xy, np.array([[1.8, 0.0], [2.4, 0.0]]))
+    assert alpha[0] == 1.0                                     # 1.8 ≤ 0.7·2.6 m: whole, and 2.8 m keeps d = 0.28
+    assert 1.0 + 2.4 * alpha[1] <= 2.86                        # 2.4 m (within d − floor = 2.6) is stopped
+
+
 def test_the_compiled_trace_equals_its_reference_and_never_passes_an_obstacle(office_person):
     _, field, _ = office_person
     rng = np.random.default_rng(11)
