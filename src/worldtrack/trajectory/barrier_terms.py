@@ -5,7 +5,7 @@ row (M, 12), which :func:`~worldtrack.trajectory.kernels.add_pair_terms` then ad
 T = 10 000 that is ~20 000 samples and a 1.9 MB Jacobian written and read back once per linearisation
 (34j profile: the two passes 1.7 ms of a 4.1 ms linearisation). Here each sample's row lives in a
 12-entry buffer and goes into the blocks at once: the same arithmetic in the same order (the sample
-by :func:`~worldtrack.trajectory.kernels.barrier_point`, the blocks as ``add_pair_terms``), so the
+by :func:`~worldtrack.trajectory.kernels.barrier_point`, the blocks by ``add_pair_row``, as ``add_pair_terms``), so the
 same numbers bit for bit; the two passes stay as its reference, and the test compares them.
 
 The residuals r (M,) and distances d (M,) are still returned: the cost is ``r @ r`` as before, and d
@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from worldtrack.trajectory.kernels import STATE, barrier_point
+from worldtrack.trajectory.kernels import STATE, add_pair_row, barrier_point
 
 
 class Hinge(NamedTuple):
@@ -54,21 +54,5 @@ def add_barrier_terms(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: fl
         r[m], d[m] = rm, dm
         if dm < hinge.clearance:
             inside_steps[t] = True
-        if rm == 0.0:                  # beyond the barrier's reach: nothing to add
-            continue
-        for i in range(2 * STATE):
-            ji = row[i]
-            if ji == 0.0:
-                continue
-            if i < STATE:
-                g[t, i] += ji * rm
-            else:
-                g[t + 1, i - STATE] += ji * rm
-            for j in range(2 * STATE):
-                v = w * ji * row[j]
-                if i < STATE and j < STATE:
-                    D[t, i, j] += v
-                elif i >= STATE and j >= STATE:
-                    D[t + 1, i - STATE, j - STATE] += v
-                elif i < STATE:
-                    B[t, i, j - STATE] += v
+        if rm != 0.0:                  # r = 0: beyond the barrier's reach, nothing to add
+            add_pair_row(D, B, g, t, row, rm, w)

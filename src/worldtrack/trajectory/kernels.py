@@ -62,26 +62,30 @@ def add_pair_terms(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray
     """In place: residuals r (M,) with Jacobians J (M, 12) on (x_t, x_{t+1}), t = step, added into
     the diagonal blocks D and upper blocks B (as weight·JᵀJ) and the half-gradient g (as Jᵀr)."""
     for m in range(step.shape[0]):
-        if r[m] == 0.0:                # a sample left out (beyond the barrier's reach): nothing to add
+        if r[m] != 0.0:                # r = 0: a sample left out (beyond the barrier's reach)
+            add_pair_row(D, B, g, step[m], J[m], r[m], weight[m])
+
+
+@njit(cache=True, inline="always")
+def add_pair_row(D: np.ndarray, B: np.ndarray, g: np.ndarray, t: int, row: np.ndarray, r: float,
+                 w: float) -> None:  # pragma: no cover (compiled)
+    """In place: one residual r with Jacobian ``row`` (12,) on (x_t, x_{t+1}) into D, B (as w·JᵀJ) and g (Jᵀr)."""
+    for i in range(2 * STATE):
+        ji = row[i]
+        if ji == 0.0:
             continue
-        t = step[m]
-        w = weight[m]
-        for i in range(2 * STATE):
-            ji = J[m, i]
-            if ji == 0.0:
-                continue
-            if i < STATE:
-                g[t, i] += ji * r[m]
-            else:
-                g[t + 1, i - STATE] += ji * r[m]
-            for j in range(2 * STATE):
-                v = w * ji * J[m, j]
-                if i < STATE and j < STATE:
-                    D[t, i, j] += v
-                elif i >= STATE and j >= STATE:
-                    D[t + 1, i - STATE, j - STATE] += v
-                elif i < STATE:
-                    B[t, i, j - STATE] += v
+        if i < STATE:
+            g[t, i] += ji * r
+        else:
+            g[t + 1, i - STATE] += ji * r
+        for j in range(2 * STATE):
+            v = w * ji * row[j]
+            if i < STATE and j < STATE:
+                D[t, i, j] += v
+            elif i >= STATE and j >= STATE:
+                D[t + 1, i - STATE, j - STATE] += v
+            elif i < STATE:
+                B[t, i, j - STATE] += v
 
 
 def add_pair_terms_reference(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray, J: np.ndarray,
@@ -262,20 +266,13 @@ def barrier_point(X: np.ndarray, t: int, a: float, dt: float, values: np.ndarray
     """One barrier sample: the Hermite point of (x_t, x_{t+1}) at α = a, its bilinear distance and gradient
     (extrapolated outside the grid), the rounded hinge r; its Jacobian on (x_t, x_{t+1}) written into
     ``row`` (12,); returns (r, d, curvature factor)."""
-    ny, nx = values.shape
     h0 = 2 * a ** 3 - 3 * a ** 2 + 1
     h1 = (a ** 3 - 2 * a ** 2 + a) * dt
     h2 = -2 * a ** 3 + 3 * a ** 2
     h3 = (a ** 3 - a ** 2) * dt
     px = h0 * X[t, 0] + h1 * X[t, 1] + h2 * X[t + 1, 0] + h3 * X[t + 1, 1]
     py = h0 * X[t, 2] + h1 * X[t, 3] + h2 * X[t + 1, 2] + h3 * X[t + 1, 3]
-    cx = min(max(px, origin[0]), origin[0] + res * (nx - 1))
-    cy = min(max(py, origin[1]), origin[1] + res * (ny - 1))
-    fi = (cx - origin[0]) / res
-    fj = (cy - origin[1]) / res
-    i0 = min(int(fi), nx - 2)
-    j0 = min(int(fj), ny - 2)
-    u, v = fi - i0, fj - j0
+    cx, cy, i0, j0, u, v = grid_cell(values, origin, res, px, py)
     v00, v01 = values[j0, i0], values[j0, i0 + 1]
     v10, v11 = values[j0 + 1, i0], values[j0 + 1, i0 + 1]
     d = (1 - u) * (1 - v) * v00 + u * (1 - v) * v01 + (1 - u) * v * v10 + u * v * v11
@@ -301,11 +298,10 @@ def barrier_point(X: np.ndarray, t: int, a: float, dt: float, values: np.ndarray
     return r, d, 1.0 + r * (1.0 - sig) / (gain * softness * sig)
 
 
-@njit(cache=True)
-def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float) -> float:  # pragma: no cover
-    """The value d of ``environment.sample_field`` at one floor point (x, y) without its gradient: bilinear on
-    the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus the distance to it.
-    The same arithmetic in the same order."""
+@njit(cache=True, inline="always")
+def grid_cell(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float):  # pragma: no cover
+    """The bilinear cell of the floor point (x, y) on the grid ``values[j, i]`` at origin + (i, j)·res: the point
+    clamped to the grid (cx, cy), the cell's corner (i0, j0) and the fractions (u, v) within it."""
     ny, nx = values.shape
     cx = min(max(x, origin[0]), origin[0] + res * (nx - 1))
     cy = min(max(y, origin[1]), origin[1] + res * (ny - 1))
@@ -313,7 +309,15 @@ def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y:
     fj = (cy - origin[1]) / res
     i0 = min(int(fi), nx - 2)
     j0 = min(int(fj), ny - 2)
-    a, b = fi - i0, fj - j0
+    return cx, cy, i0, j0, fi - i0, fj - j0
+
+
+@njit(cache=True)
+def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float) -> float:  # pragma: no cover
+    """The value d of ``environment.sample_field`` at one floor point (x, y) without its gradient: bilinear on
+    the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus the distance to it.
+    The same arithmetic in the same order."""
+    cx, cy, i0, j0, a, b = grid_cell(values, origin, res, x, y)
     d = ((1 - a) * (1 - b) * values[j0, i0] + a * (1 - b) * values[j0, i0 + 1]
          + (1 - a) * b * values[j0 + 1, i0] + a * b * values[j0 + 1, i0 + 1])
     gap = np.hypot(cx - x, cy - y)
