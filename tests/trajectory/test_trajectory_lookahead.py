@@ -49,6 +49,16 @@ def test_a_move_stops_short_of_the_clearance_of_a_wall():
     np.testing.assert_allclose(alpha[1:], [1.0, 1.0, 0.0, 1.0], atol=1e-12)
 
 
+def test_a_move_the_first_stride_covers_is_whole_only_if_the_steepest_field_keeps_it_clear():
+    """The end of a move within 0.7·(d − floor) is not looked up: still right where the field falls at 1.4 m/m
+    (a bilinear distance field's steepest, √2, along a diagonal), and a move beyond that is traced."""
+    field = _field(lambda x: 1.4 * (3.0 - x))                  # d = 2.8 at x = 1, floor 0.2 at x = 2.857 m
+    xy = np.array([[1.0, 1.0], [1.0, 1.0]])
+    alpha = _shares(field, xy, np.array([[1.8, 0.0], [2.4, 0.0]]))
+    assert alpha[0] == 1.0                                     # 1.8 ≤ 0.7·2.6 m: whole, and 2.8 m keeps d = 0.28
+    assert 1.0 + 2.4 * alpha[1] <= 2.86                        # 2.4 m (within d − floor = 2.6) is stopped
+
+
 def test_the_compiled_trace_equals_its_reference_and_never_passes_an_obstacle(office_person):
     _, field, _ = office_person
     rng = np.random.default_rng(11)
@@ -171,3 +181,20 @@ def test_a_state_takes_the_least_share_of_the_samples_on_both_its_curves():
     shares = state_shares(X, delta, Barrier(field, clearance=0.2), 0.5)   # samples: the states only
     # the curve 1 → 2 is sampled at state 1 (its start) and state 2 (the last state): both take the least
     np.testing.assert_allclose(shares, [own[0], own[1], own[1]], atol=1e-12)
+
+
+def test_traces_from_the_linearisations_distances_equal_traces_that_look_them_up(office_person):
+    """The solver hands the look-ahead the distances its linearisation has at the samples: the same shares."""
+    from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment
+    from worldtrack.trajectory.model import TimeGrid
+    from worldtrack.trajectory.objective import Problem, linearise
+    from worldtrack.trajectory.starts import straight_start
+    obs, field, height = office_person
+    grid = TimeGrid.covering(obs.time, 0.1)
+    problem = Problem.build(obs, grid, TrajectoryOptions().motion, build_environment(TrajectoryOptions(), field, 0.1))
+    X = straight_start(problem.observations, grid, height)
+    delta = np.random.default_rng(3).normal(scale=0.8, size=X.shape)
+    barrier = problem.environment.barrier
+    looked_up = state_shares(X, delta, barrier, 0.1)
+    assert 0.1 < np.mean(looked_up < 1) < 0.9
+    np.testing.assert_array_equal(state_shares(X, delta, barrier, 0.1, linearise(problem, X).barrier_d), looked_up)

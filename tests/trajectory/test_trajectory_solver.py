@@ -194,3 +194,36 @@ def test_uncertainty_is_small_in_view_and_large_between_views():
     assert sigma_x[seen].max() < 0.02 and sigma_x[~seen].max() > 10 * sigma_x[seen].max()
     mid = np.argmax(sigma_x)
     assert not seen[mid] and abs(mid - len(sigma_x) / 2) < 0.15 * len(sigma_x)
+
+
+def test_the_one_pass_barrier_kernel_equals_the_samples_and_the_scatter(walk_with_wall):
+    """``barrier_terms.add_barrier_terms`` (the solver's) against ``barrier_samples`` + ``add_pair_terms``
+    (its reference, each tested against NumPy): the same numbers bit for bit, near the block and beyond the grid."""
+    from worldtrack.trajectory.barrier_terms import Hinge, Normal, add_barrier_terms
+    problem = walk_with_wall.problem
+    env = problem.environment
+    b, f = env.barrier, env.barrier.field
+    X = straight_start(problem.observations, problem.grid, 1.7)
+    X[:, 2] += 0.3 * np.sin(np.arange(len(X)) / 9.0)
+    X[-8:, 0] += 4.0                                          # the last steps beyond the grid's edge at x = 4.95 m
+    step, alpha = b.samples(len(X))
+    gain = np.sqrt(env.weight / b.substeps) / b.scale
+    field = (f.values, np.asarray(f.origin, dtype=float), float(f.resolution))
+    r, J, d, curvature = kernels.barrier_samples(X, step, alpha, problem.grid.dt, *field, b.clearance, b.softness, gain)
+    assert np.sum(r > 0) > 20 and np.sum(r == 0) > 20 and np.sum(d < b.clearance) > 5 and d.min() < 0
+    rng = np.random.default_rng(5)
+    start = [rng.normal(size=(len(X), 6, 6)), rng.normal(size=(len(X) - 1, 6, 6)), rng.normal(size=(len(X), 6))]
+    two = [a.copy() for a in start]
+    kernels.add_pair_terms(*two, step, J, r, curvature)
+    one = Normal(*(a.copy() for a in start))
+    r1, d1, inside = np.empty(len(step)), np.empty(len(step)), np.zeros(len(X), dtype=bool)
+    add_barrier_terms(X, step, alpha, problem.grid.dt, *field, Hinge(b.clearance, b.softness, gain), one, r1, d1,
+                      inside)
+    for x, y in zip(one, two):
+        np.testing.assert_array_equal(x, y)
+    np.testing.assert_array_equal(r1, r)
+    np.testing.assert_array_equal(d1, d)
+    np.testing.assert_array_equal(inside, np.isin(np.arange(len(X)), step[d < b.clearance]))
+    lin = linearise(problem, X)                               # and the linearisation keeps them
+    np.testing.assert_array_equal(lin.barrier_d, d)
+    assert lin.costs.barrier == float(r @ r)

@@ -62,26 +62,30 @@ def add_pair_terms(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray
     """In place: residuals r (M,) with Jacobians J (M, 12) on (x_t, x_{t+1}), t = step, added into
     the diagonal blocks D and upper blocks B (as weight·JᵀJ) and the half-gradient g (as Jᵀr)."""
     for m in range(step.shape[0]):
-        if r[m] == 0.0:                # a sample left out (beyond the barrier's reach): nothing to add
+        if r[m] != 0.0:                # r = 0: a sample left out (beyond the barrier's reach)
+            add_pair_row(D, B, g, step[m], J[m], r[m], weight[m])
+
+
+@njit(cache=True, inline="always")
+def add_pair_row(D: np.ndarray, B: np.ndarray, g: np.ndarray, t: int, row: np.ndarray, r: float,
+                 w: float) -> None:  # pragma: no cover (compiled)
+    """In place: one residual r with Jacobian ``row`` (12,) on (x_t, x_{t+1}) into D, B (as w·JᵀJ) and g (Jᵀr)."""
+    for i in range(2 * STATE):
+        ji = row[i]
+        if ji == 0.0:
             continue
-        t = step[m]
-        w = weight[m]
-        for i in range(2 * STATE):
-            ji = J[m, i]
-            if ji == 0.0:
-                continue
-            if i < STATE:
-                g[t, i] += ji * r[m]
-            else:
-                g[t + 1, i - STATE] += ji * r[m]
-            for j in range(2 * STATE):
-                v = w * ji * J[m, j]
-                if i < STATE and j < STATE:
-                    D[t, i, j] += v
-                elif i >= STATE and j >= STATE:
-                    D[t + 1, i - STATE, j - STATE] += v
-                elif i < STATE:
-                    B[t, i, j - STATE] += v
+        if i < STATE:
+            g[t, i] += ji * r
+        else:
+            g[t + 1, i - STATE] += ji * r
+        for j in range(2 * STATE):
+            v = w * ji * row[j]
+            if i < STATE and j < STATE:
+                D[t, i, j] += v
+            elif i >= STATE and j >= STATE:
+                D[t + 1, i - STATE, j - STATE] += v
+            elif i < STATE:
+                B[t, i, j - STATE] += v
 
 
 def add_pair_terms_reference(D: np.ndarray, B: np.ndarray, g: np.ndarray, step: np.ndarray, J: np.ndarray,
@@ -243,66 +247,61 @@ def fill_banded_reference(D: np.ndarray, B: np.ndarray) -> np.ndarray:
 def barrier_samples(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: float, values: np.ndarray,
                     origin: np.ndarray, res: float, clearance: float, softness: float,
                     gain: float):  # pragma: no cover (compiled)
-    """The barrier at every sample in one pass (see ``environment.barrier_samples_reference``):
-    Hermite point of (x_t, x_{t+1}) at α, bilinear distance and gradient (extrapolated outside the
-    grid), rounded hinge r, its Jacobian J (M, 12), the distance d (M,) and the curvature factor."""
+    """The barrier at every sample (:func:`barrier_point`; see ``environment.barrier_samples_reference``):
+    the rounded hinge r (M,), its Jacobian J (M, 12), the distance d (M,) and the curvature factor (M,)."""
     m_count = step.shape[0]
-    ny, nx = values.shape
-    hi_x = origin[0] + res * (nx - 1)
-    hi_y = origin[1] + res * (ny - 1)
     r = np.empty(m_count)
-    J = np.empty((m_count, 2 * STATE))        # every entry written below (no separate pass to zero it)
+    J = np.empty((m_count, 2 * STATE))        # every entry written by barrier_point
     d_out = np.empty(m_count)
     curvature = np.empty(m_count)
     for m in range(m_count):
-        t, a = step[m], alpha[m]
-        h0 = 2 * a ** 3 - 3 * a ** 2 + 1
-        h1 = (a ** 3 - 2 * a ** 2 + a) * dt
-        h2 = -2 * a ** 3 + 3 * a ** 2
-        h3 = (a ** 3 - a ** 2) * dt
-        px = h0 * X[t, 0] + h1 * X[t, 1] + h2 * X[t + 1, 0] + h3 * X[t + 1, 1]
-        py = h0 * X[t, 2] + h1 * X[t, 3] + h2 * X[t + 1, 2] + h3 * X[t + 1, 3]
-        cx = min(max(px, origin[0]), hi_x)
-        cy = min(max(py, origin[1]), hi_y)
-        fi = (cx - origin[0]) / res
-        fj = (cy - origin[1]) / res
-        i0 = min(int(fi), nx - 2)
-        j0 = min(int(fj), ny - 2)
-        u, v = fi - i0, fj - j0
-        v00, v01 = values[j0, i0], values[j0, i0 + 1]
-        v10, v11 = values[j0 + 1, i0], values[j0 + 1, i0 + 1]
-        d = (1 - u) * (1 - v) * v00 + u * (1 - v) * v01 + (1 - u) * v * v10 + u * v * v11
-        gx = ((1 - v) * (v01 - v00) + v * (v11 - v10)) / res
-        gy = ((1 - u) * (v10 - v00) + u * (v11 - v01)) / res
-        ox, oy = cx - px, cy - py
-        gap = np.sqrt(ox * ox + oy * oy)
-        if gap > 0:                    # d(p) = d(c(p)) − |c(p) − p|, c the clamped point
-            d -= gap
-            gx = (0.0 if ox != 0 else gx) + ox / gap
-            gy = (0.0 if oy != 0 else gy) + oy / gap
-        z = (clearance - d) / softness
-        d_out[m] = d
-        J[m, 4], J[m, 5], J[m, 10], J[m, 11] = 0.0, 0.0, 0.0, 0.0     # the hinge reads positions only
-        if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
-            r[m] = 0.0
-            curvature[m] = 1.0
-            J[m, 0], J[m, 1], J[m, 2], J[m, 3], J[m, 6], J[m, 7], J[m, 8], J[m, 9] = 0, 0, 0, 0, 0, 0, 0, 0
-            continue
-        soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
-        sig = 1.0 / (1.0 + np.exp(-z))
-        r[m] = gain * softness * soft
-        curvature[m] = 1.0 + r[m] * (1.0 - sig) / (gain * softness * sig)
-        sx, sy = -gain * sig * gx, -gain * sig * gy
-        J[m, 0], J[m, 1], J[m, 6], J[m, 7] = sx * h0, sx * h1, sx * h2, sx * h3
-        J[m, 2], J[m, 3], J[m, 8], J[m, 9] = sy * h0, sy * h1, sy * h2, sy * h3
+        r[m], d_out[m], curvature[m] = barrier_point(X, step[m], alpha[m], dt, values, origin, res, clearance,
+                                                     softness, gain, J[m])
     return r, J, d_out, curvature
 
 
-@njit(cache=True)
-def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float) -> float:  # pragma: no cover
-    """The value d of ``environment.sample_field`` at one floor point (x, y) without its gradient: bilinear on
-    the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus the distance to it.
-    The same arithmetic in the same order."""
+@njit(cache=True, inline="always")
+def barrier_point(X: np.ndarray, t: int, a: float, dt: float, values: np.ndarray, origin: np.ndarray, res: float,
+                  clearance: float, softness: float, gain: float, row: np.ndarray):  # pragma: no cover (compiled)
+    """One barrier sample: the Hermite point of (x_t, x_{t+1}) at α = a, its bilinear distance and gradient
+    (extrapolated outside the grid), the rounded hinge r; its Jacobian on (x_t, x_{t+1}) written into
+    ``row`` (12,); returns (r, d, curvature factor)."""
+    h0 = 2 * a ** 3 - 3 * a ** 2 + 1
+    h1 = (a ** 3 - 2 * a ** 2 + a) * dt
+    h2 = -2 * a ** 3 + 3 * a ** 2
+    h3 = (a ** 3 - a ** 2) * dt
+    px = h0 * X[t, 0] + h1 * X[t, 1] + h2 * X[t + 1, 0] + h3 * X[t + 1, 1]
+    py = h0 * X[t, 2] + h1 * X[t, 3] + h2 * X[t + 1, 2] + h3 * X[t + 1, 3]
+    cx, cy, i0, j0, u, v = grid_cell(values, origin, res, px, py)
+    v00, v01 = values[j0, i0], values[j0, i0 + 1]
+    v10, v11 = values[j0 + 1, i0], values[j0 + 1, i0 + 1]
+    d = (1 - u) * (1 - v) * v00 + u * (1 - v) * v01 + (1 - u) * v * v10 + u * v * v11
+    gx = ((1 - v) * (v01 - v00) + v * (v11 - v10)) / res
+    gy = ((1 - u) * (v10 - v00) + u * (v11 - v01)) / res
+    ox, oy = cx - px, cy - py
+    gap = np.sqrt(ox * ox + oy * oy)
+    if gap > 0:                    # d(p) = d(c(p)) − |c(p) − p|, c the clamped point
+        d -= gap
+        gx = (0.0 if ox != 0 else gx) + ox / gap
+        gy = (0.0 if oy != 0 else gy) + oy / gap
+    z = (clearance - d) / softness
+    row[4], row[5], row[10], row[11] = 0.0, 0.0, 0.0, 0.0     # the hinge reads positions only
+    if z <= -30.0:                 # r < 1e-13·w/s: the sample is left out (r, J exactly 0)
+        row[0], row[1], row[2], row[3], row[6], row[7], row[8], row[9] = 0, 0, 0, 0, 0, 0, 0, 0
+        return 0.0, d, 1.0
+    soft = z + np.log1p(np.exp(-z)) if z > 0 else np.log1p(np.exp(z))
+    sig = 1.0 / (1.0 + np.exp(-z))
+    r = gain * softness * soft
+    sx, sy = -gain * sig * gx, -gain * sig * gy
+    row[0], row[1], row[6], row[7] = sx * h0, sx * h1, sx * h2, sx * h3
+    row[2], row[3], row[8], row[9] = sy * h0, sy * h1, sy * h2, sy * h3
+    return r, d, 1.0 + r * (1.0 - sig) / (gain * softness * sig)
+
+
+@njit(cache=True, inline="always")
+def grid_cell(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float):  # pragma: no cover
+    """The bilinear cell of the floor point (x, y) on the grid ``values[j, i]`` at origin + (i, j)·res: the point
+    clamped to the grid (cx, cy), the cell's corner (i0, j0) and the fractions (u, v) within it."""
     ny, nx = values.shape
     cx = min(max(x, origin[0]), origin[0] + res * (nx - 1))
     cy = min(max(y, origin[1]), origin[1] + res * (ny - 1))
@@ -310,7 +309,15 @@ def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y:
     fj = (cy - origin[1]) / res
     i0 = min(int(fi), nx - 2)
     j0 = min(int(fj), ny - 2)
-    a, b = fi - i0, fj - j0
+    return cx, cy, i0, j0, fi - i0, fj - j0
+
+
+@njit(cache=True)
+def field_value(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float) -> float:  # pragma: no cover
+    """The value d of ``environment.sample_field`` at one floor point (x, y) without its gradient: bilinear on
+    the grid ``values[j, i]`` at origin + (i, j)·res, beyond it d(nearest grid point) minus the distance to it.
+    The same arithmetic in the same order."""
+    cx, cy, i0, j0, a, b = grid_cell(values, origin, res, x, y)
     d = ((1 - a) * (1 - b) * values[j0, i0] + a * (1 - b) * values[j0, i0 + 1]
          + (1 - a) * b * values[j0 + 1, i0] + a * b * values[j0 + 1, i0 + 1])
     gap = np.hypot(cx - x, cy - y)

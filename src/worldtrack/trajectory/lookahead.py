@@ -16,7 +16,9 @@ max(0.7·(d − floor), min(clearance, max(0.7·d, half a cell))) — every poin
 keeps at least ``floor`` and every point within d is outside obstacles (the field is a distance,
 ~1-Lipschitz; bilinear slopes reach ~1.4, hence 0.7), so no partition is jumped — and stops at the
 last point before the first one closer to an obstacle than floor = min(clearance, where the sample
-starts). A state takes the least share α of the samples
+starts). A move no longer than the first stride is whole without a lookup at its end (34j: most
+moves, far from obstacles), and a trace starts from the distances the linearisation already has at
+the samples. A state takes the least share α of the samples
 on its two neighbouring curves. The shares are then made smooth in time, so that neighbouring
 states move alike: the least α within ± ``window`` steps, averaged over the same window (neither
 raises any state's α above its own look-ahead); the velocities get the derivative of α·δp (the step
@@ -43,11 +45,13 @@ _STRIDE = 0.7
 
 @njit(cache=True)
 def _trace(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: float, mx: float, my: float,
-           clearance: float) -> float:  # pragma: no cover (compiled)
-    """The share of the move (mx, my) from (x, y) that keeps min(clearance, d(x, y)) (see the module notes)."""
+           clearance: float, d: float) -> float:  # pragma: no cover (compiled)
+    """The share of the move (mx, my) from (x, y), where the field is d, that keeps min(clearance, d)
+    (see the module notes)."""
     length = np.hypot(mx, my)
-    d = field_value(values, origin, res, x, y)
     floor = min(clearance, d)
+    if length <= _STRIDE * (d - floor):      # the first stride covers the move: its end needs no lookup
+        return 1.0
     done = 0.0
     while done < length:
         ahead = min(done + max(_STRIDE * (d - floor), min(clearance, max(_STRIDE * d, 0.5 * res))), length)
@@ -60,8 +64,10 @@ def _trace(values: np.ndarray, origin: np.ndarray, res: float, x: float, y: floa
 
 @njit(cache=True)
 def _state_shares(X: np.ndarray, delta: np.ndarray, step: np.ndarray, H: np.ndarray, values: np.ndarray,
-                  origin: np.ndarray, res: float, clearance: float) -> np.ndarray:  # pragma: no cover (compiled)
-    """Every state's least share over the barrier samples (step t, Hermite weights H (M, 4)) it touches."""
+                  origin: np.ndarray, res: float, clearance: float,
+                  start: np.ndarray) -> np.ndarray:  # pragma: no cover (compiled)
+    """Every state's least share over the barrier samples (step t, Hermite weights H (M, 4)) it touches;
+    ``start`` (M,): the field at the samples, or empty (then looked up)."""
     alpha = np.ones(X.shape[0])
     for m in range(step.shape[0]):
         t = step[m]
@@ -70,15 +76,19 @@ def _state_shares(X: np.ndarray, delta: np.ndarray, step: np.ndarray, H: np.ndar
         py = h0 * X[t, _V] + h1 * X[t, _VD] + h2 * X[t + 1, _V] + h3 * X[t + 1, _VD]
         qx = h0 * delta[t, _U] + h1 * delta[t, _UD] + h2 * delta[t + 1, _U] + h3 * delta[t + 1, _UD]
         qy = h0 * delta[t, _V] + h1 * delta[t, _VD] + h2 * delta[t + 1, _V] + h3 * delta[t + 1, _VD]
-        a = _trace(values, origin, res, px, py, qx, qy, clearance)
+        d = start[m] if start.shape[0] else field_value(values, origin, res, px, py)
+        a = _trace(values, origin, res, px, py, qx, qy, clearance, d)
         alpha[t] = min(alpha[t], a)
         alpha[t + 1] = min(alpha[t + 1], a)
     return alpha
 
 
-def state_shares(X: np.ndarray, delta: np.ndarray, barrier: Barrier, dt: float) -> np.ndarray:
+def state_shares(X: np.ndarray, delta: np.ndarray, barrier: Barrier, dt: float,
+                 start: np.ndarray | None = None) -> np.ndarray:
     """(n,) each state's share α ∈ [0, 1] of the step δ (n, 6) from X (n, 6) before its samples come too
-    close to an obstacle (the module notes), grid step ``dt`` (s).
+    close to an obstacle (the module notes), grid step ``dt`` (s). ``start``: the distance field at the
+    barrier's samples (M,) in the order of :meth:`Barrier.samples`, if known (the linearisation at X has
+    it: ``Linearisation.barrier_d``); else looked up.
 
     >>> from worldtrack.scene.floor import FloorGrid
     >>> x = np.arange(0.0, 5.01, 0.05); field = FloorGrid(np.zeros(2), 0.05, np.tile(3.0 - x, (len(x), 1)))
@@ -93,7 +103,8 @@ def state_shares(X: np.ndarray, delta: np.ndarray, barrier: Barrier, dt: float) 
     f = barrier.field
     return _state_shares(np.ascontiguousarray(X, dtype=float), np.ascontiguousarray(delta, dtype=float), step,
                          hermite_weights(frac, dt), np.ascontiguousarray(f.values, dtype=float),
-                         np.asarray(f.origin, dtype=float), float(f.resolution), float(barrier.clearance))
+                         np.asarray(f.origin, dtype=float), float(f.resolution), float(barrier.clearance),
+                         np.empty(0) if start is None else np.ascontiguousarray(start, dtype=float))
 
 
 def trace_reference(field: FloorGrid, xy: np.ndarray, move: np.ndarray, clearance: float) -> np.ndarray:
@@ -103,6 +114,8 @@ def trace_reference(field: FloorGrid, xy: np.ndarray, move: np.ndarray, clearanc
         length = float(np.hypot(*m))
         d = float(sample_field(field, p[None])[0][0])
         floor, done = min(clearance, d), 0.0
+        if length <= _STRIDE * (d - floor):
+            continue                    # the first stride covers the move (out[k] stays 1)
         while done < length:
             ahead = min(done + max(_STRIDE * (d - floor), min(clearance, max(_STRIDE * d, 0.5 * field.resolution))),
                         length)
@@ -115,10 +128,11 @@ def trace_reference(field: FloorGrid, xy: np.ndarray, move: np.ndarray, clearanc
 
 
 def shape_step(delta: np.ndarray, X: np.ndarray, barrier: Barrier, least: float, window: int,
-               dt: float) -> np.ndarray:
-    """The step δ (n, 6) with each state's share α_t (:func:`state_shares`), at least ``least`` (the uniform
-    scaling's fraction), smoothed over ± ``window`` steps; velocities corrected by α̇·δp (dt s)."""
-    alpha = np.maximum(state_shares(X, delta, barrier, dt), least)
+               dt: float, start: np.ndarray | None = None) -> np.ndarray:
+    """The step δ (n, 6) with each state's share α_t (:func:`state_shares`, ``start`` as there), at least
+    ``least`` (the uniform scaling's fraction), smoothed over ± ``window`` steps; velocities corrected by
+    α̇·δp (dt s)."""
+    alpha = np.maximum(state_shares(X, delta, barrier, dt, start), least)
     if window > 0:
         alpha = uniform_filter1d(minimum_filter1d(alpha, 2 * window + 1, mode="nearest"), 2 * window + 1,
                                  mode="nearest")

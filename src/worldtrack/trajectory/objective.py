@@ -16,8 +16,9 @@ from functools import cached_property
 
 import numpy as np
 
+from worldtrack.trajectory.barrier_terms import Hinge, Normal, add_barrier_terms
 from worldtrack.trajectory.environment import (EnvironmentModel, barrier_residuals, height_residuals)
-from worldtrack.trajectory.kernels import add_motion_terms, add_pair_terms
+from worldtrack.trajectory.kernels import add_motion_terms
 from worldtrack.trajectory.model import (STATE, VEL, MotionPrior, TimeGrid, first_velocity_residuals, motion_blocks,
                                         motion_residuals)
 from worldtrack.trajectory.observation import ObservationTerm, Observations
@@ -77,6 +78,11 @@ class Problem:
         return D, B
 
     @cached_property
+    def barrier_sample_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """(step t, fraction α) of every barrier sample (:meth:`~.environment.Barrier.samples`), computed once."""
+        return self.environment.barrier.samples(self.grid.n)
+
+    @cached_property
     def observation_groups(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per pixel term: (first row of each run of equal steps, that step); rows are in time order."""
         out = []
@@ -107,13 +113,24 @@ class Costs:
 
 @dataclass
 class Linearisation:
-    """Costs, half-gradient g = Jᵀ·Wr (n, 6) and Gauss–Newton blocks D (n, 6, 6), B (n − 1, 6, 6)."""
+    """Costs, half-gradient g = Jᵀ·Wr (n, 6) and Gauss–Newton blocks D (n, 6, 6), B (n − 1, 6, 6);
+    with a barrier also its samples' residuals r (M,) and distances d (M,) (m) in the order of
+    :attr:`Problem.barrier_sample_points` (kept so that a later ``linearise(..., out=)`` writes into them
+    instead of allocating, and for the look-ahead's traces)."""
 
     costs: Costs
     g: np.ndarray
     D: np.ndarray
     B: np.ndarray
     barrier_steps: np.ndarray
+    barrier_r: np.ndarray | None = None
+    barrier_d: np.ndarray | None = None
+
+    def copy(self) -> "Linearisation":
+        """A copy with its own arrays (a solver's spare, overwritten by the next trial)."""
+        own = lambda a: None if a is None else a.copy()  # noqa: E731
+        return Linearisation(self.costs, self.g.copy(), self.D.copy(), self.B.copy(), self.barrier_steps.copy(),
+                             own(self.barrier_r), own(self.barrier_d))
 
 
 def huber(e: np.ndarray, k: float | None) -> tuple[np.ndarray, np.ndarray]:
@@ -162,6 +179,26 @@ def _add_pixel_term(term: ObservationTerm, starts: np.ndarray, steps: np.ndarray
     return float(rho.sum()) if np.all(depth > 1e-3) else np.inf
 
 
+def _add_barrier(problem: Problem, X: np.ndarray, normal: Normal, barrier_steps: np.ndarray,
+                 out: Linearisation | None) -> tuple[np.ndarray, np.ndarray]:
+    """In place: the barrier's samples into the blocks and gradient (one compiled pass,
+    :func:`~.barrier_terms.add_barrier_terms`; the steps with a sample inside the clearance marked in
+    ``barrier_steps``). Returns the samples' residuals (M,), those beyond the barrier's reach 0, and their
+    distances (M,), written into ``out``'s if it has them."""
+    env = problem.environment
+    barrier, f = env.barrier, env.barrier.field
+    step, alpha = problem.barrier_sample_points
+    if out is not None and out.barrier_r is not None and len(out.barrier_r) == len(step):
+        r, d = out.barrier_r, out.barrier_d
+    else:
+        r, d = np.empty(len(step)), np.empty(len(step))
+    gain = float(np.sqrt(env.weight / barrier.substeps) / barrier.scale)          # as ``barrier_residuals``
+    hinge = Hinge(float(barrier.clearance), float(barrier.softness), gain)
+    add_barrier_terms(X, step, alpha, problem.grid.dt, f.values, np.asarray(f.origin, dtype=float), float(f.resolution),
+                      hinge, normal, r, d, barrier_steps)
+    return r, d
+
+
 def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
               step_cost: np.ndarray | None = None) -> Linearisation:
     """Costs, gradient and the block-tridiagonal Gauss–Newton matrix at X (n, 6).
@@ -195,14 +232,12 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
         obs_cost += _add_pixel_term(term, starts, steps, problem.robust, X, D, g, step_cost)
     env = problem.environment
     barrier_cost = height_cost = 0.0
+    r = d = None
     if env.barrier is not None:
-        br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
-        if len(br.r):
-            add_pair_terms(D, B, g, br.step, br.J, br.r, br.curvature)      # skips the r = 0 samples
-            barrier_cost = float(br.r @ br.r)
-            barrier_steps[br.step[br.inside]] = True
-            if step_cost is not None:
-                step_cost += np.bincount(br.step, br.r * br.r, minlength=n)
+        r, d = _add_barrier(problem, X, Normal(D, B, g), barrier_steps, out)
+        barrier_cost = float(r @ r)
+        if step_cost is not None:
+            step_cost += np.bincount(problem.barrier_sample_points[0], r * r, minlength=n)
     if env.height is not None:
         rh, gain = height_residuals(X, env.height, env.weight)
         D[:, _W, _W] += gain * gain
@@ -211,4 +246,4 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
         if step_cost is not None:
             step_cost += rh * rh
     costs = Costs(motion_cost, obs_cost, barrier_cost, height_cost)
-    return Linearisation(costs, g, D, B, barrier_steps)
+    return Linearisation(costs, g, D, B, barrier_steps, r, d)

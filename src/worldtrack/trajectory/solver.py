@@ -135,7 +135,7 @@ class LevenbergMarquardt:
         self.move_limit = options.max_move
         # buffers reused by every iteration: the trial's linearisation and the linear solver's work
         lin = self.lin
-        self._spare = Linearisation(lin.costs, lin.g.copy(), lin.D.copy(), lin.B.copy(), lin.barrier_steps.copy())
+        self._spare = lin.copy()
         self._pending: tuple[np.ndarray, np.ndarray] | None = None     # the next step, if already solved
         n = len(self.X)
         if options.linear_solver == "lapack":
@@ -256,7 +256,7 @@ class LevenbergMarquardt:
         if self.options.look_ahead is not None:
             barrier, dt = self.problem.environment.barrier, self.problem.grid.dt
             window = int(round(self.options.look_ahead / dt))
-            shaped = shape_step(delta, self.X, barrier, self.move_limit / move, window, dt)
+            shaped = shape_step(delta, self.X, barrier, self.move_limit / move, window, dt, lin.barrier_d)
             decrease = _predicted_decrease(lin, shaped)
             if decrease > 0:
                 return shaped, decrease

@@ -149,7 +149,7 @@ class WindowedLM:
             self.lin, self.cost = carried
         self._spare_cost = np.empty(m)
         lin = self.lin
-        self._spare = Linearisation(lin.costs, lin.g.copy(), lin.D.copy(), lin.B.copy(), lin.barrier_steps.copy())
+        self._spare = lin.copy()
         self.F = window_sums(self.cost, packed.offsets[:-1])
         self.owner = np.repeat(np.arange(k), np.diff(packed.offsets))
         self.mu, self.nu = mu.copy(), nu.copy()
