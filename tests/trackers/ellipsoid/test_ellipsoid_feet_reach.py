@@ -63,3 +63,22 @@ def test_a_person_whole_in_view_near_the_edge_is_not_cut_by_the_border(seen):
     assert not cut_by_border(cam, fg, region, box, bottom=False, border="silhouette")
     fg[vs.min():vs.max(), 0] = 1                                            # foreground at the edge
     assert cut_by_border(cam, fg, region, box, bottom=False, border="silhouette")
+
+
+def test_where_somebody_else_covers_the_place_below_the_head_still_places_the_track(seen):
+    tracker, labels, instance, truth = seen
+    p, xy = misplaced(tracker, truth, 1.5)
+    p.height = truth["height"] - 0.15
+    # Somebody tracked standing 0.35 m beside the feet: p's own region is clear of them, the region
+    # drawn at the cut (nearer, larger) is theirs more than p's.
+    other, _ = misplaced(tracker, truth, 0.0)
+    other.height = truth["height"]
+    cam = tracker.scene.cameras["cam"]
+    ray = (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
+    other.x, other.y = other.x - 0.35 * ray[1], other.y + 0.35 * ray[0]
+    start = np.array([p.x, p.y])
+    anchor_to_feet([p, other], tracker.views, {"cam": labels}, tracker.walkable, FeetConfig(anchor=True),
+                   HeightConfig())
+    # No feet taken from under the other person: p stays on its line of sight, beyond them.
+    assert np.hypot(p.x - xy[0], p.y - xy[1]) > 0.5
+    assert np.hypot(p.x - start[0], p.y - start[1]) < 1.2

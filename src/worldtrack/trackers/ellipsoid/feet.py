@@ -129,9 +129,11 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
             # far along the line of sight to hold its own feet. Look again, drawn at the cut.
             probe = below
             _, ring1, box1, valid1, _ = view.forms(probe[None], np.array([hi]), np.array([1.25 * ws[k]]))
-            if not valid1[0] or (look := _look(view, labels, box1[0], ring1[0], current, k)) is None:
+            nearer = _look(view, labels, box1[0], ring1[0], current, k) if valid1[0] else None
+            if nearer is None:  # others cover the place below: keep the head's word, at the track's region
                 found = None
                 break
+            look = nearer
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= config.height_match_m \
                 and not touches_other(look[1], look[2], cam.project(found[0][None])[0], k):
             out[k] = (found[0][:2], config.sigma_m)
