@@ -28,6 +28,7 @@ from typing import Mapping, Sequence
 from worldtrack.foreground.components import extreme_indices
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.base import Person
+from worldtrack.trackers.ellipsoid.border import cut_by_border
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
@@ -77,13 +78,13 @@ def measure_height(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.n
 
 def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.ndarray,
                  region: np.ndarray, box: tuple[int, int, int, int], max_offset_m: float = 0.4,
-                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None
-                 ) -> tuple[np.ndarray, float] | None:
+                 down: np.ndarray | None = None, max_depth_offset_m: float | None = None,
+                 border: str = "box") -> tuple[np.ndarray, float] | None:
     """The feet's floor point (3,) and the height (m) of the top of the head's ray above it, of
     the person whose foreground lies in ``region`` of ``box``, or None (parameters and the
-    conditions as :func:`measure_height`, which is this without a height range)."""
-    u0, u1, v0, v1 = box
-    if u0 <= 0 or v0 <= 0 or u1 >= camera.width or v1 >= camera.height:
+    conditions as :func:`measure_height`, which is this without a height range). ``border``: how
+    a person at the image's edge is told (:func:`cut_by_border`)."""
+    if cut_by_border(camera, labels, region, box, border=border):
         return None  # the person may extend past the image border
     ends = silhouette_ends(camera, labels, region, box, down)
     if ends is None:
@@ -113,13 +114,14 @@ def measure_feet(camera: Camera, labels: np.ndarray, occ: np.ndarray, xy: np.nda
 
 
 def head_ray(camera: Camera, labels: np.ndarray, occ: np.ndarray, region: np.ndarray,
-             box: tuple[int, int, int, int], down: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+             box: tuple[int, int, int, int], down: np.ndarray | None = None,
+             border: str = "box") -> tuple[np.ndarray, np.ndarray] | None:
     """Viewing ray (origin (3,), unit direction (3,)) through the top of a person's head, or None.
 
     Needs the top of the region inside the image and not on an obstacle; the feet may be hidden.
+    ``border`` as :func:`measure_feet`'s.
     """
-    u0, u1, v0, v1 = box
-    if v0 <= 0 or u0 <= 0 or u1 >= camera.width:
+    if cut_by_border(camera, labels, region, box, bottom=False, border=border):
         return None
     ends = silhouette_ends(camera, labels, region, box, down)
     if ends is None:
