@@ -65,7 +65,7 @@ def test_the_absent_ids_travel_in_the_observation_and_older_messages_still_decod
     o = Observation("east", 1.25, "w2", 12, 1.26, (), ended=(3,), absent=(7, 9))
     assert decode_observation(encode_observation(o)) == o
     old = encode_observation(o)
-    old["o"] = old["o"].rsplit(",[", 1)[0] + "]"             # six elements: no absent list
+    old["o"] = old["o"].rsplit(",[", 3)[0] + "]"             # six elements: no absent list (nor candidates)
     assert decode_observation(old).absent == () and decode_observation(old).ended == (3,)
 
 
@@ -99,6 +99,9 @@ def test_looks_empty_needs_a_clear_view_and_counts_only_foreground_nobody_else_e
 class _Stub:
     def register_script(self, _):
         return None
+
+    def hkeys(self, _key):                     # no other camera registered
+        return []
 
 
 def test_a_worker_reports_a_map_person_its_camera_shows_nobody_at_and_drops_a_refuted_copy():
