@@ -8,19 +8,29 @@ camera across the room is a person to it. Two workers with one camera each do no
 the near worker holds a capture candidate it never confirms, the far one proposes nothing, and the
 person is missing from the map until they walk into the room. So, through the observation streams:
 
-1. each worker publishes its tracker's candidates in each camera's view
-   (``Observation.candidates``, :func:`candidates_in_views`);
+1. each worker publishes its tracker's candidates with the observation of the camera that
+   proposed them (``Observation.candidates``, :func:`candidates_in_views`);
 2. before its step, every worker reads the other cameras' latest observations before its frame
    (:func:`read_others`; in a batch run the complete previous bucket, so runs repeat);
-3. after its step it tests each candidate of another worker in its own cameras' foreground
-   (:func:`shows_somebody`, the positive counterpart of
-   :func:`~worldtrack.map.evidence.looks_empty`) and publishes the places where its camera shows
-   somebody nobody it tracks explains (``Observation.affirms``, :func:`affirmed`);
+3. after its step it looks in its own cameras' foreground for somebody within ``merge_distance_m``
+   of each candidate of another worker (:func:`somebody_near`; :func:`shows_somebody` is the
+   positive counterpart of :func:`~worldtrack.map.evidence.looks_empty`) and publishes the
+   candidates its camera shows somebody at whom nobody it tracks explains (``Observation.affirms``,
+   :func:`affirmed`);
 4. the worker whose candidate it was confirms it at its next step (:func:`confirm_affirmed`),
    with a new id from the map (or the id of a person the map has there), and tracks them on.
 
-The candidate keeps its own worker's position (the near view's depth), and the other worker takes
-the confirmed person from the map as it takes any hand-over.
+The candidate keeps its own worker's position, and the other worker takes the confirmed person
+from the map as it takes any hand-over. The cost: one ``HKEYS`` and one pipelined read of the other
+cameras' latest observations per step, and the search only where another worker has candidates.
+
+>>> from worldtrack.trackers.base import PositionMap
+>>> near = PositionMap()
+>>> _ = near.add(10.8, 2.0, time=0.0, tentative=True)       # right under the east camera
+>>> east = Observation("east", 0.0, "w-east", 0, 0.0, candidates=((10.8, 2.0, 1.7, 0.45),))
+>>> west = Observation("west", 0.1, "w-west", 1, 0.1, affirms=(("w-east", 10.8, 2.0),))  # it shows somebody
+>>> confirm_affirmed(near, [west], "w-east", 0.2, 0.5)
+[1]
 """
 
 from __future__ import annotations
