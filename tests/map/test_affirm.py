@@ -13,6 +13,7 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys, connect
 from worldtrack.map.evidence import people_boxes
+from worldtrack.map.messages import MapState
 from worldtrack.map.shared_ids import SharedPositionMap
 from worldtrack.map.worker import MapLink
 
@@ -21,6 +22,8 @@ FAR = Camera.look_at("west", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_de
 NEAR = Camera.look_at("east", 320, 240, [9.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
 PLACE = np.array([8.0, 0.0])
 T0 = 1.0e9            # capture times are wall-clock seconds (stream ids, retention: not near 0)
+#: The map as the workers read it: which cameras have reported (whose observations they read).
+STATE = MapState(T0, (), reports=(("east", T0, T0), ("west", T0, T0)))
 
 
 def _worker(url: str, name: str, camera: Camera, mask: np.ndarray | None, cfg: MapConfig):
@@ -33,7 +36,10 @@ def _worker(url: str, name: str, camera: Camera, mask: np.ndarray | None, cfg: M
 
 
 def _step(link: MapLink, tracker, t: float, tracks=()) -> tuple:
-    """One worker step without an image tracker: sync, then publish what it holds."""
+    """One worker step without an image tracker, on live cameras as MapTracker runs it: read the
+    other cameras' newest observations (after the previous step's publish), sync, publish."""
+    if link.exchange is not None:
+        link.exchange.read(STATE)
     link.sync(tracker, t)
     cam = next(iter(link.cameras))
     obs = link.observations(tracker, list(tracks), t, {cam: SimpleNamespace(t=t, index=int(round((t - T0) * 10)))})
@@ -57,6 +63,8 @@ def _run(url: str, far_mask: np.ndarray, cfg: MapConfig = MapConfig(), far_track
     near_tracker.position_map.add(*PLACE, 1.7, 0.45, time=T0, tentative=True)
     first = _step(near, near_tracker, T0)
     seen = _step(far, far_tracker, T0 + 0.1, far_tracks)
+    if near.exchange is not None:
+        near.exchange.read(STATE)
     near.sync(near_tracker, T0 + 0.2)
     return near_tracker.position_map, seen, first
 

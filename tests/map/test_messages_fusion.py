@@ -235,9 +235,6 @@ class _Record:
     def register_script(self, _):
         return None
 
-    def hkeys(self, _key):                     # no other camera registered
-        return []
-
     def add(self, bucket: int, aliases: dict) -> None:
         state = MapState(bucket / 10, (MapPerson(4, 1.0, 2.0, 1.7, 0.45, 0.0, 0.0, 0.5, 0.6, "tracking", 0.0, 0.0, 1),),
                          aliases=aliases)

@@ -100,9 +100,6 @@ class _Stub:
     def register_script(self, _):
         return None
 
-    def hkeys(self, _key):                     # no other camera registered
-        return []
-
 
 def test_a_worker_reports_a_map_person_its_camera_shows_nobody_at_and_drops_a_refuted_copy():
     link = MapLink(_Stub(), MapKeys(), MapConfig(), "w2", {"east": CAM})

@@ -10,8 +10,8 @@ person is missing from the map until they walk into the room. So, through the ob
 
 1. each worker publishes its tracker's candidates with the observation of the camera that
    proposed them (``Observation.candidates``, :func:`candidates_in_views`);
-2. before its step, every worker reads the other cameras' latest observations before its frame
-   (:func:`read_others`; in a batch run the complete previous bucket, so runs repeat);
+2. every worker reads the other cameras' latest observations (:func:`read_others`; in a batch
+   run before its step, those before its frame: the complete previous bucket, so runs repeat);
 3. after its step it looks in its own cameras' foreground for somebody within ``merge_distance_m``
    of each candidate of another worker (:func:`somebody_near`; :func:`shows_somebody` is the
    positive counterpart of :func:`~worldtrack.map.evidence.looks_empty`) and publishes the
@@ -21,8 +21,8 @@ person is missing from the map until they walk into the room. So, through the ob
    with a new id from the map (or the id of a person the map has there), and tracks them on.
 
 The candidate keeps its own worker's position, and the other worker takes the confirmed person
-from the map as it takes any hand-over. The cost: one ``HKEYS`` and one pipelined read of the other
-cameras' latest observations per step, and the search only where another worker has candidates.
+from the map as it takes any hand-over. The cost: one pipelined read of the other cameras' latest
+observations per step, and the search only where another worker has candidates.
 
 >>> from worldtrack.trackers.base import PositionMap
 >>> near = PositionMap()
@@ -44,7 +44,7 @@ import numpy as np
 from worldtrack.geometry.camera import Camera
 from worldtrack.map.connection import MapKeys
 from worldtrack.map.evidence import LEAD_SHARE, emptiness, in_views, people_boxes
-from worldtrack.map.messages import Observation, decode_observation, stream_id_ms
+from worldtrack.map.messages import MapState, Observation, decode_observation, stream_id_ms
 from worldtrack.trackers.base import PositionMap
 
 #: A place shows somebody when at least this share of the part of a person's box there that
@@ -70,12 +70,13 @@ def candidates_in_views(local: PositionMap, cameras: Mapping[str, Camera]) -> di
     return out
 
 
-def read_others(client: Any, keys: MapKeys, cameras: Sequence[str], before: float,
+def read_others(client: Any, keys: MapKeys, cameras: Sequence[str], before: float | None,
                 within_s: float) -> list[Observation]:
     """Each of ``cameras``' latest observation captured before ``before`` (s) and at most
-    ``within_s`` earlier (one pipelined ``XREVRANGE`` per camera); malformed entries are skipped."""
-    hi, lo = stream_id_ms(before) - 1, max(stream_id_ms(before - within_s), 0)
-    if not cameras or hi < lo:
+    ``within_s`` earlier (None: the newest; one pipelined ``XREVRANGE`` per camera); malformed
+    entries are skipped."""
+    hi, lo = ("+", "-") if before is None else (stream_id_ms(before) - 1, max(stream_id_ms(before - within_s), 0))
+    if not cameras or (before is not None and hi < lo):
         return []
     pipe = client.pipeline(transaction=False)
     for c in cameras:
@@ -88,12 +89,6 @@ def read_others(client: Any, keys: MapKeys, cameras: Sequence[str], before: floa
             except ValueError:
                 continue
     return out
-
-
-def other_cameras(client: Any, keys: MapKeys, mine: Sequence[str]) -> list[str]:
-    """The cameras registered on the map (``MapKeys.cameras``) that are not ``mine``, sorted."""
-    return sorted(str(c.decode() if isinstance(c, bytes) else c) for c in client.hkeys(keys.cameras)
-                  if (c.decode() if isinstance(c, bytes) else c) not in set(mine))
 
 
 def shows_somebody(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height: float, width: float,
@@ -122,13 +117,23 @@ def shows_somebody(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height:
     return shown >= LEAD_SHARE and open_share >= 0.3 and foreground >= PRESENT_SHARE
 
 
+def unexplained(mask: np.ndarray, blockers: np.ndarray | None) -> np.ndarray:
+    """The integral image (``cv2.integral``, (H+1, W+1)) of the foreground of ``mask`` outside the
+    boxes of ``blockers`` (:func:`~worldtrack.map.evidence.people_boxes`)."""
+    fg = (mask != 0).astype(np.uint8)
+    for b in (blockers if blockers is not None else ()):
+        fg[max(0, int(b[1])):max(0, int(np.ceil(b[3]))), max(0, int(b[0])):max(0, int(np.ceil(b[2])))] = 0
+    return cv2.integral(fg)
+
+
 def somebody_near(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height: float, width: float,
                   occlusion: np.ndarray | None = None, blockers: np.ndarray | None = None,
-                  radius_m: float = 0.5, step_m: float = 0.1) -> np.ndarray | None:
+                  radius_m: float = 0.5, step_m: float = 0.1, summed: np.ndarray | None = None) -> np.ndarray | None:
     """The floor place within ``radius_m`` of ``xy`` (m) whose person box in ``cam`` holds the most
     foreground nobody of ``blockers`` explains (the nearest of equals), if :func:`shows_somebody`
     there; else None. A candidate proposed from a view that shows only part of a person is off by a
-    few tenths of a metre; the other view's foreground tells where they are.
+    few tenths of a metre; the other view's foreground tells where they are. ``summed``: the
+    :func:`unexplained` integral image of ``mask`` and ``blockers`` (computed here if not given).
 
     >>> cam = Camera.look_at("c", 320, 240, [0.0, 0.0, 3.0], [4.0, 0.0, 0.0], hfov_deg=60)
     >>> from worldtrack.map.evidence import people_boxes
@@ -146,10 +151,7 @@ def somebody_near(cam: Camera, mask: np.ndarray | None, xy: np.ndarray, height: 
     offsets = np.stack(np.meshgrid(grid, grid), -1).reshape(-1, 2)
     offsets = offsets[np.hypot(*offsets.T) <= radius_m + 1e-9]
     places = xy[None, :] + offsets
-    fg = (mask != 0).astype(np.uint8)
-    for b in (blockers if blockers is not None else ()):
-        fg[max(0, int(b[1])):max(0, int(np.ceil(b[3]))), max(0, int(b[0])):max(0, int(np.ceil(b[2])))] = 0
-    summed = cv2.integral(fg)
+    summed = unexplained(mask, blockers) if summed is None else summed
     box = people_boxes(cam, np.column_stack([places, np.full(len(places), height), np.full(len(places), width)]))
     u0, v0 = (np.clip(np.floor(box[:, k]), 0, lim).astype(int) for k, lim in ((0, cam.width), (1, cam.height)))
     u1, v1 = (np.clip(np.ceil(box[:, k]), 0, lim).astype(int) for k, lim in ((2, cam.width), (3, cam.height)))
@@ -168,6 +170,7 @@ def affirmed(others: Sequence[Observation], name: str, cameras: Mapping[str, Cam
     person is on the map already), the boxes of the people it holds (``boxes``, per camera)
     explaining their own foreground."""
     out: dict[str, list[tuple]] = {c: [] for c in cameras}
+    summed: dict[str, np.ndarray] = {}         # per camera, once a candidate needs it
     for o in others:
         if o.worker == name:
             continue
@@ -176,7 +179,12 @@ def affirmed(others: Sequence[Observation], name: str, cameras: Mapping[str, Cam
             if len(held) and np.hypot(*(held - xy).T).min() < near_m:
                 continue
             for c, cam in cameras.items():
-                found = somebody_near(cam, masks.get(c), xy, h, w, occlusion.get(c), boxes.get(c), near_m)
+                mask = masks.get(c)
+                if mask is None or mask.shape[:2] != (cam.height, cam.width):
+                    continue
+                if c not in summed:
+                    summed[c] = unexplained(mask, boxes.get(c))
+                found = somebody_near(cam, mask, xy, h, w, occlusion.get(c), boxes.get(c), near_m, summed=summed[c])
                 if found is not None:
                     out[c].append((o.worker, x, y))
     return out
@@ -211,9 +219,11 @@ def confirm_affirmed(local: PositionMap, others: Sequence[Observation], name: st
 
 
 class CandidateExchange:
-    """A worker's side of steps 1-4 (module docstring): ``before_step`` reads the other cameras'
-    latest observations and confirms this worker's affirmed candidates; ``after_step`` gives what
-    to publish per camera: its own candidates and the other workers' it affirms.
+    """A worker's side of steps 1-4 (module docstring): :meth:`read` the other cameras' latest
+    observations (in a batch run before each step, those before its frame: runs repeat; on live
+    cameras after publishing, off the capture-to-map path), :meth:`confirm` this worker's affirmed
+    candidates before its step, and ``after_step``: what to publish per camera, its own candidates
+    and the other workers' it affirms.
 
     Parameters
     ----------
@@ -232,11 +242,22 @@ class CandidateExchange:
         self.others: list[Observation] = []
         self.confirmed = 0          # candidates confirmed on another worker's view (a count for status)
 
-    def before_step(self, local: PositionMap, t: float) -> list[int]:
-        """Read the other cameras' latest observations before ``t``; confirm this worker's
-        candidates they affirm. Returns the new ids."""
-        cams = other_cameras(self.client, self.keys, list(self.cameras))
-        self.others = read_others(self.client, self.keys, cams, t, self.within_s)
+    def read(self, state: MapState | None, before: float | None = None) -> None:
+        """Read the latest observation of each other camera the map state ``state`` has reports of
+        (captured before ``before`` s; None: the newest)."""
+        mine = set(self.cameras)
+        cams = sorted({c for c, _, _ in state.reports} - mine) if state is not None else []
+        self.others = read_others(self.client, self.keys, cams, before, self.within_s)
+
+    def before_step(self, local: PositionMap, state: MapState | None, t: float, read: bool) -> list[int]:
+        """Before the step at ``t``: with ``read`` (a batch run), :meth:`read` the observations
+        before ``t`` of the cameras of ``state`` (the complete previous bucket); then :meth:`confirm`."""
+        if read:
+            self.read(state, t)
+        return self.confirm(local, t)
+
+    def confirm(self, local: PositionMap, t: float) -> list[int]:
+        """Confirm this worker's candidates the other cameras' observations read affirm (new ids)."""
         new = confirm_affirmed(local, self.others, self.name, t, self.near_m)
         self.confirmed += len(new)
         return new
@@ -253,5 +274,5 @@ class CandidateExchange:
         return candidates, affirmed(self.others, self.name, mine, masks, self.occlusion, boxes, held, self.near_m)
 
 
-__all__ = ["PRESENT_SHARE", "CandidateExchange", "affirmed", "candidates_in_views", "confirm_affirmed", "other_cameras",
-           "read_others", "shows_somebody", "somebody_near"]
+__all__ = ["PRESENT_SHARE", "CandidateExchange", "affirmed", "candidates_in_views", "confirm_affirmed",
+           "read_others", "shows_somebody", "somebody_near", "unexplained"]

@@ -210,8 +210,8 @@ class MapLink:
         self._wait_for_map(t)
         state = self.read_map()
         self._state_t = t
-        if self.exchange is not None:
-            self.exchange.before_step(tracker.position_map, t)
+        if self.exchange is not None:   # a batch run reads the others' observations here, a live one after publishing
+            self.exchange.before_step(tracker.position_map, state, t, read=self.lockstep)
         if state is None:
             return
         local = tracker.position_map
