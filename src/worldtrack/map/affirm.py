@@ -240,7 +240,7 @@ class CandidateExchange:
         self.client, self.keys, self.name = client, keys, name
         self.cameras, self.occlusion, self.near_m, self.within_s = dict(cameras), dict(occlusion), near_m, within_s
         self.others: list[Observation] = []
-        self.confirmed = 0          # candidates confirmed on another worker's view (a count for status)
+        self.confirmed = 0          # candidates confirmed on another worker's view (the worker's last line says)
 
     def read(self, state: MapState | None, before: float | None = None) -> None:
         """Read the latest observation of each other camera the map state ``state`` has reports of
