@@ -89,6 +89,13 @@ def incomplete_buckets(client, cameras: list[str]) -> tuple[int, int]:
     return missing, sum(s.late for s in states)
 
 
+def any_affirms(client, cameras: list[str]) -> bool:
+    """Did any worker of the run affirm another's candidate (:mod:`worldtrack.map.affirm`)?"""
+    from worldtrack.map.messages import decode_observation
+    return any(decode_observation(fields).affirms for cam in cameras
+               for _, fields in client.xrange(MapKeys().observations(cam)))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", default="2,5,6,7,8,9,10,11,12,13,1,3,4")
@@ -98,6 +105,10 @@ def main() -> None:
                     help="a map setting for the workers (e.g. map.share_rule=support-lead)")
     ap.add_argument("--also", action="append", default=[], metavar="map.A=X,map.B=Y",
                     help="a variant run once more per seed with these settings (repeatable; runs are deterministic)")
+    ap.add_argument("--only-if-affirmed", action="store_true",
+                    help="run the --also variants only for seeds whose default run confirmed a candidate on another "
+                         "worker's view (Observation.affirms; without one the variant map.affirm_candidates=false "
+                         "runs the same steps and writes the same map)")
     ap.add_argument("--dump", type=Path, help="write per run the workers' published estimates, the map and the "
                                              "one process's tracks as CSV files in this folder (to find out why)")
     args = ap.parse_args()
@@ -117,13 +128,21 @@ def main() -> None:
                                 *[a for c in sc.camera_ids for a in ("--video", f"{c}={seq / (c + '.mp4')}")],
                                 "--out", str(seq / "one"), "--quiet", "--no-video"], check=True, capture_output=True)
                 one = evaluate_detailed(gt, read_tracks(seq / "one" / "tracks.csv"))
+                affirmed_run = None
                 for variant, sets, k in ((v, sets, k) for v, sets, n in variants for k in range(n)):
+                    if variant != "default" and args.only_if_affirmed and affirmed_run is False:
+                        rows.append([seed, f"{variant} (= default: no affirm)", k, *rows[-1][3:]])   # the same steps
+                        for key in ("mota", "idf1"):
+                            gaps[variant, key].append(gaps["default", key][-1])
+                        continue
                     server.flush()
                     run_workers(seq, server.url, sc.camera_ids, seq / f"workers{k}", sets=["map.pace_files=false", *sets])
                     fused = evaluate_detailed(gt, read_tracks(replay(connect(server.url), MapKeys(),
                                                                      seq / f"replay{k}").tracks_csv))
                     if args.dump:
                         dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
+                    if variant == "default":
+                        affirmed_run = any_affirms(connect(server.url), sc.camera_ids)
                     missing, late = incomplete_buckets(connect(server.url), sc.camera_ids)
                     digest = record_digest(connect(server.url), MapKeys())
                     worse = worse_frames(one, fused)

@@ -109,3 +109,32 @@ def test_a_bucket_waits_for_a_batch_workers_report_past_max_wait_s(redis_url):
         assert client.xlen(keys.map_stream) == 2
         client.delete(keys.camera_lease("late"))
         wait_until(lambda: client.xlen(keys.map_stream) == 3, 5.0, what="the bucket after the lease lapsed")
+
+
+def test_a_holder_that_stops_leaves_a_bucket_a_live_batch_worker_has_not_reported_to_it(redis_url):
+    """The last frames of a batch run: the worker that finishes first gives the fusion role back
+    (drain). A bucket the other batch worker, still running (its lease lives), has not reported yet
+    is left in the streams for it (it takes the role over), not written without its report; once
+    that worker's lease is gone (it died or finished) the bucket is written."""
+    client = connect(redis_url)
+    keys, cfg = MapKeys(), MapConfig(max_wait_s=0.1)
+    for cam in ("done", "going"):
+        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
+        link.lockstep = True
+        link.register()
+        client.set(keys.camera_lease(cam), f"w-{cam}", px=30000)
+    role = FusionRole(client, keys, cfg, "fuser")
+    assert role.lease.acquire()
+    role._take_over()
+    t0 = (bucket_index(time.time(), cfg.bucket_s) + 0.5) * cfg.bucket_s
+    _publish(client, keys, "done", t0, 1, 2.0)
+    _publish(client, keys, "going", t0, 2, 6.0)
+    _publish(client, keys, "done", t0 + 0.1, 1, 2.1)       # its last frame; "going" has not reported it
+    wait_until(lambda: role.step(block_ms=10) or client.xlen(keys.map_stream) == 1, 5.0, what="the first bucket")
+    role.drain(budget_s=1.0)
+    assert client.xlen(keys.map_stream) == 1                # the complete bucket only
+    client.delete(keys.camera_lease("going"))
+    role.drain(budget_s=1.0)
+    assert client.xlen(keys.map_stream) == 2
+    last = decode_map_state(client.xrevrange(keys.map_stream, count=1)[0][1])
+    assert [c for c, _, _ in last.reports] == ["done"]

@@ -235,8 +235,9 @@ def run_live(args: argparse.Namespace, cfg) -> int:
         _say(f"{cid}: {s.frames} frames grabbed, {s.dropped} dropped, {s.reconnects} reconnects, "
              f"{s.outage_s:.1f} s without signal")
     if worker is not None:
+        confirmed = worker.link.exchange.confirmed if worker.link.exchange is not None else 0
         _say(f"{worker.name}: {worker.link.handed_over} people taken from the map before they entered its "
-             f"views, {worker.link.claimed} new people took a map id")
+             f"views, {worker.link.claimed} new people took a map id, {confirmed} confirmed on another worker's view")
     _say(f"{result.frames} frames in {result.seconds:.1f} s ({result.fps:.1f} frames/s), "
          f"{len(result.track_ids)} tracks; tracks: {result.tracks_csv}")
     if result.error:

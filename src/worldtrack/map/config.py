@@ -70,6 +70,11 @@ class MapConfig(Section):
                                                          "other workers are on the map, leaves the map after this "
                                                          "long (the one-process tracker's rule for a duplicate "
                                                          "behind somebody; 0 = never)")
+    affirm_candidates: bool = Field(True, description="a worker publishes the people its tracker proposes but has "
+                                                      "not confirmed; another worker whose camera shows somebody "
+                                                      "there says so, and the first confirms them (one process "
+                                                      "confirms a person two cameras show at once; "
+                                                      "worldtrack.map.affirm; false: before issue 39k)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

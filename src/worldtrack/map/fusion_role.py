@@ -37,7 +37,6 @@ import json
 import math
 import threading
 import time
-from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from worldtrack.map.config import MapConfig
@@ -46,6 +45,7 @@ from worldtrack.map.fusion import FusionState, fuse_bucket, provisional_state
 from worldtrack.map.lease import UPDATE_MAP, WRITE_MAP, Lease
 from worldtrack.map.messages import (MapState, Observation, bucket_index, decode_map_state, decode_observation,
                                      encode_map_state, stream_id_ms)
+from worldtrack.map.status import FusionStats
 
 #: With no state to resume from, start this far back in the observation streams (s).
 COLD_START_S = 5.0
@@ -58,21 +58,6 @@ MAX_LIVE_OPEN = 10
 #: On Ctrl-C / SIGTERM the holder writes what it has for at most this long (s), then gives the
 #: lease back; what it did not write stays in the streams for the next holder.
 DRAIN_S = 1.5
-
-
-@dataclass
-class FusionStats:
-    """What the fusion role has done (for ``map status`` and the benchmarks)."""
-
-    buckets: int = 0
-    observations: int = 0
-    late: int = 0
-    malformed: int = 0
-    takeovers: int = 0
-    retaken: int = 0          # the lease lapsed and this process took it again
-    updates: int = 0
-    last_written: float = 0.0
-    lag_s: list[float] = field(default_factory=list)
 
 
 class FusionRole:
@@ -149,17 +134,23 @@ class FusionRole:
     def drain(self, budget_s: float = DRAIN_S) -> None:
         """Before giving the role back: wait a little for the open buckets' last observations, then
         write those whose observations are all read — for at most ``budget_s`` seconds (checked
-        between buckets). What is left stays in the streams: the next holder continues after the
-        last bucket written."""
+        between buckets) and up to the first still waiting for a live batch worker's report (the
+        last frames of a batch run whose other worker is still going: that worker takes the role
+        over). What is left stays in the streams: the next holder continues after the last bucket
+        written."""
         self._deadline = time.monotonic() + budget_s
         try:
             wait_end = time.monotonic() + min(self.cfg.max_wait_s + 0.1, budget_s / 2)
             while self.holding and self._buckets and time.monotonic() < wait_end:
                 self.step(block_ms=10)
+            live = self._live_cameras()
             while self.holding and self._buckets and self._caught_up and time.monotonic() < self._deadline:
                 if not self._still_holding():
                     break
                 b = min(self._buckets)
+                missing = self._missing(b, live)
+                if missing and self._waits_for(missing):
+                    break       # a live batch worker's report is to come: it takes the role over and writes it
                 if not self._write_bucket(b, self._buckets.pop(b)):
                     break
                 self._first_arrival.pop(b, None)
@@ -317,17 +308,13 @@ class FusionRole:
     def _close_due(self, renew: bool = True) -> int:
         """Write the complete (or ``max_wait_s`` old) buckets in order, at most
         :data:`MAX_BUCKETS_PER_STEP`, renewing the lease between them (``renew``)."""
-        written = 0
-        live = None
+        written, live = 0, None
         while self._buckets and written < MAX_BUCKETS_PER_STEP and time.monotonic() < self._deadline:
             b = min(self._buckets)
-            end = (b + 1) * self.cfg.bucket_s
             if self.state.last_bucket is None and self._cameras_read < self._first_arrival[b]:
                 self._refresh_cameras(force=True)    # the map's first bucket: every camera registered by now
-            if live is None:
-                live = self._live_cameras()
-            # Complete when each live camera's next frame falls after the bucket.
-            missing = [c for c in live if self._latest.get(c, -1e18) + 1.0 / self._cameras.get(c, 10.0) < end - 1e-6]
+            live = self._live_cameras() if live is None else live
+            missing = self._missing(b, live)
             if missing and (self.clock() - self._first_arrival[b] < self.cfg.max_wait_s or self._waits_for(missing)):
                 break
             if renew and not self._still_holding():
@@ -337,6 +324,12 @@ class FusionRole:
             self._first_arrival.pop(b, None)
             written += 1
         return written
+
+    def _missing(self, b: int, live: list[str]) -> list[str]:
+        """The cameras of ``live`` whose report of bucket ``b`` may still come (complete when each
+        live camera's next frame falls after the bucket)."""
+        end = (b + 1) * self.cfg.bucket_s
+        return [c for c in live if self._latest.get(c, -1e18) + 1.0 / self._cameras.get(c, 10.0) < end - 1e-6]
 
     def _waits_for(self, missing: list[str]) -> bool:
         """Past ``max_wait_s``: does the bucket still wait for these cameras? Yes for a batch worker's

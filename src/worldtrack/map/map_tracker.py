@@ -71,6 +71,8 @@ class MapTracker:
         marks.append(clock())
         if self.timings is not None:
             self.timings.write(marks)
+        if self.link.exchange is not None and not self.link.lockstep:
+            self.link.exchange.read(self.link.state)    # live: the others' newest, for the next step
         if self.on_step is not None:
             self.on_step(t)
         return tracks

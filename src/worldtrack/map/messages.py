@@ -13,7 +13,8 @@ Entry ids are capture times in ms (``<ms>-<seq>``), so streams can be read and t
 (``XRANGE``, ``MINID``) and a map bucket is written once: a second ``XADD`` of the same id fails.
 
 >>> e = Estimate(3, 1.5, 2.0, 1.7, 0.45, 0.2, 0.0, 0.8, 0.6, True, cxx=0.04, cxy=0.0, cyy=0.0025)
->>> o = Observation("cam1", 12.3, "w1", 123, 12.35, (e,), ended=(2,), absent=(5,))
+>>> o = Observation("cam1", 12.3, "w1", 123, 12.35, (e,), ended=(2,), absent=(5,),
+...                 candidates=((4.0, 1.0, 1.7, 0.45),), affirms=(("w2", 9.5, 2.0),))
 >>> decode_observation(encode_observation(o)) == o
 True
 >>> bucket_index(12.34, 0.1), stream_id_ms(12.3)
@@ -75,7 +76,9 @@ REFUTED = 0
 class Observation:
     """One camera's frame as a worker saw it. ``ended``: ids its tracker ended; ``absent``: ids of
     the map's people this camera shows the place of, clearly, with nobody there (negative evidence,
-    :func:`worldtrack.map.evidence.looks_empty`)."""
+    :func:`worldtrack.map.evidence.looks_empty`). ``candidates``: the people its tracker proposes
+    there but has not confirmed, ``(x, y, height, width)`` m; ``affirms``: other workers'
+    candidates this camera shows somebody at, ``(their worker, x, y)`` (:mod:`worldtrack.map.affirm`)."""
 
     camera: str
     t: float
@@ -85,6 +88,8 @@ class Observation:
     people: tuple[Estimate, ...] = ()
     ended: tuple[int, ...] = ()
     absent: tuple[int, ...] = ()
+    candidates: tuple[tuple[float, float, float, float], ...] = ()
+    affirms: tuple[tuple[str, float, float], ...] = ()
 
 
 class MapPerson(NamedTuple):
@@ -153,15 +158,16 @@ def _float(v) -> float:
 
 def encode_observation(o: Observation) -> dict[str, str]:
     """The stream fields of an observation: ``v``, ``t`` (capture time) and ``o``, one JSON list
-    ``[camera, worker, frame, sent, people, ended, absent]`` (one field to parse, not eight: the fusion
-    reads thousands a second). NaN stays NaN (Python's JSON)."""
+    ``[camera, worker, frame, sent, people, ended, absent, candidates, affirms]`` (one field to parse, not
+    ten: the fusion reads thousands a second). NaN stays NaN (Python's JSON)."""
     people = [[int(e.id), round(e.x, 4), round(e.y, 4), round(e.height, 3), round(e.width, 3), round(e.vx, 3),
                round(e.vy, 3), round(float(e.score), 3), round(float(e.support), 3), int(bool(e.seen)), _sig(e.ixx),
                _sig(e.ixy), _sig(e.iyy), round(float(e.visible), 2), _sig(e.cxx), _sig(e.cxy), _sig(e.cyy),
                round(float(e.own), 2)]
               for e in o.people]
     body = [o.camera, o.worker, int(o.frame), float(o.sent), people, [int(i) for i in o.ended],
-            [int(i) for i in o.absent]]
+            [int(i) for i in o.absent], [[round(float(v), 4) for v in c] for c in o.candidates],
+            [[str(w), round(float(x), 4), round(float(y), 4)] for w, x, y in o.affirms]]
     return {"v": FORMAT_VERSION, "t": repr(float(o.t)), "o": json.dumps(body, separators=(",", ":"))}
 
 
@@ -170,11 +176,15 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
     try:
         if fields.get("v") != FORMAT_VERSION:
             raise ValueError(f"format version {fields.get('v')!r}, expected {FORMAT_VERSION}")
-        camera, worker, frame, sent, people, ended, *absent = json.loads(fields["o"])   # 6: before absent
+        # 6 elements: before absent; 7: before candidates and affirms
+        camera, worker, frame, sent, people, ended, *rest = json.loads(fields["o"])
         for p in people:
             p[9] = p[9] == 1
+        absent, candidates, affirms = (rest + [[], [], []])[:3]
         return Observation(str(camera), float(fields["t"]), str(worker), int(frame), float(sent),
-                           tuple(Estimate(*p) for p in people), tuple(ended), tuple(absent[0]) if absent else ())
+                           tuple(Estimate(*p) for p in people), tuple(ended), tuple(absent),
+                           tuple(tuple(float(v) for v in c[:4]) for c in candidates),
+                           tuple((str(w), float(x), float(y)) for w, x, y in affirms))
     except (KeyError, IndexError, TypeError, ValueError, json.JSONDecodeError) as e:
         if isinstance(e, ValueError) and str(e).startswith("format version"):
             raise

@@ -4,10 +4,26 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import dataclass, field
 from typing import Any
 
 from worldtrack.map.connection import MapKeys
 from worldtrack.map.messages import FORMAT_VERSION, decode_map_state, time_of_id
+
+
+@dataclass
+class FusionStats:
+    """What the fusion role has done (for ``map status`` and the benchmarks)."""
+
+    buckets: int = 0
+    observations: int = 0
+    late: int = 0
+    malformed: int = 0
+    takeovers: int = 0
+    retaken: int = 0          # the lease lapsed and this process took it again
+    updates: int = 0
+    last_written: float = 0.0
+    lag_s: list[float] = field(default_factory=list)
 
 
 def map_status(client: Any, keys: MapKeys, now: float | None = None) -> dict[str, Any]:
@@ -86,4 +102,4 @@ def format_status(status: dict[str, Any], where: str) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["format_status", "map_status"]
+__all__ = ["FusionStats", "format_status", "map_status"]

@@ -30,6 +30,7 @@ import numpy as np
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
+from worldtrack.map.affirm import CandidateExchange
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
 from worldtrack.map.evidence import (NO_COVARIANCE, floor_information, in_views, looks_empty, people_boxes,
@@ -97,6 +98,9 @@ class MapLink:
         #: The end (s) of the last complete bucket of the map (every live camera's report in).
         self.complete_until, self._record_id = -math.inf, ""
         self._aliases: dict[int, tuple[int, float]] = {}      # batch runs: merges read from the record
+        #: Candidates confirmed with other workers' views (:mod:`worldtrack.map.affirm`); None: off.
+        self.exchange = CandidateExchange(client, keys, name, self.cameras, self.occlusion, cfg.merge_distance_m) \
+            if cfg.affirm_candidates else None
 
     # ------------------------------------------------------------------ set-up
     def register(self) -> None:
@@ -206,6 +210,8 @@ class MapLink:
         self._wait_for_map(t)
         state = self.read_map()
         self._state_t = t
+        if self.exchange is not None:   # a batch run reads the others' observations here, a live one after publishing
+            self.exchange.before_step(tracker.position_map, state, t, read=self.lockstep)
         if state is None:
             return
         local = tracker.position_map
@@ -335,8 +341,9 @@ class MapLink:
         self.ever_seen &= {p.id for p in local}
         seen_ids = {e.id for es in per_cam.values() for e in es if e.seen}
         absent = self._absent(tracker, tracks, t, cams, boxes, seen_ids) if self.cfg.negative_evidence else {}
+        cands, affirms = self.exchange.after_step(tracker, tracks, boxes, cams) if self.exchange else ({}, {})
         return [Observation(c, float(frames[c].t), self.name, int(frames[c].index), sent, tuple(per_cam[c]), ended,
-                            absent.get(c, ())) for c in cams]
+                            absent.get(c, ()), tuple(cands.get(c, ())), tuple(affirms.get(c, ()))) for c in cams]
 
     def _absent(self, tracker: Tracker, tracks: Sequence[Track], t: float, cams: list[str],
                 boxes: Mapping[str, np.ndarray], seen_ids: set[int]) -> dict[str, tuple[int, ...]]:
