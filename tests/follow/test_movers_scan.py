@@ -110,7 +110,7 @@ def test_who_caused_a_contact():
     assert seen.cause == "seen, not stopped" and seen.robot_fault
 
 
-def _walker_in_the_scan(leaving_to_walkers: bool, lateral) -> list:
+def _walker_in_the_scan(leaving_to_walkers: bool, lateral, ahead: float = 1.1) -> list:
     """The PID's commands (m/s) while a walker 1.1 m ahead of the standing robot, seen only by the scan,
     goes through ``lateral`` (m, one a frame); the target 2.3 m ahead walks east at 1 m/s."""
     open_floor = lambda xy: np.full(len(xy), 9.0)                          # noqa: E731
@@ -120,7 +120,7 @@ def _walker_in_the_scan(leaving_to_walkers: bool, lateral) -> list:
         target = np.array([2.3 + 0.1 * k, 0.0])
         step = SimpleNamespace(t=0.1 * k, found=True, xy=target, velocity=np.array([1.0, 0.0]), chosen=0,
                                candidates=SimpleNamespace(xy=target[None]), others_xy=NOBODY, others_velocity=NOBODY)
-        scan = simulate_scan((-0.1, 0.0), 0.0, np.array([[1.1, y]]), [0.2], open_floor, noise=0.0)
+        scan = simulate_scan((-0.1, 0.0), 0.0, np.array([[ahead, y]]), [0.2], open_floor, noise=0.0)
         out.append(follower.command(step, camera(0.0, 0.0, 0.0), 0.1 * k, scan=scan)[0])
     return out
 
@@ -133,3 +133,5 @@ def test_a_walker_leaving_the_path_is_left_to_the_walkers_limit_not_the_depth_st
     assert min(leaving[3:5]) >= 1.5 and max(standing[3:5]) <= 1.25
     # walking into the path: the points still count, whatever the option
     assert _walker_in_the_scan(True, out[::-1]) == _walker_in_the_scan(False, out[::-1])
+    # leaving, but still within the stop distance (0.6 m from the robot's centre): the points still count
+    assert _walker_in_the_scan(True, out, ahead=0.5) == _walker_in_the_scan(False, out, ahead=0.5)

@@ -89,8 +89,8 @@ class PIDFollower:
     (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
     the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
     leaving_to_walkers : with ``walkers`` and ``depth_stop``, the depth and scan points of somebody walking
-    away from the robot or out of its path (``LEAVING_SPEED``) are left to the walkers limit, which
-    knows where they go; False: every point is a standing obstacle (35h and before: a crosser walking
+    away from the robot or out of its path (``LEAVING_SPEED``), farther than ``stop_distance``, are left to
+    the walkers limit, which knows where they go; False: every point is a standing obstacle (35h and before: a crosser walking
     out of the path still slowed the robot as if it stood where it was)
     """
 
@@ -286,7 +286,9 @@ class PIDFollower:
             xy.append(found[away])
             vel.append(velocity[away])
         xy, vel = np.vstack(xy), np.vstack(vel)
-        self._state["leaving"] = xy[_leaving(xy - centre, vel, fwd)]
+        # (not those still within the stop distance: the depth stop keeps the robot off them)
+        near = np.hypot(*(xy - centre).T) < self.stop_distance
+        self._state["leaving"] = xy[_leaving(xy - centre, vel, fwd) & ~near]
         return moving_speed_limit(centre, float(np.arctan2(fwd[1], fwd[0])), w, xy, vel,
                                   clearance=self.stop_distance, brake=self.brake, max_speed=self.robot.max_speed)
 
