@@ -108,30 +108,3 @@ def test_who_caused_a_contact():
     assert unseen.cause == "unseen" and unseen.robot_fault
     seen = _collision(5, 2, np.array([0.45, 0.0]), driving, np.zeros(2), 0.6, step, False)
     assert seen.cause == "seen, not stopped" and seen.robot_fault
-
-
-def _walker_in_the_scan(leaving_to_walkers: bool, lateral, ahead: float = 1.1) -> list:
-    """The PID's commands (m/s) while a walker 1.1 m ahead of the standing robot, seen only by the scan,
-    goes through ``lateral`` (m, one a frame); the target 2.3 m ahead walks east at 1 m/s."""
-    open_floor = lambda xy: np.full(len(xy), 9.0)                          # noqa: E731
-    follower = PIDFollower(depth_stop=True, walkers=True, leaving_to_walkers=leaving_to_walkers)
-    out = []
-    for k, y in enumerate(lateral):
-        target = np.array([2.3 + 0.1 * k, 0.0])
-        step = SimpleNamespace(t=0.1 * k, found=True, xy=target, velocity=np.array([1.0, 0.0]), chosen=0,
-                               candidates=SimpleNamespace(xy=target[None]), others_xy=NOBODY, others_velocity=NOBODY)
-        scan = simulate_scan((-0.1, 0.0), 0.0, np.array([[ahead, y]]), [0.2], open_floor, noise=0.0)
-        out.append(follower.command(step, camera(0.0, 0.0, 0.0), 0.1 * k, scan=scan)[0])
-    return out
-
-
-def test_a_walker_leaving_the_path_is_left_to_the_walkers_limit_not_the_depth_stop():
-    # walking out of the path at 0.9 m/s: once the scan has their velocity, their points no longer
-    # stop the robot as if they stood there (35h: 1.13 and 1.21 m/s at 0.32 and 0.41 m off the path)
-    out = 0.05 + 0.09 * np.arange(8)
-    leaving, standing = _walker_in_the_scan(True, out), _walker_in_the_scan(False, out)
-    assert min(leaving[3:5]) >= 1.5 and max(standing[3:5]) <= 1.25
-    # walking into the path: the points still count, whatever the option
-    assert _walker_in_the_scan(True, out[::-1]) == _walker_in_the_scan(False, out[::-1])
-    # leaving, but still within the stop distance (0.6 m from the robot's centre): the points still count
-    assert _walker_in_the_scan(True, out, ahead=0.5) == _walker_in_the_scan(False, out, ahead=0.5)

@@ -48,7 +48,7 @@ import numpy as np
 from worldtrack.follow.movers import moving_speed_limit
 from worldtrack.follow.navigation import NavigationGrid
 from worldtrack.follow.robot import RobotLimits
-from worldtrack.follow.safety import free_path, near_points, unexplained
+from worldtrack.follow.safety import free_path, near_points
 from worldtrack.follow.scan import ScanMovers, segments
 from worldtrack.geometry.camera import Camera
 
@@ -58,10 +58,6 @@ LOOKAHEAD = 0.6
 RING = np.column_stack([np.cos(np.arange(16) * np.pi / 8), np.sin(np.arange(16) * np.pi / 8)])
 #: The pursuit's way keeps this much (m) more than the robot's radius from obstacles (the carrot cuts corners).
 NAV_MARGIN = 0.2
-#: A person walking away from the robot or out of its path at least this fast (m/s) is left to the walkers
-#: limit: their depth and scan points (within ``MOVER_RADIUS`` m of their centre) do not stop the robot.
-LEAVING_SPEED = 0.3
-MOVER_RADIUS = 0.45
 
 
 def pursuit_map(scene, robot: RobotLimits = RobotLimits()) -> NavigationGrid:
@@ -88,10 +84,6 @@ class PIDFollower:
     walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
     (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
     the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
-    leaving_to_walkers : with ``walkers`` and ``depth_stop``, the depth and scan points of somebody walking
-    away from the robot or out of its path (``LEAVING_SPEED``), farther than ``stop_distance``, are left to
-    the walkers limit, which knows where they go; False: every point is a standing obstacle (35h and before: a crosser walking
-    out of the path still slowed the robot as if it stood where it was)
     """
 
     distance: float = 1.8
@@ -107,7 +99,6 @@ class PIDFollower:
     integral_limit: float = 0.5
     depth_stop: bool = False
     walkers: bool = False
-    leaving_to_walkers: bool = True
     search_look: float | None = 2.0
     pursue: float | None = 10.0
     pursue_speed: float = 1.0
@@ -259,8 +250,6 @@ class PIDFollower:
         points = near_points(getattr(frame, "depth", None), camera)
         if scan is not None and len(scan):
             points = np.vstack([points, np.asarray(scan, float).reshape(-1, 2)])
-        if self.walkers and self.leaving_to_walkers:
-            points = unexplained(points, self._state.get("leaving", np.zeros((0, 2))), MOVER_RADIUS)
         if len(points) == 0:
             return np.inf
         fwd = camera.floor_direction
@@ -286,9 +275,6 @@ class PIDFollower:
             xy.append(found[away])
             vel.append(velocity[away])
         xy, vel = np.vstack(xy), np.vstack(vel)
-        # (not those still within the stop distance: the depth stop keeps the robot off them)
-        near = np.hypot(*(xy - centre).T) < self.stop_distance
-        self._state["leaving"] = xy[_leaving(xy - centre, vel, fwd) & ~near]
         return moving_speed_limit(centre, float(np.arctan2(fwd[1], fwd[0])), w, xy, vel,
                                   clearance=self.stop_distance, brake=self.brake, max_speed=self.robot.max_speed)
 
@@ -317,14 +303,3 @@ class PIDFollower:
         if len(gap) == 0:
             return np.inf
         return float(max(0.0, np.sqrt(2 * self.brake * max(gap.min(), 0.0)) - self.brake * dt))
-
-
-def _leaving(rel: np.ndarray, velocity: np.ndarray, fwd: np.ndarray) -> np.ndarray:
-    """(K,) bool: people at ``rel`` (K, 2) m from the robot, walking at ``velocity`` (K, 2) m/s, who walk
-    away from it, or out of its path (away from the line ahead, ``fwd``), at ``LEAVING_SPEED`` or more."""
-    rel, velocity = np.asarray(rel, float).reshape(-1, 2), np.asarray(velocity, float).reshape(-1, 2)
-    away = np.einsum("kc,kc->k", rel, velocity) / np.maximum(np.hypot(*rel.T), 1e-9)
-    left = np.array([-fwd[1], fwd[0]])
-    lateral = rel @ left
-    out = np.sign(lateral) * (velocity @ left)
-    return (away >= LEAVING_SPEED) | ((np.abs(lateral) > 0.05) & (out >= LEAVING_SPEED))
