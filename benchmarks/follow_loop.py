@@ -110,8 +110,8 @@ def out_of_band(s: dict) -> dict:
 
 def opening_collisions(causes: list) -> int:
     """Collision frames (the robot's doing by :class:`~worldtrack.follow.loop.Collision`'s rule) in which the
-    gap was opening for every person counted: they moved away faster than the robot followed (after
-    walking into it). Reported beside the collisions, not taken off them."""
+    gap was opening for every person counted: they moved away faster than the robot still moved towards
+    them (often after walking into it). Reported beside the collisions, not taken off them."""
     frames: dict = {}
     for c in causes:
         if c.robot_fault:
@@ -252,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
             + ", ".join(f"{k} {v / n_all:.3f}" for k, v in sorted(where.items(), key=lambda kv: -kv[1]))
             + f"\n- collisions (the robot driving into someone within 0.5 m, centre to centre, at least as fast as "
             f"they close in): **{totals['collisions']}** frames in {episodes['robot']} episodes (of which {opening} with the "
-            f"gap opening: the person moving away faster than the robot followed, after walking into it); people walking "
+            f"gap opening: the person moving away faster than the robot still moved towards them); people walking "
             f"into the robot (closing faster than it): {totals['walked_into']} frames in {episodes['walked']} "
             f"episodes; contacts of any kind {totals['contacts']} frames; bumper stops {totals['bumps']}\n"
             f"- contact frames by cause: " + (", ".join(f"{k} {v}" for k, v in sorted(causes.items())) or "none")
