@@ -48,6 +48,8 @@ from worldtrack.synth import make_scenario  # noqa: E402
 DISTANCE = 1.8
 TOLERANCE = 0.3
 RECOVER_S = 3.0
+#: Half the robot camera's horizontal field of view (66°): a target farther off the heading is out of view.
+HALF_VIEW_DEG = 33.0
 
 
 FOLLOWERS = {
@@ -100,7 +102,7 @@ def out_of_band(s: dict) -> dict:
     for run in np.split(np.arange(len(unseen)), edges):
         if unseen[run[0]] and len(run) >= 0.5 * fps:
             after_loss[run[-1] + 1:run[-1] + 1 + int(round(RECOVER_S * fps))] = True
-    labels = np.select([held, after, unseen & (off > np.radians(33.0)), unseen, after_loss, err < 0, off > np.radians(30.0)],
+    labels = np.select([held, after, unseen & (off > np.radians(HALF_VIEW_DEG)), unseen, after_loss, err < 0, off > np.radians(30.0)],
                        ["held", "catch-up after a hold", "target not found, out of view", "target not found, in view",
                         "catch-up after a loss", "too near (target turned or stopped)", "too far, turning"],
                        "too far, other")
@@ -202,8 +204,7 @@ def main(argv: list[str] | None = None) -> int:
     frames = 200 if args.quick else args.frames
     t0 = time.perf_counter()
     rows, all_within, all_free_within, records = [], [], [], {}
-    totals = {"contacts": 0, "collisions": 0, "walked_into": 0, "bumps": 0}
-    opening = 0
+    totals = {"contacts": 0, "collisions": 0, "walked_into": 0, "bumps": 0, "opening": 0}
     episodes = {"robot": 0, "walked": 0}
     causes: dict = {}
     where = {}
@@ -221,7 +222,7 @@ def main(argv: list[str] | None = None) -> int:
             totals[k] += getattr(r, k, 0)
         for name, n_frames in out_of_band(s).items():
             where[name] = where.get(name, 0) + n_frames
-        opening += opening_collisions(r.collision_causes)
+        totals["opening"] += opening_collisions(r.collision_causes)
         for kind, n_ep in contact_episodes(r.collision_causes).items():
             episodes[kind] += n_ep
         for c in r.collision_causes:
@@ -251,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
             f"after left out)\n- outside ±{TOLERANCE} m, share of all frames, by what was going on: "
             + ", ".join(f"{k} {v / n_all:.3f}" for k, v in sorted(where.items(), key=lambda kv: -kv[1]))
             + f"\n- collisions (the robot driving into someone within 0.5 m, centre to centre, at least as fast as "
-            f"they close in): **{totals['collisions']}** frames in {episodes['robot']} episodes (of which {opening} with the "
+            f"they close in): **{totals['collisions']}** frames in {episodes['robot']} episodes (of which {totals['opening']} with the "
             f"gap opening: the person moving away faster than the robot still moved towards them); people walking "
             f"into the robot (closing faster than it): {totals['walked_into']} frames in {episodes['walked']} "
             f"episodes; contacts of any kind {totals['contacts']} frames; bumper stops {totals['bumps']}\n"
