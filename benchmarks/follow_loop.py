@@ -48,6 +48,8 @@ from worldtrack.synth import make_scenario  # noqa: E402
 DISTANCE = 1.8
 TOLERANCE = 0.3
 RECOVER_S = 3.0
+#: Half the robot camera's horizontal field of view (66°): a target farther off the heading is out of view.
+HALF_VIEW_DEG = 33.0
 
 
 FOLLOWERS = {
@@ -82,15 +84,41 @@ def run_seed(seed: int, frames: int, size, follower: str = "pid+scan") -> dict:
 
 
 def out_of_band(s: dict) -> dict:
-    """Frames outside the band, by what was going on: held by someone in the path, the 3 s after a hold
-    (catching up), the target not found, the robot too near (the target turned or stopped), other."""
+    """Frames outside the band, by what was going on, first match: held by someone in the path, the 3 s
+    after a hold (catching up), the target not found (out of the camera's view, or in it), the 3 s after
+    the target was found again following ≥ 0.5 s unseen (catching up after a loss), the robot too near
+    (the target turned or stopped), too far with the target more than 30° off the heading (turning),
+    too far, other."""
     r = s["result"]
     err = r.distance - DISTANCE
     held, after = s["blocked"], ~s["free"] & ~s["blocked"]
-    labels = np.select([held, after, ~r.found, err < 0], ["held", "catch-up after a hold", "target not found",
-                                                          "too near (target turned or stopped)"], "too far, other")
+    fwd = r.camera_xy - r.robot_xy
+    rel = r.target_xy - r.camera_xy
+    off = np.abs(np.arctan2(fwd[:, 0] * rel[:, 1] - fwd[:, 1] * rel[:, 0], np.einsum("tc,tc->t", fwd, rel)))
+    unseen = ~r.found
+    fps = 1.0 / float(r.times[1] - r.times[0])
+    after_loss = np.zeros_like(unseen)
+    edges = np.flatnonzero(np.diff(unseen.astype(int)) != 0) + 1
+    for run in np.split(np.arange(len(unseen)), edges):
+        if unseen[run[0]] and len(run) >= 0.5 * fps:
+            after_loss[run[-1] + 1:run[-1] + 1 + int(round(RECOVER_S * fps))] = True
+    labels = np.select([held, after, unseen & (off > np.radians(HALF_VIEW_DEG)), unseen, after_loss, err < 0, off > np.radians(30.0)],
+                       ["held", "catch-up after a hold", "target not found, out of view", "target not found, in view",
+                        "catch-up after a loss", "too near (target turned or stopped)", "too far, turning"],
+                       "too far, other")
     names, counts = np.unique(labels[np.abs(err) > TOLERANCE], return_counts=True)
     return dict(zip(names.tolist(), counts.tolist()))
+
+
+def opening_collisions(causes: list) -> int:
+    """Collision frames (the robot's doing by :class:`~worldtrack.follow.loop.Collision`'s rule) in which the
+    gap was opening for every person counted: they moved away faster than the robot still moved towards
+    them (often after walking into it). Reported beside the collisions, not taken off them."""
+    frames: dict = {}
+    for c in causes:
+        if c.robot_fault:
+            frames[c.frame] = frames.get(c.frame, True) and c.robot_speed + c.person_speed < 0.0
+    return sum(frames.values())
 
 
 def contact_episodes(causes: list) -> dict:
@@ -176,7 +204,7 @@ def main(argv: list[str] | None = None) -> int:
     frames = 200 if args.quick else args.frames
     t0 = time.perf_counter()
     rows, all_within, all_free_within, records = [], [], [], {}
-    totals = {"contacts": 0, "collisions": 0, "walked_into": 0, "bumps": 0}
+    totals = {"contacts": 0, "collisions": 0, "walked_into": 0, "bumps": 0, "opening": 0}
     episodes = {"robot": 0, "walked": 0}
     causes: dict = {}
     where = {}
@@ -194,6 +222,7 @@ def main(argv: list[str] | None = None) -> int:
             totals[k] += getattr(r, k, 0)
         for name, n_frames in out_of_band(s).items():
             where[name] = where.get(name, 0) + n_frames
+        totals["opening"] += opening_collisions(r.collision_causes)
         for kind, n_ep in contact_episodes(r.collision_causes).items():
             episodes[kind] += n_ep
         for c in r.collision_causes:
@@ -223,7 +252,8 @@ def main(argv: list[str] | None = None) -> int:
             f"after left out)\n- outside ±{TOLERANCE} m, share of all frames, by what was going on: "
             + ", ".join(f"{k} {v / n_all:.3f}" for k, v in sorted(where.items(), key=lambda kv: -kv[1]))
             + f"\n- collisions (the robot driving into someone within 0.5 m, centre to centre, at least as fast as "
-            f"they close in): **{totals['collisions']}** frames in {episodes['robot']} episodes; people walking "
+            f"they close in): **{totals['collisions']}** frames in {episodes['robot']} episodes (of which {totals['opening']} with the "
+            f"gap opening: the person moving away faster than the robot still moved towards them); people walking "
             f"into the robot (closing faster than it): {totals['walked_into']} frames in {episodes['walked']} "
             f"episodes; contacts of any kind {totals['contacts']} frames; bumper stops {totals['bumps']}\n"
             f"- contact frames by cause: " + (", ".join(f"{k} {v}" for k, v in sorted(causes.items())) or "none")
