@@ -80,10 +80,20 @@ def test_a_worker_refuses_a_map_of_another_scene_and_run_yaml_hides_the_password
     assert err.count("may not publish to worldtrack:map:updates") == 1 and "Traceback" not in err
 
 
-def _run_fusion(client, cfg, seconds):
+def _run_fusion(client, cfg, seconds, until_map_t=None, patience_s=30.0):
+    """Run the fusion role for `seconds`, and on past them (up to `patience_s` more) until the map
+    stream holds a state at or after `until_map_t` (a loaded machine lags the fusion behind)."""
     role = FusionRole(client, MapKeys(), cfg, "fuser")
     t_end = time.time() + seconds
-    while time.time() < t_end:
+    t_give_up = t_end + patience_s
+
+    def behind():
+        if until_map_t is None:
+            return False
+        last = client.xrevrange(MapKeys().map_stream, count=1)
+        return not last or float(last[0][1]["t"]) < until_map_t
+
+    while time.time() < t_end or (behind() and time.time() < t_give_up):
         if not role.holding:
             assert role.lease.acquire()
             role._take_over()
@@ -98,7 +108,7 @@ def test_replay_by_time_range_and_streams_trimmed_by_retention(redis_url, tmp_pa
     pubs = Publishers(client, MapKeys(), cfg, SimulatedFloor(2, 2, np.random.default_rng(2))).start()
     t0 = time.time()
     try:
-        _run_fusion(client, cfg, 3.0)
+        _run_fusion(client, cfg, 3.0, until_map_t=t0 + 2.5)
     finally:
         pubs.stop()
     keys = MapKeys()
