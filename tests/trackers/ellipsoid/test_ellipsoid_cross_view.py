@@ -2,12 +2,12 @@
 (:mod:`worldtrack.trackers.ellipsoid.cross_view`)."""
 
 import numpy as np
-from _ellipsoid_scenes import ellipsoid_frames, noise_backgrounds
+from _ellipsoid_scenes import drawn_frame, ellipsoid_frames, noise_backgrounds
 
 from worldtrack.foreground import make_foregrounds
 from worldtrack.geometry import quadric as q
 from worldtrack.scene import scene_from_dict
-from worldtrack.trackers.base import Person
+from worldtrack.trackers.base import Frame, Person
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.ellipsoid.cameras import ray_direction
 from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view, cross_view_people, shown_share
@@ -114,3 +114,28 @@ def test_the_tracker_brings_a_hand_placed_track_back_in_one_frame_only_with_the_
         errors[search_m] = np.hypot(track.x - PERSON[0], track.y - PERSON[1])
     assert errors[3.0] < 0.15, errors
     assert errors[0.0] > 1.0, errors
+
+
+def test_the_tracker_keeps_clear_m_from_a_neighbour():
+    # A neighbour tracked 0.6 m beside the person: the other camera's silhouettes of the two
+    # overlap there, so with the default clear_m (0.8 m) the far track is not pulled next to the
+    # neighbour in the first frame; with clear_m 0.4 it is.
+    scene = narrow_two_cameras()
+    c1 = scene.camera("c1")
+    ray = ray_direction(c1, PERSON)
+    neighbour = PERSON + 0.6 * np.array([-ray[1], ray[0]])
+    off = PERSON + 2.8 * ray
+    errors = {}
+    for clear_m in (0.8, 0.4):
+        rng = np.random.default_rng(8)
+        bgs = noise_backgrounds(scene, rng)
+        cfg = EllipsoidConfig(cross_view={"search_m": 3.0, "clear_m": clear_m}, births={"where": "none"},
+                              warm_start={"frames": 0})
+        tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), cfg)
+        tracker.init_track(*off, track_id=1)
+        tracker.init_track(*neighbour, track_id=2)
+        frames = {cid: Frame(drawn_frame(scene, bgs[cid], [PERSON, neighbour], rng, cid), 0.0, 0) for cid in bgs}
+        track = [t for t in tracker.step(frames, 0.0) if t.id == 1][0]
+        errors[clear_m] = np.hypot(track.x - PERSON[0], track.y - PERSON[1])
+    assert errors[0.4] < 0.15, errors
+    assert errors[0.8] > 1.0, errors

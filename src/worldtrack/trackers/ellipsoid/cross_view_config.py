@@ -30,6 +30,9 @@ class CrossViewConfig(Section):
         "image and not hidden by an obstacle")
     min_ratio: float = Field(0.3, description="the unseeing camera's own E at the new place must be at least this")
     gain: float = Field(0.0, ge=0, description="E with every camera must beat E at the current place by this")
+    clear_m: float = Field(
+        0.8, ge=0, description="never onto a place this close to somebody else, m: there the other camera's "
+        "silhouettes of the two overlap, and what it shows is not this person's (a track pulled onto a neighbour)")
 
 
 __all__ = ["CrossViewConfig"]

@@ -267,7 +267,7 @@ class EllipsoidTracker(TrackerBase):
         cv = cfg.cross_view
         if cv.search_m > 0:
             cross_view_people(joint, people, self.views, best_e, best_den, CrossViewArgs(
-                cv.search_m, cv.step_m, cv.min_share, cv.min_ratio, cv.gain, cfg.births.min_separation_m))
+                cv.search_m, cv.step_m, cv.min_share, cv.min_ratio, cv.gain, max(cv.clear_m, cfg.births.min_separation_m)))
         for k, p in enumerate(people):
             p.x, p.y = float(joint.xy[k, 0]), float(joint.xy[k, 1])
         return [(float(best_e[k]), float(best_den[k])) for k in range(len(people))]
