@@ -13,10 +13,11 @@ the current place (where B's unexplained foreground in the searched region count
 staying) by ``gain``. Where B shows nobody along the ray, the person stays where B cannot see:
 those are the only depths left.
 
-Opt-in (``ellipsoid.cross_view.search_m`` > 0), and measured not to generalise: crowd 10, paired
-in one session, dev seeds 20–39 0.920 → 0.936 (12 better, 1 worse) but held-out 140–159
-0.932 → 0.925 (9 better, 9 worse). What B shows along A's ray is *a* person, not necessarily this
-one: a track that truly stands where B cannot see is pulled onto somebody B shows (issue 37).
+Opt-in (``ellipsoid.cross_view.search_m`` > 0). Crowd 10, paired in one session: dev seeds 20–39
+0.920 → 0.936 (12 better, 1 worse); 60 seeds never tuned on (140–179, 200–219) 0.906 → 0.915
+(36 better, 19 worse), but 140–159 alone 0.932 → 0.925. What B shows along A's ray is *a*
+person, not necessarily this one: a track that truly stands where B cannot see can be pulled
+onto somebody B shows (issue 37).
 
 >>> import numpy as np
 >>> ray_candidates(np.array([1.0, 2.0]), [np.array([1.0, 0.0])], 0.5, 0.25).round(2).tolist()
