@@ -14,8 +14,8 @@ staying) by ``gain``. Where B shows nobody along the ray, the person stays where
 those are the only depths left.
 
 Opt-in (``ellipsoid.cross_view.search_m`` > 0). Crowd 10, paired in one session: dev seeds 20–39
-0.920 → 0.936 (12 better, 1 worse); 60 seeds never tuned on (140–179, 200–219) 0.906 → 0.915
-(36 better, 19 worse), but 140–159 alone 0.932 → 0.925. What B shows along A's ray is *a*
+0.920 → 0.936 (12 better, 1 worse); held-out 140–199 0.914 → 0.920 (33 better, 21 worse),
+never-used 200–219 0.897 → 0.909, but 140–159 alone 0.932 → 0.925. What B shows along A's ray is *a*
 person, not necessarily this one: a track that truly stands where B cannot see can be pulled
 onto somebody B shows (issue 37).
 

@@ -23,8 +23,8 @@ class CrossViewConfig(Section):
     search_m: float = Field(
         0.0, ge=0, description="for a tracked person some camera does not show (out of its image, behind an "
         "obstacle): search each seeing camera's line of sight this far, m, for a place that camera shows and "
-        "confirms (0 = off, the default; 3 measured on crowd 10: dev seeds 20-39 0.920 -> 0.936, 60 held-out seeds "
-        "0.906 -> 0.915 with 19 of 60 worse)")
+        "confirms (0 = off, the default; 3 measured on crowd 10: dev seeds 20-39 0.920 -> 0.936, held-out 140-199 "
+        "0.914 -> 0.920 with 21 of 60 seeds worse)")
     step_m: float = Field(0.15, gt=0, description="... in steps of this, m")
     min_share: float = Field(
         0.5, gt=0, le=1, description="a camera shows a place when this share of the person's ellipse is in its "
