@@ -21,8 +21,8 @@ s = 50 mm, K = 3, 5 px ring (§6)            :mod:`.config` (``EllipsoidConfig.p
 ==========================================  ==================================================
 
 and worldtrack's additions: births from unexplained foreground (:mod:`.births`), searches along
-lines of sight (:mod:`.search`), support of each track (:mod:`.support`), measured heights
-(:mod:`.height`), depth from the feet or the top of the head (:mod:`.feet`), the warm start
+lines of sight (:mod:`.search`; for a place one camera cannot see, :mod:`.cross_view`), support of
+each track (:mod:`.support`), measured heights (:mod:`.height`), depth from the feet or the top of the head (:mod:`.feet`), the warm start
 (:mod:`.warm_start`), the per-camera state (:mod:`.cameras`), the
 kernels' typed arguments (:mod:`.args`), and the tracker that runs the steps in order
 (:mod:`.tracker`).

@@ -1,13 +1,11 @@
 """Settings of the ellipsoid tracker (paper 000), one section per step of the method.
 
-``EllipsoidConfig()`` is worldtrack's default; :meth:`EllipsoidConfig.paper` the method as
-published (s = 50 mm, K = 3, every pixel, eq. 5 as printed, no prediction, no searches, fixed
-1.65 m people). Durations are in seconds and turned into frames with the real frame interval
-(:func:`worldtrack.trackers.lifecycle.frames_for`). Why each default is what it is, with the
-measurements, is in ``benchmarks/results/tuning_ellipsoid.md``.
+``EllipsoidConfig()`` is worldtrack's default; :meth:`EllipsoidConfig.paper` the method as published (s = 50 mm,
+K = 3, every pixel, eq. 5 as printed, no prediction, no searches, fixed 1.65 m people). Durations are in seconds and
+turned into frames with the real frame interval (:func:`worldtrack.trackers.lifecycle.frames_for`). Why each default
+is what it is, with the measurements, is in ``benchmarks/results/tuning_ellipsoid.md``.
 
-Light on purpose (pydantic and worldtrack.config only): the command line imports it for
-``--help`` and ``--print-config``.
+Light on purpose (pydantic and worldtrack.config only): the command line imports it for ``--help`` and ``--print-config``.
 
 >>> cfg = EllipsoidConfig()
 >>> cfg.match.step_m, cfg.end.leave_after_s
@@ -27,6 +25,7 @@ from typing import ClassVar, Literal
 from pydantic import Field, model_validator
 
 from worldtrack.config import Section, with_overrides
+from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
 
 
 class ScoreConfig(Section):
@@ -383,6 +382,7 @@ class EllipsoidConfig(Section):
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
     lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
     split: SplitConfig = Field(SplitConfig(), description="one person or two on one line of sight")
+    cross_view: CrossViewConfig = Field(CrossViewConfig(), description="a track one camera cannot see, searched along another's ray")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":

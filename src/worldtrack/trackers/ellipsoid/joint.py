@@ -68,6 +68,18 @@ class JointImage:
         settings, each camera is weighed as it is there (:func:`.match.held_scores`).
         """
         s = self.settings
+        num, den, forms = self.camera_sums(k, cand, use_ring)
+        if current is not None and s.held and len(self.cids) > 1:
+            return held_scores(num, den, current), den.sum(axis=0), forms  # (one camera: the same)
+        num, den = num.sum(axis=0), den.sum(axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)
+        return e, den, forms
+
+    def camera_sums(self, k: int, cand: np.ndarray, use_ring: bool) -> tuple[np.ndarray, np.ndarray, dict[str, Forms]]:
+        """Each camera's Σ sim·real and Σ|sim| (C, J) for J candidate places ``cand`` (J, 2) of
+        person ``k``, everybody else fixed, and the candidates' per-camera forms."""
+        s = self.settings
         n = len(cand)
         heights, widths = np.full(n, self.people.heights[k]), np.full(n, self.people.widths[k])
         num = np.zeros((len(self.cids), n))
@@ -78,12 +90,7 @@ class JointImage:
             num[i], den[i], ci, cr, cb, cv, cd = score_camera(self.views[cid].args, self.real[cid], cand, heights,
                                                               widths, s.draw, self.state[cid], k, opts)
             forms[cid] = Forms(ci, cr, cb, cv, cd)
-        if current is not None and s.held and len(self.cids) > 1:
-            return held_scores(num, den, current), den.sum(axis=0), forms  # (one camera: the same)
-        num, den = num.sum(axis=0), den.sum(axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)
-        return e, den, forms
+        return num, den, forms
 
     def move(self, k: int, place: np.ndarray, forms: Mapping[str, Forms], b: int) -> None:
         """Person ``k`` moves to ``place`` (2,), candidate ``b`` of ``forms`` (from :meth:`score`)."""

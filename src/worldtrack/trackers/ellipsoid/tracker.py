@@ -7,6 +7,8 @@ One :meth:`EllipsoidTracker.step`:
 3. match: a just-proposed person is placed by the birth search (:mod:`.search`), then everybody
    is moved in turn to the best of 9 candidates, K rounds (:mod:`.match`, eq. 5 in
    :mod:`.score`), and failing tracks are rescued along their lines of sight (:mod:`.search`);
+   with ``cross_view.search_m`` > 0, a tracked person some camera does not show is searched along
+   the other cameras' lines of sight for where it does (:mod:`.cross_view`);
 4. propose new people from unexplained foreground (:mod:`.births`) and match them;
    with ``depth.fuse``, place people one camera alone shows along its line of sight from every
    cue (:mod:`.depth`);
@@ -46,6 +48,7 @@ from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
+from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view_people
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS, flag_unmeasurable, measure_support
 from worldtrack.trackers.ellipsoid.two_hypotheses import RaySplitter
@@ -261,6 +264,10 @@ class EllipsoidTracker(TrackerBase):
             rescue_people(joint, people, best_e, best_den,
                           RescueArgs(cfg.rescue.search_m, cfg.rescue.gain, cfg.births.min_separation_m),
                           RescueSchedule(self.frames_stepped, every, cfg.rescue.retry_s, 0.5 * self.frame_interval), t)
+        cv = cfg.cross_view
+        if cv.search_m > 0:
+            cross_view_people(joint, people, self.views, best_e, best_den, CrossViewArgs(
+                cv.search_m, cv.step_m, cv.min_share, cv.min_ratio, cv.gain, max(cv.clear_m, cfg.births.min_separation_m)))
         for k, p in enumerate(people):
             p.x, p.y = float(joint.xy[k, 0]), float(joint.xy[k, 1])
         return [(float(best_e[k]), float(best_den[k])) for k in range(len(people))]
