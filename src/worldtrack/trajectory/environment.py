@@ -111,6 +111,11 @@ class Barrier:
         """Samples per step so that a walker at ``max_speed`` (m/s) moves at most ``clearance`` between them."""
         return max(1, int(np.ceil(max_speed * dt / max(clearance, 1e-3))))
 
+    def gain(self, weight: float) -> float:
+        """√(λ/m)/s_h (1/m): the factor of every sample's rounded hinge, environment weight λ = ``weight``
+        spread over the m = ``substeps`` samples of a step."""
+        return float(np.sqrt(weight / self.substeps) / self.scale)
+
     def samples(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """(step t, fraction α) of every sample on a grid of ``n`` steps: α = j/m on steps
         0 … n − 2, plus α = 1 on step n − 2 (the last state)."""
@@ -209,7 +214,7 @@ def barrier_residuals(X: np.ndarray, barrier: Barrier, weight: float, dt: float,
     """
     from worldtrack.trajectory.kernels import barrier_samples
     t, alpha = barrier.samples(len(X))
-    gain = np.sqrt(weight / barrier.substeps) / barrier.scale
+    gain = barrier.gain(weight)
     f = barrier.field
     if reference:
         r, J, d, curvature = barrier_samples_reference(X, t, alpha, dt, f, barrier.clearance, barrier.softness, gain)

@@ -192,8 +192,7 @@ def _add_barrier(problem: Problem, X: np.ndarray, normal: Normal, barrier_steps:
         r, d = out.barrier_r, out.barrier_d
     else:
         r, d = np.empty(len(step)), np.empty(len(step))
-    gain = float(np.sqrt(env.weight / barrier.substeps) / barrier.scale)          # as ``barrier_residuals``
-    hinge = Hinge(float(barrier.clearance), float(barrier.softness), gain)
+    hinge = Hinge(float(barrier.clearance), float(barrier.softness), barrier.gain(env.weight))
     add_barrier_terms(X, step, alpha, problem.grid.dt, f.values, np.asarray(f.origin, dtype=float), float(f.resolution),
                       hinge, normal, r, d, barrier_steps)
     return r, d
