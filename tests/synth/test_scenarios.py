@@ -12,7 +12,7 @@ from worldtrack.synth import list_scenarios, make_scenario, scenario_parameters
 from worldtrack.synth import scenes
 from worldtrack.synth.bodies import (HEAD, L_FOOT, L_FOREARM, L_UPPER_ARM, PARTS_PER_PERSON, R_FOOT,
                                      R_FOREARM, R_UPPER_ARM)
-from worldtrack.synth.scenarios import CAM1_GRID, CAM2_GRID
+from worldtrack.synth.kato_lab import CAM1_GRID, CAM2_GRID
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 
@@ -173,7 +173,7 @@ def test_pose_scenarios_report_the_rendered_pose():
 
 
 def test_face_pose_quaternion_matches_the_head_rotation():
-    from worldtrack.synth.scenarios import _quat
+    from worldtrack.synth.booth import _quat
     from worldtrack.geometry.rotation import euler_zyx
     R = euler_zyx(0.3, -0.2, 0.1)
     w, x, y, z = _quat(R)

@@ -38,7 +38,13 @@ from worldtrack.synth.motion import Track, Waypoint, WalkerSettings, random_walk
 from worldtrack.synth.photometry import Light, LightingSchedule, LightSegment, SensorNoise, WhiteBalance
 from worldtrack.synth.render import RenderOptions, Renderer, SynthFrame
 from worldtrack.synth.scenarios import Common, list_scenarios, make_scenario, scenario_parameters
-from worldtrack.synth import unseen as _unseen  # noqa: F401  (registers the line-of-sight scenario)
+# The scenario families register themselves with make_scenario when imported, in this order (list_scenarios).
+from worldtrack.synth import kato_lab as _kato_lab  # noqa: F401  (paper 000's experiments)
+from worldtrack.synth import halls as _halls  # noqa: F401  (crowd, two rooms, entry)
+from worldtrack.synth import following as _following  # noqa: F401  (follow-target)
+from worldtrack.synth import office as _office  # noqa: F401  (non-overlapping)
+from worldtrack.synth import booth as _booth  # noqa: F401  (face-pose, upper-body)
+from worldtrack.synth import unseen as _unseen  # noqa: F401  (line-of-sight)
 from worldtrack.synth.sensors import SensorSpec
 from worldtrack.synth.sequence import CameraRig, Person, Scenario, SynthBundle
 from worldtrack.synth.writer import write_sequence
