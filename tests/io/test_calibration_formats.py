@@ -21,7 +21,8 @@ from worldtrack.cli import main
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.geometry.rotation import rotation_to_rodrigues
-from worldtrack.io.calibration_formats import decide_units, import_camera, read_calibration
+from worldtrack.io.calibration_formats import read_calibration
+from worldtrack.io.calibration_import import decide_units, import_camera
 from worldtrack.scene.load import scene_from_dict
 
 TSAI_XML = """<?xml version="1.0" encoding="UTF-8"?>

@@ -29,7 +29,7 @@ if TYPE_CHECKING:   # NumPy, and the fitting and import modules load SciPy: impo
 
     from worldtrack.geometry.calibrate import CalibrationResult
     from worldtrack.geometry.camera import Camera
-    from worldtrack.io.calibration_formats import ImportedCamera
+    from worldtrack.io.calibration_import import ImportedCamera
 
 #: worldtrack.geometry.calibrate.ADVISED_POINTS, repeated here so ``--help`` need not load SciPy
 #: (tests/cli check that the two agree).
@@ -441,7 +441,8 @@ def _block(camera: Camera) -> str:
 
 
 def run_import(args: argparse.Namespace) -> int:
-    from worldtrack.io.calibration_formats import UNITS, import_camera, read_calibration
+    from worldtrack.io.calibration_formats import read_calibration
+    from worldtrack.io.calibration_import import UNITS, import_camera
     if args.distortion or args.intrinsics is not None:
         raise InputError("--distortion and --intrinsics fit points; they do not apply with --import")
     radial_terms = _parse_radial_terms(args.radial_terms)
