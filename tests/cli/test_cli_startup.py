@@ -82,6 +82,17 @@ def test_ctrl_c_while_the_command_line_is_imported_is_one_line_and_130():
     assert (out.returncode, out.stderr) == (130, "interrupted\n")
 
 
+
+def test_sigterm_while_the_command_line_is_imported_is_one_line_and_143():
+    # Under load the import can take seconds; a SIGTERM then must not end the program silently (-15).
+    code = ("import builtins, os, signal\nreal = builtins.__import__\n"
+            "def importing(name, *args, **kwargs):\n"
+            "    if name == 'worldtrack.cli':\n        os.kill(os.getpid(), signal.SIGTERM)\n"
+            "    return real(name, *args, **kwargs)\n"
+            "builtins.__import__ = importing\nfrom worldtrack.entry import run\nrun()\n")
+    out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
+    assert (out.returncode, out.stderr) == (143, "terminated\n")
+
 def test_the_entry_point_imports_almost_nothing_before_it_can_catch_ctrl_c():
     code = "import sys\nimport worldtrack.entry\nprint(sorted(m for m in ('typing', 'argparse', 're', 'enum') if m in sys.modules))"
     out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
