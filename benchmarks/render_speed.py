@@ -23,7 +23,7 @@ import numpy as np
 
 from common import markdown_table, median_time, mog2_apply_time, write_result
 from worldtrack.synth import make_scenario
-from worldtrack.synth.render import people_pass
+from worldtrack.synth.people_pass import people_pass
 
 W, H = 640, 480
 FRAMES, WARMUP = 25, 3

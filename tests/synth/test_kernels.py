@@ -7,7 +7,7 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.synth import kernels
 from worldtrack.synth.bodies import PARTS_PER_PERSON, BodyShape, body_parts, posed
 from worldtrack.synth.photometry import SensorNoise, expose, expose_reference, noise_bytes, vignetting_map
-from worldtrack.synth.render import bounding_spheres, camera_frame_rays, people_pass, shadow_boxes
+from worldtrack.synth.people_pass import bounding_spheres, camera_frame_rays, people_pass, shadow_boxes
 
 
 def _people(n=3, seed=0):

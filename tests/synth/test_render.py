@@ -6,7 +6,7 @@ import pytest
 
 from worldtrack.synth import kernels, make_scenario
 from worldtrack.synth.environment import FLOOR
-from worldtrack.synth.render import people_pass
+from worldtrack.synth.people_pass import people_pass
 
 
 def _pixel(cam, point):
