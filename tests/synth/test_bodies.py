@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from worldtrack.synth.bodies import (HEAD, HEIGHT_RANGE, L_SHANK, L_UPPER_ARM, NOSE, PELVIS, R_UPPER_ARM,
-                                     SHOULDER_RANGE, BodyShape, JointAngles, body_parts, draw_body_shape,
-                                     gait_amplitude, posed)
+                                     SHOULDER_RANGE, BodyShape, body_parts, draw_body_shape)
+from worldtrack.synth.joints import JointAngles, gait_amplitude, posed
 
 
 def test_drawn_heights_and_shoulder_widths_stay_in_range():

@@ -5,7 +5,8 @@ import pytest
 
 from worldtrack.geometry.camera import Camera
 from worldtrack.synth import kernels
-from worldtrack.synth.bodies import PARTS_PER_PERSON, BodyShape, body_parts, posed
+from worldtrack.synth.bodies import PARTS_PER_PERSON, BodyShape, body_parts
+from worldtrack.synth.joints import posed
 from worldtrack.synth.photometry import SensorNoise, expose, expose_reference, noise_bytes, vignetting_map
 from worldtrack.synth.people_pass import bounding_spheres, camera_frame_rays, people_pass, shadow_boxes
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from worldtrack.synth import make_scenario
-from worldtrack.synth.bodies import stride_length
+from worldtrack.synth.joints import stride_length
 from worldtrack.synth.motion import Waypoint, finish_track, scripted_track
 
 

@@ -32,8 +32,9 @@ parameters); all accept ``size``, ``frames``, ``seed`` and the options of :class
 Same seed → identical arrays and files.
 """
 
-from worldtrack.synth.bodies import BodyShape, JointAngles, PartArrays, body_parts, draw_body_shape, posed
+from worldtrack.synth.bodies import BodyShape, PartArrays, body_parts, draw_body_shape
 from worldtrack.synth.environment import Environment, Window
+from worldtrack.synth.joints import JointAngles, posed
 from worldtrack.synth.motion import Track, Waypoint, WalkerSettings, random_walkers, scripted_track
 from worldtrack.synth.photometry import Light, LightingSchedule, LightSegment, SensorNoise, WhiteBalance
 from worldtrack.synth.render import RenderOptions, Renderer, SynthFrame

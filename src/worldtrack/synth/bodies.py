@@ -26,7 +26,7 @@ Joints
 * head: ``Rz·Ry·Rx`` relative to the torso about the top of the neck (ry > 0 looks down);
 * arms: each arm has a limb frame whose x axis points along the limb and, at rest, sideways out of
   the shoulder (z up). The shoulder is a rotation ``J_sh`` of that frame and the elbow a rotation
-  ``J_el`` of the upper-arm frame; :func:`limb_rotation` builds seed 003's 2-DoF ``Rz·Ry`` joints
+  ``J_el`` of the upper-arm frame; :func:`~worldtrack.synth.joints.limb_rotation` builds seed 003's 2-DoF ``Rz·Ry`` joints
   (rz swings in the horizontal plane, ry > 0 lowers the limb). The two arm frames are rotated
   copies, not mirror images: rz > 0 swings the left arm backward and the right arm forward.
 
@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
 from worldtrack.geometry.rotation import euler_zyx, rot_x, rot_y, rot_z
+from worldtrack.synth.joints import ARM_FRAMES, ARM_SIDES, JointAngles
 
 # Part indices within one person.
 PART_NAMES = ("head", "nose", "neck", "shoulders", "torso", "pelvis",
@@ -149,116 +150,6 @@ def draw_body_shape(rng: np.random.Generator, height: float | None = None, shoul
     return BodyShape(H, W, girth, skin, jitter(HAIR_COLOURS[rng.integers(len(HAIR_COLOURS))]), top, bottom,
                      jitter(SHOES[rng.integers(len(SHOES))]), bool(rng.random() < 0.3),
                      bool(rng.random() < 0.1), bool(rng.random() < 0.2), hair_style)
-
-
-# ------------------------------------------------------------------------------------ joint angles
-
-def limb_rotation(rz: ArrayLike, ry: ArrayLike) -> np.ndarray:
-    """Seed 003's 2-DoF joint ``Rz(rz)·Ry(ry)`` as rotation matrices (..., 3, 3)."""
-    return rot_z(rz) @ rot_y(ry)
-
-
-# Limb frames of the arms in the torso frame (columns: limb x, y, z): x points sideways out.
-_ARM_FRAME = np.stack([rot_z(np.pi / 2), rot_z(-np.pi / 2)])  # left, right
-_SIDE = np.array([1.0, -1.0])  # left, right: sign of the body y axis
-
-
-def arm_swing_rotation(swing: ArrayLike, abduction: ArrayLike, side: int) -> np.ndarray:
-    """Shoulder rotation ``J_sh`` (..., 3, 3) of an arm hanging down, swung forward by ``swing``.
-
-    ``abduction`` (radians) lifts the arm sideways away from the body.
-    """
-    s = _SIDE[side]
-    G = rot_y(-np.asarray(swing, float)) @ rot_x(-s * (np.pi / 2 - np.asarray(abduction, float)))
-    F = _ARM_FRAME[side]
-    return F.T @ G @ F
-
-
-def elbow_flex_rotation(flex: ArrayLike, side: int) -> np.ndarray:
-    """Elbow rotation ``J_el`` bending the forearm forward by ``flex`` radians (for a hanging arm)."""
-    return rot_z(-_SIDE[side] * np.asarray(flex, float))
-
-
-@dataclass
-class JointAngles:
-    """Pose of N people (all arrays have N rows). Angles in radians, lengths in metres.
-
-    Attributes
-    ----------
-    xy : (N, 2) ground point; yaw : (N,) heading
-    pelvis_twist : (N,) rotation of the pelvis about z
-    torso : (N, 3) (rz, ry, rx) relative to the body frame; torso_offset : (N, 3) body-frame shift
-    head : (N, 3) (rz, ry, rx) relative to the torso
-    shoulder, elbow : (N, 2, 3, 3) joint rotations (left, right)
-    hip : (N, 2, 2) (flexion, abduction); knee : (N, 2) flexion
-    grounded : (N,) bool — shift the body so the lower ankle is at standing ankle height
-    """
-
-    xy: np.ndarray
-    yaw: np.ndarray
-    pelvis_twist: np.ndarray
-    torso: np.ndarray
-    torso_offset: np.ndarray
-    head: np.ndarray
-    shoulder: np.ndarray
-    elbow: np.ndarray
-    hip: np.ndarray
-    knee: np.ndarray
-    grounded: np.ndarray
-
-    @classmethod
-    def neutral(cls, xy: ArrayLike, yaw: ArrayLike) -> "JointAngles":
-        """Standing upright, arms hanging slightly away from the body, elbows slightly bent."""
-        xy = np.atleast_2d(np.asarray(xy, dtype=float))
-        n = len(xy)
-        yaw = np.broadcast_to(np.asarray(yaw, dtype=float), (n,)).copy()
-        sh = np.stack([arm_swing_rotation(np.zeros(n), np.full(n, 0.12), k) for k in (0, 1)], axis=1)
-        el = np.stack([elbow_flex_rotation(np.full(n, 0.15), k) for k in (0, 1)], axis=1)
-        return cls(xy.copy(), yaw, np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)),
-                   sh, el, np.zeros((n, 2, 2)), np.zeros((n, 2)), np.ones(n, dtype=bool))
-
-    def __len__(self) -> int:
-        return len(self.xy)
-
-
-def gait_amplitude(speed: ArrayLike) -> np.ndarray:
-    """Relative swing amplitude of the limbs at ground speed (m/s): 0 standing, 1 at 1.3 m/s."""
-    return np.clip(np.asarray(speed, dtype=float) / 1.3, 0.0, 1.2)
-
-
-def stride_length(height: ArrayLike, speed: ArrayLike) -> np.ndarray:
-    """Length (m) of a full gait cycle (two steps): 0.83·H at 1.3 m/s, shorter when slower."""
-    v = np.clip(np.asarray(speed, dtype=float) / 1.3, 0.15, 1.3)
-    return 0.83 * np.asarray(height, dtype=float) * np.sqrt(v)
-
-
-def posed(xy: ArrayLike, yaw: ArrayLike, phase: ArrayLike, amplitude: ArrayLike, sit: ArrayLike) -> JointAngles:
-    """Joint angles for walking (gait ``phase``, radians; ``amplitude`` from :func:`gait_amplitude`)
-    blended with sitting (``sit`` = 0 standing … 1 seated). Vectorised over N people.
-
-    A standing person (amplitude 0) has no limb swing at any phase.
-    """
-    ja = JointAngles.neutral(xy, yaw)
-    n = len(ja)
-    ph = np.broadcast_to(np.asarray(phase, dtype=float), (n,))
-    a = np.broadcast_to(np.asarray(amplitude, dtype=float), (n,))
-    s = np.clip(np.broadcast_to(np.asarray(sit, dtype=float), (n,)), 0.0, 1.0)
-    walk = 1.0 - s
-    for side, ph_side in ((0, ph), (1, ph + np.pi)):
-        # Hip swings ±0.42 rad at normal speed; knee flexes in swing (hip moving forward, cos > 0).
-        hip = 0.42 * a * np.sin(ph_side)
-        knee = a * (0.08 + 0.95 * np.maximum(0.0, np.cos(ph_side)) ** 2)
-        ja.hip[:, side, 0] = walk * hip + s * (np.pi / 2)
-        ja.hip[:, side, 1] = 0.03 + 0.05 * s
-        ja.knee[:, side] = walk * knee + s * (np.pi / 2)
-        # Arms swing against the same-side leg; sitting puts the hands on the thighs.
-        swing = walk * (-0.35 * a * np.sin(ph_side)) + s * 0.35
-        ja.shoulder[:, side] = arm_swing_rotation(swing, np.full(n, 0.12), side)
-        ja.elbow[:, side] = elbow_flex_rotation(0.15 + walk * 0.25 * a + s * 0.9, side)
-    ja.pelvis_twist = walk * 0.06 * a * np.sin(ph)
-    ja.torso[:, 0] = -walk * 0.05 * a * np.sin(ph)
-    ja.torso[:, 1] = walk * 0.05 * a + 0.45 * np.sin(np.pi * s) + 0.05 * s
-    return ja
 
 
 # ------------------------------------------------------------------------------------ parts
@@ -408,7 +299,7 @@ def body_parts(shapes: list[BodyShape], ja: JointAngles) -> PartArrays:
     ell(PELVIS, pelvis_c, R_pel, np.column_stack([0.062 * H * g, 0.092 * H * g, 0.068 * H]))
     ankles = np.zeros((n, 2, 3))
     for side in (0, 1):
-        s = _SIDE[side]
+        s = ARM_SIDES[side]
         hip_j = pelvis_c + np.einsum("nij,nj->ni", R_pel, v(0, s * 0.050 * H * g, -0.025 * H))
         flex, abd = ja.hip[:, side, 0], ja.hip[:, side, 1]
         R_th = R_pel @ rot_y(-flex) @ rot_x(s * abd)
@@ -432,7 +323,7 @@ def body_parts(shapes: list[BodyShape], ja: JointAngles) -> PartArrays:
 
     ell(TORSO, at(v(0, 0, 0.11 * H)), R_tor,
         np.column_stack([0.065 * H * g, W / 2 - 0.9 * r_ua, 0.15 * H]))
-    shoulder_j = np.stack([at(v(0, s * (W / 2 - r_ua), (SHOULDER_H - LUMBAR_H) * H)) for s in _SIDE], axis=1)
+    shoulder_j = np.stack([at(v(0, s * (W / 2 - r_ua), (SHOULDER_H - LUMBAR_H) * H)) for s in ARM_SIDES], axis=1)
     cap(SHOULDERS, shoulder_j[:, 0], shoulder_j[:, 1], 1.05 * r_ua)
     neck_top = at(v(0, 0, (NECK_TOP_H - LUMBAR_H) * H))
     cap(NECK, at(v(0, 0, (NECK_BASE_H - LUMBAR_H) * H)), neck_top, r_neck)
@@ -444,7 +335,7 @@ def body_parts(shapes: list[BodyShape], ja: JointAngles) -> PartArrays:
 
     # ---- arms
     for side in (0, 1):
-        F = _ARM_FRAME[side]
+        F = ARM_FRAMES[side]
         U = R_tor @ F @ ja.shoulder[:, side]                        # upper-arm frame in body coordinates
         Fa = U @ ja.elbow[:, side]
         elbow_j = shoulder_j[:, side] + len_ua[:, None] * U[:, :, 0]

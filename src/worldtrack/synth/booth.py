@@ -10,9 +10,10 @@ import numpy as np
 
 from worldtrack.errors import InputError
 from worldtrack.synth import scenes
-from worldtrack.synth.bodies import (JointAngles, body_parts, limb_rotation, HEAD, TORSO, L_UPPER_ARM, L_FOREARM,
-                                     R_UPPER_ARM, R_FOREARM, PARTS_PER_PERSON)
+from worldtrack.synth.bodies import (body_parts, HEAD, TORSO, L_UPPER_ARM, L_FOREARM, R_UPPER_ARM, R_FOREARM,
+                                     PARTS_PER_PERSON)
 from worldtrack.synth.environment import Environment
+from worldtrack.synth.joints import JointAngles, limb_rotation
 from worldtrack.synth.motion import Track
 from worldtrack.synth.photometry import Light, light_direction
 from worldtrack.synth.scenarios import Common, _register, _scene, _options, _lighting, _rigs, _shape

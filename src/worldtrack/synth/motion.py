@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from worldtrack.errors import InputError
 from worldtrack.scene.model import Scene
-from worldtrack.synth.bodies import gait_amplitude, stride_length
+from worldtrack.synth.joints import gait_amplitude, stride_length
 
 
 @dataclass

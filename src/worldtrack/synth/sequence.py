@@ -21,9 +21,9 @@ import numpy as np
 from worldtrack.errors import InputError
 from worldtrack.geometry.camera import Camera
 from worldtrack.scene.model import Scene
-from worldtrack.synth.bodies import (HEAD, PARTS_PER_PERSON, BodyShape, JointAngles, PartArrays, body_parts,
-                                     hair_colours, posed)
+from worldtrack.synth.bodies import HEAD, PARTS_PER_PERSON, BodyShape, PartArrays, body_parts, hair_colours
 from worldtrack.synth.environment import Environment
+from worldtrack.synth.joints import JointAngles, posed
 from worldtrack.synth.motion import Track
 from worldtrack.synth.photometry import LightingSchedule, WhiteBalance, grey_world_mean
 from worldtrack.synth.render import Renderer, RenderOptions, SynthFrame
@@ -37,7 +37,7 @@ class Person:
     """A person of the sequence: id (from 1), build and clothes, motion.
 
     ``pose`` optionally overrides joint angles per frame (pose scenarios): a mapping from a
-    :class:`~worldtrack.synth.bodies.JointAngles` field name to an array with one row per frame.
+    :class:`~worldtrack.synth.joints.JointAngles` field name to an array with one row per frame.
     """
 
     id: int
