@@ -13,7 +13,9 @@ then shaped by the look-ahead, ``SolverOptions.look_ahead``), the largest move t
 since 34k the gain ratio ρ (actual ÷ predicted decrease) split by term: the decrease the Gauss–Newton model
 predicts for the step taken and the actual one, for the terms without the barrier (motion, pixels, height)
 and for the barrier, each term's curvature along the step (secant, 2·(g(X + δ) − g(X))·δ) ÷ the model's
-(2·δᵀHδ), and the barrier samples within the clearance.
+(2·δᵀHδ), and the barrier samples within the clearance; and how this step continues the last one, window by
+window (``WINDOW`` steps; windows where the step moves a state > 1 cm): how many go on in the same direction
+(cos > 0.95, with the median length ratio this ÷ last) and how many turn back (cos < −0.9).
 Then the same run goes on with the tolerance 1e-13 (``--tight-iterations`` more at most): how far the
 default stop (relative decrease 1e-5) is from the optimum its own path leads to, in objective and
 in metres.
@@ -51,6 +53,28 @@ def floor_moves(delta: np.ndarray) -> np.ndarray:
     return np.hypot(delta[:, 0], delta[:, 2])
 
 
+#: Steps per window for comparing a step with the last one (25 s at 10 steps/s).
+WINDOW = 250
+
+
+def continuation(step: np.ndarray, last: np.ndarray | None) -> list[str]:
+    """Columns: windows (``WINDOW`` steps) where ``step`` (n, 6) moves a state > 1 cm, of them those going on
+    along ``last`` (cos > 0.95) with the median length ratio, and those turning back (cos < −0.9)."""
+    if last is None:
+        return ["", "", ""]
+    same, ratios, back, moving = 0, [], 0, 0
+    for a in range(0, len(step), WINDOW):
+        u, v = last[a:a + WINDOW][:, [0, 2]].ravel(), step[a:a + WINDOW][:, [0, 2]].ravel()
+        if np.abs(v).max(initial=0.0) <= 0.01 or not np.any(u):
+            continue
+        moving += 1
+        cos = float(u @ v / (np.linalg.norm(u) * np.linalg.norm(v)))
+        same, back = same + (cos > 0.95), back + (cos < -0.9)
+        if cos > 0.95:
+            ratios.append(np.linalg.norm(v) / np.linalg.norm(u))
+    return [moving, f"{same} ({np.median(ratios):.2f})" if ratios else "0", back]
+
+
 def split_by_term(free: Problem, X: np.ndarray, delta: np.ndarray, lin: Linearisation,
                   after: Linearisation) -> list[str]:
     """Columns of one accepted step δ (n, 6) from X (n, 6): ρ, then for the terms without the barrier
@@ -80,7 +104,7 @@ def trace(T: int, seed: int, tight_iterations: int, shrink_on_reject: bool) -> t
     X0 = shortest_path_start(problem.observations, grid, height, field, opts.clearance)
     free = problem.with_environment(problem.environment.without_barrier())
     lm = LevenbergMarquardt(problem, X0, replace(opts.solver, shrink_on_reject=shrink_on_reject))
-    rows, limit = [], opts.solver.max_move
+    rows, limit, last = [], opts.solver.max_move, None
     while not lm.converged and lm.iterations < opts.solver.max_iterations:
         F, X, mu = lm.lin.costs.total, lm.X, lm.mu
         lm.model_floor()                     # solves (and keeps) the next step: the raw Gauss–Newton step
@@ -91,7 +115,8 @@ def trace(T: int, seed: int, tight_iterations: int, shrink_on_reject: bool) -> t
         split = split_by_term(free, X, lm.X - X, before, lm.lin) if lm.X is not X else ["rejected"] + [""] * 6
         rows.append([lm.iterations, f"{lm.lin.costs.total:.6f}", f"{(F - lm.lin.costs.total) / F:.1e}", f"{mu:.0e}",
                      f"{raw.max():.3f}", int((raw > limit).sum()), f"{taken.max():.3f}", int((taken > 0.01).sum()),
-                     f"{lm.lin.costs.barrier:.3f}", inside] + split)
+                     f"{lm.lin.costs.barrier:.3f}", inside] + split + continuation(lm.X - X, last))
+        last = lm.X - X if lm.X is not X else last
     X_stop, F_stop, it_stop = lm.X.copy(), lm.lin.costs.total, lm.iterations
     lm.converged, lm.tolerance = False, 1e-13
     lm.run(tight_iterations)
@@ -117,7 +142,8 @@ def main(argv: list[str] | None = None) -> int:
     head = ["iteration", "F", "ΔF / F", "μ", "raw step, largest move m", "states cut", "move taken m",
             "states moved > 1 cm", "barrier cost", "samples within the clearance", "ρ",
             "no barrier: predicted", "actual", "curvature ÷ model's", "barrier: predicted", "actual",
-            "curvature ÷ model's"]
+            "curvature ÷ model's", f"windows of {WINDOW} steps moving", "of them going on (length ratio)",
+            "turning back"]
     parts, summaries = [f"({cpu})\n"], []
     for T in sizes:
         for seed in seeds:
