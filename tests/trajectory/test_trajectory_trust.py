@@ -72,3 +72,23 @@ def test_the_trust_region_reaches_the_same_optimum(office_problem):
     assert a.converged and b.converged
     assert a.costs.total == pytest.approx(b.costs.total, rel=1e-9)
     assert np.abs(a.X[:, [0, 2]] - b.X[:, [0, 2]]).max() < 1e-4
+
+
+
+def test_inside_a_shrunk_trust_region_no_state_moves_beyond_it_with_the_look_ahead_on(office_problem):
+    # 34k: the look-ahead (on by default since 34i) lets every state whose floor is clear take its whole move,
+    # so after a rejection the halved radius did not bind and the same step was tried until the iteration limit
+    problem, X0, options = office_problem
+    lm = LevenbergMarquardt(problem, X0, replace(options.solver, shrink_on_reject=True))
+    assert lm.options.look_ahead is not None
+    lm.model_floor()
+    raw = lm._pending[0]
+    moves = np.hypot(raw[:, 0], raw[:, 2])
+    lm.move_limit = 0.5 * min(moves.max(), options.solver.max_move)      # as after this step was rejected
+    step, predicted = lm._limit(lm.lin, raw, 1.0)
+    assert np.hypot(step[:, 0], step[:, 2]).max() <= lm.move_limit * (1 + 1e-12)
+    assert predicted > 0
+    full = LevenbergMarquardt(problem, X0, options.solver)                # the full radius: the look-ahead shapes it
+    full.model_floor()
+    shaped, _ = full._limit(full.lin, full._pending[0], 1.0)
+    assert np.hypot(shaped[:, 0], shaped[:, 2]).max() > options.solver.max_move
