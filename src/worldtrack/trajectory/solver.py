@@ -135,6 +135,7 @@ class LevenbergMarquardt:
             raise ValueError("the start puts the head behind a camera")
         self.mu, self.nu = options.initial_damping, 2.0
         self.move_limit = options.max_move
+        self._shrunk = False              # inside a trust region a rejection shrank (``shrink_on_reject``)
         # buffers reused by every iteration: the trial's linearisation and the linear solver's work
         lin = self.lin
         self._spare = lin.copy()
@@ -224,6 +225,7 @@ class LevenbergMarquardt:
             self.nu = 2.0
             if barrier and rho > 0.75:
                 self.move_limit = min(2.0 * self.move_limit, options.max_move)
+                self._shrunk = self._shrunk and self.move_limit < options.max_move
             if actual <= self.tolerance * max(lin.costs.total, 1e-300) and not self._model_disagrees():
                 self.message, self.converged = "objective settled", True
             elif np.abs(delta).max() <= options.step_size:
@@ -233,9 +235,10 @@ class LevenbergMarquardt:
             return
         tried = float(np.hypot(delta[:, 0], delta[:, 2]).max()) if barrier else 0.0
         if barrier and options.shrink_on_reject and tried > 1e-3:
-            # a trust region: the next try moves no state by more than half of this one's largest move,
-            # with the same damping, so the same Gauss–Newton step (kept: no second solve)
-            self.move_limit, self._pending = 0.5 * tried, step
+            # a trust region: the next try moves no state by more than half of this one's largest move (nor
+            # beyond max_move: the look-ahead may have carried clear states further), with the same damping,
+            # so the same Gauss–Newton step (kept: no second solve)
+            self.move_limit, self._pending, self._shrunk = min(0.5 * tried, options.max_move), step, True
             return
         self.mu, self.nu = self.mu * self.nu, self.nu * 2
         if self.mu > 1e12 or predicted <= 1e-14 * max(lin.costs.total, 1e-300):
@@ -257,7 +260,7 @@ class LevenbergMarquardt:
         move = np.hypot(delta[:, 0], delta[:, 2]).max()
         if move <= self.move_limit:
             return delta, predicted
-        if self.options.look_ahead is not None and self.move_limit >= self.options.max_move:
+        if self.options.look_ahead is not None and not self._shrunk:
             barrier, dt = self.problem.environment.barrier, self.problem.grid.dt
             window = int(round(self.options.look_ahead / dt))
             shaped = shape_step(delta, self.X, barrier, self.move_limit / move, window, dt, lin.barrier_d)
