@@ -69,9 +69,10 @@ class SolverOptions:
         at all; the trust region shortens it at once (34g: 17 → 13–14 iterations on the held-out walks
         where steps are rejected, the same optimum to 1e-15). Off by default: its other path reached
         another (lower) optimum for 2 of 69 people of zara01 (camera seed 4, walls + free space), so
-        the default keeps the estimates of 34f. Inside the shrunk region the look-ahead is not used (34k: it let
-        clear states take their whole move, so the radius did not bind and walks of T = 10 000 stalled at the
-        iteration limit); held-out walks 42 / 90 / 91 at T = 10 000: 28 / 35 / 30 → 23 / 24 / 21 iterations
+        the default keeps the estimates of 34f. Inside the shrunk region (radius ≤ ``max_move``) the look-ahead
+        is not used (34k: it let clear states take their whole move, so the radius did not bind and held-out walks
+        stalled at the iteration limit); held-out walks with rejections, T = 10 000: 35 / 30 / 27 / 30 / 26 →
+        24 / 21 / 24 / 25 / 22 iterations, the others unchanged
     """
 
     max_iterations: int = 100
