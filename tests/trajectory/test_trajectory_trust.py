@@ -72,3 +72,40 @@ def test_the_trust_region_reaches_the_same_optimum(office_problem):
     assert a.converged and b.converged
     assert a.costs.total == pytest.approx(b.costs.total, rel=1e-9)
     assert np.abs(a.X[:, [0, 2]] - b.X[:, [0, 2]]).max() < 1e-4
+
+
+
+
+def test_inside_a_shrunk_trust_region_no_state_moves_beyond_it_with_the_look_ahead_on(office_problem):
+    # 34k: the look-ahead (on by default since 34i) lets every state whose floor is clear take its whole move,
+    # so after a rejection the halved radius did not bind and the same step was tried until the iteration limit
+    problem, X0, options = office_problem
+    lm = LevenbergMarquardt(problem, X0, replace(options.solver, shrink_on_reject=True))
+    assert lm.options.look_ahead is not None
+    lm.model_floor()
+    raw = lm._pending[0]
+    moves = np.hypot(raw[:, 0], raw[:, 2])
+    full, _ = lm._limit(lm.lin, raw, 1.0)                               # the full radius: the look-ahead shapes it
+    assert np.hypot(full[:, 0], full[:, 2]).max() > options.solver.max_move
+    lm.move_limit, lm._shrunk = 0.5 * min(moves.max(), options.solver.max_move), True   # as after a rejection
+    step, predicted = lm._limit(lm.lin, raw, 1.0)
+    assert np.hypot(step[:, 0], step[:, 2]).max() <= lm.move_limit * (1 + 1e-12)
+    assert predicted > 0
+
+def test_a_rejected_step_longer_than_max_move_leaves_a_radius_within_max_move(office_problem):
+    # 34k: the look-ahead may carry clear states beyond max_move; half of such a rejected move was still beyond
+    # it, the look-ahead came back and tried the same step again
+    problem, X0, options = office_problem
+    lm = LevenbergMarquardt(problem, X0, replace(options.solver, shrink_on_reject=True))
+    lm.model_floor()
+    damping = lm._pending[1]
+    bad = np.zeros_like(X0)
+    bad[:, 0] = 0.9                                                     # everybody 0.9 m to the side: F rises
+    lm._pending = (bad, damping)
+    lm._limit = lambda lin, delta, predicted: (delta, 1.0)            # as if the look-ahead took it whole
+    lm.run(1)
+    del lm._limit
+    assert lm.X is not None and np.array_equal(lm.X, X0)                # rejected
+    assert lm.move_limit == options.solver.max_move and lm._shrunk      # not 0.45 m
+    step, _ = lm._limit(lm.lin, lm._pending[0], 1.0)
+    assert np.hypot(step[:, 0], step[:, 2]).max() <= options.solver.max_move * (1 + 1e-12)
