@@ -84,6 +84,13 @@ class MapConfig(Section):
                                                         "(up to twice it) when their squared Mahalanobis distance "
                                                         "under their trackers' covariances is below this (9.21: "
                                                         "99 % of two degrees of freedom; 0 = off)")
+    same_blob_iou: float = Field(0.5, ge=0, le=1, description="a worker whose camera shows its newborn and another "
+                                                             "worker's newborn as one blob (their image boxes overlap "
+                                                             "by at least this intersection over union) says so, and "
+                                                             "the map folds its id into the other's "
+                                                             "(worldtrack.map.same_blob; 0 = off, before issue 39l)")
+    same_blob_s: float = Field(0.5, gt=0, description="see same_blob_iou: both ids born less than this long (s) "
+                                                      "before the claim")
     forget_after_s: float = Field(3.0, gt=0, description="a person no worker reports for this long leaves the "
                                                          "map (their id may be reclaimed until then)")
     claim_radius_m: float = Field(1.0, gt=0, description="a worker's new person within this distance of a "
