@@ -31,6 +31,10 @@ class MapConfig(Section):
     lease_s: float = Field(1.0, gt=0.1, le=60, description="camera and fusion leases expire this long after "
                                                             "their last renewal (a dead worker's cameras are "
                                                             "free again after it)")
+    starved_wait_s: float = Field(10.0, ge=0, description="a batch worker's camera whose lease lapsed is still "
+                                                          "waited for this long (s) while the worker is connected "
+                                                          "to Redis (starved of CPU, not dead: "
+                                                          "worldtrack.map.starved; 0 = lapsed is dead)")
     renew_s: float = Field(0.25, gt=0.01, le=20, description="leases are renewed (and standbys try to take "
                                                               "them) this often")
     retention_s: float = Field(3600.0, gt=0, description="streams keep this much capture time (older entries "
