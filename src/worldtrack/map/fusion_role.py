@@ -339,7 +339,8 @@ class FusionRole:
         (files read as fast as it can, :attr:`MapLink.lockstep`) while its lease lives: a bucket
         written without its report would make the record depend on the machine's load (the report
         dropped as late, the other workers reading a map without it); a dead worker's lease lapses
-        within ``lease_s`` (one starved of CPU stays connected: :mod:`worldtrack.map.starved`). A live camera is not waited for (a slow worker delays only itself)."""
+        within ``lease_s`` (one starved of CPU stays connected: :mod:`worldtrack.map.starved`). A live
+        camera is not waited for (a slow worker delays only itself)."""
         self._refresh_cameras(force=True)       # a batch flag registered since the last read
         return any(c in self._batch for c in missing)
 
