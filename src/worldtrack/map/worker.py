@@ -340,7 +340,7 @@ class MapLink:
                     per_cam[c].append(e)
         ended = tuple(sorted(i for i in self._reported if i not in local))
         self._reported = {i: () for i in now_ids}
-        self.ever_seen &= {p.id for p in local}
+        self.ever_seen, self.born_here = (ids & {p.id for p in local} for ids in (self.ever_seen, self.born_here))
         seen_ids = {e.id for es in per_cam.values() for e in es if e.seen}
         absent = self._absent(tracker, tracks, t, cams, boxes, seen_ids) if self.cfg.negative_evidence else {}
         cands, affirms = self.exchange.after_step(tracker, tracks, boxes, cams) if self.exchange else ({}, {})
