@@ -96,6 +96,28 @@ def any_affirms(client, cameras: list[str]) -> bool:
                for _, fields in client.xrange(MapKeys().observations(cam)))
 
 
+def same_blob_folds(client, cameras: list[str], gt) -> tuple[int, int]:
+    """How many same-blob claims the run's workers published (:mod:`worldtrack.map.same_blob`), and how
+    many of them paired two different people: the ground-truth person nearest to the claimer's
+    estimate of its id is not the one nearest to the other worker's estimate of theirs (same frame)."""
+    import numpy as np
+
+    from worldtrack.map.messages import decode_observation
+    obs = [decode_observation(fields) for cam in cameras for _, fields in client.xrange(MapKeys().observations(cam))]
+    where = {(o.worker, o.frame, e.id): (e.x, e.y) for o in obs for e in o.people}
+    claims = [(o, a, b) for o in obs for a, b in o.same]
+    wrong = 0
+    for o, a, b in claims:
+        at = gt.frame == o.frame
+        other = next(((w, f, i) for (w, f, i) in where if f == o.frame and i == b and w != o.worker), None)
+        if (o.worker, o.frame, a) not in where or other is None or not at.any():
+            continue
+        nearest = [int(gt.id[at][np.argmin(np.hypot(gt.x[at] - x, gt.y[at] - y))])
+                   for x, y in (where[o.worker, o.frame, a], where[other])]
+        wrong += nearest[0] != nearest[1]
+    return len(claims), wrong
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", default="2,5,6,7,8,9,10,11,12,13,1,3,4")
@@ -109,6 +131,9 @@ def main() -> None:
                     help="run the --also variants only for seeds whose default run confirmed a candidate on another "
                          "worker's view (Observation.affirms; without one the variant map.affirm_candidates=false "
                          "runs the same steps and writes the same map)")
+    ap.add_argument("--only-if-same", action="store_true",
+                    help="run the --also variants only for seeds whose default run published a same-blob claim "
+                         "(Observation.same; without one the variant map.same_blob_iou=0 writes the same map)")
     ap.add_argument("--dump", type=Path, help="write per run the workers' published estimates, the map and the "
                                              "one process's tracks as CSV files in this folder (to find out why)")
     args = ap.parse_args()
@@ -128,10 +153,12 @@ def main() -> None:
                                 *[a for c in sc.camera_ids for a in ("--video", f"{c}={seq / (c + '.mp4')}")],
                                 "--out", str(seq / "one"), "--quiet", "--no-video"], check=True, capture_output=True)
                 one = evaluate_detailed(gt, read_tracks(seq / "one" / "tracks.csv"))
-                affirmed_run = None
+                affirmed_run, folds_run = None, None
                 for variant, sets, k in ((v, sets, k) for v, sets, n in variants for k in range(n)):
-                    if variant != "default" and args.only_if_affirmed and affirmed_run is False:
-                        rows.append([seed, f"{variant} (= default: no affirm)", k, *rows[-1][3:]])   # the same steps
+                    if variant != "default" and ((args.only_if_affirmed and affirmed_run is False) or
+                                                 (args.only_if_same and folds_run == 0)):
+                        why = "no affirm" if args.only_if_affirmed and affirmed_run is False else "no same-blob claim"
+                        rows.append([seed, f"{variant} (= default: {why})", k, *rows[-1][3:]])   # the same steps
                         for key in ("mota", "idf1"):
                             gaps[variant, key].append(gaps["default", key][-1])
                         continue
@@ -143,19 +170,24 @@ def main() -> None:
                         dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
                     if variant == "default":
                         affirmed_run = any_affirms(connect(server.url), sc.camera_ids)
+                    folds = same_blob_folds(connect(server.url), sc.camera_ids, gt)
+                    if variant == "default":
+                        folds_run = folds[0]
                     missing, late = incomplete_buckets(connect(server.url), sc.camera_ids)
                     digest = record_digest(connect(server.url), MapKeys())
                     worse = worse_frames(one, fused)
                     m1, m2 = one.metrics, fused.metrics
                     rows.append([seed, variant, k, m1["mota"], m2["mota"], m1["idf1"], m2["idf1"], m1["num_switches"],
-                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", missing, late, digest])
+                                 m2["num_switches"], len(worse), f"{worse[0]}–{worse[-1]}" if worse else "—", "%d (%d)" % folds,
+                                 missing, late, digest])
                     for key in ("mota", "idf1"):
                         gaps[variant, key].append(m2[key] - m1[key])
                     print(rows[-1], file=sys.stderr)
         finally:
             server.stop()
     table = markdown_table(["seed", "variant", "run", "MOTA one", "MOTA workers", "IDF1 one", "IDF1 workers", "switches one",
-                            "switches workers", "worse frames", "from–to", "buckets missing a camera",
+                            "switches workers", "worse frames", "from–to", "same-blob claims (wrong)",
+                            "buckets missing a camera",
                            "late observations", "map digest"], rows)
     summary = "; ".join(
         f"{v}: MOTA mean {statistics.mean(gaps[v, 'mota']):+.3f} (worse in {sum(g < 0 for g in gaps[v, 'mota'])} of "

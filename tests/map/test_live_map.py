@@ -13,6 +13,7 @@ from worldtrack.map.connection import MapKeys, connect
 from worldtrack.map.fusion_role import FusionRole, run_fusion_thread
 from worldtrack.map.messages import (Estimate, Observation, bucket_index, decode_map_state, encode_observation,
                                      stream_id_ms)
+from worldtrack.map.starved import name_connection
 from worldtrack.map.worker import MapLink
 
 
@@ -138,3 +139,47 @@ def test_a_holder_that_stops_leaves_a_bucket_a_live_batch_worker_has_not_reporte
     assert client.xlen(keys.map_stream) == 2
     last = decode_map_state(client.xrevrange(keys.map_stream, count=1)[0][1])
     assert [c for c, _, _ in last.reports] == ["done"]
+
+
+def test_a_batch_worker_whose_lease_lapsed_is_waited_for_while_it_is_still_connected(redis_url):
+    """A batch worker starved of CPU (its lease-renewing thread did not run for ``lease_s``) is alive:
+    its connection to Redis, named after it, is open, and the bucket waits for its report; a dead
+    worker's connection is closed, and the bucket is written without it (worldtrack.map.starved)."""
+    client = connect(redis_url)
+    keys, cfg = MapKeys(), MapConfig(max_wait_s=0.2, starved_wait_s=30.0)
+    for cam in ("first", "starved"):
+        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
+        link.lockstep = True
+        link.register()
+    client.set(keys.camera_lease("first"), "w-first", px=30000)     # "starved" holds no lease: it lapsed
+    starved = connect(redis_url)
+    assert name_connection(starved, "w-starved")
+    with _fusing(client, keys, cfg) as t0:
+        _publish(client, keys, "first", t0, 1, 2.0)
+        time.sleep(5 * cfg.max_wait_s)
+        assert client.xlen(keys.map_stream) == 0            # waiting: its worker is still connected
+        _publish(client, keys, "starved", t0, 2, 6.0)
+        wait_until(lambda: client.xlen(keys.map_stream) == 1, 5.0, what="the bucket with the starved report")
+        assert decode_map_state(client.xrange(keys.map_stream)[0][1]).late == 0
+        starved.connection_pool.disconnect()                 # the worker died: its connection closed
+        _publish(client, keys, "first", t0 + 0.1, 1, 2.1)
+        wait_until(lambda: client.xlen(keys.map_stream) == 2, 5.0, what="the bucket after the worker died")
+
+
+def test_a_connected_batch_worker_whose_lease_lapsed_is_waited_for_at_most_starved_wait_s(redis_url):
+    client = connect(redis_url)
+    keys, cfg = MapKeys(), MapConfig(max_wait_s=0.1, starved_wait_s=1.0)
+    for cam in ("first", "hung"):
+        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
+        link.lockstep = True
+        link.register()
+    client.set(keys.camera_lease("first"), "w-first", px=30000)
+    hung = connect(redis_url)
+    assert name_connection(hung, "w-hung")
+    with _fusing(client, keys, cfg) as t0:
+        sent = time.time()
+        _publish(client, keys, "first", t0, 1, 2.0)
+        wait_until(lambda: client.xlen(keys.map_stream) == 1, 10.0, what="the bucket without the hung worker")
+        took = time.time() - sent
+    hung.connection_pool.disconnect()
+    assert 0.8 < took < 5.0, took

@@ -65,7 +65,9 @@ def test_the_absent_ids_travel_in_the_observation_and_older_messages_still_decod
     o = Observation("east", 1.25, "w2", 12, 1.26, (), ended=(3,), absent=(7, 9))
     assert decode_observation(encode_observation(o)) == o
     old = encode_observation(o)
-    old["o"] = old["o"].rsplit(",[", 3)[0] + "]"             # six elements: no absent list (nor candidates)
+    nine = dict(old, o=old["o"].rsplit(",[", 1)[0] + "]")    # nine elements: before same (issue 39l)
+    assert decode_observation(nine) == o
+    old["o"] = old["o"].rsplit(",[", 4)[0] + "]"             # six elements: no absent list (nor candidates)
     assert decode_observation(old).absent == () and decode_observation(old).ended == (3,)
 
 

@@ -79,6 +79,7 @@ class _Worker:
         from worldtrack.map.connection import MapKeys, check_url, claim_scene, connect, redacted, scene_digest
         from worldtrack.map.fusion_role import FusionRole
         from worldtrack.map.lease import worker_name
+        from worldtrack.map.starved import name_connection
         from worldtrack.map.worker import MapLink
         self.where = redacted(check_url(args.map))
         self.cfg = cfg.stage("map")
@@ -86,6 +87,7 @@ class _Worker:
         self.keys = MapKeys(self.cfg.prefix)
         claim_scene(self.client, self.keys, scene_digest(args.scene), scene.name, args.map)
         self.name = worker_name()
+        name_connection(self.client, self.name)     # the fusion tells this worker starved from dead by it
         self.link = MapLink(self.client, self.keys, self.cfg, self.name, {c: scene.camera(c) for c in cameras}, fps,
                             occlusion={c: scene.occlusion(c).floor_distance for c in cameras},
                             scene_cameras=list(scene.cameras))
@@ -134,6 +136,12 @@ class _Worker:
     def close(self) -> None:
         self.state = "stopped"
         self.stop.set()
+        if self.link.lockstep:          # the run's end, not a starved batch worker: not waited for
+            self.link.lockstep = False
+            try:
+                self.link.register()
+            except Exception:
+                pass
         if self.keeper is not None:
             self.keeper.stop(release=True)
         from worldtrack.map.fusion_role import DRAIN_S

@@ -31,6 +31,10 @@ class MapConfig(Section):
     lease_s: float = Field(1.0, gt=0.1, le=60, description="camera and fusion leases expire this long after "
                                                             "their last renewal (a dead worker's cameras are "
                                                             "free again after it)")
+    starved_wait_s: float = Field(10.0, ge=0, description="a batch worker's camera whose lease lapsed is still "
+                                                          "waited for this long (s) while the worker is connected "
+                                                          "to Redis (starved of CPU, not dead: "
+                                                          "worldtrack.map.starved; 0 = lapsed is dead)")
     renew_s: float = Field(0.25, gt=0.01, le=20, description="leases are renewed (and standbys try to take "
                                                               "them) this often")
     retention_s: float = Field(3600.0, gt=0, description="streams keep this much capture time (older entries "
@@ -84,6 +88,13 @@ class MapConfig(Section):
                                                         "(up to twice it) when their squared Mahalanobis distance "
                                                         "under their trackers' covariances is below this (9.21: "
                                                         "99 % of two degrees of freedom; 0 = off)")
+    same_blob_iou: float = Field(0.5, ge=0, le=1, description="a worker whose camera shows its newborn and another "
+                                                             "worker's newborn as one blob (their image boxes overlap "
+                                                             "by at least this intersection over union) says so, and "
+                                                             "the map folds its id into the other's "
+                                                             "(worldtrack.map.same_blob; 0 = off, before issue 39l)")
+    same_blob_s: float = Field(0.5, gt=0, description="see same_blob_iou: both ids born less than this long (s) "
+                                                      "before the claim")
     forget_after_s: float = Field(3.0, gt=0, description="a person no worker reports for this long leaves the "
                                                          "map (their id may be reclaimed until then)")
     claim_radius_m: float = Field(1.0, gt=0, description="a worker's new person within this distance of a "

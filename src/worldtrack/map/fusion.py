@@ -79,6 +79,7 @@ from worldtrack.map.evidence import LEAD_SHARE, floor_information, in_views, peo
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
 from worldtrack.map.merges import MIN_WEIGHT, merge_duplicates
 from worldtrack.map.refute import refute
+from worldtrack.map.same_blob import fold_same_blobs
 
 
 @dataclass
@@ -283,6 +284,7 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
         if pid in ended or t - p.last_seen > cfg.forget_after_s:
             del state.people[pid]
     aliases = merge_duplicates(state, workers_of, t, cfg, estimates)
+    aliases.update(fold_same_blobs(state, observations, t, cfg.same_blob_s) if cfg.same_blob_iou > 0 else {})
     if cfg.negative_evidence:
         aliases.update(refute(state, estimates, observations, t, cfg))
     state.aliases = {y: (e, ts) for y, (e, ts) in state.aliases.items() if t - ts <= cfg.forget_after_s}

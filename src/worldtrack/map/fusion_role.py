@@ -45,6 +45,7 @@ from worldtrack.map.fusion import FusionState, fuse_bucket, provisional_state
 from worldtrack.map.lease import UPDATE_MAP, WRITE_MAP, Lease
 from worldtrack.map.messages import (MapState, Observation, bucket_index, decode_map_state, decode_observation,
                                      encode_map_state, stream_id_ms)
+from worldtrack.map.starved import StarvedWorkers
 from worldtrack.map.status import FusionStats
 
 #: With no state to resume from, start this far back in the observation streams (s).
@@ -95,7 +96,8 @@ class FusionRole:
         self._first_arrival: dict[int, float] = {}
         self._latest: dict[str, float] = {}
         self._cameras: dict[str, float] = {}
-        self._batch: set[str] = set()    # cameras of batch workers (lockstep): waited for, however long
+        self._batch: dict[str, str] = {}     # cameras of batch workers (lockstep) -> worker: waited for
+        self._starved = StarvedWorkers(client, cfg.starved_wait_s)
         self._cameras_read = 0.0
         self._renewed = 0.0          # time.monotonic() of the last renewal made by the step loop
         self._late_pending = 0
@@ -232,7 +234,7 @@ class FusionRole:
         self._cameras_read = now
         raw = {c: json.loads(v) for c, v in self.client.hgetall(self.keys.cameras).items()}
         self._cameras = {c: float(v.get("fps") or 10.0) for c, v in raw.items()}
-        self._batch = {c for c, v in raw.items() if v.get("lockstep")}
+        self._batch = {c: str(v.get("worker") or "") for c, v in raw.items() if v.get("lockstep")}
         for c in self._cameras:
             self._cursors.setdefault(self.keys.observations(c), f"{self._start_ms}-0")
 
@@ -303,7 +305,8 @@ class FusionRole:
         if not cams:
             return []
         held = self.client.mget([self.keys.camera_lease(c) for c in cams])
-        return [c for c, h in zip(cams, held) if h]
+        lapsed = {c: self._batch[c] for c, h in zip(cams, held) if not h and c in self._batch}
+        return [c for c, h in zip(cams, held) if h] + self._starved.connected(lapsed)
 
     def _close_due(self, renew: bool = True) -> int:
         """Write the complete (or ``max_wait_s`` old) buckets in order, at most
@@ -336,7 +339,8 @@ class FusionRole:
         (files read as fast as it can, :attr:`MapLink.lockstep`) while its lease lives: a bucket
         written without its report would make the record depend on the machine's load (the report
         dropped as late, the other workers reading a map without it); a dead worker's lease lapses
-        within ``lease_s``. A live camera is not waited for (a slow worker delays only itself)."""
+        within ``lease_s`` (one starved of CPU stays connected: :mod:`worldtrack.map.starved`). A live
+        camera is not waited for (a slow worker delays only itself)."""
         self._refresh_cameras(force=True)       # a batch flag registered since the last read
         return any(c in self._batch for c in missing)
 

@@ -14,7 +14,7 @@ Entry ids are capture times in ms (``<ms>-<seq>``), so streams can be read and t
 
 >>> e = Estimate(3, 1.5, 2.0, 1.7, 0.45, 0.2, 0.0, 0.8, 0.6, True, cxx=0.04, cxy=0.0, cyy=0.0025)
 >>> o = Observation("cam1", 12.3, "w1", 123, 12.35, (e,), ended=(2,), absent=(5,),
-...                 candidates=((4.0, 1.0, 1.7, 0.45),), affirms=(("w2", 9.5, 2.0),))
+...                 candidates=((4.0, 1.0, 1.7, 0.45),), affirms=(("w2", 9.5, 2.0),), same=((4, 1),))
 >>> decode_observation(encode_observation(o)) == o
 True
 >>> bucket_index(12.34, 0.1), stream_id_ms(12.3)
@@ -78,7 +78,9 @@ class Observation:
     the map's people this camera shows the place of, clearly, with nobody there (negative evidence,
     :func:`worldtrack.map.evidence.looks_empty`). ``candidates``: the people its tracker proposes
     there but has not confirmed, ``(x, y, height, width)`` m; ``affirms``: other workers'
-    candidates this camera shows somebody at, ``(their worker, x, y)`` (:mod:`worldtrack.map.affirm`)."""
+    candidates this camera shows somebody at, ``(their worker, x, y)`` (:mod:`worldtrack.map.affirm`);
+    ``same``: ``(its id, another worker's id)``, two newborns its camera shows as one blob
+    (:mod:`worldtrack.map.same_blob`)."""
 
     camera: str
     t: float
@@ -90,6 +92,7 @@ class Observation:
     absent: tuple[int, ...] = ()
     candidates: tuple[tuple[float, float, float, float], ...] = ()
     affirms: tuple[tuple[str, float, float], ...] = ()
+    same: tuple[tuple[int, int], ...] = ()
 
 
 class MapPerson(NamedTuple):
@@ -158,7 +161,7 @@ def _float(v) -> float:
 
 def encode_observation(o: Observation) -> dict[str, str]:
     """The stream fields of an observation: ``v``, ``t`` (capture time) and ``o``, one JSON list
-    ``[camera, worker, frame, sent, people, ended, absent, candidates, affirms]`` (one field to parse, not
+    ``[camera, worker, frame, sent, people, ended, absent, candidates, affirms, same]`` (one field to parse, not
     ten: the fusion reads thousands a second). NaN stays NaN (Python's JSON)."""
     people = [[int(e.id), round(e.x, 4), round(e.y, 4), round(e.height, 3), round(e.width, 3), round(e.vx, 3),
                round(e.vy, 3), round(float(e.score), 3), round(float(e.support), 3), int(bool(e.seen)), _sig(e.ixx),
@@ -167,7 +170,8 @@ def encode_observation(o: Observation) -> dict[str, str]:
               for e in o.people]
     body = [o.camera, o.worker, int(o.frame), float(o.sent), people, [int(i) for i in o.ended],
             [int(i) for i in o.absent], [[round(float(v), 4) for v in c] for c in o.candidates],
-            [[str(w), round(float(x), 4), round(float(y), 4)] for w, x, y in o.affirms]]
+            [[str(w), round(float(x), 4), round(float(y), 4)] for w, x, y in o.affirms],
+            [[int(a), int(b)] for a, b in o.same]]
     return {"v": FORMAT_VERSION, "t": repr(float(o.t)), "o": json.dumps(body, separators=(",", ":"))}
 
 
@@ -176,15 +180,16 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
     try:
         if fields.get("v") != FORMAT_VERSION:
             raise ValueError(f"format version {fields.get('v')!r}, expected {FORMAT_VERSION}")
-        # 6 elements: before absent; 7: before candidates and affirms
+        # 6 elements: before absent; 7: before candidates and affirms; 9: before same
         camera, worker, frame, sent, people, ended, *rest = json.loads(fields["o"])
         for p in people:
             p[9] = p[9] == 1
-        absent, candidates, affirms = (rest + [[], [], []])[:3]
+        absent, candidates, affirms, same = (rest + [[], [], [], []])[:4]
         return Observation(str(camera), float(fields["t"]), str(worker), int(frame), float(sent),
                            tuple(Estimate(*p) for p in people), tuple(ended), tuple(absent),
                            tuple(tuple(float(v) for v in c[:4]) for c in candidates),
-                           tuple((str(w), float(x), float(y)) for w, x, y in affirms))
+                           tuple((str(w), float(x), float(y)) for w, x, y in affirms),
+                           tuple((int(a), int(b)) for a, b in same))
     except (KeyError, IndexError, TypeError, ValueError, json.JSONDecodeError) as e:
         if isinstance(e, ValueError) and str(e).startswith("format version"):
             raise

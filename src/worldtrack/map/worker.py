@@ -39,6 +39,7 @@ from worldtrack.map.fusion import LEAD_SHARE
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, REFUTED, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
+from worldtrack.map.same_blob import same_blob_claims
 from worldtrack.map.shared_ids import SharedPositionMap
 from worldtrack.map.timings import set_epoch
 from worldtrack.trackers.base import Frame, PositionMap, Track, Tracker
@@ -82,6 +83,7 @@ class MapLink:
         self.placed: set[int] = set()         # people put on the local map from the shared one
         self.handed_over = 0                  # how many times (hand-overs from a neighbour's view)
         self.claimed = 0                      # new people that took the id of a person the map had
+        self.born_here: set[int] = set()      # new ids this worker gave (same_blob: its newborns)
         self._reported: dict[int, tuple[str, ...]] = {}
         self.published = 0
         self.last_capture: float | None = None
@@ -133,10 +135,10 @@ class MapLink:
         if claimed is not None:
             self.claimed += 1
             return claimed
-        if self.id_slot is None:
-            return int(self.client.incr(self.keys.ids))
-        camera, slot, stride = self.id_slot
-        return (int(self.client.incr(self.keys.ids_of(camera))) - 1) * stride + slot + 1
+        camera, slot, stride = self.id_slot or ("", 0, 1)      # "": the map's one counter
+        pid = (int(self.client.incr(self.keys.ids_of(camera) if camera else self.keys.ids)) - 1) * stride + slot + 1
+        self.born_here.add(pid)
+        return pid
 
     def _claim(self, x: float, y: float) -> int | None:
         if self.state is None:
@@ -338,12 +340,15 @@ class MapLink:
                     per_cam[c].append(e)
         ended = tuple(sorted(i for i in self._reported if i not in local))
         self._reported = {i: () for i in now_ids}
-        self.ever_seen &= {p.id for p in local}
+        self.ever_seen, self.born_here = (ids & {p.id for p in local} for ids in (self.ever_seen, self.born_here))
         seen_ids = {e.id for es in per_cam.values() for e in es if e.seen}
         absent = self._absent(tracker, tracks, t, cams, boxes, seen_ids) if self.cfg.negative_evidence else {}
         cands, affirms = self.exchange.after_step(tracker, tracks, boxes, cams) if self.exchange else ({}, {})
+        same = same_blob_claims({c: self.cameras[c] for c in cams}, tracks, self.state, self.born_here, t,
+                                self.cfg.same_blob_s, self.cfg.same_blob_iou)
         return [Observation(c, float(frames[c].t), self.name, int(frames[c].index), sent, tuple(per_cam[c]), ended,
-                            absent.get(c, ()), tuple(cands.get(c, ())), tuple(affirms.get(c, ()))) for c in cams]
+                            absent.get(c, ()), tuple(cands.get(c, ())), tuple(affirms.get(c, ())),
+                            same if c == cams[0] else ()) for c in cams]
 
     def _absent(self, tracker: Tracker, tracks: Sequence[Track], t: float, cams: list[str],
                 boxes: Mapping[str, np.ndarray], seen_ids: set[int]) -> dict[str, tuple[int, ...]]:
@@ -372,12 +377,8 @@ class MapLink:
         """Append the observations to their cameras' streams (only while this worker holds them)."""
         pipe = self.client.pipeline(transaction=False)
         for o in observations:
-            fields = encode_observation(o)
-            args = [self.name, f"{stream_id_ms(o.t)}-*", str(stream_id_ms(o.t - self.cfg.retention_s))]
-            for k, v in fields.items():
-                args += [k, v]
-            self._xadd(keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)], args=args,
-                       client=pipe)
+            self._xadd(keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)],
+                       args=self._xadd_args(o), client=pipe)
         for o, res in zip(observations, pipe.execute()):
             if res == 0 and not self._retake(o):
                 holder = self.leases[o.camera].holder()[0]
@@ -387,13 +388,13 @@ class MapLink:
 
     def _retake(self, o: Observation) -> bool:
         """The lease expired while this worker stalled: take it again if nobody else has, and publish."""
-        if not self.leases[o.camera].acquire():
-            return False
-        fields = encode_observation(o)
+        return self.leases[o.camera].acquire() and self._xadd(
+            keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)], args=self._xadd_args(o)) != 0
+
+    def _xadd_args(self, o: Observation) -> list[str]:
+        """The fenced ``XADD``'s arguments: lease holder, entry id, trim bound, the observation's fields."""
         args = [self.name, f"{stream_id_ms(o.t)}-*", str(stream_id_ms(o.t - self.cfg.retention_s))]
-        for k, v in fields.items():
-            args += [k, v]
-        return self._xadd(keys=[self.keys.camera_lease(o.camera), self.keys.observations(o.camera)], args=args) != 0
+        return args + [v for kv in encode_observation(o).items() for v in kv]
 
 
 __all__ = ["MapLink", "in_views", "set_epoch"]
