@@ -170,27 +170,3 @@ def test_with_the_map_the_pursuit_goes_round_an_obstacle():
                         0.1, clearance)
         ends[name] = np.hypot(robot.x - 8.0, robot.y - 7.0)
     assert ends["straight"] > 1.0 and ends["map"] < 0.6, ends
-
-
-def test_held_by_a_crosser_the_pid_steers_behind_them_keeping_the_target_in_view():
-    # a crosser 1.2 m ahead walks out of the path to the right at 0.8 m/s (the scan has followed them
-    # for 0.5 s); the target 2.8 m ahead walks on at 1 m/s. Straight on, the crosser's scan points hold
-    # the robot back; a left curve (behind them) is free, and keeps the target within the view.
-    from worldtrack.follow.scan import simulate_scan
-
-    def run(pid, target_y=0.0):
-        for k in range(6):
-            crosser = np.array([[1.2, -0.4 + 0.08 * (5 - k)]])
-            scan = simulate_scan((-0.1, 0.0), 0.0, crosser, np.array([0.2]), lambda xy: np.full(len(xy), 9.0))
-            s = step((2.8 + 0.1 * k, target_y), velocity=(1.0, 0.0), others=crosser)
-            s.others_velocity = np.array([[0.0, -0.8]])
-            v, w = pid.command(s, CAM, 0.1 * k, scan=scan)
-        return v, w, pid.blocked
-
-    v0, w0, held0 = run(PIDFollower(depth_stop=True, walkers=True, steer=False))
-    v1, w1, held1 = run(PIDFollower(depth_stop=True, walkers=True))
-    assert held0 and v0 < 1.45 and abs(w0) < 0.05                   # waits behind them, going straight
-    assert not held1 and v1 > v0 + 0.15 and 0.1 < w1 <= 0.45        # curves left behind them, faster
-    # the target already 20° to the right: the same curve would take it out of view, so it waits
-    v2, w2, held2 = run(PIDFollower(depth_stop=True, walkers=True), target_y=-2.8 * np.tan(np.radians(20.0)))
-    assert held2 and w2 < 0

@@ -30,8 +30,8 @@ OFFSETS = np.array([-1.0, -0.8, -0.6, -0.4, -0.2, 0.2, 0.4, 0.6, 0.8, 1.0])
 
 
 def steer_round(limit_at, v: float, w: float, bearing: float, max_turn_rate: float = 1.5,
-                view_half_angle: float = np.radians(25.0), look_ahead: float = 1.0, gain: float = 0.1,
-                cost: float = 0.05, first_w: float | None = None, turn_step: float = 0.4) -> tuple[float, float]:
+                view_half_angle: float = np.radians(25.0), look_ahead: float = 1.0, gain: float = 0.15,
+                cost: float = 0.3, first_w: float | None = None, turn_step: float = 0.4) -> tuple[float, float]:
     """(turn rate rad/s, forward speed limit m/s) to command instead of the PID's ``w`` held back to
     ``limit_at(w) < v``.
 
