@@ -50,7 +50,6 @@ from worldtrack.follow.navigation import NavigationGrid
 from worldtrack.follow.robot import RobotLimits
 from worldtrack.follow.safety import free_path, near_points
 from worldtrack.follow.scan import ScanMovers, segments
-from worldtrack.follow.steer import steer_round
 from worldtrack.geometry.camera import Camera
 
 
@@ -85,9 +84,6 @@ class PIDFollower:
     walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
     (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
     the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
-    steer : when somebody holds the PID's command back, turn by up to 1 rad/s more or less if that arc's
-    safety rules let the robot go faster, the target kept in view (:func:`~worldtrack.follow.steer.steer_round`);
-    False: wait behind them (35i and before)
     """
 
     distance: float = 1.8
@@ -109,7 +105,6 @@ class PIDFollower:
     arrive: float = 0.4
     hidden_coast: float = 3.0
     nav: NavigationGrid | None = None
-    steer: bool = True
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -120,11 +115,6 @@ class PIDFollower:
         depth is read only with ``depth_stop`` (the paper's follower reads only the tracker's output);
         ``scan`` (M, 2): a range scanner's hit points round the robot (world, m, in ray order; see
         :mod:`~worldtrack.follow.scan`), read with ``depth_stop`` (its points) and ``walkers`` (its movers)."""
-        v, w = self._command(step, camera, t, frame, scan)
-        self._state["last_cmd_w"] = w
-        return v, w
-
-    def _command(self, step, camera: Camera, t: float, frame, scan) -> tuple[float, float]:
         s = self._state
         if step.found:
             s["seen"] = s["followed"] = t
@@ -155,12 +145,7 @@ class PIDFollower:
         s["t"] = t
         v = float(np.clip(v, -self.robot.max_reverse, self.robot.max_speed))
         w = float(np.clip(w, -self.robot.max_turn_rate, self.robot.max_turn_rate))
-        dt = dt if dt > 0 else 0.1
-        limit = self._forward_limit(step, camera, w, t, dt, frame, scan)
-        if self.steer and limit < v:            # held: a turn rate that passes them, the target kept in view
-            w, limit = steer_round(lambda turn: self._forward_limit(step, camera, turn, t, dt, frame, scan), v, w,
-                                   bearing, self.robot.max_turn_rate, first_w=s.get("last_cmd_w"),
-                                   turn_step=self.robot.turn_accel * dt)
+        limit = self._forward_limit(step, camera, w, t, dt if dt > 0 else 0.1, frame, scan)
         s["blocked"] = bool(limit < v)
         return min(v, limit), w
 
@@ -179,8 +164,7 @@ class PIDFollower:
         """Clear the PID's state (integrals, derivatives) but what the search needs."""
         s = self._state
         keep = {k: s[k] for k in ("seen", "followed", "search_from", "search_turn", "search_last", "last_w",
-                                  "arrived", "movers", "movers_seen", "points_seen", "way", "way_to",
-                                  "last_cmd_w") if k in s}
+                                  "arrived", "movers", "way", "way_to") if k in s}
         self.reset()
         s.update(keep)
         if s.get("search_last", -np.inf) < s.get("seen", -np.inf):         # a new loss
@@ -263,13 +247,9 @@ class PIDFollower:
     def _depth_limit(self, frame, camera: Camera, w: float, dt: float, scan=None) -> float:
         """The local planner's safety layer (:mod:`~worldtrack.follow.safety`) on the PID: the speed that
         stops 0.35 m (body) short of any near depth point (or scan point) along the next 1.5 s arc at ω."""
-        seen = self._state.get("points_seen")
-        if seen is None or seen[0] is not frame or seen[1] is not scan:     # once a frame (the steering's arcs)
-            points = near_points(getattr(frame, "depth", None), camera)
-            if scan is not None and len(scan):
-                points = np.vstack([points, np.asarray(scan, float).reshape(-1, 2)])
-            self._state["points_seen"] = seen = (frame, scan, points)
-        points = seen[2]
+        points = near_points(getattr(frame, "depth", None), camera)
+        if scan is not None and len(scan):
+            points = np.vstack([points, np.asarray(scan, float).reshape(-1, 2)])
         if len(points) == 0:
             return np.inf
         fwd = camera.floor_direction
@@ -289,12 +269,8 @@ class PIDFollower:
         fwd = camera.floor_direction
         centre = camera.centre[:2] - 0.1 * fwd
         if scan is not None:
-            seen = self._state.get("movers_seen")
-            if seen is None or seen[0] != t:         # once a frame: the steering asks for several arcs
-                movers = self._state.setdefault("movers", ScanMovers())
-                seen = (t, *movers.update(segments(scan, origin=centre), t))
-                self._state["movers_seen"] = seen
-            found, velocity = seen[1], seen[2]
+            movers = self._state.setdefault("movers", ScanMovers())
+            found, velocity = movers.update(segments(scan, origin=centre), t)
             away = np.hypot(*(found - np.asarray(step.xy, float)).T) > 0.5     # the target is not a mover
             xy.append(found[away])
             vel.append(velocity[away])
