@@ -37,6 +37,7 @@ from worldtrack.follow.movers import moving_speed_limit  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 
 DEPARTURES = (-1.0, -0.6, -0.3, 0.0, 0.3, 0.6, 1.0)
+MAX_SPEED = 1.6
 
 
 class _Done(Exception):
@@ -100,7 +101,8 @@ def main(argv: list[str] | None = None) -> int:
     in_view = [i for i, d in enumerate(DEPARTURES) if abs(d) <= 0.45]
     for k, v, w, lim in rows:
         allowed = lim.min(axis=0)                                   # (D,) every rule at once
-        gain = {name: float(np.min([v, allowed[idx].max()]) - min(v, allowed[centre]))
+        top = np.minimum(allowed, MAX_SPEED)                        # the PID asks for more than it is allowed
+        gain = {name: float(top[idx].max() - top[centre])
                 for name, idx in (("in view", in_view), ("any", list(range(len(DEPARTURES)))))}
         gains.append((gain["in view"], gain["any"]))
         table.append([k, f"{v:.2f}", f"{w:+.2f}"] + [
@@ -109,12 +111,12 @@ def main(argv: list[str] | None = None) -> int:
     gains = np.array(gains).reshape(-1, 2)
     n = len(gains)
     summary = (f"Seed {args.seed}, frames 0–{args.until}, pid+scan: **{n}** held frames (the PID's forward speed "
-               f"limited below its command). Some turn rate lets it go ≥ 0.1 m/s faster in "
+               f"limited below its command). Some turn rate's arc allows ≥ 0.1 m/s faster in "
                f"**{int((gains[:, 0] >= 0.1).sum()) if n else 0}** of them keeping the target in view (|δ| ≤ 0.45 rad/s), "
                f"**{int((gains[:, 1] >= 0.1).sum()) if n else 0}** with any departure up to ±1 rad/s; median gain "
                f"{np.median(gains[:, 0]) if n else 0:.2f} / {np.median(gains[:, 1]) if n else 0:.2f} m/s.\n\n"
                "Each cell: path check / walkers / depth + scan limit (m/s) along the arc at w + δ.\n\n")
-    text = summary + markdown_table(["frame", "PID v", "PID w"] + [f"δ {d:+.1f}" for d in DEPARTURES]
+    text = summary + markdown_table(["frame", "v (held)", "PID w"] + [f"δ {d:+.1f}" for d in DEPARTURES]
                                     + ["gain in view", "gain any"], table) + "\n"
     print(text)
     save_tagged("follow_hold_limits", args.tag, "Held by somebody: the safety rules' limits over turn rates",
