@@ -26,6 +26,7 @@ from pydantic import Field, model_validator
 
 from worldtrack.config import Section, with_overrides
 from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
+from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
 
 
 class ScoreConfig(Section):
@@ -383,6 +384,7 @@ class EllipsoidConfig(Section):
     lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
     split: SplitConfig = Field(SplitConfig(), description="one person or two on one line of sight")
     cross_view: CrossViewConfig = Field(CrossViewConfig(), description="a track one camera cannot see, searched along another's ray")
+    crowd: CrowdConfig = Field(CrowdConfig(), description="people one camera alone shows, in a crowd")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -396,5 +398,4 @@ class EllipsoidConfig(Section):
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig",
-           "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]
+__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig", "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]

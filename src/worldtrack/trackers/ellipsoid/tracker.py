@@ -46,6 +46,7 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
+from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
 from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view_people
@@ -211,11 +212,20 @@ class EllipsoidTracker(TrackerBase):
 
     def _predict(self, people: Sequence[Person], dt: float, t: float) -> None:
         """Constant-velocity prediction of tracked people, once per time stamp; a prediction into a
-        wall or a desk stays where it was."""
+        wall or a desk stays where it was; ``crowd.predict_along_ray`` < 1 damps the velocity along
+        a lone camera's line of sight (:mod:`.prediction`)."""
         if not (self.config.match.predict and dt > 0):
             return
         moving = [p for p in people if p.mode == "tracking" and p.once("predict", t)]
-        ahead = np.array([[p.x + p.vx * dt, p.y + p.vy * dt] for p in moving]).reshape(-1, 2)
+        share = float(self.config.crowd.predict_along_ray)
+        if share == 1.0:
+            ahead = np.array([[p.x + p.vx * dt, p.y + p.vy * dt] for p in moving]).reshape(-1, 2)
+        else:  # the velocity along a lone camera's line of sight damped (:mod:`.prediction`)
+            cids = list(self.views)
+            which = np.array([lone_camera(p.seen_by, cids) for p in moving], dtype=int)
+            ahead = predicted_places(np.array([[p.x, p.y] for p in moving]).reshape(-1, 2),
+                                     np.array([[p.vx, p.vy] for p in moving]).reshape(-1, 2), dt,
+                                     [self.views[c].camera for c in cids], which, which >= 0, share)
         for p, (x, y), ok in zip(moving, ahead, self.walkable(ahead)):
             if ok:
                 p.x, p.y = float(x), float(y)
