@@ -1,4 +1,5 @@
-"""Settings for crowds one camera sees (:mod:`worldtrack.trackers.ellipsoid.prediction`); a section of
+"""Settings for crowds one camera sees (:mod:`worldtrack.trackers.ellipsoid.prediction`,
+:mod:`~worldtrack.trackers.ellipsoid.coast`); a section of
 :class:`~worldtrack.trackers.ellipsoid.config.EllipsoidConfig`, kept apart so the two stay light.
 
 >>> CrowdConfig().predict_along_ray
@@ -24,6 +25,10 @@ class CrowdConfig(Section):
         "one camera alone shows (across it: all). One camera places people worst along its ray, and a slide of the "
         "match, read as velocity, carried tracks on: 1 = the full velocity, as before (default); 0 = across the ray "
         "only (one-camera crowd of 50 started on everyone, dev seeds 0-2: 9.3 -> 18.7 of 50 held)")
+    coast_behind_obstacles_s: float = Field(
+        0.0, ge=0, description="a track the scene's obstacles wholly hide from a camera that has it in its image is "
+        "kept this long unseen, carried by the prediction, instead of ending after end.leave_after_s as one that "
+        "left the view (0 = off, the default)")
 
 
 __all__ = ["CrowdConfig"]

@@ -37,6 +37,7 @@ from worldtrack.trackers.base import Frame, Overlay, Person, PositionMap, Track,
 from worldtrack.trackers.ellipsoid.args import DrawArgs, People, Scoring, StepArgs, Walkable
 from worldtrack.trackers.ellipsoid.births import Births
 from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
+from worldtrack.trackers.ellipsoid.coast import behind_obstacles
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
 from worldtrack.trackers.ellipsoid.depth import DepthFusion
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
@@ -121,6 +122,8 @@ class EllipsoidTracker(TrackerBase):
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
         self._now = 0.0
+        if cfg.crowd.coast_behind_obstacles_s > 0:
+            self.life.coasting = self._coasting
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -330,6 +333,13 @@ class EllipsoidTracker(TrackerBase):
             update_heights(present, heights_due(judged, cfg.height, self.frames_stepped), self.views,
                            self.last_labels, lambda pid: self.scene.people.size_of(pid)[0], cfg.height)
         self.life.merge_duplicates(t, interval)
+
+    def _coasting(self, p: Person) -> bool:
+        """An unseen person behind obstacles, unseen for less than ``crowd.coast_behind_obstacles_s``."""
+        if p.count("unseen") >= frames_for(self.config.crowd.coast_behind_obstacles_s, self.frame_interval):
+            return False
+        return bool(behind_obstacles(np.array([[p.x, p.y]]), np.array([p.height]),
+                                     [v.camera for v in self.views.values()], self.scene.occlusion)[0])
 
     def _promote(self, p: Person) -> None:
         """A confirmed candidate gets its public id and the scene's size for that id."""
