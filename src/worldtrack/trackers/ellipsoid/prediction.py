@@ -17,6 +17,11 @@ the component across the ray, which one camera measures well, is kept in full. A
 cameras show is predicted with the full velocity: another camera measures their depth. The
 velocity itself is not changed (it is also what the reported velocity filter starts from).
 
+It is for dense crowds only: on PETS 2009 (one camera, a handful of people who walk along its
+rays for seconds) the setting at 0 loses MOTA 0.927 -> 0.804 (also 0.824 when only people whose
+image box meets another's are damped): there the match follows a walker along the ray only with
+the prediction's help.
+
 >>> import numpy as np
 >>> from worldtrack.geometry.camera import Camera
 >>> cam = Camera.look_at("c", 160, 120, [0.0, -4.0, 2.6], [0.0, 0.0, 0.8], hfov_deg=60.0)
