@@ -69,8 +69,7 @@ class MatchConfig(Section):
     max_step_m: float = Field(0.4, gt=0, description="largest adaptive step, m")
     max_iterations: int = Field(6, ge=1, description="cap on rounds with the adaptive step")
     predict: bool = Field(True, description="constant-velocity prediction before matching")
-    velocity_smoothing: float = Field(
-        0.5, ge=0, le=1, description="weight of each frame's velocity measurement (0..1)")
+    velocity_smoothing: float = Field(0.5, ge=0, le=1, description="weight of each frame's velocity measurement (0..1)")
     max_speed_mps: float = Field(3.0, gt=0, description="velocities are clipped to this speed (a running person), m/s")
     rounds: Literal["compiled", "python"] = Field(
         "compiled", description="the compiled rounds, or their readable Python reference (same tracks, slower)")
