@@ -18,13 +18,21 @@ Per seed it reports:
 * MOTA, IDF1, false positives, misses, ID switches, mean error, and what the errors are
   (:func:`worldtrack.eval.error_causes`).
 
-Each seed is tracked twice: from a cold start, and given everyone's true place on frame 0.
+Each seed is tracked twice: from a cold start, and given everyone's true place on frame 0. Started
+on the truth, track ids are the people's, so the script also says how each person's own track was
+first lost (:mod:`crowd_losses`: ended out of sight or in view, onto a neighbour, off along the
+camera's ray or across it).
+
+Issue 37's opt-in settings for this case (``ellipsoid.crowd``): ``--set crowd.predict_along_ray=0``
+(the prediction keeps only the velocity across the lone camera's line of sight) and ``--set
+crowd.coast_behind_obstacles_s=2`` (a track behind a pillar coasts instead of ending).
 Seeds 100–102 by default (held out: the crowd at 50 was looked at frame by frame on seed 0 only).
 
 Usage::
 
     .venv/bin/python benchmarks/crowd50.py                  # seeds 100-102, ~10 min on an idle core
     .venv/bin/python benchmarks/crowd50.py --seeds 0 --frames 40 --set identity.enabled=false
+    .venv/bin/python benchmarks/crowd50.py --seeds 103-108 --set crowd.predict_along_ray=0 --set crowd.coast_behind_obstacles_s=2
 
 Writes ``benchmarks/results/crowd50.md`` (not with ``--set`` or ``--quick``).
 """
@@ -32,6 +40,7 @@ Writes ``benchmarks/results/crowd50.md`` (not with ``--set`` or ``--quick``).
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 import time
 from collections import Counter
@@ -40,8 +49,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result, setting_value  # noqa: E402
-from crowd_seeds import SIZE, _seed_list, render_seed, run_seed  # noqa: E402
+from common import markdown_table, save_result, setting_value, write_result  # noqa: E402
+from crowd_losses import LOSSES, first_losses  # noqa: E402
+from crowd_seeds import GATE_M, SIZE, _seed_list, render_seed, run_seed  # noqa: E402
 
 from worldtrack.eval import CAUSES  # noqa: E402
 
@@ -62,18 +72,22 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an ellipsoid setting by dotted path; results are then only printed")
     p.add_argument("--quick", action="store_true", help="a smoke run: seed 100, 30 frames; prints only")
+    p.add_argument("--tag", default="", help="write results/crowd50<TAG>.md, also with --set (a setting's own table)")
     args = p.parse_args(argv)
     seeds = ([100] if args.quick else SEEDS) if args.seeds is None else sum(args.seeds, [])
     frames = args.frames or (30 if args.quick else FRAMES)
     options = {k: setting_value(v) for k, v in (s.split("=", 1) for s in args.set)}
     t0 = time.perf_counter()
-    rows, total = [], {start: Counter() for start in STARTS}
+    rows, total, losses = [], {start: Counter() for start in STARTS}, Counter()
     for seed in seeds:
         rendered = render_seed(seed, frames, PEOPLE, CAMERAS)
         for start in STARTS:
             r = run_seed(seed, frames, PEOPLE, options, cameras=CAMERAS, rendered=rendered,
                          init_from_gt=start == "true places")
             total[start] += r["causes"]
+            if start == "true places":  # track ids are the people's: how each one's own track was lost
+                camera = next(iter(rendered[0].scene.cameras.values()))
+                losses += first_losses(*r["tables"], camera.centre[:2], GATE_M)
             held, scored = r["held"]
             rows.append([seed, start, scored, held, r["tracks"], r["mota"], r["idf1"], r["fp"], r["miss"],
                          r["switches"], r["error"]] + [r["causes"][c] for c in CAUSES] + [r["fps"]])
@@ -87,6 +101,9 @@ def main(argv: list[str] | None = None) -> int:
                      f"(min {a[:, 1].min():.0f}; target ≥ {TARGET_HELD}), tracks per frame {a[:, 2].mean():.1f}, "
                      f"MOTA mean **{a[:, 3].mean():.3f}** (min {a[:, 3].min():.3f}), IDF1 mean {a[:, 4].mean():.3f}; "
                      "errors by cause: " + ", ".join(f"{c} {total[start][c]}" for c in CAUSES) + ".")
+    lines.append("- true places, how each person's own track was first lost (crowd_losses.py): "
+                 + ", ".join(f"{c} {losses[c]}" for c in LOSSES) + f"; none for {len(seeds) * PEOPLE - sum(losses.values())} "
+                 f"of {len(seeds) * PEOPLE} (held to the end, or never).")
     summary = f"Over {len(seeds)} seeds:\n\n" + "\n".join(lines)
     headers = (["seed", "start", "people scored", "held (≥ 80 % of frames)", "tracks per frame", "MOTA", "IDF1",
                 "false positives", "misses", "ID switches", "mean error m"] + list(CAUSES) + ["frames/s (step)"])
@@ -94,8 +111,14 @@ def main(argv: list[str] | None = None) -> int:
             f"preset{', options ' + str(options) if options else ''}, colour foreground, gate 0.5 m.\n\n"
             f"{markdown_table(headers, rows)}\n\n{summary}\n")
     print(text)
-    save_result("crowd50", "Ellipsoid tracker on 50 people seen by one 640x480 camera", text,
-                args.quick or bool(options), time.perf_counter() - t0)
+    title, seconds = "Ellipsoid tracker on 50 people seen by one 640x480 camera", time.perf_counter() - t0
+    if args.tag and not args.quick:
+        command = "".join(f" {shlex.quote(a)}" for a in sys.argv[1:] if a)
+        path = write_result(f"crowd50{args.tag}", title,
+                            f"Command: `.venv/bin/python benchmarks/crowd50.py{command}` ({seconds:.0f} s)\n\n{text}")
+        print(f"wrote {path} in {seconds:.0f} s", file=sys.stderr)
+    else:
+        save_result("crowd50", title, text, args.quick or bool(options), seconds)
     return 0
 
 

@@ -77,7 +77,8 @@ def run_seed(seed: int, frames: int, people: int, options: dict, texture_ncc: fl
             "start": (int(np.isin(at_start, tracked_at_start).sum()), len(at_start)),
             # Issue 37's "tracks held": people tracked (within the gate) in >= 80 % of the frames they
             # are scored in — motmetrics' "mostly tracked" — out of the people scored.
-            "held": (m["mostly_tracked"], m["num_unique_objects"]), "tracks": len(r.pred_all) / max(r.frames, 1)}
+            "held": (m["mostly_tracked"], m["num_unique_objects"]), "tracks": len(r.pred_all) / max(r.frames, 1),
+            "tables": (r.gt_all, r.pred_all)}
 
 
 def views_table(by_views: dict[int, Counter]) -> str:

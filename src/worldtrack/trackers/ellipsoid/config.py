@@ -26,6 +26,7 @@ from pydantic import Field, model_validator
 
 from worldtrack.config import Section, with_overrides
 from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
+from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
 
 
 class ScoreConfig(Section):
@@ -68,8 +69,7 @@ class MatchConfig(Section):
     max_step_m: float = Field(0.4, gt=0, description="largest adaptive step, m")
     max_iterations: int = Field(6, ge=1, description="cap on rounds with the adaptive step")
     predict: bool = Field(True, description="constant-velocity prediction before matching")
-    velocity_smoothing: float = Field(
-        0.5, ge=0, le=1, description="weight of each frame's velocity measurement (0..1)")
+    velocity_smoothing: float = Field(0.5, ge=0, le=1, description="weight of each frame's velocity measurement (0..1)")
     max_speed_mps: float = Field(3.0, gt=0, description="velocities are clipped to this speed (a running person), m/s")
     rounds: Literal["compiled", "python"] = Field(
         "compiled", description="the compiled rounds, or their readable Python reference (same tracks, slower)")
@@ -383,6 +383,7 @@ class EllipsoidConfig(Section):
     lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
     split: SplitConfig = Field(SplitConfig(), description="one person or two on one line of sight")
     cross_view: CrossViewConfig = Field(CrossViewConfig(), description="a track one camera cannot see, searched along another's ray")
+    crowd: CrowdConfig = Field(CrowdConfig(), description="people one camera alone shows, in a crowd")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":
@@ -396,5 +397,4 @@ class EllipsoidConfig(Section):
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig",
-           "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]
+__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig", "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]

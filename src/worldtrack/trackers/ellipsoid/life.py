@@ -143,6 +143,8 @@ class LifeCycle:
         self.several_cameras = several_cameras
         self.promote = promote
         self.evidence: Evidence = EVIDENCE[config.score.kind](config)
+        #: Whether an unseen person is kept a while longer (``crowd.coast_behind_obstacles_s``, :mod:`.coast`).
+        self.coasting: Callable[[Person], bool] = lambda p: False
 
     def end(self, p: Person) -> None:
         """Take person ``p`` off the map (if still there)."""
@@ -203,7 +205,7 @@ class LifeCycle:
             if counts_for(p, "low", t, low, by) >= lost_after:
                 self.end(p)
                 return False
-        if p.count("unseen") >= leave_after:
+        if p.count("unseen") >= leave_after and not self.coasting(p):
             self.end(p)
             return False
         return True

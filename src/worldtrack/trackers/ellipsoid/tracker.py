@@ -37,6 +37,7 @@ from worldtrack.trackers.base import Frame, Overlay, Person, PositionMap, Track,
 from worldtrack.trackers.ellipsoid.args import DrawArgs, People, Scoring, StepArgs, Walkable
 from worldtrack.trackers.ellipsoid.births import Births
 from worldtrack.trackers.ellipsoid.cameras import CameraView, camera_view
+from worldtrack.trackers.ellipsoid.coast import behind_obstacles
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
 from worldtrack.trackers.ellipsoid.depth import DepthFusion
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
@@ -46,6 +47,7 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
+from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
 from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view_people
@@ -120,6 +122,8 @@ class EllipsoidTracker(TrackerBase):
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
         self._now = 0.0
+        if cfg.crowd.coast_behind_obstacles_s > 0:
+            self.life.coasting = self._coasting
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -211,11 +215,20 @@ class EllipsoidTracker(TrackerBase):
 
     def _predict(self, people: Sequence[Person], dt: float, t: float) -> None:
         """Constant-velocity prediction of tracked people, once per time stamp; a prediction into a
-        wall or a desk stays where it was."""
+        wall or a desk stays where it was; ``crowd.predict_along_ray`` < 1 damps the velocity along
+        a lone camera's line of sight (:mod:`.prediction`)."""
         if not (self.config.match.predict and dt > 0):
             return
         moving = [p for p in people if p.mode == "tracking" and p.once("predict", t)]
-        ahead = np.array([[p.x + p.vx * dt, p.y + p.vy * dt] for p in moving]).reshape(-1, 2)
+        share = float(self.config.crowd.predict_along_ray)
+        if share == 1.0:
+            ahead = np.array([[p.x + p.vx * dt, p.y + p.vy * dt] for p in moving]).reshape(-1, 2)
+        else:  # the velocity along a lone camera's line of sight damped (:mod:`.prediction`)
+            cids = list(self.views)
+            which = np.array([lone_camera(p.seen_by, cids) for p in moving], dtype=int)
+            ahead = predicted_places(np.array([[p.x, p.y] for p in moving]).reshape(-1, 2),
+                                     np.array([[p.vx, p.vy] for p in moving]).reshape(-1, 2), dt,
+                                     [self.views[c].camera for c in cids], which, which >= 0, share)
         for p, (x, y), ok in zip(moving, ahead, self.walkable(ahead)):
             if ok:
                 p.x, p.y = float(x), float(y)
@@ -320,6 +333,13 @@ class EllipsoidTracker(TrackerBase):
             update_heights(present, heights_due(judged, cfg.height, self.frames_stepped), self.views,
                            self.last_labels, lambda pid: self.scene.people.size_of(pid)[0], cfg.height)
         self.life.merge_duplicates(t, interval)
+
+    def _coasting(self, p: Person) -> bool:
+        """An unseen person behind obstacles, unseen for less than ``crowd.coast_behind_obstacles_s``."""
+        if p.count("unseen") >= frames_for(self.config.crowd.coast_behind_obstacles_s, self.frame_interval):
+            return False
+        return bool(behind_obstacles(np.array([[p.x, p.y]]), np.array([p.height]),
+                                     [v.camera for v in self.views.values()], self.scene.occlusion)[0])
 
     def _promote(self, p: Person) -> None:
         """A confirmed candidate gets its public id and the scene's size for that id."""

@@ -1,0 +1,63 @@
+"""The prediction before matching: constant velocity, the part along a lone camera's ray damped
+(``crowd.predict_along_ray``, :mod:`worldtrack.trackers.ellipsoid.prediction`)."""
+
+import numpy as np
+import pytest
+from _ellipsoid_scenes import noise_backgrounds, one_camera_scene, two_camera_scene
+
+from worldtrack.foreground import make_foregrounds
+from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
+from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
+
+
+@pytest.mark.parametrize("share", [0.0, 0.3, 1.0])
+def test_only_the_velocity_along_the_lone_cameras_ray_is_scaled(share):
+    scene = one_camera_scene()
+    cam = scene.cameras["cam"]
+    xy = np.array([[-1.0, 1.5], [0.5, 3.0], [-2.0, 2.0]])
+    v = np.array([[0.4, 1.2], [-0.8, 0.3], [1.0, -1.0]])
+    lone = np.array([True, True, False])
+    out = predicted_places(xy, v, 0.1, [cam], np.zeros(3, int), lone, share)
+    ray = cam.floor_rays(xy, min_distance=0.3)[0]
+    move = (out - xy) / 0.1
+    along, want_along = np.sum(move * ray, axis=1), np.sum(v * ray, axis=1)
+    across, want_across = move[:, 0] * ray[:, 1] - move[:, 1] * ray[:, 0], v[:, 0] * ray[:, 1] - v[:, 1] * ray[:, 0]
+    np.testing.assert_allclose(across, want_across, atol=1e-12)            # across the ray: all of it
+    np.testing.assert_allclose(along[:2], share * want_along[:2], atol=1e-12)
+    np.testing.assert_allclose(out[2], xy[2] + 0.1 * v[2], atol=1e-12)     # several cameras: the full velocity
+
+
+def test_each_person_is_damped_along_their_own_cameras_ray():
+    scene = two_camera_scene()
+    cams = [scene.cameras["c1"], scene.cameras["c2"]]
+    xy = np.array([[-1.0, 1.5], [-1.0, 1.5]])
+    v = np.array([[0.5, 0.5], [0.5, 0.5]])
+    out = predicted_places(xy, v, 1.0, cams, np.array([0, 1]), np.array([True, True]), 0.0)
+    for k in range(2):
+        ray = cams[k].floor_rays(xy[k], min_distance=0.3)[0]
+        assert abs((out[k] - xy[k]) @ ray) < 1e-12
+    assert np.linalg.norm(out[0] - out[1]) > 0.1       # the two cameras' rays differ there
+
+
+def test_the_lone_camera_is_the_only_one_of_the_trackers_that_showed_the_person():
+    assert lone_camera(("c2",), ["c1", "c2"]) == 1
+    assert lone_camera(("c1", "c2"), ["c1", "c2"]) == -1
+    assert lone_camera(("other",), ["c1", "c2"]) == -1      # another tracker's camera
+    assert lone_camera((), ["cam"]) == 0                    # one camera: always it
+
+
+@pytest.mark.parametrize("share", [0.0, 1.0])
+def test_the_tracker_predicts_a_one_camera_person_across_the_ray_only_when_asked(share):
+    scene = one_camera_scene()
+    rng = np.random.default_rng(0)
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"),
+                               EllipsoidConfig(crowd={"predict_along_ray": share}))
+    p = tracker.init_track(-1.0, 2.0)
+    person = tracker.position_map[p.id]
+    ray = scene.cameras["cam"].floor_rays(np.array([-1.0, 2.0]), min_distance=0.3)[0]
+    across = np.array([-ray[1], ray[0]])
+    person.vx, person.vy = 0.8 * ray + 0.5 * across
+    tracker._predict([person], 0.1, 0.1)
+    moved = np.array([person.x, person.y]) - (-1.0, 2.0)
+    assert moved @ across == pytest.approx(0.05, abs=1e-9)
+    assert moved @ ray == pytest.approx(0.08 * share, abs=1e-9)
