@@ -1,0 +1,29 @@
+"""The lowest point of a silhouette is the toe of the nearer shoe, not where the person stands (opt-in).
+
+Seen obliquely from one camera, a person's silhouette ends at the front edge of the shoe nearest
+the camera; the person's floor point (between the feet, under the body's centre) is farther along
+the line of sight by about half a shoe's length, more with a stride. On the line-of-sight
+development seeds 20-39 the feet the anchor trusted were 8-9 cm nearer than the truth (median of
+3206 readings; 9 seeds, near and far alike), a bias the feet's σ (0.1 m) does not express.
+``feet.centre_offset_m`` moves the feet found that far along the camera's line of sight.
+
+>>> import numpy as np
+>>> beyond_toes(np.array([0.0, 5.0]), np.zeros(2), 0.1).round(3).tolist()
+[0.0, 5.1]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def beyond_toes(feet_xy: np.ndarray, camera_xy: np.ndarray, offset_m: float) -> np.ndarray:
+    """The floor point (2,) ``offset_m`` (m) beyond ``feet_xy`` (2,) along the line of sight from the camera's
+    floor point ``camera_xy`` (2,); ``feet_xy`` itself with offset 0."""
+    if offset_m == 0:
+        return feet_xy
+    ray = np.asarray(feet_xy, dtype=float) - camera_xy
+    return feet_xy + offset_m * ray / max(float(np.hypot(*ray)), 1e-9)
+
+
+__all__ = ["beyond_toes"]
