@@ -235,7 +235,6 @@ class FeetConfig(Section):
     sigma_m: float = Field(0.1, gt=0, description="σ of the feet's place along the line of sight, m (a shoe's length)")
     centre_offset_m: float = Field(0.0, ge=0, description="with anchor: the person stands this far beyond the lowest "
                                    "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
-    behind_margin_m: float = Field(0.0, ge=0, description="with anchor: people this far behind one do not hide them, m")
     ellipse_sigma_m: float = Field(
         0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(

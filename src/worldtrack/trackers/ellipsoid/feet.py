@@ -44,13 +44,12 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from worldtrack.trackers.base import Person
-from worldtrack.trackers.ellipsoid.behind import farther, in_front, overlaps_behind
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
-from worldtrack.trackers.ellipsoid.toes import beyond_toes
 from worldtrack.trackers.ellipsoid.height import MAX_COVERED_FOR_HEIGHT, head_ray, measure_feet, silhouette_ends
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS
+from worldtrack.trackers.ellipsoid.toes import beyond_toes
 
 
 def feet_weight(ellipse_sigma_m: float, feet_sigma_m: float) -> float:
@@ -118,8 +117,7 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
             continue
         if np.hypot(*(xy[k] - cam.centre[:2])) < cam.centre[2] - 0.5 * hs[k]:
             continue  # seen from above: the feet are in the middle of the silhouette
-        behind = farther(cam.centre[:2], xy, k, config.behind_margin_m) if config.behind_margin_m > 0 else None
-        look = _look(view, labels, b, ring[k], current, k, behind)
+        look = _look(view, labels, b, ring[k], current, k)
         if look is None:
             continue
         probe = xy[k]
@@ -136,15 +134,12 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
             # far along the line of sight to hold its own feet. Look again, drawn at the cut.
             probe = below
             _, ring1, box1, valid1, _ = view.forms(probe[None], np.array([hi]), np.array([1.25 * ws[k]]))
-            nearer = _look(view, labels, box1[0], ring1[0], current, k, behind) if valid1[0] else None
+            nearer = _look(view, labels, box1[0], ring1[0], current, k) if valid1[0] else None
             if nearer is None:  # others cover the place below: keep the head's word, at the track's region
                 found = None
                 break
             look = nearer
-        # With somebody behind in the region, the top above the feet may be theirs: only "too short" is telling.
-        taller_ok = behind is not None and overlaps_behind(current.box, look[2], behind)
-        if found is not None and lo <= found[1] <= hi and -config.height_match_m <= found[1] - hs[k] \
-                and (found[1] - hs[k] <= config.height_match_m or taller_ok) \
+        if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= config.height_match_m \
                 and not touches_other(look[1], look[2], cam.project(found[0][None])[0], k):
             out[k] = (beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m), config.sigma_m)
             continue
@@ -160,21 +155,16 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
 REACH_STEPS = 3
 
 
-def _look(view: CameraView, labels: np.ndarray, box: np.ndarray, ring: np.ndarray, current, k: int,
-          behind: np.ndarray | None = None):
+def _look(view: CameraView, labels: np.ndarray, box: np.ndarray, ring: np.ndarray, current, k: int):
     """Where person ``k``'s feet may be seen in ``box`` (the tallest plausible ellipse and its ring,
     ``ring``): (region clear of others (h, w) bool, owner (h, w) int32, box (4,), image down (2,)), or None
-    when others cover too much of it or the box is empty (with ``behind`` (N,) bool, people behind ``k`` do not
-    count as cover: :mod:`.behind`)."""
+    when others cover too much of it or the box is empty."""
     cam = view.camera
     u0, u1, v0, v1 = (int(v) for v in box)
     if u0 >= u1 or v0 >= v1:
         return None
     region = ellipse_crop(ring, box, view.grid, cam.has_distortion)
-    if behind is not None:  # only people in front hide this person's pixels, or may own the feet found
-        owner = owner_crop(box, in_front(current, k, behind), view.grid, cam.has_distortion)
-    else:
-        owner = owner_crop(box, current, view.grid, cam.has_distortion)
+    owner = owner_crop(box, current, view.grid, cam.has_distortion)
     free = (owner == k) | (owner == -1)
     if np.count_nonzero(region & ~free) > MAX_COVERED_FOR_HEIGHT * np.count_nonzero(region):
         return None
