@@ -10,8 +10,9 @@ development seeds 20-39 the feet the anchor trusted were 8-9 cm nearer than the 
 Measured with the best one-camera opt-in (evidence shadow test, ``feet.anchor``, re-measuring after
 encounters, height prior 0.1 m) and ``feet.centre_offset_m=0.08``, 640x480, 0.5 m gate, paired by
 seed (issue 37): never-used seeds 260-279 MOTA 0.713 -> 0.786 (+0.073 +- 0.029 s.e., 15 seeds better,
-4 worse), longest run > 0.5 m along the ray 6.0 -> 3.0 s; fresh 280-299 0.743 -> 0.746; the dev
-seeds 20-39 that three sessions tuned on 0.807 -> 0.779. Off by default (the anchor itself is).
+4 worse), longest run > 0.5 m along the ray 6.0 -> 3.0 s; fresh 280-299 0.743 -> 0.746; held-out
+150-169 0.780 -> 0.758; the dev seeds 20-39 that three sessions tuned on 0.807 -> 0.779. Over the 60
+seeds not tuned on, +0.019: no better than neutral. Off by default (the anchor itself is).
 
 >>> import numpy as np
 >>> beyond_toes(np.array([0.0, 5.0]), np.zeros(2), 0.1).round(3).tolist()
