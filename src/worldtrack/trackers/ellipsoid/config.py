@@ -231,11 +231,10 @@ class FeetConfig(Section):
 
     anchor: bool = Field(
         False, description="move people one camera alone shows towards their feet (or the top of the head) along its "
-        "line of sight; off by default: on the line-of-sight scenario MOTA -0.06 -> 0.28 (10 held-out seeds), "
-        "but PETS 2009 0.853 -> 0.785 (issue 37); ellipsoid.depth.fuse weighs these cues with the others")
-    sigma_m: float = Field(
-        0.1, gt=0, description="uncertainty of the feet's place along the line of sight, m (the feet's pixel "
-        "scatter, a shoe's length)")
+        "line of sight; off by default: it costs PETS 2009 MOTA (issue 37); ellipsoid.depth.fuse weighs all the cues")
+    sigma_m: float = Field(0.1, gt=0, description="σ of the feet's place along the line of sight, m (a shoe's length)")
+    centre_offset_m: float = Field(0.0, ge=0, description="with anchor: the person stands this far beyond the lowest "
+                                   "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
     ellipse_sigma_m: float = Field(
         0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(
