@@ -34,8 +34,8 @@ def _true_colours(tracker, cid):
     return colours_at(tracker.views[cid], tracker.last_images[cid], tracker.last_labels[cid], figure, 0, PERSON, 10)
 
 
-def _check(tracker, models, people):
-    return ColourCheck(people, models, tracker.views, tracker.last_images, tracker.last_labels, 10, 0.6)
+def _check(tracker, models, people, veto_only=False):
+    return ColourCheck(people, models, tracker.views, tracker.last_images, tracker.last_labels, 10, 0.6, veto_only)
 
 
 def test_a_move_is_allowed_only_onto_the_person_s_own_colours():
@@ -58,6 +58,12 @@ def test_a_move_is_allowed_only_onto_the_person_s_own_colours():
     assert _check(tracker, {people[0]: {"c1": _true_colours(tracker, "c1")}}, people)(joint, 0, ["c2"], PERSON)
     # Where the unseeing camera shows nobody's pixels, no colours: no move.
     assert not _check(tracker, {people[0]: {"c2": green}}, people)(joint, 0, ["c2"], FAR)
+    # veto_only: what cannot be measured does not refuse; colours that are somebody else's still do.
+    assert _check(tracker, {}, people, veto_only=True)(joint, 0, ["c2"], PERSON)
+    assert _check(tracker, {people[0]: {"c2": green}}, people, veto_only=True)(joint, 0, ["c2"], FAR)
+    assert not _check(tracker, {people[0]: {"c2": red}}, people, veto_only=True)(joint, 0, ["c2"], PERSON)
+    assert not _check(tracker, {people[0]: {"c2": green}, people[1]: {"c2": green}}, people,
+                      veto_only=True)(joint, 0, ["c2"], PERSON)
 
 
 def test_the_tracker_moves_a_track_only_with_a_colour_model_that_fits():

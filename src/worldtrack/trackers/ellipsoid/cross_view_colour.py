@@ -10,7 +10,8 @@ upper- and lower-body histograms (:func:`.colours.colours_of`) — and compares 
 person's own colour model (:mod:`.identity`): B's model if it has learnt one, else the mean of
 the distances to the other cameras' models. The move is allowed only when that distance is at
 most ``max_distance`` (Bhattacharyya, mean of the body parts) and no other tracked person's
-model is nearer to those colours. A person without a model yet is not moved.
+model is nearer to those colours. A person without a model yet, or a place where the camera gives
+too few of their pixels, is not moved — or, with ``veto_only``, moved as without the test.
 
 >>> from worldtrack.trackers.ellipsoid.colours import HIST_BINS, Colours
 >>> a = np.zeros(HIST_BINS, np.float32); a[0, 0, 0] = 1
@@ -73,12 +74,15 @@ class ColourCheck:
     views, images, labels : the cameras, their BGR images and foreground labels, by id
     min_pixels : a body part gives colours only with this many pixels the person owns
     max_distance : the largest colour distance of an allowed move
+    veto_only : the colours only refuse: a person without a model, or a place where no camera
+        gives enough of their pixels, may move (as without the test)
     """
 
     def __init__(self, people: Sequence[Person], models: Mapping[Person, Mapping[str, Colours]],
                  views: Mapping[str, CameraView], images: Mapping[str, np.ndarray],
-                 labels: Mapping[str, np.ndarray], min_pixels: int, max_distance: float):
+                 labels: Mapping[str, np.ndarray], min_pixels: int, max_distance: float, veto_only: bool = False):
         self.people, self.models = list(people), models
+        self.veto_only = veto_only
         self.views, self.images, self.labels = views, images, labels
         self.min_pixels, self.max_distance = min_pixels, max_distance
         self.refused = 0
@@ -90,7 +94,7 @@ class ColourCheck:
         figures = [_Figure(i, float(x), float(y), float(h), float(w)) for i, ((x, y), h, w)
                    in enumerate(zip(joint.xy, joint.people.heights, joint.people.widths))]
         model = self.models.get(self.people[k]) if k < len(self.people) else None
-        ok = False
+        ok, measured = False, False
         if model:
             others = [self.models.get(p) for i, p in enumerate(self.people) if i != k]
             for cid in unseeing:
@@ -100,11 +104,13 @@ class ColourCheck:
                                   self.min_pixels)
                 if seen is None:
                     continue
+                measured = True
                 mine = model_distance(seen, model, cid)
                 theirs = [d for m in others if m for d in [model_distance(seen, m, cid)] if d is not None]
                 if mine is not None and mine <= self.max_distance and all(mine < d for d in theirs):
                     ok = True
                     break
+        ok = ok or (self.veto_only and not measured)
         self.refused += not ok
         return ok
 

@@ -42,6 +42,9 @@ class CrossViewConfig(Section):
     colour_min_pixels: int = Field(
         10, ge=1, description="... measured where each body part has at least this many foreground pixels the person's "
         "ellipse alone covers there (fewer than the identity model's own: the place may be near the image's edge)")
+    colour_veto_only: bool = Field(
+        False, description="... the colours only refuse a move: a person without a colour model yet, or a place where "
+        "too few of their pixels are seen, moves as without the test")
 
 
 __all__ = ["CrossViewConfig"]

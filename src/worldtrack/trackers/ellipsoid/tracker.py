@@ -272,7 +272,8 @@ class EllipsoidTracker(TrackerBase):
         cv = cfg.cross_view
         if cv.search_m > 0:
             accept = ColourCheck(list(people) + list(fixed), self.identity.models, self.views, self.last_images,
-                                 self.last_labels, cv.colour_min_pixels, cv.colour_distance) \
+                                 self.last_labels, cv.colour_min_pixels, cv.colour_distance,
+                                 cv.colour_veto_only) \
                 if cv.colour_distance > 0 and cfg.identity.enabled else None
             cross_view_people(joint, people, self.views, best_e, best_den, CrossViewArgs(
                 cv.search_m, cv.step_m, cv.min_share, cv.min_ratio, cv.gain, max(cv.clear_m, cfg.births.min_separation_m)),
