@@ -333,8 +333,7 @@ class IdentityConfig(Section):
 
 
 class LostConfig(Section):
-    """Track management: confirmed tracks that ended, kept a moment to give their ids back
-    (:mod:`worldtrack.trackers.ellipsoid.reentry`)."""
+    """Track management: confirmed tracks that ended, kept to give their ids back (:mod:`.reentry`)."""
 
     path: ClassVar[str] = "ellipsoid.lost"
 
@@ -342,12 +341,13 @@ class LostConfig(Section):
         2.0, ge=0, description="a confirmed track that ended this recently gives its id back by place alone: a person "
         "who comes out from behind a pole or another person, s (0 = off)")
     near_m: float = Field(1.0, ge=0, description="... to a new person within this distance, m, ...")
-    speed_mps: float = Field(
-        1.0, ge=0, description="... plus this speed times the time since, of where the lost one was heading, m/s")
+    speed_mps: float = Field(1.0, ge=0, description="... plus this speed × the time since, on the lost one's heading, m/s")
     margin_m: float = Field(1.0, ge=0, description="... when no other lost person is within this much as near, m")
     colour_veto: float = Field(
         0.6, ge=0, le=1, description="... and, when both have colour models, their colour distance is at most this")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept, s")
+    border_share: float = Field(0.0, ge=0, le=1, description="not by place to a track lost with less than this share "
+                                "of its ellipse inside any camera's image: it walked out of view (:mod:`.exits`; 0 = off)")
 
 
 class WarmStartConfig(Section):

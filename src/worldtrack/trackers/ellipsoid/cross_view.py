@@ -26,13 +26,17 @@ onto somebody B shows (issue 37).
 
 from __future__ import annotations
 
-from typing import Mapping, NamedTuple, Sequence
+from typing import Callable, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView, ray_direction
 from worldtrack.trackers.ellipsoid.joint import JointImage
+
+
+#: A last test of a move: (joint image, person index, unseeing camera ids, new place (2,) m) → allowed.
+Accept = Callable[[JointImage, int, Sequence[str], np.ndarray], bool]
 
 
 class CrossViewArgs(NamedTuple):
@@ -68,9 +72,11 @@ def ray_candidates(xy: np.ndarray, rays: Sequence[np.ndarray], search_m: float, 
     return np.concatenate([xy + along[:, None] * d for d in rays]) if rays else np.empty((0, 2))
 
 
-def cross_view(joint: JointImage, k: int, unseeing: Sequence[str], args: CrossViewArgs) -> tuple[float, float] | None:
+def cross_view(joint: JointImage, k: int, unseeing: Sequence[str], args: CrossViewArgs,
+               accept: Accept | None = None) -> tuple[float, float] | None:
     """Search the rays of the cameras that show person ``k`` for a place that the cameras
-    ``unseeing`` (which do not show where ``k`` is now) show and confirm.
+    ``unseeing`` (which do not show where ``k`` is now) show and confirm; ``accept(joint, k,
+    unseeing, xy)``, when given, must allow the best place too (:mod:`.cross_view_colour`).
 
     Returns (E, denominator) of the new place (the person has moved there in ``joint``), or None.
     """
@@ -104,12 +110,15 @@ def cross_view(joint: JointImage, k: int, unseeing: Sequence[str], args: CrossVi
     b = int(np.argmax(e))
     if not np.isfinite(e[b]) or e[b] < e_here + args.gain:
         return None
+    if accept is not None and not accept(joint, k, unseeing, cand[b]):
+        return None
     joint.move(k, cand[b], forms, b)
     return float(e[b]), float(tot_den[b])
 
 
 def cross_view_people(joint: JointImage, people: Sequence[Person], views: Mapping[str, CameraView],
-                      best_e: np.ndarray, best_den: np.ndarray, args: CrossViewArgs) -> int:
+                      best_e: np.ndarray, best_den: np.ndarray, args: CrossViewArgs,
+                      accept: Accept | None = None) -> int:
     """Run :func:`cross_view` on each tracked person of ``people`` (person ``k`` is ``joint``'s
     ``k``) whose place some camera of ``joint`` does not show; a moved person's E and denominator
     replace theirs in ``best_e``, ``best_den`` (in place). Returns how many moved."""
@@ -124,7 +133,7 @@ def cross_view_people(joint: JointImage, people: Sequence[Person], views: Mappin
                     if shown_share(views[c], here, p.height, p.width)[0] < args.min_share]
         if not unseeing or len(unseeing) == len(joint.cids):
             continue
-        found = cross_view(joint, k, unseeing, args)
+        found = cross_view(joint, k, unseeing, args, accept)
         if found is not None:
             best_e[k], best_den[k] = found
             moved += 1

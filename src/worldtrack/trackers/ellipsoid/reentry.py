@@ -48,6 +48,8 @@ class Vanished:
     xy: np.ndarray
     v: np.ndarray
     t: float
+    #: Lost at the image's edge (:mod:`.exits`): not given back by place alone.
+    left_view: bool = False
 
 
 @dataclass
@@ -65,20 +67,23 @@ class LostTracks:
     _alive: dict[int, tuple[Person, np.ndarray, np.ndarray, float]] = field(default_factory=dict)
     given_back: int = 0
 
-    def file(self, person_id: int, xy: Sequence[float], v: Sequence[float], t: float) -> None:
-        """Keep person ``person_id``, last at ``xy`` m moving at ``v`` m/s at time ``t`` s, as lost."""
-        self.lost.append(Vanished(int(person_id), np.asarray(xy, float), np.asarray(v, float), float(t)))
+    def file(self, person_id: int, xy: Sequence[float], v: Sequence[float], t: float, left_view: bool = False) -> None:
+        """Keep person ``person_id``, last at ``xy`` m moving at ``v`` m/s at time ``t`` s, as lost
+        (``left_view``: at the image's edge, their id is not given back by place)."""
+        self.lost.append(Vanished(int(person_id), np.asarray(xy, float), np.asarray(v, float), float(t), left_view))
 
-    def watch(self, people: Iterable[Person], t: float, alive: Callable[[Person], bool]) -> None:
+    def watch(self, people: Iterable[Person], t: float, alive: Callable[[Person], bool],
+              left_view: Callable[[Person, np.ndarray], bool] | None = None) -> None:
         """After a step: file the confirmed people seen at the last call who are no longer on the
         map (``alive(person)`` is False), remember the confirmed people now on it, forget the lost
-        older than ``lost.keep_s``."""
+        older than ``lost.keep_s``. ``left_view(person, xy)``: whether they were lost at the
+        image's edge (:mod:`.exits`)."""
         cfg = self.config
         for pid, (p, xy, v, seen) in list(self._alive.items()):
             if not alive(p):
                 del self._alive[pid]
                 if p.confirmed and seen - p.born >= cfg.min_age_s:
-                    self.file(pid, xy, v, seen)
+                    self.file(pid, xy, v, seen, left_view is not None and left_view(p, xy))
         for p in people:
             # The place where the evidence last held them, not where a failing track slid to.
             if p.confirmed and p.id > 0 and (p.count("low") == 0 or _new(self._alive, p)):
@@ -107,6 +112,8 @@ class LostTracks:
         if any(f is not best and f[1] - best[1] < cfg.margin_m for f in fits):
             return None
         g = best[2]
+        if g.left_view:
+            return None   # the nearest lost person walked out of view: a newcomer is as likely somebody else
         if colour_distance is not None:
             d = colour_distance(g.id)
             if d is not None and d > cfg.colour_veto:

@@ -49,8 +49,10 @@ from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
 from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
 from worldtrack.trackers.ellipsoid.real import ternary_real
+from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
 from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view_people
+from worldtrack.trackers.ellipsoid.cross_view_colour import ColourCheck
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS, flag_unmeasurable, measure_support
 from worldtrack.trackers.ellipsoid.two_hypotheses import RaySplitter
@@ -184,7 +186,10 @@ class EllipsoidTracker(TrackerBase):
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
-            self.reentry.watch(self.position_map, t, lambda p: self.position_map.get(p.id) is p)
+            share = self.config.lost.border_share
+            self.reentry.watch(self.position_map, t, lambda p: self.position_map.get(p.id) is p,
+                               (lambda p, xy: left_the_view(self.views.values(), xy, p.height, p.width, share))
+                               if share > 0 else None)
         if self.config.height.keep_with_id:
             self.kept_heights.remember(self.position_map)
         self._last_t = t
@@ -279,8 +284,13 @@ class EllipsoidTracker(TrackerBase):
                           RescueSchedule(self.frames_stepped, every, cfg.rescue.retry_s, 0.5 * self.frame_interval), t)
         cv = cfg.cross_view
         if cv.search_m > 0:
+            accept = ColourCheck(list(people) + list(fixed), self.identity.models, self.views, self.last_images,
+                                 self.last_labels, cv.colour_min_pixels, cv.colour_distance,
+                                 cv.colour_veto_only) \
+                if cv.colour_distance > 0 and cfg.identity.enabled else None
             cross_view_people(joint, people, self.views, best_e, best_den, CrossViewArgs(
-                cv.search_m, cv.step_m, cv.min_share, cv.min_ratio, cv.gain, max(cv.clear_m, cfg.births.min_separation_m)))
+                cv.search_m, cv.step_m, cv.min_share, cv.min_ratio, cv.gain, max(cv.clear_m, cfg.births.min_separation_m)),
+                accept)
         for k, p in enumerate(people):
             p.x, p.y = float(joint.xy[k, 0]), float(joint.xy[k, 1])
         return [(float(best_e[k]), float(best_den[k])) for k in range(len(people))]
