@@ -346,7 +346,7 @@ class LostConfig(Section):
     colour_veto: float = Field(
         0.6, ge=0, le=1, description="... and, when both have colour models, their colour distance is at most this")
     min_age_s: float = Field(1.0, ge=0, description="only tracks that lived this long are kept, s")
-    border_share: float = Field(0.0, ge=0, le=1, description="not by place to a track lost with less than this share "
+    border_share: float = Field(0.9, ge=0, le=1, description="not by place to a track lost with less than this share "
                                 "of its ellipse inside any camera's image: it walked out of view (:mod:`.exits`; 0 = off)")
 
 

@@ -9,7 +9,7 @@ where the evidence last held it, is cut by the image border in every camera (les
 ``lost.border_share`` of the person's ellipse inside any image) is filed as *left the view*; its id
 can come back only by colour (:mod:`.identity`, which asks for a close colour match and a margin).
 
-Opt-in (``lost.border_share`` > 0). Measured at 0.9 (issue 37, one session): PETS 2009 S2.L1 start
+On by default (``lost.border_share`` = 0.9; 0 turns it off). Measured at 0.9 (issue 37, one session): PETS 2009 S2.L1 start
 frames 0–2, IDF1 0.796 → 0.828, against the whole-view ids 0.906 → 0.949, switches 2.3 → 1.0, MOTA
 0.927 → 0.926, mean error 0.251 → 0.251 m (start frames 0–7: IDF1 0.811 → 0.830, error 0.253 →
 0.255 m); no decision changed on crowd 10's held-out seeds 140–199, the one-camera line-of-sight
