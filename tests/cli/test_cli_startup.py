@@ -71,27 +71,27 @@ def test_a_closed_pipe_ends_the_command_quietly():
     assert err == "" and code == 141
 
 
-def test_ctrl_c_while_the_command_line_is_imported_is_one_line_and_130():
-    # The interrupt lands in the import of worldtrack.cli (the entry point's first moments).
-    code = ("import builtins\nreal = builtins.__import__\n"
+def _run_entry_while_cli_is_imported(action: str) -> subprocess.CompletedProcess:
+    """Start the program as its entry point does, running ``action`` (one statement; ``os`` and ``signal``
+    imported) the moment ``worldtrack.cli`` starts to be imported: the entry point's first moments."""
+    code = ("import builtins, os, signal\nreal = builtins.__import__\n"
             "def importing(name, *args, **kwargs):\n"
-            "    if name == 'worldtrack.cli':\n        raise KeyboardInterrupt\n"
+            f"    if name == 'worldtrack.cli':\n        {action}\n"
             "    return real(name, *args, **kwargs)\n"
             "builtins.__import__ = importing\nfrom worldtrack.entry import run\nrun()\n")
-    out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
-    assert (out.returncode, out.stderr) == (130, "interrupted\n")
+    return subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
 
+
+def test_ctrl_c_while_the_command_line_is_imported_is_one_line_and_130():
+    out = _run_entry_while_cli_is_imported("raise KeyboardInterrupt")
+    assert (out.returncode, out.stderr) == (130, "interrupted\n")
 
 
 def test_sigterm_while_the_command_line_is_imported_is_one_line_and_143():
     # Under load the import can take seconds; a SIGTERM then must not end the program silently (-15).
-    code = ("import builtins, os, signal\nreal = builtins.__import__\n"
-            "def importing(name, *args, **kwargs):\n"
-            "    if name == 'worldtrack.cli':\n        os.kill(os.getpid(), signal.SIGTERM)\n"
-            "    return real(name, *args, **kwargs)\n"
-            "builtins.__import__ = importing\nfrom worldtrack.entry import run\nrun()\n")
-    out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
+    out = _run_entry_while_cli_is_imported("os.kill(os.getpid(), signal.SIGTERM)")
     assert (out.returncode, out.stderr) == (143, "terminated\n")
+
 
 def test_the_entry_point_imports_almost_nothing_before_it_can_catch_ctrl_c():
     code = "import sys\nimport worldtrack.entry\nprint(sorted(m for m in ('typing', 'argparse', 're', 'enum') if m in sys.modules))"
