@@ -141,19 +141,26 @@ def test_a_holder_that_stops_leaves_a_bucket_a_live_batch_worker_has_not_reporte
     assert [c for c, _, _ in last.reports] == ["done"]
 
 
+def _batch_pair_with_a_lapsed_lease(redis_url, client, keys, cfg, lapsed: str):
+    """Two batch workers, ``w-first`` (camera ``first``, its lease held) and ``w-<lapsed>`` (camera
+    ``lapsed``, no lease: it lapsed); returns the latter's own connection, named after it."""
+    for cam in ("first", lapsed):
+        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
+        link.lockstep = True
+        link.register()
+    client.set(keys.camera_lease("first"), "w-first", px=30000)
+    own = connect(redis_url)
+    assert name_connection(own, f"w-{lapsed}")
+    return own
+
+
 def test_a_batch_worker_whose_lease_lapsed_is_waited_for_while_it_is_still_connected(redis_url):
     """A batch worker starved of CPU (its lease-renewing thread did not run for ``lease_s``) is alive:
     its connection to Redis, named after it, is open, and the bucket waits for its report; a dead
     worker's connection is closed, and the bucket is written without it (worldtrack.map.starved)."""
     client = connect(redis_url)
     keys, cfg = MapKeys(), MapConfig(max_wait_s=0.2, starved_wait_s=30.0)
-    for cam in ("first", "starved"):
-        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
-        link.lockstep = True
-        link.register()
-    client.set(keys.camera_lease("first"), "w-first", px=30000)     # "starved" holds no lease: it lapsed
-    starved = connect(redis_url)
-    assert name_connection(starved, "w-starved")
+    starved = _batch_pair_with_a_lapsed_lease(redis_url, client, keys, cfg, "starved")
     with _fusing(client, keys, cfg) as t0:
         _publish(client, keys, "first", t0, 1, 2.0)
         time.sleep(5 * cfg.max_wait_s)
@@ -169,13 +176,7 @@ def test_a_batch_worker_whose_lease_lapsed_is_waited_for_while_it_is_still_conne
 def test_a_connected_batch_worker_whose_lease_lapsed_is_waited_for_at_most_starved_wait_s(redis_url):
     client = connect(redis_url)
     keys, cfg = MapKeys(), MapConfig(max_wait_s=0.1, starved_wait_s=1.0)
-    for cam in ("first", "hung"):
-        link = MapLink(client, keys, cfg, f"w-{cam}", {cam: None})
-        link.lockstep = True
-        link.register()
-    client.set(keys.camera_lease("first"), "w-first", px=30000)
-    hung = connect(redis_url)
-    assert name_connection(hung, "w-hung")
+    hung = _batch_pair_with_a_lapsed_lease(redis_url, client, keys, cfg, "hung")
     with _fusing(client, keys, cfg) as t0:
         sent = time.time()
         _publish(client, keys, "first", t0, 1, 2.0)

@@ -226,14 +226,12 @@ class EllipsoidTracker(TrackerBase):
             return
         moving = [p for p in people if p.mode == "tracking" and p.once("predict", t)]
         share = float(self.config.crowd.predict_along_ray)
-        if share == 1.0:
-            ahead = np.array([[p.x + p.vx * dt, p.y + p.vy * dt] for p in moving]).reshape(-1, 2)
-        else:  # the velocity along a lone camera's line of sight damped (:mod:`.prediction`)
-            cids = list(self.views)
-            which = np.array([lone_camera(p.seen_by, cids) for p in moving], dtype=int)
-            ahead = predicted_places(np.array([[p.x, p.y] for p in moving]).reshape(-1, 2),
-                                     np.array([[p.vx, p.vy] for p in moving]).reshape(-1, 2), dt,
-                                     [self.views[c].camera for c in cids], which, which >= 0, share)
+        cids = list(self.views)
+        # Which lone camera's ray damps a person's velocity; nobody's at the default share 1.
+        which = np.array([lone_camera(p.seen_by, cids) if share != 1.0 else -1 for p in moving], dtype=int)
+        ahead = predicted_places(np.array([[p.x, p.y] for p in moving]).reshape(-1, 2),
+                                 np.array([[p.vx, p.vy] for p in moving]).reshape(-1, 2), dt,
+                                 [self.views[c].camera for c in cids], which, which >= 0, share)
         for p, (x, y), ok in zip(moving, ahead, self.walkable(ahead)):
             if ok:
                 p.x, p.y = float(x), float(y)
