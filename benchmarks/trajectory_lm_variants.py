@@ -19,6 +19,7 @@ keeps LM's acceptance: a changed step that does not lower F is followed by the p
 - *projection*: after the step, every state within 0.3 m of the clearance is moved along the field's
   gradient at its new place to the distance the linear model predicted (d + ∇d·δp): a slide round a
   convex end then keeps its distance instead of drifting outward (velocities: the derivative of the shift);
+  *smoothed*: the shift first averaged twice over ± 1.5 s (31 steps), as a motion the prior can follow;
 - *geodesic* (Transtrum & Sethna 2011): δ = v + ½a with a = −(H + μD)⁻¹ J_bᵀ r_vv, r_vv the barrier
   residuals' second directional derivative along v by finite differences (step h·v), kept if 2|a| ≤ 0.75|v|.
 
@@ -42,6 +43,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
@@ -172,6 +174,8 @@ class Projection(VariantLM):
         if not near.any():
             return None
         shift = np.where(near, (d0 + (g0 * (p1 - p0)).sum(axis=1) - d1) / np.where(near, g2, 1.0), 0.0)[:, None] * g1
+        for _ in range(2 if self.kw.get("smooth", 1) > 1 else 0):     # twice a running mean: a smooth shift
+            shift = uniform_filter1d(shift, self.kw["smooth"], axis=0, mode="nearest")
         out = v.copy()
         out[:, [0, 2]] += shift
         out[:, [1, 3]] += np.gradient(shift, self.problem.grid.dt, axis=0)
@@ -196,7 +200,7 @@ class Geodesic(VariantLM):
 
 
 VARIANTS = {"window scale": (WindowScale, {}), "window extrapolation": (WindowExtrapolation, {}),
-            "projection": (Projection, {}), "geodesic h = 0.1": (Geodesic, {"h": 0.1}),
+            "projection": (Projection, {}), "projection, smoothed": (Projection, {"smooth": 31}), "geodesic h = 0.1": (Geodesic, {"h": 0.1}),
             "geodesic h = 1": (Geodesic, {"h": 1.0})}
 
 
