@@ -19,7 +19,8 @@ seconds (``time.process_time``) of ``--repeats`` calls, pinned to one processor:
 - *iterations for 3×*: the leader iterations at its measured cost per iteration that 3 × without leaves
   after the rest of full.
 
-Run: ``.venv/bin/python benchmarks/trajectory_setup_costs.py [--sizes 1000,10000] [--seeds 3,42,90]``.
+Run: ``.venv/bin/python benchmarks/trajectory_setup_costs.py [--sizes 1000,10000] [--seeds 3,42,90] [--settle]``
+(``--settle``: the estimate and the leader with ``settle_windows``, :mod:`worldtrack.trajectory.settle`).
 Writes ``benchmarks/results/trajectory_setup_costs.md``. About a minute.
 """
 
@@ -39,6 +40,7 @@ from trajectory_speed import problem_of  # noqa: E402
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory  # noqa: E402
 from worldtrack.trajectory.model import TimeGrid, frame_interval  # noqa: E402
 from worldtrack.trajectory.objective import Problem  # noqa: E402
+from worldtrack.trajectory.settle import run_settling  # noqa: E402
 from worldtrack.trajectory.solver import LevenbergMarquardt, levenberg_marquardt  # noqa: E402
 from worldtrack.trajectory.starts import anchor_points, shortest_path_start, straight_start  # noqa: E402
 from worldtrack.trajectory.uncertainty import marginal_covariances  # noqa: E402
@@ -54,10 +56,10 @@ def least_cpu(fn, repeats: int):
     return best, out
 
 
-def row(T: int, seed: int, repeats: int) -> list:
+def row(T: int, seed: int, repeats: int, settle: bool = False) -> list:
     scene, obs, height = problem_of(T, seed)
     field = scene.distance_field(0.05)
-    opts = TrajectoryOptions(height=height)
+    opts = TrajectoryOptions(height=height, settle_windows=settle)
     full, est = least_cpu(lambda: estimate_trajectory(obs, field, opts), repeats)
     without, _ = least_cpu(lambda: estimate_trajectory(obs, field, replace(opts, environment=False)), repeats)
     dt = frame_interval(obs.time, obs.camera)
@@ -70,7 +72,9 @@ def row(T: int, seed: int, repeats: int) -> list:
     route, short = least_cpu(lambda: shortest_path_start(problem.observations, grid, height, field, opts.clearance,
                                                          0.1, anchors), repeats)
     setup, _ = least_cpu(lambda: LevenbergMarquardt(problem, short, opts.solver), repeats)
-    leader, res = least_cpu(lambda: levenberg_marquardt(problem, short, opts.solver), repeats)
+    lead = (lambda: run_settling(LevenbergMarquardt(problem, short, opts.solver))[0]) if settle else \
+        (lambda: levenberg_marquardt(problem, short, opts.solver))
+    leader, res = least_cpu(lead, repeats)
     cov, _ = least_cpu(lambda: marginal_covariances(res.linearisation.D, res.linearisation.B), repeats)
     rest = full - leader
     per_iteration = leader / max(res.iterations, 1)
@@ -88,6 +92,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
     ap.add_argument("--quick", action="store_true", help="T = 300, seed 3, one repeat; prints only")
+    ap.add_argument("--settle", action="store_true", help="settle_windows=True (34b); writes _settle.md")
     args = ap.parse_args(argv)
     cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
     sizes = [300] if args.quick else [int(s) for s in args.sizes.split(",")]
@@ -96,14 +101,15 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     scene, obs, height = problem_of(300, 3)                  # load the compiled kernels untimed
     estimate_trajectory(obs, scene.distance_field(0.05), TrajectoryOptions(height=height))
-    rows = [row(T, seed, repeats) for T in sizes for seed in seeds]
+    rows = [row(T, seed, repeats, args.settle) for T in sizes for seed in seeds]
     text = f"({cpu}; CPU ms, the least of {repeats})\n\n" + markdown_table(
         ["T", "seed", "full ms", "without ms", "full ÷ without", "free LM ms", "covariance ms", "route ms",
          "start set-up ms (each)", "leader LM ms (iterations)", "leader ÷ full", "route + 3 set-ups ÷ full",
          "ratio without set-up", "leader iterations for 3×", "start won", "iterations per start"], rows)
     print(text)
-    save_result("trajectory_setup_costs", "Seed 002: the parts of the estimate with the environment", text,
-                args.quick, time.perf_counter() - t0)
+    tail = " (settle_windows)" if args.settle else ""
+    save_result("trajectory_setup_costs" + ("_settle" if args.settle else ""),
+                "Seed 002: the parts of the estimate with the environment" + tail, text, args.quick, time.perf_counter() - t0)
     return 0
 
 

@@ -15,7 +15,8 @@ settled the whole has. Once windows holding ``share`` of the steps have settled:
    each range's first and last state held where it borders a settled window (δ = 0 there);
 2. Levenberg–Marquardt runs on it with the same options, from the run's damping, to the solver's stop test
    with the *whole* objective's threshold tol · F (the terms of held states are constants, so each iteration's
-   decrease is the whole trajectory's): O(active steps) per iteration;
+   decrease is the whole trajectory's): O(active steps) per iteration; it settles in turn (the restriction
+   nests, the held states of every level held);
 3. the whole trajectory is linearised again and the ordinary iterations go on from there (the first one
    confirms the stop or, if the held states must still move, continues; the restriction may happen again).
 """
@@ -99,8 +100,8 @@ def restrict(run: LevenbergMarquardt, cuts: np.ndarray, active: np.ndarray, shar
     run.X, run.lin, run._spare = X, whole, run.lin
     run.mu, run.nu, run._pending, run._rejected = sub.mu, sub.nu, None, None
     run.iterations += sub.iterations
-    work = (sub.iterations - (log.iterations if log else 0)) * len(packed.index) + (log.work * len(packed.index) if log else 0)
-    return sub.iterations, work / len(X)
+    inner, inner_work = (log.iterations, log.work) if log else (0, 0.0)     # nested phases, in sub-problem iterations
+    return sub.iterations, (sub.iterations - inner + inner_work) * len(packed.index) / len(X)
 
 
 def run_settling(run: LevenbergMarquardt, share: float = SHARE, nested: bool = True) -> tuple[SolveResult, Settling]:
