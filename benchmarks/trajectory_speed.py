@@ -28,7 +28,7 @@ time includes waiting for other jobs, the CPU time does not):
   banded solves, comparable across machines.
 
 Run: ``.venv/bin/python benchmarks/trajectory_speed.py [--sizes 1000,10000,100000] [--cpu 1]
-[--repeats 3] [--quick]``. Writes ``benchmarks/results/trajectory_speed.md``. About 4 minutes
+[--repeats 3] [--quick] [--settle]``. Writes ``benchmarks/results/trajectory_speed.md`` (with ``--settle``: ``_settle.md``). About 4 minutes
 (most of it GTSAM at T = 100 000).
 """
 
@@ -99,10 +99,10 @@ def problem_of(T: int, seed: int):
     return scene, obs, height
 
 
-def run_size(T: int, repeats: int, seed: int, gtsam_max: int, gtsam_barrier_max: int) -> dict:
+def run_size(T: int, repeats: int, seed: int, gtsam_max: int, gtsam_barrier_max: int, settle: bool = False) -> dict:
     scene, obs, height = problem_of(T, seed)
     field = scene.distance_field(0.05)
-    opts = TrajectoryOptions(height=height)
+    opts = TrajectoryOptions(height=height, settle_windows=settle)
     out = {"T": T}
     out["full"], est = timed(lambda: estimate_trajectory(obs, field, opts), repeats)
     out["full_cpu"], out["full_cpu_min"], out["full_min"] = LAST_CPU
@@ -203,6 +203,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--gtsam-max", type=int, default=100000, help="largest T to run GTSAM on")
     ap.add_argument("--gtsam-barrier-max", type=int, default=1000, help="largest T for GTSAM with the barrier")
     ap.add_argument("--quick", action="store_true", help="T = 1 000 and 3 000, one repeat; prints only")
+    ap.add_argument("--settle", action="store_true", help="full with settle_windows=True (opt-in, 34b); "
+                    "writes results/trajectory_speed_settle.md")
     args = ap.parse_args(argv)
     cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
     sizes = [1000, 3000] if args.quick else [int(s) for s in args.sizes.split(",")]
@@ -214,12 +216,13 @@ def main(argv: list[str] | None = None) -> int:
     estimate_trajectory(obs, scene.distance_field(0.05), TrajectoryOptions(height=height))
     results = []
     for T in sizes:
-        results.append(run_size(T, repeats, args.seed, args.gtsam_max, args.gtsam_barrier_max))
+        results.append(run_size(T, repeats, args.seed, args.gtsam_max, args.gtsam_barrier_max, args.settle))
         print(f"T = {T}: full {results[-1]['full']:.2f} s ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     text = tables(results, cpu)
     print(text)
-    save_result("trajectory_speed", "Seed 002: speed on one core, scaling, environment cost, GTSAM", text, args.quick,
-                time.perf_counter() - t_start)
+    save_result("trajectory_speed_settle" if args.settle else "trajectory_speed",
+                "Seed 002: speed on one core, scaling, environment cost, GTSAM" + (" (settle_windows)" if args.settle else ""),
+                text, args.quick, time.perf_counter() - t_start)
     return 0
 
 

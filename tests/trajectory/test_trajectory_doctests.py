@@ -7,7 +7,7 @@ import pytest
 
 MODULES = ["worldtrack.trajectory.model", "worldtrack.trajectory.observation", "worldtrack.trajectory.estimate",
            "worldtrack.trajectory.uncertainty", "worldtrack.trajectory.windows", "worldtrack.trajectory.coarse",
-           "worldtrack.trajectory.lookahead",
+           "worldtrack.trajectory.lookahead", "worldtrack.trajectory.settle",
            "worldtrack.synth.observations"]
 
 

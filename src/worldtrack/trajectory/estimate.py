@@ -21,6 +21,7 @@ from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import LevenbergMarquardt, SolveResult, SolverOptions, levenberg_marquardt
 from worldtrack.trajectory.starts import START_NAMES, anchor_points, shortest_path_start, straight_start
 from worldtrack.trajectory.uncertainty import marginal_covariances
+from worldtrack.trajectory.settle import run_settling
 from worldtrack.trajectory.windows import race_by_gap
 
 
@@ -76,6 +77,8 @@ class TrajectoryOptions:
         objective within 1e-6 for all but one zara01 person (camera seed 4, walls + free space), whose
         other minimum moved that row's between-views RMSE 0.303 → 0.348 m
     coarse_tolerance : float — the relative decrease that ends the coarse solve
+    settle_windows : bool — with a race, the leader's iterations go on the windows still moving only, once
+        windows with half of the steps have settled (:mod:`.settle`); off by default
     solver : SolverOptions
     """
 
@@ -96,6 +99,7 @@ class TrajectoryOptions:
     race_by_gap: bool = False
     coarse_steps: int | None = None
     coarse_tolerance: float = 1e-3
+    settle_windows: bool = False
     solver: SolverOptions = field(default_factory=SolverOptions)
 
     def __post_init__(self) -> None:
@@ -274,7 +278,7 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
         if options.coarse_steps and not runs[name].converged:
             runs[name], coarse = _coarse_to_fine(problem, runs[name].X, options)
         leader = runs[name]
-        leader.run()
+        run_settling(leader) if options.settle_windows else leader.run()
         if coarse:
             leader.message += f" (after {coarse} iterations on every {options.coarse_steps}th step)"
         if sample_field(problem.environment.barrier.field, leader.X[:, [POS[0], POS[1]]])[0].min() < 0:

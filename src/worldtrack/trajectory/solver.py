@@ -141,6 +141,7 @@ class LevenbergMarquardt:
         lin = self.lin
         self._spare = lin.copy()
         self._pending: tuple[np.ndarray, np.ndarray] | None = None     # the next step, if already solved
+        self._rejected: tuple[np.ndarray, float] | None = None   # the last rejected step, its trial's F
         n = len(self.X)
         if options.linear_solver == "lapack":
             self._ab = np.zeros((BANDWIDTH + 1, self.X.size), order="F")
@@ -217,9 +218,12 @@ class LevenbergMarquardt:
         barrier = self.problem.environment.barrier is not None
         if barrier:
             delta, predicted = self._limit(lin, delta, predicted)
+        if self._still_rejected(delta):
+            return self._raise_damping(lin, predicted)
         trial = linearise(self.problem, self.X + delta, out=self._spare)
         actual = lin.costs.total - trial.costs.total
         rho = actual / predicted if predicted > 0 else -1.0
+        self._rejected = None
         if np.isfinite(trial.costs.total) and rho > 0:
             self.X, self.lin, self._spare = self.X + delta, trial, lin
             self.mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
@@ -241,9 +245,32 @@ class LevenbergMarquardt:
             # so the same Gauss–Newton step (kept: no second solve)
             self.move_limit, self._pending, self._shrunk = min(0.5 * tried, options.max_move), step, True
             return
+        if np.isfinite(trial.costs.total):
+            self._rejected = (delta, trial.costs.total)     # the trial's linearisation stays in self._spare
+        self._raise_damping(lin, predicted)
+
+    def _raise_damping(self, lin: Linearisation, predicted: float) -> None:
+        """A rejected step: μ grows by ν (2, 4, 8, …); stop where that can no longer help."""
         self.mu, self.nu = self.mu * self.nu, self.nu * 2
         if self.mu > 1e12 or predicted <= 1e-14 * max(lin.costs.total, 1e-300):
             self.message, self.converged = "no further decrease possible", True
+
+    def _still_rejected(self, delta: np.ndarray) -> bool:
+        """Whether the step δ (n, 6) after a rejection is the rejected δ₀ but for a change Δ so small that its trial
+        must be rejected too (then it is not linearised: 34k saw the same step come back up to 6 times, μ at 1e-18 …
+        1e-13 of diag H): max |Δ| ≤ 1 mm (m, m/s; the barrier's softness is 3 cm) and the rejected trial's rise
+        F(X + δ₀) − F(X) above 10× the bound 2·Σ|g₀Δ| + ΔᵀH₀Δ of its Gauss–Newton model's change (g₀, H₀ at
+        X + δ₀) plus 1e-12·F for rounding. The iterates are those of evaluating it."""
+        if self._rejected is None:
+            return False
+        old, F_old = self._rejected
+        change = delta - old
+        if np.abs(change).max() > 1e-3:
+            return False
+        t = self._spare                                          # the linearisation at X + δ₀
+        first = 2.0 * float(np.abs(t.g * change).sum())
+        bound = first - model_decrease(t.D, t.B, t.g, change) - 2.0 * float(np.sum(t.g * change))   # + ΔᵀH₀Δ
+        return F_old - self.lin.costs.total > 10.0 * bound + 1e-12 * abs(self.lin.costs.total)
 
     def _model_disagrees(self) -> bool:
         """With ``confirm_stop`` and a barrier: whether the next step's model still promises more than the
