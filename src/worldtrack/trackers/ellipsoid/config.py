@@ -233,6 +233,7 @@ class FeetConfig(Section):
         False, description="move people one camera alone shows towards their feet (or the top of the head) along its "
         "line of sight; off by default: it costs PETS 2009 MOTA (issue 37); ellipsoid.depth.fuse weighs all the cues")
     sigma_m: float = Field(0.1, gt=0, description="σ of the feet's place along the line of sight, m (a shoe's length)")
+    pixel_sigma_px: float = Field(0.0, ge=0, description="with > 0, the feet's σ also holds this many pixels' floor span (feet_pixel.py)")
     centre_offset_m: float = Field(0.0, ge=0, description="with anchor: the person stands this far beyond the lowest "
                                    "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
     ellipse_sigma_m: float = Field(
