@@ -145,6 +145,8 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
             sigma = feet_sigma_m(cam, found[0][:2], look[3], config.sigma_m, config.pixel_sigma_px)
             out[k] = (beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m), sigma)
             continue
+        if not config.head_fallback:
+            continue
         head = head_ray(cam, labels, view.occ, look[0], tuple(look[2]), look[3], border="silhouette")
         sigma_h = config.measured_height_sigma_m if len(p.height_samples) >= 3 else config.height_sigma_m
         place = under_head(head, hs[k], sigma_h, xy[k], cam, height.depth_offset_m)
