@@ -16,7 +16,8 @@ Measured with the best one-camera opt-in (evidence shadow test, ``feet.anchor``,
 encounters, height prior 0.1 m), issue 37: PETS View_001 (3 start frames) MOTA 0.846 -> 0.883, ID
 switches 23.7 -> 18 (the head cue off altogether: 0.889); line-of-sight 640x480, 0.5 m gate, dev seeds
 400-419 0.773 -> 0.759 (-0.014 +- 0.012 s.e., 8 better / 6 worse; head cue off: 0.739), held-out
-420-439 0.732 -> 0.771 (+0.039 +- 0.020, 13 / 7; longest run > 0.5 m along the ray 7.0 -> 3.2 s).
+420-439 0.732 -> 0.771 (+0.039 +- 0.020, 13 / 7; longest run > 0.5 m along the ray 7.0 -> 3.2 s),
+never-used 440-449 0.682 -> 0.754 (+0.072 +- 0.025, 7 / 1; 5.8 -> 2.6 s).
 Off by default (the anchor itself is).
 """
 
