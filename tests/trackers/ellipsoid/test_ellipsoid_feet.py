@@ -48,3 +48,22 @@ def test_without_legs_in_the_foreground_the_head_places_the_person_not_the_waist
     anchor_to_feet([q], tracker.views, {"cam": cut}, tracker.walkable, FeetConfig(anchor=True), HeightConfig())
     assert np.hypot(q.x - xy[0], q.y - xy[1]) < 0.3
     assert feet_weight(0.3, 0.1) > 0.85
+
+
+def test_without_the_head_fallback_only_trusted_feet_move_a_person(seen):
+    tracker, labels, instance, truth = seen
+    body = instance == truth["id"]
+    rows = np.nonzero(body.any(axis=1))[0]
+    legs = body & (np.arange(labels.shape[0])[:, None] > (rows.min() + rows.max()) / 2)
+    cut = labels.copy()
+    cut[legs & (cut == 1)] = 2
+    config = FeetConfig(anchor=True, head_fallback=False)
+    q, xy = misplaced(tracker, truth, 0.6)
+    q.height_samples.extend([truth["height"]] * 3)
+    # Legs not foreground: the feet are not trusted, and the head is not asked; the person stays put.
+    assert anchor_to_feet([q], tracker.views, {"cam": cut}, tracker.walkable, config, HeightConfig()) == 0
+    assert np.hypot(q.x - xy[0], q.y - xy[1]) == pytest.approx(0.6, abs=1e-9)
+    # Whole legs: the feet still pull the person back.
+    p, _ = misplaced(tracker, truth, 0.6)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == 1
+    assert np.hypot(p.x - xy[0], p.y - xy[1]) < 0.2

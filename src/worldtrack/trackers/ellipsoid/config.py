@@ -233,13 +233,14 @@ class FeetConfig(Section):
         False, description="move people one camera alone shows towards their feet (or the top of the head) along its "
         "line of sight; off by default: it costs PETS 2009 MOTA (issue 37); ellipsoid.depth.fuse weighs all the cues")
     sigma_m: float = Field(0.1, gt=0, description="σ of the feet's place along the line of sight, m (a shoe's length)")
+    head_fallback: bool = Field(True, description="with anchor: where the feet are not trusted, the top of the head places the person")
+    head_clear: bool = Field(False, description="with anchor: the head only when clear of others and of the region's top (head_clear.py)")
+    pixel_sigma_px: float = Field(0.0, ge=0, description="with > 0, the feet's σ also holds this many pixels' floor span (feet_pixel.py)")
     centre_offset_m: float = Field(0.0, ge=0, description="with anchor: the person stands this far beyond the lowest "
                                    "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
-    ellipse_sigma_m: float = Field(
-        0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
-    height_match_m: float = Field(
-        0.3, ge=0, description="the feet count only where the head's ray above them is this close to the person's "
-        "height, m (legs the floor's colour end the silhouette at the waist)")
+    ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
+    height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
+                                  "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")
     height_sigma_m: float = Field(
         0.1, gt=0, description="where the feet are not to be trusted, the top of the head places the person at their "
         "height, uncertain by this much while it is not measured, m (people's heights scatter by 0.1 m)")

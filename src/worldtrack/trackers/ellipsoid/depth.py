@@ -52,6 +52,7 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.encounters import covered_in_some_view
 from worldtrack.trackers.ellipsoid.feet import under_head
+from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
 from worldtrack.trackers.ellipsoid.height import MAX_COVERED_FOR_HEIGHT, head_ray, measure_feet, silhouette_ends
 from worldtrack.trackers.ellipsoid.height_sigma import height_sigma
@@ -169,7 +170,8 @@ class DepthFusion:
                             max_depth_offset_m=self.height.depth_offset_m)
         if (feet is not None and lo <= feet[1] <= hi and abs(feet[1] - p.height) <= self.feet.height_match_m
                 and self._legs_shown(cam, labels, region, box, down)):
-            found.append((float((feet[0][:2] - xy) @ ray), self.feet.sigma_m))
+            sigma = feet_sigma_m(cam, feet[0][:2], down, self.feet.sigma_m, self.feet.pixel_sigma_px)
+            found.append((float((feet[0][:2] - xy) @ ray), sigma))
             return True
         sigma_h = height_sigma(p, self.feet.height_sigma_m, self.feet.measured_height_sigma_m)
         place = under_head(head_ray(cam, labels, view.occ, region, box, down), p.height, sigma_h, xy, cam,

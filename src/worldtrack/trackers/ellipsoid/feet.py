@@ -46,6 +46,8 @@ import numpy as np
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
+from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
+from worldtrack.trackers.ellipsoid.head_clear import head_is_clear
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
 from worldtrack.trackers.ellipsoid.height import MAX_COVERED_FOR_HEIGHT, head_ray, measure_feet, silhouette_ends
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS
@@ -141,7 +143,10 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
             look = nearer
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= config.height_match_m \
                 and not touches_other(look[1], look[2], cam.project(found[0][None])[0], k):
-            out[k] = (beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m), config.sigma_m)
+            sigma = feet_sigma_m(cam, found[0][:2], look[3], config.sigma_m, config.pixel_sigma_px)
+            out[k] = (beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m), sigma)
+            continue
+        if not config.head_fallback or (config.head_clear and not head_is_clear(cam, labels, look, k)):
             continue
         head = head_ray(cam, labels, view.occ, look[0], tuple(look[2]), look[3], border="silhouette")
         sigma_h = config.measured_height_sigma_m if len(p.height_samples) >= 3 else config.height_sigma_m
