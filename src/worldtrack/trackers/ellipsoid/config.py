@@ -27,6 +27,7 @@ from pydantic import Field, model_validator
 from worldtrack.config import Section, with_overrides
 from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
 from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
+from worldtrack.trackers.ellipsoid.region_config import RegionConfig
 
 
 class ScoreConfig(Section):
@@ -48,8 +49,7 @@ class ScoreConfig(Section):
     ring_fraction: float = Field(
         2.0, ge=0, description="the ring is at most this fraction of the ellipse's semi-minor axis (0 = always the "
         "scaled width, as published): a far, small person gets a ring no wider than itself")
-    min_depth_m: float = Field(
-        0.1, ge=0, description="ellipsoids nearer than this to a camera's image plane are not drawn, m")
+    min_depth_m: float = Field(0.1, ge=0, description="ellipsoids nearer than this to a camera's image plane are not drawn, m")
 
 
 class MatchConfig(Section):
@@ -383,6 +383,7 @@ class EllipsoidConfig(Section):
     split: SplitConfig = Field(SplitConfig(), description="one person or two on one line of sight")
     cross_view: CrossViewConfig = Field(CrossViewConfig(), description="a track one camera cannot see, searched along another's ray")
     crowd: CrowdConfig = Field(CrowdConfig(), description="people one camera alone shows, in a crowd")
+    region: RegionConfig = Field(RegionConfig(), description="a region of interest on the floor: one id per visit")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":

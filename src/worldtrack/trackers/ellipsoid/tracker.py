@@ -51,6 +51,7 @@ from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_plac
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
+from worldtrack.trackers.ellipsoid.region import RegionVisits
 from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view_people
 from worldtrack.trackers.ellipsoid.cross_view_colour import ColourCheck
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
@@ -123,6 +124,8 @@ class EllipsoidTracker(TrackerBase):
         #: One person or two on one line of sight (:mod:`.two_hypotheses`; ``split.enabled``).
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
+        #: One id per visit to the region of interest (:mod:`.region`; ``region.area``, off when empty).
+        self.region = RegionVisits(cfg.region)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
@@ -194,7 +197,7 @@ class EllipsoidTracker(TrackerBase):
             self.kept_heights.remember(self.position_map)
         self._last_t = t
         self.frames_stepped += 1
-        return self.uncertainty.tracks(self.position_map, t)
+        return self.region.relabel(self.uncertainty.tracks(self.position_map, t), t)
 
     # ------------------------------------------------------------------ steps
     def _read(self, frames: Mapping[str, Frame]) -> dict[str, np.ndarray]:
