@@ -129,6 +129,8 @@ class EllipsoidTracker(TrackerBase):
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
+        if cfg.match.velocity_along_ray != 1.0:
+            self.life.velocity_ray = self._lone_ray
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -351,6 +353,14 @@ class EllipsoidTracker(TrackerBase):
             return False
         return bool(behind_obstacles(np.array([[p.x, p.y]]), np.array([p.height]),
                                      [v.camera for v in self.views.values()], self.scene.occlusion)[0])
+
+    def _lone_ray(self, p: Person) -> np.ndarray | None:
+        """The floor ray (2,) through ``p`` of the one camera of this tracker that showed them; None
+        when several did (``match.velocity_along_ray``, :mod:`.ray_velocity`)."""
+        c = lone_camera(p.seen_by, list(self.views))
+        if c < 0:
+            return None
+        return list(self.views.values())[c].camera.floor_rays(np.array([[p.x, p.y]]), min_distance=0.3)[0][0]
 
     def _promote(self, p: Person) -> None:
         """A confirmed candidate gets its public id and the scene's size for that id."""
