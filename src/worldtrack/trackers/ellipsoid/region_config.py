@@ -31,7 +31,7 @@ class RegionConfig(Section):
         [], description="the region of interest, a floor polygon x1,y1,x2,y2,... m (at least 3 points); a person who "
         "was outside it for region.outside_s and steps back in is reported under a new id: one id per visit, as a "
         "count of visits or an evaluation cropped to the region numbers them ([] = off, the default; PETS 2009 with "
-        "Milan's tracking area: see benchmarks/real_data.py --set)")
+        "Milan's tracking area: examples/pets2009/README.md)")
     outside_s: float = Field(
         1.0, ge=0, description="... outside for at least this long, s: a person walking along the region's edge, "
         "whose place wavers across it, keeps their id")
