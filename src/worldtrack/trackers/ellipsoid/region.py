@@ -14,8 +14,7 @@ outside keeps the id of their last visit. So with a region the reported ids are 
 Measured (issue 37, ``benchmarks/real_data.py --set region.area=<tracking_area.txt's numbers>``): PETS 2009
 S2.L1 start frames 0-7, IDF1 against the cropped ids 0.830 -> 0.946 (start frames 3-7, not looked at while
 building it: 0.831 -> 0.948), against the whole-view ids 0.945 -> 0.824 (as it should: those keep the id),
-MOTA and mean error unchanged (0.926, 0.255 m), ID switches 2.75 -> 3.25 (a return our track makes a frame
-apart from the annotator's).
+MOTA and mean error unchanged (0.926, 0.255 m), ID switches 2.75 -> 3.25 (not looked into).
 
 >>> from worldtrack.trackers.base import Track
 >>> from worldtrack.trackers.ellipsoid.region_config import RegionConfig
