@@ -9,7 +9,8 @@ per return. With ``region.area`` set, a confirmed person who has been outside th
 map keeps its own ids (they also pace per-person schedules, so none is taken from it), and the
 returned tracks carry visit ids instead, numbered 1, 2, ... in the order the visits begin; a person
 outside keeps the id of their last visit. So with a region the reported ids are not the map's
-(``position_map.get(track.id)`` does not find the person). Off by default (``region.area`` empty).
+(``position_map.get(track.id)`` does not find the person), and trackers sharing one map each number
+the visits they report on their own. Off by default (``region.area`` empty).
 
 Measured (issue 37, ``benchmarks/real_data.py --set region.area=<tracking_area.txt's numbers>``): PETS 2009
 S2.L1 start frames 0-7, IDF1 against the cropped ids 0.830 -> 0.946 (start frames 3-7, not looked at while
