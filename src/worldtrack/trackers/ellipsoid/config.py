@@ -27,6 +27,7 @@ from pydantic import Field, model_validator
 from worldtrack.config import Section, with_overrides
 from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
 from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
+from worldtrack.trackers.ellipsoid.region_config import RegionConfig
 
 
 class ScoreConfig(Section):
@@ -48,8 +49,7 @@ class ScoreConfig(Section):
     ring_fraction: float = Field(
         2.0, ge=0, description="the ring is at most this fraction of the ellipse's semi-minor axis (0 = always the "
         "scaled width, as published): a far, small person gets a ring no wider than itself")
-    min_depth_m: float = Field(
-        0.1, ge=0, description="ellipsoids nearer than this to a camera's image plane are not drawn, m")
+    min_depth_m: float = Field(0.1, ge=0, description="ellipsoids nearer than this to a camera's image plane are not drawn, m")
 
 
 class MatchConfig(Section):
@@ -62,17 +62,17 @@ class MatchConfig(Section):
     adaptive_step: bool = Field(
         True, description="halve the step when 'stay' wins, double it (to max_step_m) when still moving after K "
         "rounds: fast walkers are followed and the final place is finer than the grid")
-    min_gain: float = Field(
-        0.002, ge=0, description="with the adaptive step, a move must raise E by this much (smaller gains are "
-        "noise and count as 'stay')")
+    min_gain: float = Field(0.002, ge=0, description="with the adaptive step, a move must raise E by this much "
+                            "(smaller gains are noise and count as 'stay')")
     min_step_m: float = Field(0.025, gt=0, description="smallest adaptive step, m")
     max_step_m: float = Field(0.4, gt=0, description="largest adaptive step, m")
     max_iterations: int = Field(6, ge=1, description="cap on rounds with the adaptive step")
     predict: bool = Field(True, description="constant-velocity prediction before matching")
     velocity_smoothing: float = Field(0.5, ge=0, le=1, description="weight of each frame's velocity measurement (0..1)")
     max_speed_mps: float = Field(3.0, gt=0, description="velocities are clipped to this speed (a running person), m/s")
-    rounds: Literal["compiled", "python"] = Field(
-        "compiled", description="the compiled rounds, or their readable Python reference (same tracks, slower)")
+    velocity_along_ray: float = Field(1.0, ge=0, le=1, description="velocity_smoothing's share along the line of sight "
+        "of the one camera that showed a person (1 = all, the default; PETS 2009 at 0.4: 0.251 -> 0.238 m, MOTA 0.926 -> 0.912)")
+    rounds: Literal["compiled", "python"] = Field("compiled", description="the compiled rounds, or their readable Python reference (same tracks, slower)")
 
     @model_validator(mode="after")
     def _steps_in_order(self) -> "MatchConfig":
@@ -384,6 +384,7 @@ class EllipsoidConfig(Section):
     split: SplitConfig = Field(SplitConfig(), description="one person or two on one line of sight")
     cross_view: CrossViewConfig = Field(CrossViewConfig(), description="a track one camera cannot see, searched along another's ray")
     crowd: CrowdConfig = Field(CrowdConfig(), description="people one camera alone shows, in a crowd")
+    region: RegionConfig = Field(RegionConfig(), description="a region of interest on the floor: one id per visit")
 
     @classmethod
     def paper(cls) -> "EllipsoidConfig":

@@ -25,9 +25,12 @@ from __future__ import annotations
 import math
 from typing import Callable, NamedTuple, Protocol, Sequence
 
+import numpy as np
+
 from worldtrack.registry import Registry
 from worldtrack.trackers.base import Person, PositionMap
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
+from worldtrack.trackers.ellipsoid.ray_velocity import damped_velocity
 from worldtrack.trackers.ellipsoid.support import MIN_OWN_PIXELS, Support
 from worldtrack.trackers.lifecycle import counts_for, frames_for, merge_duplicates
 
@@ -145,6 +148,9 @@ class LifeCycle:
         self.evidence: Evidence = EVIDENCE[config.score.kind](config)
         #: Whether an unseen person is kept a while longer (``crowd.coast_behind_obstacles_s``, :mod:`.coast`).
         self.coasting: Callable[[Person], bool] = lambda p: False
+        #: The floor ray (2,) of the one camera that showed a person, whose velocity gain along it is
+        #: ``match.velocity_along_ray`` of the rest (:mod:`.ray_velocity`); None: the same gain.
+        self.velocity_ray: Callable[[Person], np.ndarray | None] = lambda p: None
 
     def end(self, p: Person) -> None:
         """Take person ``p`` off the map (if still there)."""
@@ -224,6 +230,11 @@ class LifeCycle:
         a = self.config.match.velocity_smoothing
         vx = (1 - a) * p.vx + a * (p.x - p.prev_x) / dt
         vy = (1 - a) * p.vy + a * (p.y - p.prev_y) / dt
+        ray = self.velocity_ray(p)
+        if ray is not None:
+            moved = np.array([p.x - p.prev_x, p.y - p.prev_y]) / dt
+            v = damped_velocity(np.array([p.vx, p.vy]), moved, a, self.config.match.velocity_along_ray, ray)
+            vx, vy = float(v[0]), float(v[1])
         speed = math.hypot(vx, vy)
         scale = min(1.0, self.config.match.max_speed_mps / speed) if speed > 0 else 1.0
         p.vx, p.vy = vx * scale, vy * scale

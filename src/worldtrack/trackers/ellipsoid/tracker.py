@@ -51,6 +51,7 @@ from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_plac
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
+from worldtrack.trackers.ellipsoid.region import RegionVisits
 from worldtrack.trackers.ellipsoid.cross_view import CrossViewArgs, cross_view_people
 from worldtrack.trackers.ellipsoid.cross_view_colour import ColourCheck
 from worldtrack.trackers.ellipsoid.search import RescueArgs, RescueSchedule, birth_search, rescue_people
@@ -123,9 +124,13 @@ class EllipsoidTracker(TrackerBase):
         #: One person or two on one line of sight (:mod:`.two_hypotheses`; ``split.enabled``).
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
+        #: One id per visit to the region of interest (:mod:`.region`; ``region.area``, off when empty).
+        self.region = RegionVisits(cfg.region)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
+        if cfg.match.velocity_along_ray != 1.0:
+            self.life.velocity_ray = self._lone_ray
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -194,7 +199,7 @@ class EllipsoidTracker(TrackerBase):
             self.kept_heights.remember(self.position_map)
         self._last_t = t
         self.frames_stepped += 1
-        return self.uncertainty.tracks(self.position_map, t)
+        return self.region.relabel(self.uncertainty.tracks(self.position_map, t), t)
 
     # ------------------------------------------------------------------ steps
     def _read(self, frames: Mapping[str, Frame]) -> dict[str, np.ndarray]:
@@ -348,6 +353,14 @@ class EllipsoidTracker(TrackerBase):
             return False
         return bool(behind_obstacles(np.array([[p.x, p.y]]), np.array([p.height]),
                                      [v.camera for v in self.views.values()], self.scene.occlusion)[0])
+
+    def _lone_ray(self, p: Person) -> np.ndarray | None:
+        """The floor ray (2,) through ``p`` of the one camera of this tracker that showed them; None
+        when several did (``match.velocity_along_ray``, :mod:`.ray_velocity`)."""
+        c = lone_camera(p.seen_by, list(self.views))
+        if c < 0:
+            return None
+        return list(self.views.values())[c].camera.floor_rays(np.array([[p.x, p.y]]), min_distance=0.3)[0][0]
 
     def _promote(self, p: Person) -> None:
         """A confirmed candidate gets its public id and the scene's size for that id."""
