@@ -7,7 +7,8 @@ from _ellipsoid_scenes import noise_backgrounds, one_camera_scene, two_camera_sc
 
 from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
-from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
+from worldtrack.trackers.base import Person
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, lone_camera, predicted_places
 
 
 @pytest.mark.parametrize("share", [0.0, 0.3, 1.0])
@@ -61,3 +62,64 @@ def test_the_tracker_predicts_a_one_camera_person_across_the_ray_only_when_asked
     moved = np.array([person.x, person.y]) - (-1.0, 2.0)
     assert moved @ across == pytest.approx(0.05, abs=1e-9)
     assert moved @ ray == pytest.approx(0.08 * share, abs=1e-9)
+
+
+def test_each_person_keeps_their_own_share_along_the_ray():
+    scene = one_camera_scene()
+    cam = scene.cameras["cam"]
+    xy = np.array([[-1.0, 1.5], [0.5, 3.0]])
+    v = np.array([[0.4, 1.2], [-0.8, 0.3]])
+    out = predicted_places(xy, v, 0.1, [cam], np.zeros(2, int), np.array([True, True]), np.array([0.25, 1.0]))
+    ray = cam.floor_rays(xy, min_distance=0.3)[0]
+    along = np.sum((out - xy) / 0.1 * ray, axis=1)
+    np.testing.assert_allclose(along, [0.25, 1.0] * np.sum(v * ray, axis=1), atol=1e-12)
+
+
+def _seen(p, t, own_share):
+    p.own_share = own_share
+    p.mark_seen(t, ("cam",))
+
+
+def test_the_measured_share_is_the_velocitys_average_of_clear_frames():
+    p = Person(1, 0.0, 0.0, mode="tracking")
+    m = MeasuredShare(0.5, 0.5)
+    assert m.shares([p]).tolist() == [1.0]                  # not counted yet: the full velocity
+    for k, own in enumerate([0.3, 0.3, 0.3]):               # covered by others three frames
+        _seen(p, 0.1 * (k + 1), own)
+        m.update([p], 0.1 * (k + 1))
+        m.update([p], 0.1 * (k + 1))                        # once per time stamp
+    assert m.shares([p])[0] == pytest.approx(0.125)
+    _seen(p, 0.4, 0.9)                                      # clear again: back up by a
+    m.update([p], 0.4)
+    assert m.shares([p])[0] == pytest.approx(0.5625)
+    m.update([p], 0.5)                                      # nobody showed them at 0.5: not clear
+    assert m.shares([p])[0] == pytest.approx(0.28125)
+
+
+def test_the_measured_share_counts_clear_from_the_configured_own_share():
+    p, q = Person(1, 0.0, 0.0, mode="tracking"), Person(2, 1.0, 0.0, mode="tracking")
+    _seen(p, 0.1, 0.6)
+    _seen(q, 0.1, 0.6)
+    lenient, strict = MeasuredShare(1.0, 0.5), MeasuredShare(1.0, 0.7)
+    lenient.update([p], 0.1)
+    strict.update([q], 0.1)
+    assert lenient.shares([p]).tolist() == [1.0] and strict.shares([q]).tolist() == [0.0]
+
+
+@pytest.mark.parametrize("measured", [False, True])
+def test_the_tracker_damps_along_the_ray_by_the_measured_share_only_when_asked(measured):
+    scene = one_camera_scene()
+    rng = np.random.default_rng(0)
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"),
+                               EllipsoidConfig(crowd={"predict_along_ray_measured": measured}))
+    p = tracker.init_track(-1.0, 2.0)
+    person = tracker.position_map[p.id]
+    _seen(person, 0.0, 0.2)                                 # others cover them: half the velocity is a slide
+    tracker.measured_share.update([person], 0.0)
+    ray = scene.cameras["cam"].floor_rays(np.array([-1.0, 2.0]), min_distance=0.3)[0]
+    across = np.array([-ray[1], ray[0]])
+    person.vx, person.vy = 0.8 * ray + 0.5 * across
+    tracker._predict([person], 0.1, 0.1)
+    moved = np.array([person.x, person.y]) - (-1.0, 2.0)
+    assert moved @ across == pytest.approx(0.05, abs=1e-9)
+    assert moved @ ray == pytest.approx(0.08 * (0.5 if measured else 1.0), abs=1e-9)

@@ -22,6 +22,13 @@ rays for seconds) the setting at 0 loses MOTA 0.927 -> 0.804 (also 0.824 when on
 image box meets another's are damped): there the match follows a walker along the ray only with
 the prediction's help.
 
+``crowd.predict_along_ray_measured`` (default off) damps by how well depth was observed instead
+of by a fixed share: the prediction keeps the share of the velocity that was measured while the
+person was clear of others (:class:`MeasuredShare`) — a walker who was clear keeps their velocity
+into a brief crossing; a velocity built from slides inside a merged crowd is dropped. (The score's
+own curvature along the ray, the reported σ, does not tell the two apart: it is as flat on PETS
+as in the crowd, median 0.41 against 0.43 1/m², both below its floor.)
+
 >>> import numpy as np
 >>> from worldtrack.geometry.camera import Camera
 >>> cam = Camera.look_at("c", 160, 120, [0.0, -4.0, 2.6], [0.0, 0.0, 0.8], hfov_deg=60.0)
@@ -35,15 +42,17 @@ the prediction's help.
 
 from __future__ import annotations
 
+import weakref
 from typing import Sequence
 
 import numpy as np
 
 from worldtrack.geometry.camera import Camera
+from worldtrack.trackers.base import Person
 
 
 def predicted_places(xy: np.ndarray, velocity: np.ndarray, dt: float, cameras: Sequence[Camera],
-                     camera_of: np.ndarray, lone: np.ndarray, along_share: float) -> np.ndarray:
+                     camera_of: np.ndarray, lone: np.ndarray, along_share: float | np.ndarray) -> np.ndarray:
     """Constant-velocity places after ``dt`` s, the velocity's part along a lone camera's ray scaled.
 
     Parameters
@@ -55,7 +64,8 @@ def predicted_places(xy: np.ndarray, velocity: np.ndarray, dt: float, cameras: S
     camera_of : (N,) int — index into ``cameras`` of the camera that showed each person last
         (read only where ``lone``)
     lone : (N,) bool — exactly one camera showed the person: their depth rests on it alone
-    along_share : float — share of the velocity along that camera's ray kept (0..1)
+    along_share : float or (N,) float — share of the velocity along that camera's ray kept (0..1),
+        for everyone or per person (:class:`MeasuredShare`)
 
     Returns
     -------
@@ -63,14 +73,62 @@ def predicted_places(xy: np.ndarray, velocity: np.ndarray, dt: float, cameras: S
     """
     xy = np.asarray(xy, float).reshape(-1, 2)
     v = np.array(velocity, float).reshape(-1, 2)
-    if along_share != 1.0:
+    share = np.broadcast_to(np.asarray(along_share, float), (len(xy),))
+    damped = np.asarray(lone, bool) & (share != 1.0)
+    if damped.any():
         for c, cam in enumerate(cameras):
-            rows = np.flatnonzero(lone & (camera_of == c))
+            rows = np.flatnonzero(damped & (camera_of == c))
             if rows.size:
                 ray = cam.floor_rays(xy[rows], min_distance=0.3)[0]
                 along = np.sum(v[rows] * ray, axis=1, keepdims=True)
-                v[rows] -= (1.0 - along_share) * along * ray
+                v[rows] -= (1.0 - share[rows, None]) * along * ray
     return xy + dt * v
+
+
+class MeasuredShare:
+    """Per person, the share of their velocity that was measured while their depth was observed.
+
+    The tracker's velocity is an exponential average of the frame-to-frame moves, each weighed
+    ``smoothing`` (a) and decaying by 1 − a a frame (:meth:`~.life.LifeCycle._update_velocity`).
+    Its part along a lone camera's line of sight is only as good as the depths those moves were
+    measured from. A person whose visible pixels are mostly their own (``own_share`` ≥
+    ``min_own_share``) shows their silhouette's ends, feet included, so one camera has their depth;
+    a person others cover (or nobody shows) is placed along the ray by a merged blob, whose slide
+    is no walk. The share kept here is the same average of that yes / no: 1 for a person clear in
+    every recent frame, ``(1 − a)ⁿ`` n frames into a cover, back towards 1 as soon as they are clear
+    again. The prediction keeps that share of the velocity along the ray
+    (``crowd.predict_along_ray_measured``), so a walker who was clear keeps their velocity into a
+    brief crossing, while a velocity made of slides inside a crowd is dropped.
+
+    >>> from worldtrack.trackers.base import Person
+    >>> p = Person(1, 0.0, 0.0, mode="tracking", own_share=0.2)
+    >>> m = MeasuredShare(0.5, 0.5)
+    >>> for t in (0.1, 0.2):                         # seen, but others cover most of them
+    ...     p.mark_seen(t, ("c",)); m.update([p], t)
+    >>> m.shares([p]).tolist()
+    [0.25]
+    >>> p.own_share = 0.9; p.mark_seen(0.3, ("c",)); m.update([p], 0.3)   # clear again
+    >>> m.shares([p]).tolist()
+    [0.625]
+    """
+
+    def __init__(self, smoothing: float, min_own_share: float) -> None:
+        self.smoothing = float(np.clip(smoothing, 0.0, 1.0))
+        self.min_own_share = float(min_own_share)
+        self._share: "weakref.WeakKeyDictionary[Person, float]" = weakref.WeakKeyDictionary()
+
+    def update(self, people: Sequence[Person], t: float) -> None:
+        """Count this frame (time ``t`` s, once) for each tracked person of ``people``: clear or not
+        (call after the life cycle, which measures ``own_share`` and moves the velocity)."""
+        a = self.smoothing
+        for p in people:
+            if p.mode == "tracking" and p.once("measured_share", t):
+                clear = bool(p.seen_now(t) and p.own_share >= self.min_own_share)   # NaN: not clear
+                self._share[p] = (1.0 - a) * self._share.get(p, 1.0) + a * clear
+
+    def shares(self, people: Sequence[Person]) -> np.ndarray:
+        """(N,) float in [0, 1] — each person's measured share (1 for one not counted yet)."""
+        return np.array([self._share.get(p, 1.0) for p in people], dtype=float).reshape(-1)
 
 
 def lone_camera(seen_by: Sequence[str], camera_ids: Sequence[str]) -> int:
@@ -86,4 +144,4 @@ def lone_camera(seen_by: Sequence[str], camera_ids: Sequence[str]) -> int:
     return mine[0] if len(mine) == 1 else -1
 
 
-__all__ = ["lone_camera", "predicted_places"]
+__all__ = ["MeasuredShare", "lone_camera", "predicted_places"]

@@ -47,7 +47,7 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
-from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, lone_camera, predicted_places
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
@@ -123,6 +123,8 @@ class EllipsoidTracker(TrackerBase):
         #: One person or two on one line of sight (:mod:`.two_hypotheses`; ``split.enabled``).
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
+        #: Each person's share of velocity measured while their depth was observed (:mod:`.prediction`).
+        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing, cfg.crowd.clear_own_share)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
@@ -184,6 +186,8 @@ class EllipsoidTracker(TrackerBase):
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
                                  lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
+        if self.config.crowd.predict_along_ray_measured:
+            self.measured_share.update(judged, t)
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
             share = self.config.lost.border_share
@@ -221,14 +225,18 @@ class EllipsoidTracker(TrackerBase):
     def _predict(self, people: Sequence[Person], dt: float, t: float) -> None:
         """Constant-velocity prediction of tracked people, once per time stamp; a prediction into a
         wall or a desk stays where it was; ``crowd.predict_along_ray`` < 1 damps the velocity along
-        a lone camera's line of sight (:mod:`.prediction`)."""
+        a lone camera's line of sight, ``crowd.predict_along_ray_measured`` by the share of it
+        measured while the person was clear of others (:mod:`.prediction`)."""
         if not (self.config.match.predict and dt > 0):
             return
         moving = [p for p in people if p.mode == "tracking" and p.once("predict", t)]
-        share = float(self.config.crowd.predict_along_ray)
+        share: float | np.ndarray = float(self.config.crowd.predict_along_ray)
+        if self.config.crowd.predict_along_ray_measured:   # the share measured with depth observed
+            share = share * self.measured_share.shares(moving)
         cids = list(self.views)
         # Which lone camera's ray damps a person's velocity; nobody's at the default share 1.
-        which = np.array([lone_camera(p.seen_by, cids) if share != 1.0 else -1 for p in moving], dtype=int)
+        damps = bool(np.any(np.asarray(share) != 1.0))
+        which = np.array([lone_camera(p.seen_by, cids) if damps else -1 for p in moving], dtype=int)
         ahead = predicted_places(np.array([[p.x, p.y] for p in moving]).reshape(-1, 2),
                                  np.array([[p.vx, p.vy] for p in moving]).reshape(-1, 2), dt,
                                  [self.views[c].camera for c in cids], which, which >= 0, share)
