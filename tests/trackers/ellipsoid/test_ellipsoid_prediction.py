@@ -8,7 +8,7 @@ from _ellipsoid_scenes import noise_backgrounds, one_camera_scene, two_camera_sc
 from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.base import Person
-from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, depth_observed, lone_camera, predicted_places
 
 
 @pytest.mark.parametrize("share", [0.0, 0.3, 1.0])
@@ -80,30 +80,31 @@ def _seen(p, t, own_share):
     p.mark_seen(t, ("cam",))
 
 
-def test_the_measured_share_is_the_velocitys_average_of_clear_frames():
+def test_the_measured_share_is_the_velocitys_average_of_observed_frames():
     p = Person(1, 0.0, 0.0, mode="tracking")
-    m = MeasuredShare(0.5, 0.5)
+    m = MeasuredShare(0.5)
     assert m.shares([p]).tolist() == [1.0]                  # not counted yet: the full velocity
-    for k, own in enumerate([0.3, 0.3, 0.3]):               # covered by others three frames
-        _seen(p, 0.1 * (k + 1), own)
-        m.update([p], 0.1 * (k + 1))
-        m.update([p], 0.1 * (k + 1))                        # once per time stamp
+    for t in (0.1, 0.2, 0.3):                               # depth not observed three frames
+        m.update([p], t, np.array([False]))
+        m.update([p], t, np.array([False]))                 # once per time stamp
     assert m.shares([p])[0] == pytest.approx(0.125)
-    _seen(p, 0.4, 0.9)                                      # clear again: back up by a
-    m.update([p], 0.4)
+    m.update([p], 0.4, np.array([True]))                    # observed again: back up by a
     assert m.shares([p])[0] == pytest.approx(0.5625)
-    m.update([p], 0.5)                                      # nobody showed them at 0.5: not clear
-    assert m.shares([p])[0] == pytest.approx(0.28125)
 
 
-def test_the_measured_share_counts_clear_from_the_configured_own_share():
-    p, q = Person(1, 0.0, 0.0, mode="tracking"), Person(2, 1.0, 0.0, mode="tracking")
-    _seen(p, 0.1, 0.6)
-    _seen(q, 0.1, 0.6)
-    lenient, strict = MeasuredShare(1.0, 0.5), MeasuredShare(1.0, 0.7)
-    lenient.update([p], 0.1)
-    strict.update([q], 0.1)
-    assert lenient.shares([p]).tolist() == [1.0] and strict.shares([q]).tolist() == [0.0]
+def test_depth_counts_as_observed_where_a_camera_that_showed_them_sees_their_feet():
+    scene = one_camera_scene()
+    rng = np.random.default_rng(0)
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"))
+    view = tracker.views["cam"]
+    near = np.array([-1.0, 1.0])
+    far = near + 1.2 * view.camera.floor_rays(near, min_distance=0.3)[0]     # right behind, on the same ray
+    people = [Person(k, *xy, mode="tracking") for k, xy in enumerate([near, far, [0.3, 1.5]], 1)]
+    for p in people:
+        _seen(p, 0.1, 0.3)
+    assert depth_observed(people, [], [view], 0.1).tolist() == [True, False, True]
+    assert depth_observed(people[1:], people[:1], [view], 0.1).tolist() == [False, True]  # others cover too
+    assert depth_observed(people, [], [view], 0.2).tolist() == [False] * 3   # nobody showed them at 0.2
 
 
 @pytest.mark.parametrize("measured", [False, True])
@@ -114,8 +115,7 @@ def test_the_tracker_damps_along_the_ray_by_the_measured_share_only_when_asked(m
                                EllipsoidConfig(crowd={"predict_along_ray_measured": measured}))
     p = tracker.init_track(-1.0, 2.0)
     person = tracker.position_map[p.id]
-    _seen(person, 0.0, 0.2)                                 # others cover them: half the velocity is a slide
-    tracker.measured_share.update([person], 0.0)
+    tracker.measured_share.update([person], 0.0, np.array([False]))    # half the velocity is a slide
     ray = scene.cameras["cam"].floor_rays(np.array([-1.0, 2.0]), min_distance=0.3)[0]
     across = np.array([-ray[1], ray[0]])
     person.vx, person.vy = 0.8 * ray + 0.5 * across

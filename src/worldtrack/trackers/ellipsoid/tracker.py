@@ -47,7 +47,7 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
-from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, depth_observed, lone_camera, predicted_places
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
@@ -124,7 +124,7 @@ class EllipsoidTracker(TrackerBase):
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
         #: Each person's share of velocity measured while their depth was observed (:mod:`.prediction`).
-        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing, cfg.crowd.clear_own_share)
+        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
@@ -186,8 +186,10 @@ class EllipsoidTracker(TrackerBase):
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
                                  lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
-        if self.config.crowd.predict_along_ray_measured:
-            self.measured_share.update(judged, t)
+        crowd = self.config.crowd
+        if crowd.predict_along_ray_measured:   # was each one's depth observed (the feet in view)?
+            self.measured_share.update(judged, t, depth_observed(
+                judged, list(self.position_map), [self.views[c] for c in self.last_labels], t))
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
             share = self.config.lost.border_share
@@ -226,7 +228,7 @@ class EllipsoidTracker(TrackerBase):
         """Constant-velocity prediction of tracked people, once per time stamp; a prediction into a
         wall or a desk stays where it was; ``crowd.predict_along_ray`` < 1 damps the velocity along
         a lone camera's line of sight, ``crowd.predict_along_ray_measured`` by the share of it
-        measured while the person was clear of others (:mod:`.prediction`)."""
+        measured while the person's depth was observed (:mod:`.prediction`)."""
         if not (self.config.match.predict and dt > 0):
             return
         moving = [p for p in people if p.mode == "tracking" and p.once("predict", t)]
