@@ -27,8 +27,10 @@ of by a fixed share: the prediction keeps the share of the velocity that was mea
 camera saw the person's feet (:mod:`.ground_contact`, :class:`MeasuredShare`) — a walker seen
 whole keeps their velocity into a brief crossing; a velocity built from slides inside a merged
 crowd is dropped. Crowd 50, dev seeds 110–112: from the true places 9.7 -> 15.3 of 50 held (MOTA
-0.390 -> 0.486), cold 9.0 -> 12.3 (0.353 -> 0.409); PETS 2009 MOTA 0.926 -> 0.909 (three starts,
-IDF1 0.828 -> 0.800): off by default. Tried on the same seeds: "clear" as own_share >= 0.5
+0.390 -> 0.486), cold 9.0 -> 12.3 (0.353 -> 0.409); held-out 113–118: 13.0 -> 17.5 (0.431 ->
+0.492), cold 7.3 -> 10.3 (0.330 -> 0.389), about what the share 0 gives there (17.0, 10.7). PETS
+2009 over 8 start frames: MOTA 0.926 -> 0.917, IDF1 0.830 -> 0.816 (the share 0: 0.801 over 3):
+off by default. Tried on the same seeds: "clear" as own_share >= 0.5
 instead of the feet (crowd 16.3 / 10.3 held, PETS 0.895), and only nearer people hiding the feet
 (obstacles and the image's edge not counted: crowd 11.3 / 10.7, PETS 0.901). (The score's
 own curvature along the ray, the reported σ, does not tell the two apart: it is as flat on PETS
