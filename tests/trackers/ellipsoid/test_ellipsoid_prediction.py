@@ -8,7 +8,7 @@ from _ellipsoid_scenes import noise_backgrounds, one_camera_scene, two_camera_sc
 from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.base import Person
-from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, depth_observed, lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, depth_observed, lone_camera, lone_rays, predicted_places
 
 
 @pytest.mark.parametrize("share", [0.0, 0.3, 1.0])
@@ -123,3 +123,29 @@ def test_the_tracker_damps_along_the_ray_by_the_measured_share_only_when_asked(m
     moved = np.array([person.x, person.y]) - (-1.0, 2.0)
     assert moved @ across == pytest.approx(0.05, abs=1e-9)
     assert moved @ ray == pytest.approx(0.08 * (0.5 if measured else 1.0), abs=1e-9)
+
+
+@pytest.mark.parametrize("hold, observed, lone", [(True, False, True), (True, True, True), (False, False, True),
+                                                  (True, False, False)])
+def test_an_unobserved_frame_does_not_change_the_velocity_along_the_ray_with_hold(hold, observed, lone):
+    p = Person(1, 0.0, 0.0, mode="tracking", vx=0.3, vy=0.0)
+    ray = np.array([[0.6, 0.8]])
+    m = MeasuredShare(0.5, hold=hold)
+    m.update([p], 0.1, np.array([True]), ray)               # the velocity measured with the feet in view
+    p.vx, p.vy = 0.3 + 1.2 * 0.6 - 0.5 * 0.8, 1.2 * 0.8 + 0.5 * 0.6   # the next move: a slide along, a step across
+    m.update([p], 0.2, np.array([observed]), ray if lone else np.full((1, 2), np.nan))
+    v, before = np.array([p.vx, p.vy]), np.array([0.3, 0.0])
+    across = np.array([-0.8, 0.6])
+    assert v @ across == pytest.approx(before @ across + 0.5)                 # across the ray: as measured
+    held = hold and not observed and lone
+    assert v @ ray[0] == pytest.approx(before @ ray[0] + (0.0 if held else 1.2))
+    assert m.shares([p])[0] == pytest.approx(1.0 if observed else 0.5)
+
+
+def test_lone_rays_point_from_the_lone_camera_to_the_person():
+    scene = two_camera_scene()
+    cams = [scene.cameras["c1"], scene.cameras["c2"]]
+    people = [Person(k, -1.0, 1.5, mode="tracking", seen_by=s) for k, s in enumerate([("c2",), ("c1", "c2")], 1)]
+    rays = lone_rays(people, cams, ["c1", "c2"])
+    np.testing.assert_allclose(rays[0], cams[1].floor_rays(np.array([-1.0, 1.5]), min_distance=0.3)[0])
+    assert np.isnan(rays[1]).all()

@@ -118,17 +118,29 @@ class MeasuredShare:
     [0.625]
     """
 
-    def __init__(self, smoothing: float) -> None:
+    def __init__(self, smoothing: float, hold: bool = False) -> None:
         self.smoothing = float(np.clip(smoothing, 0.0, 1.0))
+        self.hold = bool(hold)
         self._share: "weakref.WeakKeyDictionary[Person, float]" = weakref.WeakKeyDictionary()
+        self._velocity: "weakref.WeakKeyDictionary[Person, np.ndarray]" = weakref.WeakKeyDictionary()
 
-    def update(self, people: Sequence[Person], t: float, observed: np.ndarray) -> None:
+    def update(self, people: Sequence[Person], t: float, observed: np.ndarray, rays: np.ndarray | None = None) -> None:
         """Count this frame (time ``t`` s, once) for each tracked person of ``people``, whose depth
-        was ``observed`` (N,) bool or not (call after the life cycle has moved the velocity)."""
+        was ``observed`` (N,) bool or not (call after the life cycle has moved the velocity). With
+        ``hold`` (``crowd.hold_along_ray_unobserved``), a person whose depth was not observed gets
+        back their velocity's part along ``rays`` (N, 2) — their lone camera's line of sight, NaN
+        where several cameras show them — from before this frame: a slide is not read as a walk,
+        and the prediction carries the walk measured before the cover, damped by the share."""
         a = self.smoothing
-        for p, seen in zip(people, np.asarray(observed, bool)):
-            if p.mode == "tracking" and p.once("measured_share", t):
-                self._share[p] = (1.0 - a) * self._share.get(p, 1.0) + a * bool(seen)
+        for k, (p, seen) in enumerate(zip(people, np.asarray(observed, bool))):
+            if not (p.mode == "tracking" and p.once("measured_share", t)):
+                continue
+            before = self._velocity.get(p)
+            if self.hold and not seen and rays is not None and before is not None and np.isfinite(rays[k]).all():
+                v = np.array([p.vx, p.vy])
+                p.vx, p.vy = (float(c) for c in v + ((before - v) @ rays[k]) * rays[k])
+            self._velocity[p] = np.array([p.vx, p.vy])
+            self._share[p] = (1.0 - a) * self._share.get(p, 1.0) + a * bool(seen)
 
     def shares(self, people: Sequence[Person]) -> np.ndarray:
         """(N,) float in [0, 1] — each person's measured share (1 for one not counted yet)."""
@@ -152,6 +164,17 @@ def depth_observed(people: Sequence[Person], others: Sequence[Person], views: Se
     return seen & feet
 
 
+def lone_rays(people: Sequence[Person], cameras: Sequence[Camera], camera_ids: Sequence[str]) -> np.ndarray:
+    """(N, 2) — unit floor direction of the line of sight of the one camera of ``cameras`` (ids
+    ``camera_ids``) that showed each person (:func:`lone_camera`); NaN where none or several did."""
+    out = np.full((len(people), 2), np.nan)
+    for k, p in enumerate(people):
+        c = lone_camera(p.seen_by, camera_ids)
+        if c >= 0:
+            out[k] = cameras[c].floor_rays(np.array([p.x, p.y]), min_distance=0.3)[0]
+    return out
+
+
 def lone_camera(seen_by: Sequence[str], camera_ids: Sequence[str]) -> int:
     """Index in ``camera_ids`` of the one camera of this tracker in ``seen_by``; −1 when none or
     several of them showed the person (a tracker with one camera: that camera once it has).
@@ -165,4 +188,4 @@ def lone_camera(seen_by: Sequence[str], camera_ids: Sequence[str]) -> int:
     return mine[0] if len(mine) == 1 else -1
 
 
-__all__ = ["MeasuredShare", "depth_observed", "lone_camera", "predicted_places"]
+__all__ = ["MeasuredShare", "depth_observed", "lone_camera", "lone_rays", "predicted_places"]

@@ -47,7 +47,8 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
-from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, depth_observed, lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.prediction import (MeasuredShare, depth_observed, lone_camera, lone_rays,
+                                                     predicted_places)
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
@@ -124,7 +125,7 @@ class EllipsoidTracker(TrackerBase):
         self.splitter = RaySplitter(cfg.split, cfg.births.min_separation_m, self.walkable, scene.people.width,
                                     tuple(cfg.height.range_m))
         #: Each person's share of velocity measured while their depth was observed (:mod:`.prediction`).
-        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing)
+        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing, cfg.crowd.hold_along_ray_unobserved)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
@@ -188,8 +189,10 @@ class EllipsoidTracker(TrackerBase):
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
         crowd = self.config.crowd
         if crowd.predict_along_ray_measured:   # was each one's depth observed (the feet in view)?
+            cams = [v.camera for v in self.views.values()]
+            rays = lone_rays(judged, cams, list(self.views)) if crowd.hold_along_ray_unobserved else None
             self.measured_share.update(judged, t, depth_observed(
-                judged, list(self.position_map), [self.views[c] for c in self.last_labels], t))
+                judged, list(self.position_map), [self.views[c] for c in self.last_labels], t), rays)
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
             share = self.config.lost.border_share
