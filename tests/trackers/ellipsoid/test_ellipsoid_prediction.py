@@ -7,7 +7,8 @@ from _ellipsoid_scenes import noise_backgrounds, one_camera_scene, two_camera_sc
 
 from worldtrack.foreground import make_foregrounds
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
-from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
+from worldtrack.trackers.base import Person
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, depth_observed, lone_camera, lone_rays, predicted_places
 
 
 @pytest.mark.parametrize("share", [0.0, 0.3, 1.0])
@@ -61,3 +62,90 @@ def test_the_tracker_predicts_a_one_camera_person_across_the_ray_only_when_asked
     moved = np.array([person.x, person.y]) - (-1.0, 2.0)
     assert moved @ across == pytest.approx(0.05, abs=1e-9)
     assert moved @ ray == pytest.approx(0.08 * share, abs=1e-9)
+
+
+def test_each_person_keeps_their_own_share_along_the_ray():
+    scene = one_camera_scene()
+    cam = scene.cameras["cam"]
+    xy = np.array([[-1.0, 1.5], [0.5, 3.0]])
+    v = np.array([[0.4, 1.2], [-0.8, 0.3]])
+    out = predicted_places(xy, v, 0.1, [cam], np.zeros(2, int), np.array([True, True]), np.array([0.25, 1.0]))
+    ray = cam.floor_rays(xy, min_distance=0.3)[0]
+    along = np.sum((out - xy) / 0.1 * ray, axis=1)
+    np.testing.assert_allclose(along, [0.25, 1.0] * np.sum(v * ray, axis=1), atol=1e-12)
+
+
+def _seen(p, t, own_share):
+    p.own_share = own_share
+    p.mark_seen(t, ("cam",))
+
+
+def test_the_measured_share_is_the_velocitys_average_of_observed_frames():
+    p = Person(1, 0.0, 0.0, mode="tracking")
+    m = MeasuredShare(0.5)
+    assert m.shares([p]).tolist() == [1.0]                  # not counted yet: the full velocity
+    for t in (0.1, 0.2, 0.3):                               # depth not observed three frames
+        m.update([p], t, np.array([False]))
+        m.update([p], t, np.array([False]))                 # once per time stamp
+    assert m.shares([p])[0] == pytest.approx(0.125)
+    m.update([p], 0.4, np.array([True]))                    # observed again: back up by a
+    assert m.shares([p])[0] == pytest.approx(0.5625)
+
+
+def test_depth_counts_as_observed_where_a_camera_that_showed_them_sees_their_feet():
+    scene = one_camera_scene()
+    rng = np.random.default_rng(0)
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"))
+    view = tracker.views["cam"]
+    near = np.array([-1.0, 1.0])
+    far = near + 1.2 * view.camera.floor_rays(near, min_distance=0.3)[0]     # right behind, on the same ray
+    people = [Person(k, *xy, mode="tracking") for k, xy in enumerate([near, far, [0.3, 1.5]], 1)]
+    for p in people:
+        _seen(p, 0.1, 0.3)
+    assert depth_observed(people, [], [view], 0.1).tolist() == [True, False, True]
+    assert depth_observed(people[1:], people[:1], [view], 0.1).tolist() == [False, True]  # others cover too
+    assert depth_observed(people, [], [view], 0.2).tolist() == [False] * 3   # nobody showed them at 0.2
+
+
+@pytest.mark.parametrize("measured", [False, True])
+def test_the_tracker_damps_along_the_ray_by_the_measured_share_only_when_asked(measured):
+    scene = one_camera_scene()
+    rng = np.random.default_rng(0)
+    tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"),
+                               EllipsoidConfig(crowd={"predict_along_ray_measured": measured}))
+    p = tracker.init_track(-1.0, 2.0)
+    person = tracker.position_map[p.id]
+    tracker.measured_share.update([person], 0.0, np.array([False]))    # half the velocity is a slide
+    ray = scene.cameras["cam"].floor_rays(np.array([-1.0, 2.0]), min_distance=0.3)[0]
+    across = np.array([-ray[1], ray[0]])
+    person.vx, person.vy = 0.8 * ray + 0.5 * across
+    tracker._predict([person], 0.1, 0.1)
+    moved = np.array([person.x, person.y]) - (-1.0, 2.0)
+    assert moved @ across == pytest.approx(0.05, abs=1e-9)
+    assert moved @ ray == pytest.approx(0.08 * (0.5 if measured else 1.0), abs=1e-9)
+
+
+@pytest.mark.parametrize("hold, observed, lone", [(True, False, True), (True, True, True), (False, False, True),
+                                                  (True, False, False)])
+def test_an_unobserved_frame_does_not_change_the_velocity_along_the_ray_with_hold(hold, observed, lone):
+    p = Person(1, 0.0, 0.0, mode="tracking", vx=0.3, vy=0.0)
+    ray = np.array([[0.6, 0.8]])
+    m = MeasuredShare(0.5, hold=hold)
+    m.update([p], 0.1, np.array([True]), ray)               # the velocity measured with the feet in view
+    p.vx, p.vy = 0.3 + 1.2 * 0.6 - 0.5 * 0.8, 1.2 * 0.8 + 0.5 * 0.6   # the next move: a slide along, a step across
+    m.update([p], 0.2, np.array([observed]), ray if lone else np.full((1, 2), np.nan))
+    v, before = np.array([p.vx, p.vy]), np.array([0.3, 0.0])
+    across = np.array([-0.8, 0.6])
+    assert v @ across == pytest.approx(before @ across + 0.5)                 # across the ray: as measured
+    held = hold and not observed and lone
+    assert v @ ray[0] == pytest.approx(before @ ray[0] + (0.0 if held else 1.2))
+    assert m.shares([p])[0] == pytest.approx(1.0 if observed else 0.5)
+
+
+def test_lone_rays_point_from_the_lone_camera_to_the_person():
+    scene = two_camera_scene()
+    cams = [scene.cameras["c1"], scene.cameras["c2"]]
+    people = [Person(k, -1.0, 1.5, mode="tracking", seen_by=s) for k, s in enumerate([("c2",), ("c1", "c2")], 1)]
+    rays = lone_rays(people, cams, ["c1", "c2"])
+    np.testing.assert_allclose(rays[0], cams[1].floor_rays(np.array([-1.0, 1.5]), min_distance=0.3)[0])
+    assert np.isnan(rays[1]).all()

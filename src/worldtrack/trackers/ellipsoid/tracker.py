@@ -47,7 +47,8 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
-from worldtrack.trackers.ellipsoid.prediction import lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.prediction import (MeasuredShare, depth_observed, lone_camera, lone_rays,
+                                                     predicted_places)
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
@@ -126,6 +127,8 @@ class EllipsoidTracker(TrackerBase):
                                     tuple(cfg.height.range_m))
         #: One id per visit to the region of interest (:mod:`.region`; ``region.area``, off when empty).
         self.region = RegionVisits(cfg.region)
+        #: Each person's share of velocity measured while their depth was observed (:mod:`.prediction`).
+        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing, cfg.crowd.hold_along_ray_unobserved)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
@@ -189,6 +192,12 @@ class EllipsoidTracker(TrackerBase):
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
                                  lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
+        crowd = self.config.crowd
+        if crowd.predict_along_ray_measured:   # was each one's depth observed (the feet in view)?
+            cams = [v.camera for v in self.views.values()]
+            rays = lone_rays(judged, cams, list(self.views)) if crowd.hold_along_ray_unobserved else None
+            self.measured_share.update(judged, t, depth_observed(
+                judged, list(self.position_map), [self.views[c] for c in self.last_labels], t), rays)
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
             share = self.config.lost.border_share
@@ -226,14 +235,18 @@ class EllipsoidTracker(TrackerBase):
     def _predict(self, people: Sequence[Person], dt: float, t: float) -> None:
         """Constant-velocity prediction of tracked people, once per time stamp; a prediction into a
         wall or a desk stays where it was; ``crowd.predict_along_ray`` < 1 damps the velocity along
-        a lone camera's line of sight (:mod:`.prediction`)."""
+        a lone camera's line of sight, ``crowd.predict_along_ray_measured`` by the share of it
+        measured while the person's depth was observed (:mod:`.prediction`)."""
         if not (self.config.match.predict and dt > 0):
             return
         moving = [p for p in people if p.mode == "tracking" and p.once("predict", t)]
-        share = float(self.config.crowd.predict_along_ray)
+        share: float | np.ndarray = float(self.config.crowd.predict_along_ray)
+        if self.config.crowd.predict_along_ray_measured:   # the share measured with depth observed
+            share = share * self.measured_share.shares(moving)
         cids = list(self.views)
         # Which lone camera's ray damps a person's velocity; nobody's at the default share 1.
-        which = np.array([lone_camera(p.seen_by, cids) if share != 1.0 else -1 for p in moving], dtype=int)
+        damps = bool(np.any(np.asarray(share) != 1.0))
+        which = np.array([lone_camera(p.seen_by, cids) if damps else -1 for p in moving], dtype=int)
         ahead = predicted_places(np.array([[p.x, p.y] for p in moving]).reshape(-1, 2),
                                  np.array([[p.vx, p.vy] for p in moving]).reshape(-1, 2), dt,
                                  [self.views[c].camera for c in cids], which, which >= 0, share)
