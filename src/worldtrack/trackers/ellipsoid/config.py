@@ -27,6 +27,7 @@ from pydantic import Field, model_validator
 from worldtrack.config import Section, with_overrides
 from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
 from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
+from worldtrack.trackers.ellipsoid.depth_config import DepthConfig, FeetConfig
 from worldtrack.trackers.ellipsoid.region_config import RegionConfig
 
 
@@ -221,58 +222,6 @@ class HeightConfig(Section):
         if not 0 < lo < hi:
             raise ValueError(f"range_m: expected 0 < min < max, got {list(self.range_m)}")
         return self
-
-
-class FeetConfig(Section):
-    """Depth from the feet: after matching, a person seen whole and alone moves along the line of
-    sight towards their feet (:mod:`worldtrack.trackers.ellipsoid.feet`)."""
-
-    path: ClassVar[str] = "ellipsoid.feet"
-
-    anchor: bool = Field(
-        False, description="move people one camera alone shows towards their feet (or the top of the head) along its "
-        "line of sight; off by default: it costs PETS 2009 MOTA (issue 37); ellipsoid.depth.fuse weighs all the cues")
-    sigma_m: float = Field(0.1, gt=0, description="σ of the feet's place along the line of sight, m (a shoe's length)")
-    head_fallback: bool = Field(True, description="with anchor: where the feet are not trusted, the top of the head places the person")
-    head_clear: bool = Field(False, description="with anchor: the head only when clear of others and of the region's top (head_clear.py)")
-    pixel_sigma_px: float = Field(0.0, ge=0, description="with > 0, the feet's σ also holds this many pixels' floor span (feet_pixel.py)")
-    centre_offset_m: float = Field(0.0, ge=0, description="with anchor: the person stands this far beyond the lowest "
-                                   "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
-    ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
-    height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
-                                  "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")
-    height_sigma_m: float = Field(
-        0.1, gt=0, description="where the feet are not to be trusted, the top of the head places the person at their "
-        "height, uncertain by this much while it is not measured, m (people's heights scatter by 0.1 m)")
-    measured_height_sigma_m: float = Field(
-        0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter; with depth.fuse, the "
-        "least σ of a measured height)")
-    min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
-
-
-class DepthConfig(Section):
-    """Depth along one camera's line of sight from every cue, each weighed by its σ
-    (:mod:`worldtrack.trackers.ellipsoid.depth`); the feet's and the head's σ are ``ellipsoid.feet``'s."""
-
-    path: ClassVar[str] = "ellipsoid.depth"
-
-    fuse: bool = Field(
-        False, description="place people one camera alone shows along its line of sight by the inverse-variance mean "
-        "of the ellipse, the prediction, the feet (where the legs are foreground) and the top of the head; off by "
-        "default (issue 37: helps one oblique camera, not measured to be harmless in crowds and PETS)")
-    prior_speed_mps: float = Field(
-        1.5, gt=0, description="σ of the constant-velocity prediction along the line of sight is this times the "
-        "frame interval, m/s (the velocity prior: no 0.6 m jump in 0.1 s)")
-    weak_sigma_m: float = Field(
-        0.6, gt=0, description="σ of the matched ellipse's place along the line of sight where its evidence is weak "
-        "(legs not foreground, or others cover the person), m")
-    legs_min_share: float = Field(
-        0.5, ge=0, le=1, description="the feet count only where at least this share of the labelled pixels below the "
-        "knees is foreground (not shadow-like)")
-    remeasure_after_encounter: bool = Field(
-        False, description="drop a person's height samples once others stop covering them: the height is measured "
-        "afresh, not carried through a crossing (with or without depth.fuse; with feet.anchor and height.prior_sigma_m "
-        "0.1, heights within 3 cm 67 -> 84 of 97 on held-out line-of-sight seeds, issue 37)")
 
 
 class SplitConfig(Section):

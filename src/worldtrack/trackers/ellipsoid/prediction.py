@@ -50,7 +50,7 @@ as in the crowd, median 0.41 against 0.43 1/m², both below its floor.)
 from __future__ import annotations
 
 import weakref
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -141,6 +141,15 @@ class MeasuredShare:
                 p.vx, p.vy = (float(c) for c in v + ((before - v) @ rays[k]) * rays[k])
             self._velocity[p] = np.array([p.vx, p.vy])
             self._share[p] = (1.0 - a) * self._share.get(p, 1.0) + a * bool(seen)
+
+    def observe(self, people: Sequence[Person], everyone: Sequence[Person], views: Mapping[str, CameraView],
+                labelled: Sequence[str], t: float) -> None:
+        """:meth:`update` with each of ``people``'s depth judged by :func:`depth_observed` in the
+        cameras ``labelled`` (ids of ``views`` with an image this frame) among ``everyone`` on the
+        map, and, with ``hold``, their lone camera's rays (:func:`lone_rays`)."""
+        cids = list(views)
+        rays = lone_rays(people, [v.camera for v in views.values()], cids) if self.hold else None
+        self.update(people, t, depth_observed(people, everyone, [views[c] for c in labelled], t), rays)
 
     def shares(self, people: Sequence[Person]) -> np.ndarray:
         """(N,) float in [0, 1] — each person's measured share (1 for one not counted yet)."""

@@ -47,8 +47,7 @@ from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
-from worldtrack.trackers.ellipsoid.prediction import (MeasuredShare, depth_observed, lone_camera, lone_rays,
-                                                     predicted_places)
+from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, lone_camera, predicted_places
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
@@ -192,12 +191,8 @@ class EllipsoidTracker(TrackerBase):
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
                                  lambda p: self.position_map.get(p.id) is p)
         self._update(judged + born, bystanders, scores, len(judged), t, dt)
-        crowd = self.config.crowd
-        if crowd.predict_along_ray_measured:   # was each one's depth observed (the feet in view)?
-            cams = [v.camera for v in self.views.values()]
-            rays = lone_rays(judged, cams, list(self.views)) if crowd.hold_along_ray_unobserved else None
-            self.measured_share.update(judged, t, depth_observed(
-                judged, list(self.position_map), [self.views[c] for c in self.last_labels], t), rays)
+        if self.config.crowd.predict_along_ray_measured:   # was each one's depth observed (the feet in view)?
+            self.measured_share.observe(judged, list(self.position_map), self.views, list(self.last_labels), t)
         self.uncertainty.measure(self, real, t)
         if self.config.lost.keep_s > 0:
             share = self.config.lost.border_share
