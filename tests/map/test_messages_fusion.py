@@ -78,6 +78,16 @@ def test_a_model_error_along_each_line_of_sight_when_asked():
                      MapConfig(ray_error_m=0.3)).people
     assert p.x == pytest.approx(3.0, abs=0.01) and p.y == pytest.approx(1.0, abs=0.01)
 
+
+def test_the_height_from_the_views_that_show_the_person_when_asked():
+    a = est(1, 2.0, 1.0)._replace(height=1.60)                 # shows the whole body as its own
+    b = est(1, 2.0, 1.0)._replace(height=1.80, own=0.2)        # the person behind somebody: the head only
+    two = [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])]
+    p, = fuse_bucket(FusionState(), 10, two, MapConfig()).people
+    assert p.height == pytest.approx(1.70)                     # off: by support alone (0.8 each)
+    p, = fuse_bucket(FusionState(), 10, two, MapConfig(height_by_view=True)).people
+    assert p.height == pytest.approx((1.60 + 0.2 * 1.80) / 1.2) and p.x == pytest.approx(2.0)
+
 def test_weighed_by_the_trackers_covariances_when_asked_and_every_estimate_has_one():
     cfg = MapConfig(weigh_by="tracker")
     # w1 measured σ 0.1 m along x, w2 0.3 m: information 100 against 11.1 along x; y equal.

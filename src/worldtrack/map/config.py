@@ -69,6 +69,10 @@ class MapConfig(Section):
                                                             "sight to the floor geometry it is weighed by (a "
                                                             "one-camera tracker's depth slides by tenths of a metre; "
                                                             "worldtrack.map.evidence.with_ray_error); 0 = off")
+    height_by_view: bool = Field(False, description="the map's height of a person weighs each worker's by support x "
+                                                    "the share of the body its views show as its own (a worker "
+                                                    "that sees a person behind somebody measures no height), not "
+                                                    "by support alone")
     weigh_own: bool = Field(False, description="weigh each worker's estimate (and choose the lead) by support x "
                                               "the share of the body no other person it holds covers in its "
                                               "views, not by support alone: a worker that sees a person behind "
