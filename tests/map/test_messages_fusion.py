@@ -61,6 +61,33 @@ def test_support_and_geometry_weigh_two_workers():
     assert s.people[0].x == pytest.approx((100 * 2.0 + 10 * 3.0) / 110) and s.people[0].y == pytest.approx(1.5)
 
 
+
+def test_a_model_error_along_each_line_of_sight_when_asked():
+    # Two cameras looking along x (one axis): w1 resolves x 4x finer by pixels (400 against 100 /m²).
+    a, b = est(1, 2.0, 1.0, info=(400.0, 0.0, 4000.0)), est(1, 3.0, 1.2, info=(100.0, 0.0, 4000.0))
+    two = [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])]
+    p, = fuse_bucket(FusionState(), 10, two, MapConfig()).people
+    assert p.x == pytest.approx((400 * 2.0 + 100 * 3.0) / 500)           # off: by pixels alone
+    p, = fuse_bucket(FusionState(), 10, two, MapConfig(ray_error_m=0.3)).people
+    va, vb = 1 / (0.8 * 400) + 0.09, 1 / (0.8 * 100) + 0.09             # support 0.8; + 0.3² m² along the ray
+    assert p.x == pytest.approx((2.0 / va + 3.0 / vb) / (1 / va + 1 / vb))   # about alike: 2.46 m
+    assert p.y == pytest.approx(1.1)                                     # across: as before
+    # At right angles (w2 looks along y): each fixes the other's depth, as before.
+    c = est(1, 3.0, 1.2, info=(4000.0, 0.0, 100.0))
+    p, = fuse_bucket(FusionState(), 10, [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [c])],
+                     MapConfig(ray_error_m=0.3)).people
+    assert p.x == pytest.approx(3.0, abs=0.01) and p.y == pytest.approx(1.0, abs=0.01)
+
+
+def test_the_height_from_the_views_that_show_the_person_when_asked():
+    a = est(1, 2.0, 1.0)._replace(height=1.60)                 # shows the whole body as its own
+    b = est(1, 2.0, 1.0)._replace(height=1.80, own=0.2)        # the person behind somebody: the head only
+    two = [obs("a", 1.0, "w1", [a]), obs("b", 1.0, "w2", [b])]
+    p, = fuse_bucket(FusionState(), 10, two, MapConfig()).people
+    assert p.height == pytest.approx(1.70)                     # off: by support alone (0.8 each)
+    p, = fuse_bucket(FusionState(), 10, two, MapConfig(height_by_view=True)).people
+    assert p.height == pytest.approx((1.60 + 0.2 * 1.80) / 1.2) and p.x == pytest.approx(2.0)
+
 def test_weighed_by_the_trackers_covariances_when_asked_and_every_estimate_has_one():
     cfg = MapConfig(weigh_by="tracker")
     # w1 measured σ 0.1 m along x, w2 0.3 m: information 100 against 11.1 along x; y equal.

@@ -122,6 +122,27 @@ def floor_information(cameras: Sequence[Camera], xy: np.ndarray, height: float, 
     return float(info[0, 0]), float(info[0, 1]), float(info[1, 1])
 
 
+
+def with_ray_error(info: np.ndarray, sigma_m: float) -> np.ndarray:
+    """The information (2, 2) 1/m² of an estimate whose pixel information is ``info`` (1/m²) once a
+    model error of ``sigma_m`` metres along the worker's line of sight is added: the covariance
+    ``info⁻¹ + sigma_m² d dᵀ``, ``d`` the direction ``info`` resolves worst (a camera's line of sight
+    on the floor), inverted again. A one-camera tracker's depth errs by tenths of a metre when it
+    slides along the ray (a person behind another, the feet cut), far beyond what a pixel's error
+    explains; two workers whose cameras look along one axis then count about alike along it, and
+    two at an angle still triangulate (each fixes the other's depth across its own ray).
+
+    >>> along = with_ray_error(np.diag([400.0, 4000.0]), 0.3)   # x: the line of sight
+    >>> round(float(1 / along[0, 0]), 4), round(float(1 / along[1, 1]), 6)   # 0.0025 + 0.09 m² along; across as before
+    (0.0925, 0.00025)
+    """
+    if sigma_m <= 0:
+        return info
+    values, vectors = np.linalg.eigh(info)
+    d = vectors[:, 0]                                   # the smallest eigenvalue: along the ray
+    cov = np.linalg.inv(info) + sigma_m ** 2 * np.outer(d, d)
+    return np.linalg.inv(cov)
+
 #: A place looks empty when less than this share of the pixels of a person's box there that no
 #: other person explains is foreground (a person standing there fills ~half of their box).
 EMPTY_SHARE = 0.1
@@ -206,4 +227,4 @@ def support_of(person: Person | None, tr: Track) -> float:
 
 
 __all__ = ["EMPTY_SHARE", "LEAD_SHARE", "NO_COVARIANCE", "floor_information", "in_views", "looks_empty", "people_boxes",
-           "support_of", "tracker_covariance", "visible_share"]
+           "support_of", "tracker_covariance", "visible_share", "with_ray_error"]

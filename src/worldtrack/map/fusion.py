@@ -75,7 +75,8 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from worldtrack.map.config import MapConfig
-from worldtrack.map.evidence import LEAD_SHARE, floor_information, in_views, people_boxes, visible_share  # noqa: F401
+from worldtrack.map.evidence import (LEAD_SHARE, floor_information, in_views, people_boxes, visible_share,  # noqa: F401
+                                     with_ray_error)
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
 from worldtrack.map.merges import MIN_WEIGHT, merge_duplicates
 from worldtrack.map.refute import refute
@@ -191,39 +192,45 @@ def measured_information(e: Estimate) -> np.ndarray | None:
     return np.linalg.inv(c)
 
 
-def _weights(estimates: list[Estimate], weigh_by: str, weigh_own: bool = True) -> tuple[list[np.ndarray], bool]:
+def _weights(estimates: list[Estimate], weigh_by: str, weigh_own: bool = True,
+             ray_error_m: float = 0.0) -> tuple[list[np.ndarray], bool]:
     """Each estimate's weight matrix, and whether they are the trackers' measured information
     (``weigh_by="tracker"`` and every estimate has one) rather than support (× own share, see
-    :func:`own_weight`) × floor geometry."""
+    :func:`own_weight`) × floor geometry (with ``ray_error_m`` > 0 plus that model error along the
+    worker's line of sight, :func:`~worldtrack.map.evidence.with_ray_error`)."""
     measured = [measured_information(e) for e in estimates] if weigh_by == "tracker" else [None]
     if all(m is not None for m in measured):
         return measured, True
     w = [own_weight(e, weigh_own) for e in estimates]
-    infos = [wi * _information(e) for wi, e in zip(w, estimates)]
+    infos = [with_ray_error(wi * _information(e), ray_error_m) for wi, e in zip(w, estimates)]
     scale = np.mean([np.trace(m) for m in infos])
     return [m / scale for m in infos], False         # relative weights: keeps the solve well scaled
 
 
-def _weighted(estimates: list[Estimate], weigh_by: str = "geometry", weigh_own: bool = True) -> tuple[float, ...]:
+def _weighted(estimates: list[Estimate], weigh_by: str = "geometry", weigh_own: bool = True,
+              ray_error_m: float = 0.0, height_by_view: bool = False) -> tuple[float, ...]:
     if len(estimates) == 1:           # most people, most of the time: one worker sees them
         e = estimates[0]
         return e.x, e.y, e.height, e.width, e.vx, e.vy, e.score, e.support
     w = [estimate_weight(e) for e in estimates]
     total = sum(w)
-    infos, _ = _weights(estimates, weigh_by, weigh_own)
+    infos, _ = _weights(estimates, weigh_by, weigh_own, ray_error_m)
     total_info = sum(infos)
     xy = np.linalg.solve(total_info, sum(m @ np.array([e.x, e.y]) for m, e in zip(infos, estimates)))
     v_ok = [(m, e) for m, e in zip(infos, estimates) if math.isfinite(e.vx) and math.isfinite(e.vy)]
     vxy = (np.linalg.solve(sum(m for m, _ in v_ok), sum(m @ np.array([e.vx, e.vy]) for m, e in v_ok))
            if v_ok else np.array([0.0, 0.0]))
 
-    def mean(attr: str) -> float:
-        vals = [(wi, getattr(e, attr)) for wi, e in zip(w, estimates) if math.isfinite(getattr(e, attr))]
+    def mean(attr: str, by_view: bool = False) -> float:
+        # by_view: × the share of the body the worker's views show as its own (Estimate.own): a
+        # worker that shows neither feet nor head of a person (behind somebody) measures no height.
+        vals = [(wi * (max(MIN_WEIGHT, min(1.0, e.own)) if by_view and math.isfinite(e.own) else 1.0), getattr(e, attr))
+                for wi, e in zip(w, estimates) if math.isfinite(getattr(e, attr))]
         s = sum(wi for wi, _ in vals)
         return sum(wi * v for wi, v in vals) / s if s > 0 else float("nan")
 
     supports = [e.support for e in estimates if math.isfinite(e.support)]
-    return (float(xy[0]), float(xy[1]), mean("height"), mean("width"), float(vxy[0]), float(vxy[1]),
+    return (float(xy[0]), float(xy[1]), mean("height", height_by_view), mean("width"), float(vxy[0]), float(vxy[1]),
             sum(wi * e.score for wi, e in zip(w, estimates)) / total, max(supports) if supports else float("nan"))
 
 
@@ -274,7 +281,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     t = bucket * cfg.bucket_s
     observations = sorted(observations, key=lambda o: (o.t, o.camera, o.frame))
     estimates = _per_worker(state, observations)
-    workers_of = _update_people(state.people, estimates, t, cfg.weigh_by, weigh_own=cfg.weigh_own)
+    workers_of = _update_people(state.people, estimates, t, cfg.weigh_by, weigh_own=cfg.weigh_own,
+                                ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -295,7 +303,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 
 
 def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
-                   weigh_by: str = "geometry", copy: bool = False, weigh_own: bool = True) -> dict[int, set[str]]:
+                   weigh_by: str = "geometry", copy: bool = False, weigh_own: bool = True,
+                   ray_error_m: float = 0.0, height_by_view: bool = False) -> dict[int, set[str]]:
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
     committed state stay as they are). Returns, per person, the workers that see them."""
@@ -303,7 +312,7 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
     for pid, by_worker in estimates.items():
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
-        x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by, weigh_own)
+        x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by, weigh_own, ray_error_m, height_by_view)
         p = people.get(pid)
         if p is None:
             p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
@@ -339,7 +348,7 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     people = dict(state.people)
     for b in sorted(buckets):
         _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True,
-                       weigh_own=cfg.weigh_own)
+                       weigh_own=cfg.weigh_own, ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view)
     t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
     reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))
