@@ -322,28 +322,3 @@ def test_a_target_back_far_from_its_prediction_is_found_again_after_a_long_loss(
         assert labels[56:] == ["T"] * 24, text             # unseen 3 s at k = 55: its track may be it
     else:
         assert "T" not in labels[25:], text
-
-
-def test_a_look_alike_seen_beside_the_target_is_not_taken_for_it_after_a_long_loss():
-    """A person in the red target's clothes stands 2.5 m from where it walks; the target vanishes for
-    good at 2.5 s. Their track fits the templates as well as the target would, but they were seen
-    beside the target, so colour at that level tells nothing: with the long-loss rule on (3 s), they
-    are never taken for it."""
-    from worldtrack.geometry.camera import Camera
-
-    cam = Camera.look_at("c", 320, 240, position=(0, -6, 3), target=(0, 0, 0.8), hfov_deg=60)
-    cfg = FollowConfig(reid_any_track_after=3.0)
-    tracker = FollowTracker(cfg)
-    rng = np.random.default_rng(4)
-    red = (50, 70, 160)
-    labels = []
-    for k in range(70):
-        t = k / 10
-        people, names = [[1.5, 1.5]], ["L"]
-        if k < 25:
-            people, names = [[-2.0 + 0.4 * t, 0.0]] + people, ["T"] + names
-        obs = _seen(cam, cfg, people, [(red, red)] * len(people), [np.nan] * len(people), rng)
-        step = tracker.start_with(obs, t, people[0]) if k == 0 else tracker.step_with(obs, t)
-        labels.append(names[step.chosen] if step.found else ".")
-    assert labels[:25] == ["T"] * 25 and "L" not in labels, "".join(labels)
-    assert tracker.lookalike_rb < cfg.reid_rbhat
