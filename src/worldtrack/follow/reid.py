@@ -8,9 +8,7 @@ must be recognised as it. Who qualifies (:func:`reidentify`):
   have got to (``maybe_target``): somebody seen at the same time as the target is somebody else;
 * after a long loss (``reid_any_track_after`` seconds unseen), also any other track whose own colour
   — the average of its silhouettes, not one frame's — fits the target's templates
-  (RBhat < ``reid_rbhat``) better than the track of anybody ever seen beside the found target (more
-  than 1 m from it) did (``lookalike_rb``: a look-alike seen beside the target is not the target, so
-  colour alone at that level tells nothing). A target that came back far from where it was predicted (it turned
+  (RBhat < ``reid_rbhat``). A target that came back far from where it was predicted (it turned
   round, or walked out of view and in again elsewhere) is first tracked as a stranger, and the
   first rule never hands it back, even while it walks past in full view. After that long the
   prediction says little, and a track carrying the target's colours is the best evidence left;
@@ -49,20 +47,18 @@ def within_reach(xy: np.ndarray, predicted: np.ndarray, unseen: float, cfg: Foll
     return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - predicted).T) <= reach
 
 
-def long_lost_tracks(others: Others, templates: Templates, unseen: float, cfg: FollowConfig,
-                     lookalike_rb: float = np.inf) -> np.ndarray:
+def long_lost_tracks(others: Others, templates: Templates, unseen: float, cfg: FollowConfig) -> np.ndarray:
     """(K',) ids of the other tracks that may be the target after ``unseen`` seconds without it: none
     before ``reid_any_track_after``, then every track whose own histogram fits the templates
-    (RBhat) under both ``reid_rbhat`` and ``lookalike_rb`` (the best fit of anybody seen beside the
-    found target)."""
+    (RBhat < ``reid_rbhat``)."""
     if unseen < cfg.reid_any_track_after or len(others) == 0:
         return np.zeros(0, dtype=np.int64)
-    return others.ids[templates.rbhat(others.hist) < min(cfg.reid_rbhat, lookalike_rb)]
+    return others.ids[templates.rbhat(others.hist) < cfg.reid_rbhat]
 
 
 def reidentify(obs: Observation, owner: np.ndarray, hiding: np.ndarray, t: float, *, others: Others,
                templates: Templates, predicted: np.ndarray, last_seen: float, alpha: float, coast_s: float,
-               cfg: FollowConfig, lookalike_rb: float = np.inf) -> int:
+               cfg: FollowConfig) -> int:
     """Re-identify the lost target (see the module docstring).
 
     Parameters
@@ -73,7 +69,6 @@ def reidentify(obs: Observation, owner: np.ndarray, hiding: np.ndarray, t: float
     t : s, now; others, templates : the other tracks and the target's templates
     predicted : (2,) m, the target's prediction; last_seen : s; alpha : this frame's α (eq. 3)
     coast_s : s, how long the prediction alone is trusted
-    lookalike_rb : the lowest RBhat of the track of anybody seen beside the found target (inf: nobody)
 
     Returns
     -------
@@ -81,7 +76,7 @@ def reidentify(obs: Observation, owner: np.ndarray, hiding: np.ndarray, t: float
     """
     unseen = t - last_seen
     young_ids = others.ids[(others.born > last_seen) & others.maybe_target]
-    may_be = np.concatenate([young_ids, long_lost_tracks(others, templates, unseen, cfg, lookalike_rb)])
+    may_be = np.concatenate([young_ids, long_lost_tracks(others, templates, unseen, cfg)])
     eligible = ((owner == 0) | np.isin(owner, may_be)) & ~hiding
     eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, may_be))
     eligible = np.flatnonzero(eligible)

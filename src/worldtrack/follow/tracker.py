@@ -132,8 +132,6 @@ class FollowTracker:
         self.probation_until = -np.inf
         self.height = TargetHeight()
         self.hidden = False
-        #: the lowest RBhat of anybody's track seen beside the found target: colour alone tells no better
-        self.lookalike_rb = np.inf
 
     # ------------------------------------------------------------------ observation
     def observe(self, frame: Frame, camera: Camera) -> Observation:
@@ -171,7 +169,6 @@ class FollowTracker:
         self.t = self.last_seen = t
         self.identity = IdentityEvidence(self.config.identity_tau)
         self.probation_until = -np.inf
-        self.lookalike_rb = np.inf
         self.last_xy = c.xy[i].copy()
         self.height = TargetHeight()
         if heads_seen(c, obs.silhouettes, obs.camera)[i]:
@@ -280,8 +277,7 @@ class FollowTracker:
             owner[chosen], chosen = 0, -1       # found again beside somebody tracked: a piece of them
         if chosen < 0:
             chosen = reidentify(obs, owner, hiding, t, others=others, templates=self.templates, predicted=self.x[:2],
-                                last_seen=self.last_seen, alpha=self._alpha, coast_s=COAST_S, cfg=cfg,
-                                lookalike_rb=self.lookalike_rb)
+                                last_seen=self.last_seen, alpha=self._alpha, coast_s=COAST_S, cfg=cfg)
         free = np.flatnonzero(owner == 0)
         maybe = self._within_reach(c.xy[free], t) & ~pieces_of_others(c.xy, owner > 1)[free]
         owner[free] = others.add(c.xy[free], obs.hists[free], t, maybe)
@@ -298,11 +294,6 @@ class FollowTracker:
             return chosen
         seen = np.flatnonzero(owner > 1)
         self.identity.observe(dt, float(rb[chosen]) if chosen >= 0 else None, owner[seen], rb[seen])
-        if chosen >= 0:     # the best fit of anybody's track seen beside the target (not a piece of it)
-            apart = np.hypot(*(obs.candidates.xy[seen] - obs.candidates.xy[chosen]).T) > CLEAR_RADIUS
-            rows = np.isin(self.others.ids, owner[seen][apart])
-            if rows.any():
-                self.lookalike_rb = min(self.lookalike_rb, float(self.templates.rbhat(self.others.hist[rows]).min()))
         better = self.identity.better(cfg.identity_margin)
         if better is None or better not in owner:
             return chosen
