@@ -39,9 +39,10 @@ from common import markdown_table  # noqa: E402
 from follow_common import SCENARIO, save_tagged, seed_cached  # noqa: E402
 from follow_synth import parse_seeds  # noqa: E402
 
-from worldtrack.follow import PIDFollower  # noqa: E402
+from worldtrack.follow import FollowConfig, FollowTracker, PIDFollower  # noqa: E402
 from worldtrack.follow.pid import pursuit_map  # noqa: E402
 from worldtrack.follow.planner import LocalPlanner  # noqa: E402
+from worldtrack.errors import InputError  # noqa: E402
 from worldtrack.follow.loop import run_closed_loop  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 
@@ -69,11 +70,12 @@ def make_follower(name: str, scene):
                        search_look=None if name.endswith("nosearch") else 2.0, nav=pursuit_map(scene))
 
 
-def run_seed(seed: int, frames: int, size, follower: str = "pid+scan") -> dict:
+def run_seed(seed: int, frames: int, size, follower: str = "pid+scan", tracker_config: dict | None = None) -> dict:
     sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, distance=DISTANCE, **SCENARIO)
     pid = make_follower(follower, sc.scene)
+    tracker = FollowTracker(FollowConfig.preset("default", **(tracker_config or {})), sc.scene)
     blocked = []
-    result = run_closed_loop(sc, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked),
+    result = run_closed_loop(sc, tracker=tracker, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked),
                              side_scan=follower.startswith("pid+scan"))
     blocked = np.array(blocked)
     within = np.abs(result.distance - DISTANCE) <= TOLERANCE
@@ -199,7 +201,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--tag", default="", help="write results/<name><TAG>.md beside the main table")
     ap.add_argument("--plot", action="store_true", help="also draw the seed with the least time within the band "
                                                         "(results/follow_loop<TAG>_worst.png)")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=3; repeatable")
     args = ap.parse_args(argv)
+    try:
+        settings = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
+        FollowConfig.preset("default", **settings)
+    except (ValueError, InputError) as err:
+        print(f"follow_loop: --set: {err}", file=sys.stderr)
+        return 2
+    setting_key = "".join(f"-{k}={v:g}" for k, v in sorted(settings.items()))
     seeds = [100] if args.quick else parse_seeds(args.seeds)
     frames = 200 if args.quick else args.frames
     t0 = time.perf_counter()
@@ -211,8 +222,8 @@ def main(argv: list[str] | None = None) -> int:
     collision_rows = []
     for seed in seeds:
         ts = time.perf_counter()
-        s = seed_cached(args.cache, f"loop-{args.follower}-{seed}-{frames}",
-                        lambda: run_seed(seed, frames, (160, 120), args.follower))
+        s = seed_cached(args.cache, f"loop-{args.follower}{setting_key}-{seed}-{frames}",
+                        lambda: run_seed(seed, frames, (160, 120), args.follower, settings))
         r = s["result"]
         records[seed] = s
         err = np.abs(r.distance - DISTANCE)
@@ -244,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
                             "median |error| m", "95th pct m", "max m", "target found", "contacts",
                             "collisions (robot's doing)", "walked into the robot", "bumper stops",
                             "nearest person m", "nearest wall m"], rows)
-    text = (f"Follower: {args.follower} — {FOLLOWERS[args.follower]}. Seeds {', '.join(map(str, seeds))}; {frames} "
+    text = (f"Follower: {args.follower} — {FOLLOWERS[args.follower]}. Tracker settings: {settings or 'defaults'}. Seeds {', '.join(map(str, seeds))}; {frames} "
             f"frames at 10 fps, 160x120; set distance {DISTANCE} m. Every frame counts (the robot starts at the set "
             f"distance; no start-up or target-unseen window is left out).\n\n"
             f"- within ±{TOLERANCE} m of the set distance: **{pooled:.3f}** of all frames (target ≥ 0.95); "

@@ -7,7 +7,7 @@ import pytest
 
 MODULES = ["worldtrack.follow", "worldtrack.follow.colour", "worldtrack.follow.config", "worldtrack.follow.dissimilarity",
            "worldtrack.follow.kalman", "worldtrack.follow.others", "worldtrack.follow.pid", "worldtrack.follow.planview",
-           "worldtrack.follow.silhouette", "worldtrack.follow.stereo", "worldtrack.follow.templates",
+           "worldtrack.follow.reid", "worldtrack.follow.silhouette", "worldtrack.follow.stereo", "worldtrack.follow.templates",
            "worldtrack.follow.tracker", "worldtrack.follow.loop", "worldtrack.eval.follow"]
 
 

@@ -287,3 +287,38 @@ def test_a_taller_person_is_not_taken_for_the_target_while_it_is_seen():
         step = tracker.start_with(obs, t, [-2.0, 0.0]) if k == 0 else tracker.step_with(obs, t)
         labels.append(name if step.found else ".")
     assert labels[:25] == ["T"] * 25 and "X" not in labels, "".join(labels)
+
+
+@pytest.mark.parametrize("after, recovers", [(3.0, True), (np.inf, False)])
+def test_a_target_back_far_from_its_prediction_is_found_again_after_a_long_loss(after, recovers):
+    """The red target walks right for 2.5 s and vanishes; 0.5 s later it comes back 3 m from where it
+    was predicted (it turned round out of view) — beyond reach, so it is tracked as a stranger — and
+    walks slowly across the view beside a person in blue. Once it has been unseen for
+    ``reid_any_track_after`` (3 s) its track, whose colour fits the templates, may be the target:
+    it is followed again from then on, and the person in blue never is. Without the rule (inf, as
+    before) the target is never found again although it is in full view."""
+    from worldtrack.geometry.camera import Camera
+
+    cam = Camera.look_at("c", 320, 240, position=(0, -6, 3), target=(0, 0, 0.8), hfov_deg=60)
+    cfg = FollowConfig(reid_any_track_after=after)
+    tracker = FollowTracker(cfg)
+    rng = np.random.default_rng(3)
+    red, blue = (50, 70, 160), (160, 70, 50)
+    labels = []
+    for k in range(80):
+        t = k / 10
+        people, colours, names = [[-1.0, 1.5]], [(blue, blue)], ["B"]
+        if k < 25:
+            people, colours, names = [[-2.0 + 0.4 * t, 0.0]] + people, [(red, red)] + colours, ["T"] + names
+        elif k >= 30:
+            people, colours, names = [[2.0 - 0.2 * (t - 3.0), 1.0]] + people, [(red, red)] + colours, ["T"] + names
+        obs = _seen(cam, cfg, people, colours, [np.nan] * len(people), rng)
+        step = tracker.start_with(obs, t, people[0]) if k == 0 else tracker.step_with(obs, t)
+        labels.append(names[step.chosen] if step.found else ".")
+    text = "".join(labels)
+    assert labels[:25] == ["T"] * 25 and "B" not in labels, text
+    assert labels[30:54] == ["."] * 24, text               # back, but beyond reach: a stranger
+    if recovers:
+        assert labels[56:] == ["T"] * 24, text             # unseen 3 s at k = 55: its track may be it
+    else:
+        assert "T" not in labels[25:], text

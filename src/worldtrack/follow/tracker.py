@@ -10,7 +10,8 @@ Per frame (:meth:`FollowTracker.step`):
 3. for every candidate RBhat (eq. 1) against the target's templates, E (eq. 2) against its
    prediction, the illumination weight α and D (eq. 3) (:mod:`~worldtrack.follow.dissimilarity`);
 4. the decision: the paper's smallest D under the threshold, or (``track_others``) one assignment
-   of all candidates to the target and the others (:mod:`~worldtrack.follow.others`);
+   of all candidates to the target and the others (:mod:`~worldtrack.follow.others`); a lost
+   target is looked for among the people seen now (:mod:`~worldtrack.follow.reid`);
 5. the identity kept open (:mod:`~worldtrack.follow.identity`): each person's colour against the
    target's templates is averaged over time, and another track that clearly fits better takes the
    target's place (a wrong pick at a cut-in is undone when the target shows itself again);
@@ -45,6 +46,7 @@ from worldtrack.follow.dissimilarity import (decide, dissimilarity, illumination
 from worldtrack.follow.identity import IdentityEvidence
 from worldtrack.follow.observation import Observation
 from worldtrack.follow.others import Others, assign
+from worldtrack.follow.reid import reidentify, within_reach
 from worldtrack.follow.planview import Candidates, detect
 from worldtrack.follow.silhouette import silhouettes
 from worldtrack.follow.templates import Templates
@@ -274,55 +276,12 @@ class FollowTracker:
         if chosen >= 0 and t - self.last_seen >= REACQUIRED_AFTER and pieces_of_others(c.xy, owner > 1)[chosen]:
             owner[chosen], chosen = 0, -1       # found again beside somebody tracked: a piece of them
         if chosen < 0:
-            chosen = self._reidentify(obs, owner, D, hiding, t)
+            chosen = reidentify(obs, owner, hiding, t, others=others, templates=self.templates, predicted=self.x[:2],
+                                last_seen=self.last_seen, alpha=self._alpha, coast_s=COAST_S, cfg=cfg)
         free = np.flatnonzero(owner == 0)
         maybe = self._within_reach(c.xy[free], t) & ~pieces_of_others(c.xy, owner > 1)[free]
         owner[free] = others.add(c.xy[free], obs.hists[free], t, maybe)
         return chosen, owner
-
-    def _reidentify(self, obs: Observation, owner: np.ndarray, D: np.ndarray, hiding: np.ndarray, t: float) -> int:
-        """Re-identify the lost target among the people who appeared since it was last seen.
-
-        Somebody seen at the same time as the target cannot be the target, so only candidates
-        nobody owns and those of tracks born after the target's last sighting, within its reach
-        (a person who reappears half hidden is often first taken for somebody new; one who appeared
-        beyond where the target could have got to is somebody else), qualify; not one who may be
-        hiding the target or is of another height (``hiding``), nor a piece of somebody another track
-        holds now (:mod:`~worldtrack.follow.vetoes`). They must look like it (RBhat < ``reid_rbhat``)
-        or, while it coasts (unseen up to ``COAST_S``), score like it (D < ``threshold``; later, with E
-        discounted, that would take anybody near with RBhat under 1), and be no farther from its
-        velocity-consistent prediction than a walker could have gone (:meth:`_within_reach`); the
-        smallest D wins (E counting only the distance beyond half of what a walker could have strayed
-        from the prediction while unseen). A track taken over ends. Changes
-        ``owner`` in place; returns the candidate's index or −1.
-        """
-        cfg = self.config
-        others = self.others
-        young_ids = others.ids[(others.born > self.last_seen) & others.maybe_target]
-        eligible = ((owner == 0) | np.isin(owner, young_ids)) & ~hiding
-        eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, young_ids))
-        eligible = np.flatnonzero(eligible)
-        if len(eligible) == 0:
-            return -1
-        c = obs.candidates
-        rb = self.templates.rbhat(obs.hists[eligible])
-        dist = np.hypot(*(c.xy[eligible] - self.x[:2]).T)
-        unseen = t - self.last_seen
-        # Position counts only beyond half of what a walker could have strayed from the prediction.
-        e = cfg.k * np.maximum(0.0, dist - 0.5 * cfg.reid_speed * unseen)
-        d = dissimilarity(rb, e, self._alpha, cfg.alpha_th)
-        # Position speaks while the prediction is trusted (coasting, up to COAST_S: a change of light may
-        # have changed every colour meanwhile); after that, with E discounted, D under the threshold would
-        # take anybody near whose RBhat is under 1, so colour must agree.
-        looks = (rb < cfg.reid_rbhat) | ((d < cfg.threshold) & (unseen <= COAST_S))
-        ok = looks & self._within_reach(c.xy[eligible], t)
-        if not ok.any():
-            return -1
-        pick = int(eligible[np.flatnonzero(ok)[np.argmin(d[ok])]])
-        if owner[pick] > 1:
-            others.remove(others.ids != owner[pick])
-        owner[pick] = 1
-        return pick
 
     def _weigh_identity(self, obs: Observation, rb: np.ndarray, chosen: int, owner: np.ndarray, t: float,
                         dt: float) -> int:
@@ -351,11 +310,8 @@ class FollowTracker:
         return new
 
     def _within_reach(self, xy: np.ndarray, t: float) -> np.ndarray:
-        """(N,) positions (N, 2) no farther from the lost target's constant-velocity prediction than
-        ``reid_near + min(reid_speed·unseen, reid_accel·unseen²/2)``."""
-        cfg, unseen = self.config, t - self.last_seen
-        reach = cfg.reid_near + min(cfg.reid_speed * unseen, cfg.reid_accel * unseen ** 2 / 2)
-        return np.hypot(*(np.asarray(xy, float).reshape(-1, 2) - self.x[:2]).T) <= reach
+        """(N,) positions (N, 2) within reach of the lost target (:func:`~worldtrack.follow.reid.within_reach`)."""
+        return within_reach(xy, self.x[:2], t - self.last_seen, self.config)
 
     def _update_templates(self, obs: Observation, chosen: int, D: np.ndarray, rb: np.ndarray, alpha: float,
                           dt: float) -> None:
