@@ -93,6 +93,16 @@ def test_sigterm_while_the_command_line_is_imported_is_one_line_and_143():
     assert (out.returncode, out.stderr) == (143, "terminated\n")
 
 
+@pytest.mark.parametrize("status, finalised", [(143, False), (130, False), (0, True), (2, True)])
+def test_an_interrupted_run_ends_without_finalising_the_interpreter(status, finalised):
+    # Finalising while a native library's thread is inside a call aborted one signalled start-up (-6).
+    code = ("import atexit, sys\natexit.register(lambda: print('finalised', file=sys.stderr))\n"
+            f"import worldtrack.cli\nworldtrack.cli.main = lambda: {status}\n"
+            "print('said', file=sys.stderr, end=' ')\nfrom worldtrack.entry import run\nrun()\n")
+    out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
+    assert (out.returncode, out.stderr) == (status, "said finalised\n" if finalised else "said ")
+
+
 def test_the_entry_point_imports_almost_nothing_before_it_can_catch_ctrl_c():
     code = "import sys\nimport worldtrack.entry\nprint(sorted(m for m in ('typing', 'argparse', 're', 'enum') if m in sys.modules))"
     out = subprocess.run([*PY, code], capture_output=True, text=True, timeout=120)
