@@ -11,8 +11,10 @@ Scores, per person, on the estimate's grid against the ground-truth head points:
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +39,36 @@ def pin_to_one_core(cpu: int | None) -> str:
     except OSError as e:
         return f"not pinned ({e.strerror})"
     return f"pinned to cpu {cpu}"
+
+
+def walks_parser(doc: str, repeats: int, quick_size: int = 300) -> argparse.ArgumentParser:
+    """The options of the benchmarks that time long office walks (``--sizes``, ``--seeds``,
+    ``--repeats``, ``--cpu``, ``--quick``); ``doc``'s first paragraph is the description."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--sizes", default="1000,10000")
+    ap.add_argument("--seeds", default="3,42,90")
+    ap.add_argument("--repeats", type=int, default=repeats)
+    ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
+    ap.add_argument("--quick", action="store_true", help=f"T = {quick_size}, seed 3, one repeat; prints only")
+    return ap
+
+
+def walks_of(args: argparse.Namespace, quick_size: int = 300) -> tuple[str, list[int], list[int], int]:
+    """Pin this process as ``args.cpu`` asks; (what was granted, walk sizes, seeds, repeats)."""
+    cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
+    if args.quick:
+        return cpu, [quick_size], [3], 1
+    return cpu, [int(s) for s in args.sizes.split(",")], [int(s) for s in args.seeds.split(",")], args.repeats
+
+
+def least_cpu(fn, repeats: int):
+    """(least CPU seconds of ``repeats`` calls of ``fn``, the last call's result)."""
+    best, out = float("inf"), None
+    for _ in range(repeats):
+        c0 = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - c0)
+    return best, out
 
 
 def rmse(e: np.ndarray) -> float:

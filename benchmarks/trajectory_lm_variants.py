@@ -37,7 +37,6 @@ Writes ``benchmarks/results/trajectory_lm_variants.md``. About a minute per (T, 
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -47,7 +46,7 @@ from scipy.ndimage import uniform_filter1d
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import pin_to_one_core  # noqa: E402
+from trajectory_common import least_cpu, walks_of, walks_parser  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
 from worldtrack.trajectory.environment import barrier_residuals, sample_field  # noqa: E402
@@ -204,14 +203,6 @@ VARIANTS = {"window scale": (WindowScale, {}), "window extrapolation": (WindowEx
             "geodesic h = 1": (Geodesic, {"h": 1.0})}
 
 
-def least_cpu(fn, repeats: int):
-    best, out = np.inf, None
-    for _ in range(repeats):
-        c0 = time.process_time()
-        out = fn()
-        best = min(best, time.process_time() - c0)
-    return best, out
-
 
 def run(T: int, seed: int, repeats: int) -> list[list]:
     scene, obs, height = problem_of(T, seed)
@@ -241,17 +232,9 @@ def run(T: int, seed: int, repeats: int) -> list[list]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--sizes", default="1000,10000")
-    ap.add_argument("--seeds", default="3,42,90")
-    ap.add_argument("--repeats", type=int, default=2)
-    ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
-    ap.add_argument("--quick", action="store_true", help="T = 300, seed 3, one repeat; prints only")
+    ap = walks_parser(__doc__, 2)
     args = ap.parse_args(argv)
-    cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
-    sizes = [300] if args.quick else [int(s) for s in args.sizes.split(",")]
-    seeds = [3] if args.quick else [int(s) for s in args.seeds.split(",")]
-    repeats = 1 if args.quick else args.repeats
+    cpu, sizes, seeds, repeats = walks_of(args)
     t0 = time.perf_counter()
     rows = []
     for T in sizes:

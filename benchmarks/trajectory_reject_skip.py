@@ -15,7 +15,6 @@ Writes ``benchmarks/results/trajectory_reject_skip.md``. About a minute.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -24,7 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import pin_to_one_core  # noqa: E402
+from trajectory_common import walks_of, walks_parser  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
 from worldtrack.trajectory.estimate import TrajectoryOptions, estimate_trajectory  # noqa: E402
@@ -63,17 +62,9 @@ def row(T: int, seed: int, repeats: int) -> list:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--sizes", default="1000,10000")
-    ap.add_argument("--seeds", default="3,42,90")
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
-    ap.add_argument("--quick", action="store_true", help="T = 300, seed 3, one repeat; prints only")
+    ap = walks_parser(__doc__, 3)
     args = ap.parse_args(argv)
-    cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
-    sizes = [300] if args.quick else [int(s) for s in args.sizes.split(",")]
-    seeds = [3] if args.quick else [int(s) for s in args.seeds.split(",")]
-    repeats = 1 if args.quick else args.repeats
+    cpu, sizes, seeds, repeats = walks_of(args)
     t0 = time.perf_counter()
     scene, obs, height = problem_of(300, 3)                  # load the compiled kernels untimed
     estimate_trajectory(obs, scene.distance_field(0.05), TrajectoryOptions(height=height))

@@ -20,7 +20,6 @@ Writes ``benchmarks/results/trajectory_settle.md``. About two minutes.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from dataclasses import replace
@@ -30,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import pin_to_one_core  # noqa: E402
+from trajectory_common import least_cpu, walks_of, walks_parser  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
 import worldtrack.trajectory.estimate as estimate  # noqa: E402
@@ -51,14 +50,6 @@ def _logged(run, *args):
 
 estimate.run_settling = _logged           # the estimate's own call, its log kept
 
-
-def least_cpu(fn, repeats: int):
-    best, out = float("inf"), None
-    for _ in range(repeats):
-        c0 = time.process_time()
-        out = fn()
-        best = min(best, time.process_time() - c0)
-    return best, out
 
 
 def floor_gap(a: np.ndarray, b: np.ndarray) -> float:
@@ -87,17 +78,9 @@ def row(T: int, seed: int, repeats: int) -> list:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--sizes", default="1000,10000")
-    ap.add_argument("--seeds", default="3,42,90")
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
-    ap.add_argument("--quick", action="store_true", help="T = 1 000, seed 3, one repeat; prints only")
+    ap = walks_parser(__doc__, 3, 1000)
     args = ap.parse_args(argv)
-    cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
-    sizes = [1000] if args.quick else [int(s) for s in args.sizes.split(",")]
-    seeds = [3] if args.quick else [int(s) for s in args.seeds.split(",")]
-    repeats = 1 if args.quick else args.repeats
+    cpu, sizes, seeds, repeats = walks_of(args, 1000)
     t0 = time.perf_counter()
     scene, obs, height = problem_of(300, 3)                  # load the compiled kernels untimed
     estimate_trajectory(obs, scene.distance_field(0.05), TrajectoryOptions(height=height, settle_windows=True))

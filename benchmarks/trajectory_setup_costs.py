@@ -26,7 +26,6 @@ Writes ``benchmarks/results/trajectory_setup_costs.md``. About a minute.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from dataclasses import replace
@@ -34,7 +33,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import pin_to_one_core  # noqa: E402
+from trajectory_common import least_cpu, walks_of, walks_parser  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory  # noqa: E402
@@ -45,15 +44,6 @@ from worldtrack.trajectory.solver import LevenbergMarquardt, levenberg_marquardt
 from worldtrack.trajectory.starts import anchor_points, shortest_path_start, straight_start  # noqa: E402
 from worldtrack.trajectory.uncertainty import marginal_covariances  # noqa: E402
 
-
-def least_cpu(fn, repeats: int):
-    """(least CPU seconds of ``repeats`` calls, the last result)."""
-    best, out = float("inf"), None
-    for _ in range(repeats):
-        c0 = time.process_time()
-        out = fn()
-        best = min(best, time.process_time() - c0)
-    return best, out
 
 
 def row(T: int, seed: int, repeats: int, settle: bool = False) -> list:
@@ -86,18 +76,10 @@ def row(T: int, seed: int, repeats: int, settle: bool = False) -> list:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--sizes", default="1000,10000")
-    ap.add_argument("--seeds", default="3,42,90")
-    ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--cpu", type=int, default=1, help="processor to pin to (-1: do not pin)")
-    ap.add_argument("--quick", action="store_true", help="T = 300, seed 3, one repeat; prints only")
+    ap = walks_parser(__doc__, 5)
     ap.add_argument("--settle", action="store_true", help="settle_windows=True (34b); writes _settle.md")
     args = ap.parse_args(argv)
-    cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
-    sizes = [300] if args.quick else [int(s) for s in args.sizes.split(",")]
-    seeds = [3] if args.quick else [int(s) for s in args.seeds.split(",")]
-    repeats = 1 if args.quick else args.repeats
+    cpu, sizes, seeds, repeats = walks_of(args)
     t0 = time.perf_counter()
     scene, obs, height = problem_of(300, 3)                  # load the compiled kernels untimed
     estimate_trajectory(obs, scene.distance_field(0.05), TrajectoryOptions(height=height))
