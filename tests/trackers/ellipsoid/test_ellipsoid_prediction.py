@@ -47,19 +47,26 @@ def test_the_lone_camera_is_the_only_one_of_the_trackers_that_showed_the_person(
     assert lone_camera((), ["cam"]) == 0                    # one camera: always it
 
 
-@pytest.mark.parametrize("share", [0.0, 1.0])
-def test_the_tracker_predicts_a_one_camera_person_across_the_ray_only_when_asked(share):
+def _one_camera_walker(crowd: dict, before=lambda tracker, person: None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A one-camera tracker with ``crowd`` settings and one person at (-1, 2) m walking 0.8 m/s along
+    the camera's ray and 0.5 m/s across it (``before(tracker, person)`` runs first), predicted 0.1 s
+    ahead: (their move (2,) m, the ray's floor direction (2,), the direction across it (2,))."""
     scene = one_camera_scene()
     rng = np.random.default_rng(0)
     tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"),
-                               EllipsoidConfig(crowd={"predict_along_ray": share}))
-    p = tracker.init_track(-1.0, 2.0)
-    person = tracker.position_map[p.id]
+                               EllipsoidConfig(crowd=crowd))
+    person = tracker.position_map[tracker.init_track(-1.0, 2.0).id]
+    before(tracker, person)
     ray = scene.cameras["cam"].floor_rays(np.array([-1.0, 2.0]), min_distance=0.3)[0]
     across = np.array([-ray[1], ray[0]])
     person.vx, person.vy = 0.8 * ray + 0.5 * across
     tracker._predict([person], 0.1, 0.1)
-    moved = np.array([person.x, person.y]) - (-1.0, 2.0)
+    return np.array([person.x, person.y]) - (-1.0, 2.0), ray, across
+
+
+@pytest.mark.parametrize("share", [0.0, 1.0])
+def test_the_tracker_predicts_a_one_camera_person_across_the_ray_only_when_asked(share):
+    moved, ray, across = _one_camera_walker({"predict_along_ray": share})
     assert moved @ across == pytest.approx(0.05, abs=1e-9)
     assert moved @ ray == pytest.approx(0.08 * share, abs=1e-9)
 
@@ -109,18 +116,10 @@ def test_depth_counts_as_observed_where_a_camera_that_showed_them_sees_their_fee
 
 @pytest.mark.parametrize("measured", [False, True])
 def test_the_tracker_damps_along_the_ray_by_the_measured_share_only_when_asked(measured):
-    scene = one_camera_scene()
-    rng = np.random.default_rng(0)
-    tracker = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, rng), "colour"),
-                               EllipsoidConfig(crowd={"predict_along_ray_measured": measured}))
-    p = tracker.init_track(-1.0, 2.0)
-    person = tracker.position_map[p.id]
-    tracker.measured_share.update([person], 0.0, np.array([False]))    # half the velocity is a slide
-    ray = scene.cameras["cam"].floor_rays(np.array([-1.0, 2.0]), min_distance=0.3)[0]
-    across = np.array([-ray[1], ray[0]])
-    person.vx, person.vy = 0.8 * ray + 0.5 * across
-    tracker._predict([person], 0.1, 0.1)
-    moved = np.array([person.x, person.y]) - (-1.0, 2.0)
+    def half_a_slide(tracker, person):   # half the velocity is a slide
+        tracker.measured_share.update([person], 0.0, np.array([False]))
+
+    moved, ray, across = _one_camera_walker({"predict_along_ray_measured": measured}, half_a_slide)
     assert moved @ across == pytest.approx(0.05, abs=1e-9)
     assert moved @ ray == pytest.approx(0.08 * (0.5 if measured else 1.0), abs=1e-9)
 
