@@ -28,14 +28,20 @@ def test_the_feet_pull_a_track_that_sits_too_far_along_the_line_of_sight_back_to
     assert np.hypot(r.x - xy[0], r.y - xy[1]) < 0.15
 
 
-def test_without_legs_in_the_foreground_the_head_places_the_person_not_the_waist(seen):
-    tracker, labels, instance, truth = seen
-    # Legs the floor's colour: the body's pixels below its middle read as shadow-like ("unsure", 2).
+def _legs_as_shadow(labels, instance, truth):
+    """``labels`` with legs the floor's colour: the person's foreground pixels below the body's
+    middle read as shadow-like ("unsure", 2)."""
     body = instance == truth["id"]
     rows = np.nonzero(body.any(axis=1))[0]
     legs = body & (np.arange(labels.shape[0])[:, None] > (rows.min() + rows.max()) / 2)
     cut = labels.copy()
     cut[legs & (cut == 1)] = 2
+    return cut
+
+
+def test_without_legs_in_the_foreground_the_head_places_the_person_not_the_waist(seen):
+    tracker, labels, instance, truth = seen
+    cut = _legs_as_shadow(labels, instance, truth)
     p, xy = misplaced(tracker, truth, 0.6)
     moved = anchor_to_feet([p], tracker.views, {"cam": cut}, tracker.walkable, FeetConfig(anchor=True), HeightConfig())
     assert moved == 1
@@ -52,11 +58,7 @@ def test_without_legs_in_the_foreground_the_head_places_the_person_not_the_waist
 
 def test_without_the_head_fallback_only_trusted_feet_move_a_person(seen):
     tracker, labels, instance, truth = seen
-    body = instance == truth["id"]
-    rows = np.nonzero(body.any(axis=1))[0]
-    legs = body & (np.arange(labels.shape[0])[:, None] > (rows.min() + rows.max()) / 2)
-    cut = labels.copy()
-    cut[legs & (cut == 1)] = 2
+    cut = _legs_as_shadow(labels, instance, truth)
     config = FeetConfig(anchor=True, head_fallback=False)
     q, xy = misplaced(tracker, truth, 0.6)
     q.height_samples.extend([truth["height"]] * 3)
