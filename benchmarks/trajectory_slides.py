@@ -14,9 +14,10 @@ from the shortest-path start (the start that wins the race on these walks), defa
   (across ∇d): their share of the barrier model's error (model − actual change of r²), and the median
   (actual − linearised) distance after the step of those moving > 1 cm (mm) — positive: the field curves away
   under a straight move;
-- (a) *cubic start*: as ``shortest``, but each routed gap walked with cubic (Hermite) timing s(t) along the
-  route, its end speeds the MAP without the barrier's velocities at the gap's ends along the route
-  (:func:`cubic_timed_start`) instead of at constant speed — the motion prior's own timing between two states;
+- (a) *cubic start*: as ``shortest``, but each routed gap walked with cubic timing s(t) along the route, its end
+  speeds the MAP without the barrier's velocities at the gap's ends along the route, instead of at constant speed
+  — the motion prior's own timing between two states (``shortest_path_start(..., timing="cubic")``, the opt-in
+  ``TrajectoryOptions.route_timing``);
 - (b) *curvature*: the Gauss–Newton matrix of every barrier sample plus γ·r·r′·∇²d (the exact Hessian's term
   that Gauss–Newton drops; ∇²d by second differences of the field smoothed over one cell), from iteration k
   (:class:`CurvatureLM`). The gradient, hence every optimum, is unchanged.
@@ -49,51 +50,9 @@ from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment 
 from worldtrack.trajectory.model import TimeGrid, frame_interval  # noqa: E402
 from worldtrack.trajectory.objective import Linearisation, Problem, linearise  # noqa: E402
 from worldtrack.trajectory.solver import LevenbergMarquardt, levenberg_marquardt  # noqa: E402
-from worldtrack.trajectory.starts import (_blocked_gaps, anchor_points, free_space_route,  # noqa: E402
-                                          shortest_path_start, states_from_positions, straight_start)
+from worldtrack.trajectory.starts import anchor_points, shortest_path_start, straight_start  # noqa: E402
 
 FLOOR = [0, 2]          # u, v in the state
-
-
-# ------------------------------------------------------------------ (a) the start's timing
-
-def cubic_timing(length: float, duration: float, v0: float, v1: float, n: int) -> np.ndarray:
-    """(n,) arc length (m) at n equal time steps over ``duration`` (s) on a route of ``length`` (m): the cubic
-    Hermite s(t) from (0, v0) to (length, v1) (speeds in m/s, clipped at 0), kept in [0, length] and non-decreasing.
-
-    >>> cubic_timing(2.0, 2.0, 1.0, 1.0, 5).round(3).tolist()
-    [0.0, 0.5, 1.0, 1.5, 2.0]
-    """
-    tau = np.linspace(0.0, 1.0, n)
-    h10, h01, h11 = tau ** 3 - 2 * tau ** 2 + tau, -2 * tau ** 3 + 3 * tau ** 2, tau ** 3 - tau ** 2
-    s = h10 * duration * max(v0, 0.0) + h01 * length + h11 * duration * max(v1, 0.0)
-    return np.maximum.accumulate(np.clip(s, 0.0, length))
-
-
-def cubic_timed_start(problem: Problem, height: float, field: FloorGrid, clearance: float,
-                      free_X: np.ndarray) -> np.ndarray:
-    """The shortest-path start (n, 6) with every routed gap walked by :func:`cubic_timing`; the end speeds are
-    ``free_X``'s velocities (the MAP without the barrier) at the gap's two ends along the route's first and last
-    half metre."""
-    grid = problem.grid
-    steps, xy = anchor_points(problem.observations, height)
-    k = np.arange(grid.n)
-    path = np.column_stack([np.interp(k, steps, xy[:, 0]), np.interp(k, steps, xy[:, 1])])
-    gaps = np.flatnonzero(np.diff(steps) > 1)
-    for i in gaps[_blocked_gaps(field, xy[gaps], xy[gaps + 1], clearance)]:
-        k0, k1 = steps[i], steps[i + 1]
-        route = free_space_route(field, xy[i], xy[i + 1], clearance, 0.1)
-        if route is None:
-            continue
-        route = np.vstack([xy[i], route[1:-1], xy[i + 1]])
-        s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(route, axis=0).T))]
-        at = lambda a: np.array([np.interp(a, s, route[:, 0]), np.interp(a, s, route[:, 1])])  # noqa: E731
-        h = min(0.5, s[-1] / 2)
-        t0, t1 = at(h) - route[0], route[-1] - at(s[-1] - h)
-        v0 = float(free_X[k0, [1, 3]] @ t0) / max(np.linalg.norm(t0), 1e-9)
-        v1 = float(free_X[k1, [1, 3]] @ t1) / max(np.linalg.norm(t1), 1e-9)
-        path[k0:k1 + 1] = at(cubic_timing(s[-1], (k1 - k0) * grid.dt, v0, v1, k1 - k0 + 1)).T
-    return states_from_positions(path, grid, height)
 
 
 # ------------------------------------------------------------------ (b) the field's curvature
@@ -229,7 +188,8 @@ def row(T: int, seed: int, block: str) -> list:
         gap = float(np.hypot(*(res.X[:, FLOOR] - ref.X[:, FLOOR]).T).max())
         return f"{res.iterations} ({res.costs.total / ref.costs.total - 1:+.1e}, {gap:.2f} m)"
 
-    cubic = levenberg_marquardt(problem, cubic_timed_start(problem, height, field, opts.clearance, free_X), opts.solver)
+    cubic = levenberg_marquardt(problem, shortest_path_start(problem.observations, grid, height, field, opts.clearance,
+                                                             0.1, anchors, "cubic", free_X[:, [1, 3]]), opts.solver)
     curv1 = CurvatureLM(problem, X0, opts.solver, 1.0, 0).run()
     curv_half = CurvatureLM(problem, X0, opts.solver, 0.5, 6).run()
     return [T, f"{seed} ({block})", ref.iterations, f"{ref.costs.total:.4f}", f"{a0:.2f} / {c0:.2f}",

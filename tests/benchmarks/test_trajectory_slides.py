@@ -1,5 +1,5 @@
-"""The slides benchmark's pieces measure what they say: the cubic timing, the along/across split, and the field
-curvature term of the barrier's model (benchmarks/trajectory_slides.py)."""
+"""The slides benchmark's pieces measure what they say: the along/across split and the field curvature term
+of the barrier's model (benchmarks/trajectory_slides.py)."""
 
 import sys
 from pathlib import Path
@@ -8,17 +8,10 @@ from types import SimpleNamespace
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from trajectory_slides import along_across, cubic_timing, curvature_blocks, field_hessian, sample_points  # noqa: E402
+from trajectory_slides import along_across, curvature_blocks, field_hessian, sample_points  # noqa: E402
 
 from worldtrack.scene.floor import FloorGrid  # noqa: E402
 from worldtrack.trajectory.environment import Barrier, EnvironmentModel, sample_field  # noqa: E402
-
-
-def test_cubic_timing_meets_both_ends_and_starts_slowly_from_rest():
-    s = cubic_timing(3.0, 3.0, 0.0, 1.0, 31)
-    assert s[0] == 0.0 and s[-1] == 3.0 and np.all(np.diff(s) >= 0)
-    assert s[1] < 0.1 * 0.25                      # from rest: well below the 0.1 m per step of constant speed
-    assert abs((s[-1] - s[-2]) / 0.1 - 1.0) < 0.1      # arrives at 1 m/s
 
 
 def test_along_across_splits_a_shift_by_the_direction_of_travel():
