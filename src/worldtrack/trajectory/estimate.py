@@ -82,11 +82,12 @@ class TrajectoryOptions:
         windows with half of the steps have settled (:mod:`.settle`); off by default
     route_timing : str — how the ``shortest`` start walks each route: ``"constant"`` speed (the default) or
         ``"cubic"``, the motion prior's timing from the MAP without the barrier's velocities at the gap's ends
-        (:func:`~.starts.cubic_timing`). 34m (``benchmarks/trajectory_slides.py``, office walks of
-        ``trajectory_speed.py``): leader iterations at T = 10 000 21/28/35 → 18/19/34 (dev walks 3/42/90),
-        26/19/28/10/10/21 → 18/18/19/10/10/14 (held-out 200–202, 400–402), but another stop on the flat slides:
-        objective −4.0e-5 … +8.9e-6 of the default's, and at T = 1 000 walk 3 a neighbouring minimum +2.0e-4
-        higher — hence opt-in
+        (:func:`~.starts.cubic_timing`). 34m (``benchmarks/trajectory_slides.py``, the walks of
+        ``trajectory_speed.py``): leader iterations at T = 10 000 21/28/35 → 17/19/31 (dev walks 3/42/90),
+        26/19/28/10/10/21 → 18/19/19/10/10/14 (held-out 200–202, 400–402), but it stops elsewhere on the flat
+        slides: objective −4.6e-5 … +7.6e-6 of the default's (3 of 9 above +1e-6), and at T = 1 000 walk 3 in a
+        neighbouring minimum +2.0e-4 higher; office (``trajectory_office.py --route-timing cubic``) between views
+        0.778 → 0.781 m, in view, obstacles and crossings unchanged — hence opt-in
     solver : SolverOptions
     """
 
