@@ -98,7 +98,8 @@ def run_seed(seed: int, frames: int, totals: dict, starts: Counter, best: dict, 
         # every start to convergence (no race), to tell which start wins and which tie
         known = estimate_trajectory(obs, field, TrajectoryOptions(height=track.height, race_iterations=None,
                                                                  route_timing=route_timing))
-        unknown = estimate_trajectory(obs, field, TrajectoryOptions(height=sc.scene.people.height, route_timing=route_timing))
+        unknown = estimate_trajectory(obs, field, TrajectoryOptions(height=sc.scene.people.height,
+                                                                    route_timing=route_timing))
         with_feet = Observations.from_rows(mine.time, mine.camera, mine.uv, sc.scene.cameras, 2.0, mine.feet_uv, 2.0)
         feet = estimate_trajectory(with_feet, field, TrajectoryOptions(height=sc.scene.people.height, fit_height=True,
                                                                           route_timing=route_timing))
@@ -199,7 +200,8 @@ def main(argv: list[str] | None = None) -> int:
     if best and not args.quick and not cubic:
         picture(best)
     save_result("trajectory_office" + ("_cubic" if cubic else ""), "Seed 002: office with detours, MAP vs Kalman + RTS"
-                + (" (route_timing='cubic')" if cubic else ""), text, args.quick, time.perf_counter() - t_start)
+                + (" (route_timing='cubic')" if cubic else ""), text, args.quick,
+                time.perf_counter() - t_start, script="trajectory_office")
     return 0
 
 

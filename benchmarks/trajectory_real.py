@@ -262,7 +262,8 @@ def main(argv: list[str] | None = None) -> int:
     if keep and not args.quick:
         picture(keep)
     save_result("trajectory_real" + ("_cubic" if cubic else ""), "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)"
-                + (" (route_timing='cubic')" if cubic else ""), text, args.quick, time.perf_counter() - t_start)
+                + (" (route_timing='cubic')" if cubic else ""), text, args.quick,
+                time.perf_counter() - t_start, script="trajectory_real")
     return 0
 
 

@@ -228,7 +228,7 @@ def main(argv: list[str] | None = None) -> int:
     tail = ("_settle" if args.settle else "") + ("_cubic" if args.route_timing != "constant" else "")
     save_result("trajectory_speed" + tail, "Seed 002: speed on one core, scaling, environment cost, GTSAM"
                 + (" (settle_windows)" if args.settle else "") + (" (route_timing='cubic')" if "cubic" in tail else ""),
-                text, args.quick, time.perf_counter() - t_start)
+                text, args.quick, time.perf_counter() - t_start, script="trajectory_speed")
     return 0
 
 
