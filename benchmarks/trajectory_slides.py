@@ -25,8 +25,8 @@ from the shortest-path start (the start that wins the race on these walks), defa
 Each lever: its iterations, its stop's objective ÷ the default's − 1 (≤ 1e-6 or lower is the bar) and the
 largest floor distance between the two stops (m).
 
-Run: ``.venv/bin/python benchmarks/trajectory_slides.py [--sizes 1000,10000] [--seeds 3,42,90] [--quick]``.
-Writes ``benchmarks/results/trajectory_slides.md``. About 10 s per walk of T = 10 000.
+Run: ``.venv/bin/python benchmarks/trajectory_slides.py [--sizes 1000,10000] [--seeds 3,42,90] [--held-out 200]
+[--never-used 500] [--tag never_used] [--quick]``. Writes ``benchmarks/results/trajectory_slides[_<tag>].md``. About 10 s per walk of T = 10 000.
 """
 
 from __future__ import annotations
@@ -201,6 +201,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = walks_parser(__doc__, 1)
     ap.add_argument("--held-out", default="", help="seeds (comma-separated) labelled held-out in the table")
     ap.add_argument("--never-used", default="", help="seeds labelled never-used")
+    ap.add_argument("--tag", default="", help="writes results/trajectory_slides_<tag>.md instead")
     args = ap.parse_args(argv)
     cpu, sizes, seeds, _ = walks_of(args)
     labels = {int(s): name for name, given in (("held-out", args.held_out), ("never-used", args.never_used))
@@ -213,8 +214,9 @@ def main(argv: list[str] | None = None) -> int:
          "(a) cubic start: iterations (F ÷ default − 1, largest gap)", "(b) curvature γ = 1 from it. 0",
          "(b) curvature γ = 0.5 from it. 6"], rows)
     print(text)
-    save_result("trajectory_slides", "Seed 002: the leader's last iterations, and two levers", text, args.quick,
-                time.perf_counter() - t0)
+    save_result("trajectory_slides" + (f"_{args.tag}" if args.tag else ""),
+                "Seed 002: the leader's last iterations, and two levers", text, args.quick, time.perf_counter() - t0,
+                script="trajectory_slides")
     return 0
 
 
