@@ -26,7 +26,8 @@ Each lever: its iterations, its stop's objective ÷ the default's − 1 (≤ 1e-
 largest floor distance between the two stops (m).
 
 Run: ``.venv/bin/python benchmarks/trajectory_slides.py [--sizes 1000,10000] [--seeds 3,42,90] [--held-out 200]
-[--never-used 500] [--tag never_used] [--quick]``. Writes ``benchmarks/results/trajectory_slides[_<tag>].md``. About 10 s per walk of T = 10 000.
+[--never-used 500] [--tag never_used] [--quick]``. Writes ``benchmarks/results/trajectory_slides[_<tag>].md``.
+About 10 s per walk of T = 10 000.
 """
 
 from __future__ import annotations
