@@ -84,9 +84,9 @@ class TrajectoryOptions:
         ``"cubic"``, the motion prior's timing from the MAP without the barrier's velocities at the gap's ends
         (:func:`~.starts.cubic_timing`). 34m (``benchmarks/trajectory_slides.py``, the walks of
         ``trajectory_speed.py``): leader iterations at T = 10 000 21/28/35 → 17/19/31 (dev walks 3/42/90),
-        26/19/28/10/10/21 → 18/19/19/10/10/14 (held-out 200–202, 400–402), but it stops elsewhere on the flat
-        slides: objective −4.6e-5 … +7.6e-6 of the default's (3 of 9 above +1e-6), and at T = 1 000 walk 3 in a
-        neighbouring minimum +2.0e-4 higher; office (``trajectory_office.py --route-timing cubic``) between views
+        26/19/28/10/10/21 → 18/19/19/10/10/14 (held-out 200–202, 400–402), 24/9/25 → 20/9/27 (never-used
+        500–502), but it stops elsewhere on the flat slides: objective −4.6e-5 … +2.2e-5 of the default's (4 of 12
+        above +1e-6), and at T = 1 000 walk 3 in a neighbouring minimum +2.0e-4 higher; office (``trajectory_office.py --route-timing cubic``) between views
         0.778 → 0.781 m, in view, obstacles and crossings unchanged — hence opt-in
     solver : SolverOptions
     """
