@@ -135,11 +135,12 @@ def setting_value(text: str):
     return {"true": True, "false": False}.get(text.lower(), text)
 
 
-def save_result(name: str, title: str, text: str, quick: bool, seconds: float) -> None:
-    """Write ``results/<name>.md`` for the script ``benchmarks/<name>.py``; ``--quick`` runs only print."""
+def save_result(name: str, title: str, text: str, quick: bool, seconds: float, script: str | None = None) -> None:
+    """Write ``results/<name>.md`` for the script ``benchmarks/<script or name>.py``; ``--quick`` runs only print."""
     if quick:
         print(f"{name}: --quick smoke run in {seconds:.0f} s; results/{name}.md not written", file=sys.stderr)
         return
     args = "".join(f" {shlex.quote(a)}" for a in sys.argv[1:])  # the arguments this run was given
-    path = write_result(name, title, f"Command: `.venv/bin/python benchmarks/{name}.py{args}` ({seconds:.0f} s)\n\n{text}")
+    command = f"`.venv/bin/python benchmarks/{script or name}.py{args}`"
+    path = write_result(name, title, f"Command: {command} ({seconds:.0f} s)\n\n{text}")
     print(f"wrote {path} in {seconds:.0f} s", file=sys.stderr)

@@ -140,7 +140,8 @@ class FreeSpace:
         return field_from_walkable(self.base & near, self.origin, RESOLUTION)
 
 
-def run_sequence(name: str, root: Path, seed: int, totals: dict, starts: Counter, quick: bool, keep: dict) -> list:
+def run_sequence(name: str, root: Path, seed: int, totals: dict, starts: Counter, quick: bool, keep: dict,
+                 route_timing: str = "constant") -> list:
     folder, n_cams = SEQUENCES[name]
     people, walls, pillars = load(root / folder)
     rng = np.random.default_rng([seed, sum(map(ord, name))])
@@ -163,11 +164,11 @@ def run_sequence(name: str, root: Path, seed: int, totals: dict, starts: Counter
             continue
         order = np.argsort(rows, kind="stable")
         obs = Observations.from_rows(t[np.array(rows)[order]], np.array(ids)[order], np.vstack(uvs)[order], cams, 2.0)
-        opts = TrajectoryOptions(dt=0.4, height=1.70, race_iterations=None)     # every start converges
+        opts = TrajectoryOptions(dt=0.4, height=1.70, race_iterations=None, route_timing=route_timing)  # every start
         est = estimate_trajectory(obs, field, opts)
         learnt = estimate_trajectory(obs, free.field_without(pid), opts)
         c0 = time.process_time()
-        race = estimate_trajectory(obs, field, TrajectoryOptions(dt=0.4, height=1.70))
+        race = estimate_trajectory(obs, field, TrajectoryOptions(dt=0.4, height=1.70, route_timing=route_timing))
         c1 = time.process_time()
         estimate_trajectory(obs, None, TrajectoryOptions(dt=0.4, height=1.70, environment=False))
         starts[(name, "cpu", "walls")] += c1 - c0
@@ -200,7 +201,8 @@ def picture(keep: dict) -> None:
                                f"truth (dashed); virtual cameras")
 
 
-def report(seed: int, root: Path, missing: list[str], quick: bool, keep: dict, t_start: float) -> str:
+def report(seed: int, root: Path, missing: list[str], quick: bool, keep: dict, t_start: float,
+           route_timing: str = "constant") -> str:
     """Every sequence with the cameras of one seed: the table and which start won."""
     totals: dict = {}
     starts: Counter = Counter()
@@ -209,7 +211,7 @@ def report(seed: int, root: Path, missing: list[str], quick: bool, keep: dict, t
         if name in missing:
             print(f"{name}: not under {root}; skipped", file=sys.stderr)
             continue
-        seqs.append(run_sequence(name, root, seed, totals, starts, quick, keep))
+        seqs.append(run_sequence(name, root, seed, totals, starts, quick, keep, route_timing))
         print(f"seed {seed}, {name} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     rows = []
     for name, n_people, used, truth_cross in seqs:
@@ -240,6 +242,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", default="0,1,2", help="camera placements (with heights and noise), e.g. 0,1,2")
     ap.add_argument("--quick", action="store_true", help="seed 0, 8 people per sequence; prints only")
+    ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
+                    help="TrajectoryOptions.route_timing (opt-in cubic, 34m): writes results/trajectory_real_cubic.md, "
+                         "no picture")
     args = ap.parse_args(argv)
     root = data_root()
     missing = [n for n, (f, _) in SEQUENCES.items() if not (root / f / "obsmat.txt").is_file()]
@@ -249,13 +254,16 @@ def main(argv: list[str] | None = None) -> int:
     t_start = time.perf_counter()
     seeds = [0] if args.quick else [int(s) for s in args.seeds.split(",")]
     keep: dict = {}
-    sections = [report(seed, root, missing, args.quick, keep if seed == seeds[0] else {}, t_start) for seed in seeds]
+    cubic = args.route_timing != "constant"
+    sections = [report(seed, root, missing, args.quick, keep if seed == seeds[0] and not cubic else {}, t_start,
+                       args.route_timing) for seed in seeds]
     text = ("Head heights U(1.6, 1.8) m, estimated with 1.70 m; 2 px noise; grid 0.4 s.\n\n" + "\n".join(sections))
     print(text)
     if keep and not args.quick:
         picture(keep)
-    save_result("trajectory_real", "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)", text, args.quick,
-                time.perf_counter() - t_start)
+    save_result("trajectory_real" + ("_cubic" if cubic else ""), "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)"
+                + (" (route_timing='cubic')" if cubic else ""), text, args.quick,
+                time.perf_counter() - t_start, script="trajectory_real")
     return 0
 
 

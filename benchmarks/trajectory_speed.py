@@ -28,7 +28,8 @@ time includes waiting for other jobs, the CPU time does not):
   banded solves, comparable across machines.
 
 Run: ``.venv/bin/python benchmarks/trajectory_speed.py [--sizes 1000,10000,100000] [--cpu 1]
-[--repeats 3] [--quick] [--settle]``. Writes ``benchmarks/results/trajectory_speed.md`` (with ``--settle``: ``_settle.md``). About 4 minutes
+[--repeats 3] [--quick] [--settle] [--route-timing cubic]``. Writes ``benchmarks/results/trajectory_speed.md`` (with
+``--settle``: ``_settle.md``; with ``--route-timing cubic``: ``_cubic.md``). About 4 minutes
 (most of it GTSAM at T = 100 000).
 """
 
@@ -99,10 +100,11 @@ def problem_of(T: int, seed: int):
     return scene, obs, height
 
 
-def run_size(T: int, repeats: int, seed: int, gtsam_max: int, gtsam_barrier_max: int, settle: bool = False) -> dict:
+def run_size(T: int, repeats: int, seed: int, gtsam_max: int, gtsam_barrier_max: int, settle: bool = False,
+             route_timing: str = "constant") -> dict:
     scene, obs, height = problem_of(T, seed)
     field = scene.distance_field(0.05)
-    opts = TrajectoryOptions(height=height, settle_windows=settle)
+    opts = TrajectoryOptions(height=height, settle_windows=settle, route_timing=route_timing)
     out = {"T": T}
     out["full"], est = timed(lambda: estimate_trajectory(obs, field, opts), repeats)
     out["full_cpu"], out["full_cpu_min"], out["full_min"] = LAST_CPU
@@ -205,6 +207,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="T = 1 000 and 3 000, one repeat; prints only")
     ap.add_argument("--settle", action="store_true", help="full with settle_windows=True (opt-in, 34b); "
                     "writes results/trajectory_speed_settle.md")
+    ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
+                    help="full with TrajectoryOptions.route_timing (opt-in cubic, 34m); writes _cubic.md")
     args = ap.parse_args(argv)
     cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
     sizes = [1000, 3000] if args.quick else [int(s) for s in args.sizes.split(",")]
@@ -216,13 +220,15 @@ def main(argv: list[str] | None = None) -> int:
     estimate_trajectory(obs, scene.distance_field(0.05), TrajectoryOptions(height=height))
     results = []
     for T in sizes:
-        results.append(run_size(T, repeats, args.seed, args.gtsam_max, args.gtsam_barrier_max, args.settle))
+        results.append(run_size(T, repeats, args.seed, args.gtsam_max, args.gtsam_barrier_max, args.settle,
+                                args.route_timing))
         print(f"T = {T}: full {results[-1]['full']:.2f} s ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     text = tables(results, cpu)
     print(text)
-    save_result("trajectory_speed_settle" if args.settle else "trajectory_speed",
-                "Seed 002: speed on one core, scaling, environment cost, GTSAM" + (" (settle_windows)" if args.settle else ""),
-                text, args.quick, time.perf_counter() - t_start)
+    tail = ("_settle" if args.settle else "") + ("_cubic" if args.route_timing != "constant" else "")
+    save_result("trajectory_speed" + tail, "Seed 002: speed on one core, scaling, environment cost, GTSAM"
+                + (" (settle_windows)" if args.settle else "") + (" (route_timing='cubic')" if "cubic" in tail else ""),
+                text, args.quick, time.perf_counter() - t_start, script="trajectory_speed")
     return 0
 
 

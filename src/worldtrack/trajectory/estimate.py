@@ -19,7 +19,8 @@ from worldtrack.trajectory.model import POS, VEL, MotionPrior, TimeGrid, frame_i
 from worldtrack.trajectory.objective import Problem
 from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import LevenbergMarquardt, SolveResult, SolverOptions, levenberg_marquardt
-from worldtrack.trajectory.starts import START_NAMES, anchor_points, shortest_path_start, straight_start
+from worldtrack.trajectory.starts import (ROUTE_TIMINGS, START_NAMES, anchor_points, shortest_path_start,
+                                         straight_start)
 from worldtrack.trajectory.uncertainty import marginal_covariances
 from worldtrack.trajectory.settle import run_settling
 from worldtrack.trajectory.windows import race_by_gap
@@ -79,6 +80,14 @@ class TrajectoryOptions:
     coarse_tolerance : float — the relative decrease that ends the coarse solve
     settle_windows : bool — with a race, the leader's iterations go on the windows still moving only, once
         windows with half of the steps have settled (:mod:`.settle`); off by default
+    route_timing : str — how the ``shortest`` start walks each route: ``"constant"`` speed (the default) or
+        ``"cubic"``, the motion prior's timing from the MAP without the barrier's velocities at the gap's ends
+        (:func:`~.starts.cubic_timing`). 34m (``benchmarks/trajectory_slides.py``, the walks of
+        ``trajectory_speed.py``): leader iterations at T = 10 000 21/28/35 → 17/19/31 (dev walks 3/42/90),
+        26/19/28/10/10/21 → 18/19/19/10/10/14 (held-out 200–202, 400–402), 24/9/25 → 20/9/27 (never-used
+        500–502), but it stops elsewhere on the flat slides: objective −4.6e-5 … +2.2e-5 of the default's (4 of 12
+        above +1e-6), and at T = 1 000 walk 3 in a neighbouring minimum +2.0e-4 higher; office (``trajectory_office.py --route-timing cubic``) between views
+        0.778 → 0.781 m, in view, obstacles and crossings unchanged — hence opt-in
     solver : SolverOptions
     """
 
@@ -100,6 +109,7 @@ class TrajectoryOptions:
     coarse_steps: int | None = None
     coarse_tolerance: float = 1e-3
     settle_windows: bool = False
+    route_timing: str = "constant"
     solver: SolverOptions = field(default_factory=SolverOptions)
 
     def __post_init__(self) -> None:
@@ -110,6 +120,8 @@ class TrajectoryOptions:
             raise InputError(f"robust: expected a positive Huber threshold in sigmas, got {self.robust}")
         if not self.weight > 0:
             raise InputError(f"weight: expected λ > 0, got {self.weight}")
+        if self.route_timing not in ROUTE_TIMINGS:
+            raise InputError(f"route_timing: expected one of {', '.join(ROUTE_TIMINGS)}, got {self.route_timing!r}")
         if self.coarse_steps is not None and (int(self.coarse_steps) != self.coarse_steps or self.coarse_steps < 2):
             raise InputError(f"coarse_steps: expected an integer ≥ 2 or None, got {self.coarse_steps}")
 
@@ -258,7 +270,8 @@ def _barrier_starts(problem: Problem, straight: np.ndarray, without: SolveResult
     barrier = problem.environment.barrier
     if "shortest" in options.starts:
         starts["shortest"] = shortest_path_start(problem.observations, problem.grid, options.height, barrier.field,
-                                                 options.clearance, max(barrier.field.resolution, 0.1), anchors)
+                                                 options.clearance, max(barrier.field.resolution, 0.1), anchors,
+                                                 options.route_timing, without.X[:, [VEL[0], VEL[1]]])
     if options.race_iterations is not None and options.race_by_gap:
         result, wins, _ = race_by_gap(problem, {name: starts[name] for name in options.starts}, without.X,
                                       options.solver)

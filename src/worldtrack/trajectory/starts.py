@@ -9,7 +9,10 @@ empirically given initial trajectories and keeps the one with the lowest objecti
   than the clearance follows the shortest path through free space instead (Dijkstra on the
   distance field's raster, ``scipy.sparse.csgraph``; cells inside the clearance cost more, cells
   inside obstacles are barred), walked at constant speed. This start carries the right topology
-  (which side of a partition, which door) that the barrier alone cannot find.
+  (which side of a partition, which door) that the barrier alone cannot find. With ``timing="cubic"``
+  (``TrajectoryOptions.route_timing``, opt-in) each route is walked with the motion prior's own timing
+  between two states instead, :func:`cubic_timing` (34m: the start's error the leader's last iterations
+  remove is mostly along the path, ``benchmarks/trajectory_slides.py``).
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ from worldtrack.trajectory.model import STATE, TimeGrid
 from worldtrack.trajectory.observation import ObservationTerm
 
 START_NAMES = ("straight", "map", "shortest")
+#: How a route of the ``shortest`` start is walked in time (see :func:`shortest_path_start`).
+ROUTE_TIMINGS = ("constant", "cubic")
 #: Gaps whose ends fall in the same cells of this size (m) share one shortest-path search.
 ROUTE_CACHE_CELL = 0.25
 
@@ -66,9 +71,15 @@ def straight_start(term: ObservationTerm, grid: TimeGrid, head_height: float,
 
 def shortest_path_start(term: ObservationTerm, grid: TimeGrid, head_height: float, field: FloorGrid,
                         clearance: float, resolution: float = 0.1,
-                        anchors: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                        anchors: tuple[np.ndarray, np.ndarray] | None = None, timing: str = "constant",
+                        velocities: np.ndarray | None = None) -> np.ndarray:
     """Start ``shortest``: ``straight`` with every blocked gap replaced by a free-space shortest path.
-    ``anchors``: :func:`anchor_points` of ``term`` at ``head_height`` if already computed."""
+    ``anchors``: :func:`anchor_points` of ``term`` at ``head_height`` if already computed. ``timing``: each
+    route walked at constant speed, or ``"cubic"``: by :func:`cubic_timing`, its end speeds ``velocities``
+    ((n, 2) floor velocities, m/s, e.g. the MAP's without the barrier) at the gap's two ends along the route."""
+    if timing not in ROUTE_TIMINGS or (timing == "cubic" and velocities is None):
+        raise InputError(f"route timing: expected one of {', '.join(ROUTE_TIMINGS)} (cubic with velocities), "
+                         f"got {timing!r}")
     steps, xy = anchors or anchor_points(term, head_height)
     k = np.arange(grid.n)
     path = np.column_stack([np.interp(k, steps, xy[:, 0]), np.interp(k, steps, xy[:, 1])])
@@ -83,7 +94,10 @@ def shortest_path_start(term: ObservationTerm, grid: TimeGrid, head_height: floa
         route = routes[key]
         if route is not None:
             route = np.vstack([a, route[1:-1], b])          # a cached route, joined to these ends
-            path[k0:k1 + 1] = resample_by_length(route, k1 - k0 + 1)
+            if timing == "cubic":
+                path[k0:k1 + 1] = walk_route(route, (k1 - k0) * grid.dt, velocities[k0], velocities[k1], k1 - k0 + 1)
+            else:
+                path[k0:k1 + 1] = resample_by_length(route, k1 - k0 + 1)
     return states_from_positions(path, grid, head_height)
 
 
@@ -123,6 +137,35 @@ def resample_by_length(route: np.ndarray, n: int) -> np.ndarray:
         return np.repeat(route[:1], n, axis=0)
     target = np.linspace(0.0, s[-1], n)
     return np.column_stack([np.interp(target, s, route[:, 0]), np.interp(target, s, route[:, 1])])
+
+
+def cubic_timing(length: float, duration: float, v0: float, v1: float, n: int) -> np.ndarray:
+    """(n,) arc length (m) at n equal time steps over ``duration`` (s) along a route of ``length`` (m): the cubic
+    s(t) from (0, v0) to (``length``, v1) (speeds in m/s, negative ones taken as 0) — the path of least squared
+    acceleration between two states, the motion prior's mean between them — kept in [0, length], non-decreasing.
+
+    >>> cubic_timing(2.0, 2.0, 1.0, 1.0, 5).tolist()          # the mean speed at both ends: constant speed
+    [0.0, 0.5, 1.0, 1.5, 2.0]
+    """
+    tau = np.linspace(0.0, 1.0, n)
+    h10, h01, h11 = tau ** 3 - 2 * tau ** 2 + tau, -2 * tau ** 3 + 3 * tau ** 2, tau ** 3 - tau ** 2
+    s = h10 * duration * max(v0, 0.0) + h01 * length + h11 * duration * max(v1, 0.0)
+    return np.maximum.accumulate(np.clip(s, 0.0, length))
+
+
+def walk_route(route: np.ndarray, duration: float, v0: np.ndarray, v1: np.ndarray, n: int) -> np.ndarray:
+    """``n`` points (n, 2) along a polyline (M, 2), m, at equal time steps over ``duration`` (s), with
+    :func:`cubic_timing`; the end speeds are the velocities v0, v1 ((2,), m/s) along the route's first and
+    last half metre (or half its length)."""
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(route, axis=0).T))]
+    if s[-1] <= 0:
+        return np.repeat(route[:1], n, axis=0)
+    h = min(0.5, s[-1] / 2)
+    at = lambda a: np.column_stack([np.interp(a, s, route[:, 0]), np.interp(a, s, route[:, 1])])  # noqa: E731
+    (ahead,), (behind,) = at(h) - route[0], route[-1] - at(s[-1] - h)
+    speed0 = float(np.dot(v0, ahead)) / max(float(np.hypot(*ahead)), 1e-12)
+    speed1 = float(np.dot(v1, behind)) / max(float(np.hypot(*behind)), 1e-12)
+    return at(cubic_timing(s[-1], duration, speed0, speed1, n))
 
 
 def free_space_route(field: FloorGrid, a: np.ndarray, b: np.ndarray, clearance: float,
