@@ -76,6 +76,11 @@ class MapConfig(Section):
                                                     "that sees a person behind somebody measures no height), not "
                                                     "by support alone (held-out 24-53: 5 seeds better, 9 worse, "
                                                     "MOTA -0.008)")
+    head_rays: bool = Field(False, description="each worker publishes per person its cameras' own rays through the "
+                                               "top of the head and the bottom of the feet in its foreground, and "
+                                               "the map puts a person two workers see where their rays meet "
+                                               "(worldtrack.map.rays: cameras facing each other fix depth and "
+                                               "height there, which their estimates only average)")
     weigh_own: bool = Field(False, description="weigh each worker's estimate (and choose the lead) by support x "
                                               "the share of the body no other person it holds covers in its "
                                               "views, not by support alone: a worker that sees a person behind "

@@ -1,0 +1,225 @@
+"""Each worker's own view rays of a person, and the point the rays of several workers meet at.
+
+A one-camera worker's depth slides along its line of sight (0.4–0.9 m on two-rooms, issue 39m)
+while the pixels it rests on do not: the top of the head and the bottom of the feet in its
+foreground fix two *directions* from its camera, whatever height and depth its tracker settled
+on (and the height it copies from the map). So, with ``map.head_rays``, a worker publishes per
+person and camera the camera's centre and the unit directions through those two pixels
+(:func:`view_rays`, NaN where a pixel is not clearly shown), and the fusion finds the point and
+height nearest to all workers' rays (:func:`triangulate`). Two cameras facing each other along
+one axis see a person's floor point on one line — their estimates only average there — but
+their head rays cross in 3-D at ~30° (from 3 m above the floor to a 1.7 m head 5 m away from
+each), which fixes depth and height to centimetres.
+
+>>> head = np.array([5.0, 2.5, 1.75])
+>>> rays = [ViewRay(1, *o, *((head - o) / np.linalg.norm(head - o)), *((head * [1, 1, 0] - o) /
+...         np.linalg.norm(head * [1, 1, 0] - o))) for o in (np.array([0.3, 2.5, 3.0]), np.array([11.7, 2.5, 3.0]))]
+>>> point, cov = triangulate(rays, np.array([5.6, 2.5, 1.7]))
+>>> np.round(point, 3).tolist(), round(float(np.sqrt(cov[0, 0])), 2)     # σ along the shared axis, m
+([5.0, 2.5, 1.75], 0.05)
+>>> [round(v, 3) for v in meet(rays, np.array([5.6, 2.5, 1.7]))]            # what the fusion takes
+[5.0, 2.5, 1.75]
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping, NamedTuple, Sequence
+
+import numpy as np
+
+from worldtrack.geometry.camera import Camera
+from worldtrack.map.evidence import people_boxes
+
+#: Foreground pixels a person's region needs before its ends are read.
+MIN_PIXELS = 20
+#: The region around a person's image box searched for their silhouette's ends, as a share of the
+#: box's height above and below it (a depth 0.6 m off at 5 m from a 3 m camera moves the feet by 0.17).
+SEARCH_MARGIN = 0.35
+
+
+class ViewRay(NamedTuple):
+    """One camera's rays of one person (metres, unit vectors): its centre ``ox, oy, oz``, the
+    direction through the top of the head ``hx, hy, hz`` and through the bottom of the feet
+    ``fx, fy, fz`` (NaN where the camera does not show that end clearly)."""
+
+    id: int
+    ox: float
+    oy: float
+    oz: float
+    hx: float = float("nan")
+    hy: float = float("nan")
+    hz: float = float("nan")
+    fx: float = float("nan")
+    fy: float = float("nan")
+    fz: float = float("nan")
+
+
+def _ends(fg: np.ndarray, down: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The top and bottom (u, v) of the foreground pixels ``fg`` (n, 2) along image direction
+    ``down``: the mean of the extreme 1 % on each side (with those within half a pixel of them), moved half
+    a pixel outwards."""
+    if len(fg) < MIN_PIXELS:
+        return None
+    along = fg @ down
+    n = max(1, len(fg) // 100)
+    lo, hi = np.partition(along, [n - 1, len(along) - n])[[n - 1, len(along) - n]]
+    # All pixels level with the cut: a flat top (a box, a hat) is taken whole, not its left end.
+    return fg[along <= lo + 0.5].mean(0) - 0.5 * down, fg[along >= hi - 0.5].mean(0) + 0.5 * down
+
+
+def view_rays(cam: Camera, mask: np.ndarray | None, people: np.ndarray, ids: Sequence[int],
+              occlusion: np.ndarray | None = None) -> list[ViewRay]:
+    """The head and feet rays of ``people`` (n, 4: x, y, height, width m) in ``cam``'s foreground
+    ``mask`` (H, W, 1 = foreground), one :class:`ViewRay` per person that shows (ids ``ids``).
+
+    A person's pixels are the foreground in their image box (:func:`~worldtrack.map.evidence.people_boxes`,
+    1.25× as wide, :data:`SEARCH_MARGIN` taller on each side) not inside the box of a person nearer
+    to the camera, nor inside a farther person's box outside their own. An end counts only where
+    it is clearly shown: the pixel two steps beyond it is inside the image and the searched region
+    (not cut), not in a nearer person's box, not another person's foreground (the silhouette may
+    go on there), and for the feet not behind an obstacle
+    (``occlusion``: (H, W) floor distance of the scene's obstacles, m); a silhouette touching the
+    image's left or right edge gives none (a sliver)."""
+    people = np.asarray(people, float).reshape(-1, 4)
+    if mask is None or mask.shape[:2] != (cam.height, cam.width) or not len(people):
+        return []
+    boxes = people_boxes(cam, people * [1, 1, 1, 1.25])
+    out = []
+    for k, (u0, v0, u1, v1, dist) in enumerate(boxes):
+        if not (u1 > u0 and v1 > v0):
+            continue
+        pad = SEARCH_MARGIN * (v1 - v0)
+        iu0, iv0 = max(0, int(math.floor(u0))), max(0, int(math.floor(v0 - pad)))
+        iu1, iv1 = min(cam.width, int(math.ceil(u1))), min(cam.height, int(math.ceil(v1 + pad)))
+        if iu1 <= iu0 or iv1 <= iv0:
+            continue
+        vv, uu = np.mgrid[iv0:iv1, iu0:iu1]
+        own = (uu >= u0) & (uu <= u1) & (vv >= v0) & (vv <= v1)
+        region = np.ones_like(own)
+        nearer = np.zeros_like(own)
+        for j, (bu0, bv0, bu1, bv1, bdist) in enumerate(boxes):
+            if j == k or not (bu1 > bu0):
+                continue
+            inside = (uu >= bu0) & (uu <= bu1) & (vv >= bv0) & (vv <= bv1)
+            if bdist < dist - 0.3:
+                nearer |= inside
+            else:
+                region &= ~inside | own
+        region &= ~nearer
+        fg = mask[iv0:iv1, iu0:iu1] == 1
+        pts = np.column_stack([uu[fg & region], vv[fg & region]]).astype(float)
+        mine = fg & region
+        if len(pts) < MIN_PIXELS or (iu0 == 0 and mine[:, 0].any()) or (iu1 == cam.width and mine[:, -1].any()):
+            continue
+        down = cam.image_down_direction(pts.mean(0)[None])[0]
+        ends = _ends(pts, down) if np.isfinite(down).all() else None
+        if ends is None:
+            continue
+        dirs = []
+        for end, step in zip(ends, (-2.0, 2.0)):
+            q = end + step * down
+            iq = np.round(q).astype(int)
+            ok = bool(cam.in_image(q[None])[0]) and iv0 <= iq[1] < iv1 and iu0 <= iq[0] < iu1
+            ok = ok and not nearer[iq[1] - iv0, iq[0] - iu0] and (region[iq[1] - iv0, iq[0] - iu0] or not fg[
+                iq[1] - iv0, iq[0] - iu0])
+            if ok and step > 0 and occlusion is not None:
+                ok = bool(occlusion[iq[1], iq[0]] > dist - 0.3)
+            d = cam.rays(end[None])[1].reshape(3) if ok else np.full(3, np.nan)
+            dirs.append(d if np.isfinite(d).all() else np.full(3, np.nan))
+        if np.isfinite(np.concatenate(dirs)).any():
+            out.append(ViewRay(int(ids[k]), *(float(v) for v in cam.centre), *(float(v) for v in np.concatenate(dirs))))
+    return out
+
+
+def camera_rays(cameras: Mapping[str, Camera], tracker: Any, cams: Sequence[str], tracks: Sequence[Any],
+                ids: set[int], occlusion: Mapping[str, np.ndarray]) -> dict[str, tuple[ViewRay, ...]]:
+    """Per camera of ``cams``, the :func:`view_rays` of the people ``ids`` among ``tracks`` (a
+    worker's tracker's tracks: everybody it holds, whose image boxes tell who covers whom) in the
+    foreground its ``tracker`` read last (``tracker.overlay(camera).mask``)."""
+    bodies = np.array([[tr.x, tr.y, tr.height, tr.width] for tr in tracks], float).reshape(-1, 4)
+    held = [tr.id for tr in tracks]
+    out = {}
+    for c in cams:
+        mask = getattr(tracker.overlay(c), "mask", None) if hasattr(tracker, "overlay") else None
+        out[c] = tuple(r for r in view_rays(cameras[c], mask, bodies, held, occlusion.get(c)) if r.id in ids)
+    return out
+
+
+def triangulate(rays: Sequence[ViewRay], near: np.ndarray, sigma_rad: float = 0.006
+                ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The point ``(x, y, height)`` (m) nearest to ``rays`` — the head rays pass through
+    ``(x, y, height)``, the feet rays through ``(x, y, 0)`` — by least squares weighing each ray
+    by ``1 / (sigma_rad · range)²`` (an angular error; ``range`` from the ray's origin to ``near``
+    (3,), the person's current place and height), with its covariance (3, 3) m². Without head
+    rays the height is ``near``'s and its variance 0. None when the rays do not fix the point
+    (one head ray alone, parallel rays)."""
+    m, b = np.zeros((3, 3)), np.zeros(3)
+    heads = 0
+    for r in rays:
+        o = np.array([r.ox, r.oy, r.oz])
+        for d, on_floor in ((np.array([r.hx, r.hy, r.hz]), False), (np.array([r.fx, r.fy, r.fz]), True)):
+            if not np.isfinite(d).all():
+                continue
+            target = near * [1.0, 1.0, 0.0] if on_floor else near
+            w = 1.0 / (sigma_rad * max(float(np.linalg.norm(target - o)), 0.5)) ** 2
+            p = np.eye(3) - np.outer(d, d)
+            s = np.diag([1.0, 1.0, 0.0]) if on_floor else np.eye(3)
+            m += w * s.T @ p @ s
+            b += w * s.T @ p @ o
+            heads += not on_floor
+    n = 3 if heads else 2
+    sub = m[:n, :n]
+    if not np.isfinite(sub).all() or np.linalg.cond(sub) > 1e8 or np.linalg.det(sub) <= 0:
+        return None
+    cov = np.zeros((3, 3))
+    cov[:n, :n] = np.linalg.inv(sub)
+    point = np.array(near, float)
+    point[:n] = cov[:n, :n] @ b[:n]
+    return point, cov
+
+
+def ray_gaps(rays: Sequence[ViewRay], point: np.ndarray) -> np.ndarray:
+    """How far (m) each ray of ``rays`` passes from ``point`` (x, y, height): head rays from the
+    head, feet rays from the floor point below it; (k,) over the rays given, in order."""
+    gaps = []
+    for r in rays:
+        o = np.array([r.ox, r.oy, r.oz])
+        for d, q in ((np.array([r.hx, r.hy, r.hz]), point), (np.array([r.fx, r.fy, r.fz]), point * [1, 1, 0])):
+            if np.isfinite(d).all():
+                v = q - o
+                gaps.append(float(np.linalg.norm(v - (v @ d) * d)))
+    return np.array(gaps)
+
+
+def meet(rays: Sequence[ViewRay], near: np.ndarray, max_shift_m: float = 1.0, max_sigma_m: float = 0.3,
+         height_range_m: tuple[float, float] = (1.2, 2.2)) -> tuple[float, float, float] | None:
+    """Where the rays of several workers put a person: ``(x, y, height)`` m, the height NaN unless
+    head rays of two cameras fix it; None when they do not agree. ``near`` (3,): the estimates'
+    weighted place and height (m).
+
+    The rays agree when each passes within three of its own σ (plus 5 cm for the silhouette's
+    edge) of their point, that point is within ``max_shift_m`` of ``near``, and its σ in the worst
+    floor direction is below ``max_sigma_m`` — otherwise some view's top of the head or feet are
+    somebody else's, or the views are too nearly parallel to tell."""
+    found = triangulate(rays, near)
+    if found is None:
+        return None
+    point, cov = found
+    ranges = []
+    for r in rays:
+        o = np.array([r.ox, r.oy, r.oz])
+        ranges += [float(np.linalg.norm(q - o)) for d, q in (((r.hx, r.hy, r.hz), point), ((r.fx, r.fy, r.fz),
+                                                                                          point * [1, 1, 0]))
+                   if np.isfinite(d).all()]
+    if (ray_gaps(rays, point) > 3 * 0.006 * np.array(ranges) + 0.05).any():
+        return None
+    if np.hypot(*(point[:2] - near[:2])) > max_shift_m or np.sqrt(np.linalg.eigvalsh(cov[:2, :2])[-1]) > max_sigma_m:
+        return None
+    cams = {(r.ox, r.oy, r.oz) for r in rays if math.isfinite(r.hx)}
+    lo, hi = height_range_m
+    h = float(point[2]) if len(cams) >= 2 and np.sqrt(cov[2, 2]) < 0.1 and lo <= point[2] <= hi else float("nan")
+    return float(point[0]), float(point[1]), h
+
+
+__all__ = ["MIN_PIXELS", "SEARCH_MARGIN", "ViewRay", "camera_rays", "meet", "ray_gaps", "triangulate", "view_rays"]

@@ -1,0 +1,104 @@
+"""Each worker's own head and feet rays (map.head_rays): measured in its foreground, carried in the
+observation beside format 2, and met by the fusion (pure functions, no server)."""
+
+import math
+
+import numpy as np
+
+from worldtrack.geometry.camera import Camera
+from worldtrack.map.config import MapConfig
+from worldtrack.map.evidence import people_boxes
+from worldtrack.map.fusion import FusionState, fuse_bucket
+from worldtrack.map.messages import Estimate, Observation, decode_observation, encode_observation
+from worldtrack.map.rays import ViewRay, meet, view_rays
+
+WEST = Camera.look_at("west", 320, 240, [0.3, 2.5, 3.0], [6.0, 2.5, 0.0], hfov_deg=60)
+EAST = Camera.look_at("east", 320, 240, [11.7, 2.5, 3.0], [6.0, 2.5, 0.0], hfov_deg=60)
+
+
+def drawn(cam, people):
+    """A foreground mask with each person of ``people`` (x, y, height, width) drawn as their box."""
+    mask = np.zeros((cam.height, cam.width), np.uint8)
+    for u0, v0, u1, v1, _ in people_boxes(cam, np.asarray(people, float)):
+        mask[int(round(v0)):int(round(v1)), int(round(u0)):int(round(u1))] = 1
+    return mask
+
+
+def through(ray_o, d, z):
+    """Where the ray from ``ray_o`` along ``d`` is at height ``z``: (x, y)."""
+    s = (z - ray_o[2]) / d[2]
+    return ray_o[:2] + s * d[:2]
+
+
+def test_the_rays_go_through_the_head_and_feet_the_foreground_shows_not_the_estimates():
+    truth = [5.0, 2.5, 1.85, 0.45]
+    mask = drawn(WEST, [truth])
+    # The worker's tracker slid 0.6 m away along the ray with the map's 1.7 m height.
+    r, = view_rays(WEST, mask, np.array([[5.6, 2.5, 1.7, 0.45]]), [7])
+    o = np.array([r.ox, r.oy, r.oz])
+    head, feet = np.array([r.hx, r.hy, r.hz]), np.array([r.fx, r.fy, r.fz])
+    assert r.id == 7 and np.allclose(through(o, head, 1.85), [5.0, 2.5], atol=0.12)
+    assert np.allclose(through(o, feet, 0.0), [5.0, 2.5], atol=0.12)
+
+
+def test_a_person_behind_another_gives_no_feet_ray_and_the_one_in_front_not_the_others_head():
+    front, back = [4.0, 2.5, 1.6, 0.45], [6.0, 2.85, 1.9, 0.45]    # the taller one behind, half covered
+    rays = {r.id: r for r in view_rays(WEST, drawn(WEST, [front, back]), np.array([front, back]), [1, 2])}
+    o = np.array([rays[1].ox, rays[1].oy, rays[1].oz])
+    assert np.allclose(through(o, np.array(rays[1][4:7]), 1.6), [4.0, 2.5], atol=0.12)
+    assert np.allclose(through(o, np.array(rays[2][4:7]), 1.9), [6.0, 2.85], atol=0.12)
+    assert abs(through(o, np.array(rays[2][7:10]), 0.0)[0] - 6.0) < 0.1     # the depth of the feet's visible side
+    back[1] = 2.5                                                  # right behind: feet hidden, head above the other's
+    rays = {r.id: r for r in view_rays(WEST, drawn(WEST, [front, back]), np.array([front, back]), [1, 2])}
+    assert math.isnan(rays[2].fx) and np.allclose(through(o, np.array(rays[2][4:7]), 1.9), [6.0, 2.5], atol=0.12)
+    # The one in front: feet shown; above their head the other's silhouette goes on, so no head ray.
+    assert math.isnan(rays[1].hx) and np.allclose(through(o, np.array(rays[1][7:10]), 0.0), [4.0, 2.5], atol=0.12)
+
+
+def test_a_sliver_at_the_image_edge_gives_no_rays():
+    mask = np.zeros((240, 320), np.uint8)
+    mask[60:200, 0:6] = 1
+    xy = WEST.backproject(np.array([[3.0, 200.0]]), 0.0)[0][:2]
+    assert view_rays(WEST, mask, np.array([[*xy, 1.7, 0.45]]), [1]) == []
+
+
+def test_the_rays_travel_in_a_field_of_their_own_that_older_readers_do_not_read():
+    r = ViewRay(4, 0.3, 2.5, 3.0, 0.9, 0.0, -0.3, float("nan"), float("nan"), float("nan"))
+    o = Observation("west", 1.0, "w1", 10, 1.01, (Estimate(4, 5.0, 2.5, 1.7, 0.45, 0, 0, 0.5, 0.8, True),), rays=(r,))
+    fields = encode_observation(o)
+    back = decode_observation(fields)
+    assert fields["v"] == "2" and back.people[0][:10] == o.people[0][:10] and back.rays[0][:7] == r[:7] and math.isnan(back.rays[0].fx)
+    assert decode_observation({k: v for k, v in fields.items() if k != "rays"}).rays == ()    # an older worker
+    assert decode_observation(fields | {"rays": '[99, [[1, 2]]]'}).rays == ()                # a later ray format
+    assert "rays" not in encode_observation(o.__class__(*[getattr(o, f) for f in ("camera", "t", "worker", "frame",
+                                                                                 "sent", "people")]))
+
+
+def _opposite_workers(truth, west_x, east_x):
+    """Both workers see ``truth`` (x, y, h, w); their trackers put it at ``west_x`` / ``east_x``."""
+    obs = []
+    for cam, x, worker in ((WEST, west_x, "w1"), (EAST, east_x, "w2")):
+        e = Estimate(7, x, 2.5, 1.7, 0.45, 0, 0, 0.5, 0.8, True)
+        rays = tuple(view_rays(cam, drawn(cam, [truth]), np.array([[x, 2.5, 1.7, 0.45]]), [7]))
+        obs.append(Observation(cam.id, 5.0, worker, 50, 5.01, (e,), rays=rays))
+    return obs
+
+
+def test_the_map_puts_a_person_two_facing_workers_see_where_their_rays_meet_when_asked():
+    truth = [5.3, 2.5, 1.85, 0.45]
+    observations = _opposite_workers(truth, 6.0, 4.9)     # both slid, along the one axis they share
+    off, = fuse_bucket(FusionState(), 50, observations, MapConfig()).people
+    on, = fuse_bucket(FusionState(), 50, observations, MapConfig(head_rays=True)).people
+    assert abs(off.x - 5.3) > 0.1 and off.height == 1.7              # the default: the estimates' mean
+    assert abs(on.x - 5.3) < 0.08 and abs(on.height - 1.85) < 0.06 and abs(on.y - 2.5) < 0.05
+
+
+def test_rays_that_miss_each_other_leave_the_estimates_mean():
+    far_apart = [ViewRay(7, 0.3, 2.5, 3.0, *(v / np.linalg.norm(v)), math.nan, math.nan, math.nan)
+                 for v in (np.array([4.7, 0.0, -1.3]), np.array([4.7, 1.5, -1.3]))]
+    assert meet(far_apart, np.array([5.0, 2.5, 1.7])) is None        # one camera's two rays apart
+    crossing = [ViewRay(7, 0.3, 2.5, 3.0, *(v / np.linalg.norm(v)), math.nan, math.nan, math.nan)
+                for v in (np.array([4.7, 0.0, -1.3]),)] + \
+               [ViewRay(7, 11.7, 2.5, 3.0, *(v / np.linalg.norm(v)), math.nan, math.nan, math.nan)
+                for v in (np.array([-3.0, 0.0, -1.3]),)]                 # they meet 1.9 m off the estimates
+    assert meet(crossing, np.array([4.0, 2.5, 1.7])) is None
