@@ -10,7 +10,7 @@ from worldtrack.map.config import MapConfig
 from worldtrack.map.evidence import people_boxes
 from worldtrack.map.fusion import FusionState, fuse_bucket
 from worldtrack.map.messages import Estimate, Observation, decode_observation, encode_observation
-from worldtrack.map.rays import ViewRay, meet, view_rays
+from worldtrack.map.rays import ViewRay, ray_height, view_rays
 
 WEST = Camera.look_at("west", 320, 240, [0.3, 2.5, 3.0], [6.0, 2.5, 0.0], hfov_deg=60)
 EAST = Camera.look_at("east", 320, 240, [11.7, 2.5, 3.0], [6.0, 2.5, 0.0], hfov_deg=60)
@@ -74,31 +74,57 @@ def test_the_rays_travel_in_a_field_of_their_own_that_older_readers_do_not_read(
                                                                                  "sent", "people")]))
 
 
-def _opposite_workers(truth, west_x, east_x):
-    """Both workers see ``truth`` (x, y, h, w); their trackers put it at ``west_x`` / ``east_x``."""
+def _opposite_workers(truth, west_x, east_x, t=5.0):
+    """Both workers see ``truth`` (x, y, h, w); their trackers put it at ``west_x`` / ``east_x``, 1.7 m tall."""
     obs = []
     for cam, x, worker in ((WEST, west_x, "w1"), (EAST, east_x, "w2")):
         e = Estimate(7, x, 2.5, 1.7, 0.45, 0, 0, 0.5, 0.8, True)
         rays = tuple(view_rays(cam, drawn(cam, [truth]), np.array([[x, 2.5, 1.7, 0.45]]), [7]))
-        obs.append(Observation(cam.id, 5.0, worker, 50, 5.01, (e,), rays=rays))
+        obs.append(Observation(cam.id, t, worker, int(t * 10), t + 0.01, (e,), rays=rays))
     return obs
 
 
-def test_the_map_puts_a_person_two_facing_workers_see_where_their_rays_meet_when_asked():
+def test_the_map_takes_the_height_two_facing_workers_head_rays_tell_when_asked():
     truth = [5.3, 2.5, 1.85, 0.45]
-    observations = _opposite_workers(truth, 6.0, 4.9)     # both slid, along the one axis they share
-    off, = fuse_bucket(FusionState(), 50, observations, MapConfig()).people
-    on, = fuse_bucket(FusionState(), 50, observations, MapConfig(head_rays=True)).people
-    assert abs(off.x - 5.3) > 0.1 and off.height == 1.7              # the default: the estimates' mean
-    assert abs(on.x - 5.3) < 0.08 and abs(on.height - 1.85) < 0.06 and abs(on.y - 2.5) < 0.05
+    heights = {}
+    for on in (False, True):
+        state = FusionState()
+        for b in range(50, 54):          # both slid along the one axis they share, with the map's 1.7 m
+            p, = fuse_bucket(state, b, _opposite_workers(truth, 6.0, 4.9, b / 10), MapConfig(head_rays=on)).people
+            heights.setdefault(on, []).append(p.height)
+    assert heights[False] == [1.7] * 4                                  # the default: the estimates' height
+    assert heights[True][:2] == [1.7, 1.7] and abs(heights[True][-1] - 1.85) < 0.04    # from the third on
+    assert len(state.people[7].ray_heights) == 4
 
 
-def test_rays_that_miss_each_other_leave_the_estimates_mean():
-    far_apart = [ViewRay(7, 0.3, 2.5, 3.0, *(v / np.linalg.norm(v)), math.nan, math.nan, math.nan)
-                 for v in (np.array([4.7, 0.0, -1.3]), np.array([4.7, 1.5, -1.3]))]
-    assert meet(far_apart, np.array([5.0, 2.5, 1.7])) is None        # one camera's two rays apart
-    crossing = [ViewRay(7, 0.3, 2.5, 3.0, *(v / np.linalg.norm(v)), math.nan, math.nan, math.nan)
-                for v in (np.array([4.7, 0.0, -1.3]),)] + \
-               [ViewRay(7, 11.7, 2.5, 3.0, *(v / np.linalg.norm(v)), math.nan, math.nan, math.nan)
-                for v in (np.array([-3.0, 0.0, -1.3]),)]                 # they meet 1.9 m off the estimates
-    assert meet(crossing, np.array([4.0, 2.5, 1.7])) is None
+def test_head_rays_that_do_not_agree_tell_no_height():
+    o1, o2 = np.array([0.3, 2.5, 3.0]), np.array([11.7, 2.5, 3.0])
+    unit = lambda v: v / np.linalg.norm(v)        # noqa: E731
+    agree = [ViewRay(7, *o, *unit(np.array([5.0, 2.5, 1.85]) - o)) for o in (o1, o2)]
+    assert abs(ray_height(agree, np.array([5.2, 2.5, 1.7])) - 1.85) < 0.12
+    # East's "top of the head" is somebody else's, 1.5 m farther on: the rays meet 0.7 m off the
+    # estimates, or not at all.
+    other = [agree[0], ViewRay(7, *o2, *unit(np.array([3.5, 2.5, 1.85]) - o2))]
+    assert ray_height(other, np.array([5.2, 2.5, 1.7])) is None
+    assert ray_height(agree[:1], np.array([5.2, 2.5, 1.7])) is None          # one camera
+
+
+def tangent_to_head(o, crown, radius=0.1):
+    """The ray from ``o`` over the top of a spherical head (``radius`` m) whose crown is at ``crown``."""
+    centre = crown - [0.0, 0.0, radius]
+    flat = np.append(centre[:2] - o[:2], 0.0)
+    dist, drop = np.linalg.norm(flat), o[2] - centre[2]
+    below = math.atan2(drop, dist) - math.asin(radius / math.hypot(dist, drop))    # over the head, not through it
+    return ViewRay(7, *o, *(flat / dist * math.cos(below) - [0.0, 0.0, math.sin(below)]))
+
+
+def test_the_height_from_rays_over_the_head_and_to_the_near_edge_of_the_feet():
+    crown, o1, o2 = np.array([4.0, 2.5, 1.85]), np.array([0.3, 2.5, 3.0]), np.array([11.7, 2.5, 3.0])
+    rays = [tangent_to_head(o, crown) for o in (o1, o2)]
+    assert abs(ray_height(rays, np.array([4.4, 2.5, 1.7])) - 1.85) < 0.001         # exact for a round head
+    # With the feet: west's feet ray to the near edge of the feet fits; one 0.6 m beyond does not.
+    unit = lambda v: v / np.linalg.norm(v)        # noqa: E731
+    edge = ViewRay(7, *o1, *rays[0][4:7], *unit(np.array([4.0 - 0.15, 2.5, 0.0]) - o1))
+    beyond = ViewRay(7, *o1, *rays[0][4:7], *unit(np.array([4.6, 2.5, 0.0]) - o1))
+    assert abs(ray_height([edge, rays[1]], np.array([4.4, 2.5, 1.7])) - 1.85) < 0.01
+    assert ray_height([beyond, rays[1]], np.array([4.4, 2.5, 1.7])) is None

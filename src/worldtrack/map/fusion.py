@@ -79,7 +79,11 @@ from worldtrack.map.evidence import (LEAD_SHARE, floor_information, in_views, pe
                                      with_ray_error)
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
 from worldtrack.map.merges import MIN_WEIGHT, merge_duplicates
-from worldtrack.map.rays import ViewRay, meet
+from worldtrack.map.rays import ViewRay, ray_height
+
+#: ``map.head_rays``: the map's height of a person is the median of their last this many heights
+#: from head rays (:func:`~worldtrack.map.rays.ray_height`), once three are in.
+RAY_HEIGHTS = 15
 from worldtrack.map.refute import refute
 from worldtrack.map.same_blob import fold_same_blobs
 
@@ -107,6 +111,8 @@ class FusedPerson:
     doubt: int = 0
     #: Buckets running in which only one worker reported them, covered by other people there.
     hidden: int = 0
+    #: ``map.head_rays``: their last heights (m) from two workers' head rays, oldest first.
+    ray_heights: list = field(default_factory=list)
 
     def public(self) -> MapPerson:
         return MapPerson(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
@@ -322,24 +328,28 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
     committed state stay as they are). ``rays``: per person the view rays of each worker and camera
-    (:func:`_rays_of`); a person two workers that see them publish rays of is where the rays meet
-    (:func:`~worldtrack.map.rays.meet`), when they agree. Returns, per person, the workers that see them."""
+    (:func:`_rays_of`); the height of a person two workers that see them publish head rays of is
+    the median of their last :data:`RAY_HEIGHTS` heights from those rays
+    (:func:`~worldtrack.map.rays.ray_height`), once three are in. Returns, per person, the workers
+    that see them."""
     workers_of: dict[int, set[str]] = {}
     for pid, by_worker in estimates.items():
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
         x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by, weigh_own, ray_error_m, height_by_view)
         mine = {key: r for key, r in (rays or {}).get(pid, {}).items() if key[0] in by_worker and by_worker[key[0]].seen}
-        if len({k for k, _ in mine}) >= 2:
-            met = meet(list(mine.values()), np.array([x, y, h if math.isfinite(h) else 1.7]))
-            if met is not None:
-                x, y, h = met[0], met[1], met[2] if math.isfinite(met[2]) else h
+        measured = ray_height(list(mine.values()), np.array([x, y, h if math.isfinite(h) else 1.7])) \
+            if len({k for k, _ in mine}) >= 2 else None
         p = people.get(pid)
         if p is None:
             p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
         elif copy:
             p = people[pid] = replace(p)
         p.x, p.y, p.vx, p.vy, p.score, p.support = x, y, vx, vy, score, support
+        if measured is not None:     # a new list: a copy (copy=True) must not change the committed person's
+            p.ray_heights = [*p.ray_heights[1 - RAY_HEIGHTS:], measured]
+        if len(p.ray_heights) >= 3:
+            h = float(np.median(p.ray_heights))
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)

@@ -1,24 +1,24 @@
-"""Each worker's own view rays of a person, and the point the rays of several workers meet at.
+"""Each worker's own view rays of a person, and the height the head rays of several workers tell.
 
 A one-camera worker's depth slides along its line of sight (0.4–0.9 m on two-rooms, issue 39m)
 while the pixels it rests on do not: the top of the head and the bottom of the feet in its
 foreground fix two *directions* from its camera, whatever height and depth its tracker settled
-on (and the height it copies from the map). So, with ``map.head_rays``, a worker publishes per
-person and camera the camera's centre and the unit directions through those two pixels
-(:func:`view_rays`, NaN where a pixel is not clearly shown), and the fusion finds the point and
-height nearest to all workers' rays (:func:`triangulate`). Two cameras facing each other along
-one axis see a person's floor point on one line — their estimates only average there — but
-their head rays cross in 3-D at ~30° (from 3 m above the floor to a 1.7 m head 5 m away from
-each), which fixes depth and height to centimetres.
+on. A worker that sees a person only with its own camera cannot measure their height when the
+feet are hidden, and the workers copy the map's height (0.075 m off on two-rooms dev seeds, one
+process 0.035) — and a height 0.1 m off moves a head-only depth ~0.5 m at 7 m from a 3 m camera.
 
->>> head = np.array([5.0, 2.5, 1.75])
->>> rays = [ViewRay(1, *o, *((head - o) / np.linalg.norm(head - o)), *((head * [1, 1, 0] - o) /
-...         np.linalg.norm(head * [1, 1, 0] - o))) for o in (np.array([0.3, 2.5, 3.0]), np.array([11.7, 2.5, 3.0]))]
->>> point, cov = triangulate(rays, np.array([5.6, 2.5, 1.7]))
->>> np.round(point, 3).tolist(), round(float(np.sqrt(cov[0, 0])), 2)     # σ along the shared axis, m
-([5.0, 2.5, 1.75], 0.05)
->>> [round(v, 3) for v in meet(rays, np.array([5.6, 2.5, 1.7]))]            # what the fusion takes
-[5.0, 2.5, 1.75]
+So, with ``map.head_rays``, a worker publishes per person and camera the camera's centre and the
+unit directions through those two pixels (:func:`view_rays`, NaN where a pixel is not clearly
+shown), and the fusion triangulates the height where two workers' cameras show the head
+(:func:`ray_height`): two cameras facing each other along one axis see a person's floor point on
+one line, but their head rays cross in 3-D at ~30° (from 3 m above the floor to a 1.7 m head
+5 m from each). The map keeps the median of a person's last such heights
+(:mod:`worldtrack.map.fusion`). Their *place* the rays tell worse than the trackers' fits
+(two-rooms seed 17, clear frames: 0.10 m against 0.086 m), so it is left to them.
+
+>>> o = np.array([0.3, 2.5, 3.0])
+>>> ray_height([ViewRay(1, *o, 0.9, 0.0, -0.3)], np.array([5.0, 2.5, 1.7])) is None    # one camera: no height
+True
 """
 
 from __future__ import annotations
@@ -146,80 +146,93 @@ def camera_rays(cameras: Mapping[str, Camera], tracker: Any, cams: Sequence[str]
     return out
 
 
-def triangulate(rays: Sequence[ViewRay], near: np.ndarray, sigma_rad: float = 0.006
-                ) -> tuple[np.ndarray, np.ndarray] | None:
-    """The point ``(x, y, height)`` (m) nearest to ``rays`` — the head rays pass through
-    ``(x, y, height)``, the feet rays through ``(x, y, 0)`` — by least squares weighing each ray
-    by ``1 / (sigma_rad · range)²`` (an angular error; ``range`` from the ray's origin to ``near``
-    (3,), the person's current place and height), with its covariance (3, 3) m². Without head
-    rays the height is ``near``'s and its variance 0. None when the rays do not fix the point
-    (one head ray alone, parallel rays)."""
-    m, b = np.zeros((3, 3)), np.zeros(3)
-    heads = 0
+#: The top of a silhouette is a ray tangent to the head (a sphere of about this radius, m), not
+#: through the crown: from a camera above, it passes the far side of the head.
+HEAD_RADIUS_M = 0.1
+#: The bottom of a silhouette is the near edge of the feet: this far (m) from the body's axis
+#: towards the camera.
+FEET_REACH_M = 0.15
+#: The angular error (rad) of a silhouette's end: ~1.7 px at 277 px focal length (two-rooms).
+SIGMA_RAD = 0.006
+
+
+def _targets(r: ViewRay, near: np.ndarray):
+    """The rays of ``r`` that are given, each as (origin (3,), direction (3,), on the floor, offset
+    (3,) of the point the ray touches from ``(x, y, height)`` resp. ``(x, y, 0)``)."""
+    o = np.array([r.ox, r.oy, r.oz])
+    towards = np.append(near[:2] - o[:2], 0.0)
+    towards /= max(float(np.linalg.norm(towards)), 1e-9)
+    for d, floor in ((np.array([r.hx, r.hy, r.hz]), False), (np.array([r.fx, r.fy, r.fz]), True)):
+        if not np.isfinite(d).all():
+            continue
+        if floor:
+            yield o, d, True, -FEET_REACH_M * towards
+        else:
+            below = -np.array([0.0, 0.0, 1.0]) + d[2] * d            # down, across the ray
+            n = below / max(float(np.linalg.norm(below)), 1e-9)
+            yield o, d, False, -HEAD_RADIUS_M * (np.array([0.0, 0.0, 1.0]) + n)
+
+
+def triangulate(rays: Sequence[ViewRay], near: np.ndarray, sigma_rad: float = SIGMA_RAD
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The place and height ``(x, y, height)`` (m) that fit ``rays`` best, its covariance (3, 3)
+    m² and how far (m) each given ray passes from where it should, in order (head rays first per
+    :class:`ViewRay`).
+
+    Each head ray is a tangent to the head (:data:`HEAD_RADIUS_M`, its centre that far below
+    ``height``), each feet ray goes through the near edge of the feet (:data:`FEET_REACH_M`
+    towards its camera from ``(x, y, 0)``); least squares, each ray weighed by
+    ``1 / (sigma_rad · range)²`` (``range`` from its origin to ``near`` (3,), the person's
+    current place and height). Without head rays the height is ``near``'s (variance 0). None when
+    the rays do not fix the point (one head ray alone, parallel rays).
+    """
+    near = np.asarray(near, float)
+    m, b, heads, rows = np.zeros((3, 3)), np.zeros(3), 0, []
     for r in rays:
-        o = np.array([r.ox, r.oy, r.oz])
-        for d, on_floor in ((np.array([r.hx, r.hy, r.hz]), False), (np.array([r.fx, r.fy, r.fz]), True)):
-            if not np.isfinite(d).all():
-                continue
-            target = near * [1.0, 1.0, 0.0] if on_floor else near
-            w = 1.0 / (sigma_rad * max(float(np.linalg.norm(target - o)), 0.5)) ** 2
+        for o, d, floor, off in _targets(r, near):
+            s = np.diag([1.0, 1.0, 0.0]) if floor else np.eye(3)
             p = np.eye(3) - np.outer(d, d)
-            s = np.diag([1.0, 1.0, 0.0]) if on_floor else np.eye(3)
+            w = 1.0 / (sigma_rad * max(float(np.linalg.norm(s @ near + off - o)), 0.5)) ** 2
             m += w * s.T @ p @ s
-            b += w * s.T @ p @ o
-            heads += not on_floor
+            b += w * s.T @ p @ (o - off)
+            heads += not floor
+            rows.append((o, d, s, off))
     n = 3 if heads else 2
     sub = m[:n, :n]
-    if not np.isfinite(sub).all() or np.linalg.cond(sub) > 1e8 or np.linalg.det(sub) <= 0:
+    if not rows or not np.isfinite(sub).all() or np.linalg.det(sub) <= 0 or np.linalg.cond(sub) > 1e8:
         return None
     cov = np.zeros((3, 3))
     cov[:n, :n] = np.linalg.inv(sub)
-    point = np.array(near, float)
+    point = near.copy()
     point[:n] = cov[:n, :n] @ b[:n]
-    return point, cov
-
-
-def ray_gaps(rays: Sequence[ViewRay], point: np.ndarray) -> np.ndarray:
-    """How far (m) each ray of ``rays`` passes from ``point`` (x, y, height): head rays from the
-    head, feet rays from the floor point below it; (k,) over the rays given, in order."""
     gaps = []
-    for r in rays:
-        o = np.array([r.ox, r.oy, r.oz])
-        for d, q in ((np.array([r.hx, r.hy, r.hz]), point), (np.array([r.fx, r.fy, r.fz]), point * [1, 1, 0])):
-            if np.isfinite(d).all():
-                v = q - o
-                gaps.append(float(np.linalg.norm(v - (v @ d) * d)))
-    return np.array(gaps)
+    for o, d, s, off in rows:
+        v = s @ point + off - o
+        gaps.append(float(np.linalg.norm(v - (v @ d) * d)))
+    return point, cov, np.array(gaps)
 
 
-def meet(rays: Sequence[ViewRay], near: np.ndarray, max_shift_m: float = 1.0, max_sigma_m: float = 0.3,
-         height_range_m: tuple[float, float] = (1.2, 2.2)) -> tuple[float, float, float] | None:
-    """Where the rays of several workers put a person: ``(x, y, height)`` m, the height NaN unless
-    head rays of two cameras fix it; None when they do not agree. ``near`` (3,): the estimates'
-    weighted place and height (m).
-
-    The rays agree when each passes within three of its own σ (plus 5 cm for the silhouette's
-    edge) of their point, that point is within ``max_shift_m`` of ``near``, and its σ in the worst
-    floor direction is below ``max_sigma_m`` — otherwise some view's top of the head or feet are
-    somebody else's, or the views are too nearly parallel to tell."""
+def ray_height(rays: Sequence[ViewRay], near: np.ndarray, max_shift_m: float = 0.5,
+               height_range_m: tuple[float, float] = (1.2, 2.2)) -> float | None:
+    """A person's height (m) from the head rays of two cameras or more (with whatever feet rays
+    are given), or None when they do not fix it or do not agree: some ray passes farther than
+    three of its σ (plus 5 cm) from the fit, the fit is more than ``max_shift_m`` from ``near``
+    (3,: the estimates' place and height) or its height is implausible or unsure (σ ≥ 5 cm).
+    Then some view's top of the head is another person's, or the views are too nearly alike."""
+    near = np.asarray(near, float)
+    if len({(r.ox, r.oy, r.oz) for r in rays if math.isfinite(r.hx)}) < 2:
+        return None
     found = triangulate(rays, near)
     if found is None:
         return None
-    point, cov = found
-    ranges = []
-    for r in rays:
-        o = np.array([r.ox, r.oy, r.oz])
-        ranges += [float(np.linalg.norm(q - o)) for d, q in (((r.hx, r.hy, r.hz), point), ((r.fx, r.fy, r.fz),
-                                                                                          point * [1, 1, 0]))
-                   if np.isfinite(d).all()]
-    if (ray_gaps(rays, point) > 3 * 0.006 * np.array(ranges) + 0.05).any():
-        return None
-    if np.hypot(*(point[:2] - near[:2])) > max_shift_m or np.sqrt(np.linalg.eigvalsh(cov[:2, :2])[-1]) > max_sigma_m:
-        return None
-    cams = {(r.ox, r.oy, r.oz) for r in rays if math.isfinite(r.hx)}
+    point, cov, gaps = found
+    ranges = np.array([np.linalg.norm(s @ point + off - o) for r in rays for o, _, floor, off in _targets(r, near)
+                       for s in [np.diag([1.0, 1.0, 0.0]) if floor else np.eye(3)]])
     lo, hi = height_range_m
-    h = float(point[2]) if len(cams) >= 2 and np.sqrt(cov[2, 2]) < 0.1 and lo <= point[2] <= hi else float("nan")
-    return float(point[0]), float(point[1]), h
+    if (gaps > 3 * SIGMA_RAD * ranges + 0.05).any() or np.hypot(*(point[:2] - near[:2])) > max_shift_m:
+        return None
+    return float(point[2]) if lo <= point[2] <= hi and np.sqrt(cov[2, 2]) < 0.05 else None
 
 
-__all__ = ["MIN_PIXELS", "SEARCH_MARGIN", "ViewRay", "camera_rays", "meet", "ray_gaps", "triangulate", "view_rays"]
+__all__ = ["FEET_REACH_M", "HEAD_RADIUS_M", "MIN_PIXELS", "SEARCH_MARGIN", "SIGMA_RAD", "ViewRay", "camera_rays",
+           "ray_height", "triangulate", "view_rays"]
