@@ -128,3 +128,15 @@ def test_the_height_from_rays_over_the_head_and_to_the_near_edge_of_the_feet():
     beyond = ViewRay(7, *o1, *rays[0][4:7], *unit(np.array([4.6, 2.5, 0.0]) - o1))
     assert abs(ray_height([edge, rays[1]], np.array([4.4, 2.5, 1.7])) - 1.85) < 0.01
     assert ray_height([beyond, rays[1]], np.array([4.4, 2.5, 1.7])) is None
+
+
+def test_no_height_from_a_camera_that_sees_the_person_from_above():
+    o1, o2 = np.array([0.3, 2.5, 3.0]), np.array([11.7, 2.5, 3.0])
+    unit = lambda v: v / np.linalg.norm(v)        # noqa: E731
+
+    def seen(crown):                   # head and feet rays of both cameras, as a round head and feet show
+        edge = lambda o: crown * [1, 1, 0] + 0.15 * unit((o - crown) * [1, 1, 0])      # noqa: E731
+        return [ViewRay(7, *o, *tangent_to_head(o, crown)[4:7], *unit(edge(o) - o)) for o in (o1, o2)]
+    crown = np.array([10.2, 2.5, 1.8])                    # 1.5 m from east's foot point, 3 m up
+    assert ray_height(seen(crown), crown - [0.3, 0.0, 0.1]) is None
+    assert abs(ray_height(seen(crown - [1.0, 0, 0]), crown - [1.3, 0.0, 0.1]) - 1.8) < 0.01      # 2.5 m: counted

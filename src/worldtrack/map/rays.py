@@ -218,8 +218,13 @@ def ray_height(rays: Sequence[ViewRay], near: np.ndarray, max_shift_m: float = 0
     are given), or None when they do not fix it or do not agree: some ray passes farther than
     three of its σ (plus 5 cm) from the fit, the fit is more than ``max_shift_m`` from ``near``
     (3,: the estimates' place and height) or its height is implausible or unsure (σ ≥ 5 cm).
-    Then some view's top of the head is another person's, or the views are too nearly alike."""
+    Then some view's top of the head is another person's, or the views are too nearly alike.
+    Rays of a camera that sees the person from above (floor distance below its height less half
+    the person's) are left out."""
     near = np.asarray(near, float)
+    # From above (floor distance below the camera's height less half the person's), the top of
+    # the silhouette is the far side of the head and shoulders: the tracker's rule (height.py).
+    rays = [r for r in rays if math.hypot(near[0] - r.ox, near[1] - r.oy) >= r.oz - 0.5 * near[2]]
     if len({(r.ox, r.oy, r.oz) for r in rays if math.isfinite(r.hx)}) < 2:
         return None
     found = triangulate(rays, near)
