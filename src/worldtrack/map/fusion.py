@@ -134,7 +134,10 @@ class FusionState:
     last_bucket: int | None = None
 
     def to_json(self) -> str:
-        return json.dumps({"fields": _PERSON_FIELDS, "people": [list(vars(p).values()) for p in self.people.values()],
+        # Without map.head_rays's heights (the last field) as before: an older fusion role reads it.
+        n = len(_PERSON_FIELDS) - (not any(p.ray_heights for p in self.people.values()))
+        return json.dumps({"fields": _PERSON_FIELDS[:n],
+                           "people": [list(vars(p).values())[:n] for p in self.people.values()],
                            "close_since": [[a, b, t] for (a, b), t in self.close_since.items()],
                            "aliases": [[y, e, t] for y, (e, t) in self.aliases.items()],
                            "last_bucket": self.last_bucket}, allow_nan=True)
@@ -337,7 +340,8 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
         x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by, weigh_own, ray_error_m, height_by_view)
-        mine = {key: r for key, r in (rays or {}).get(pid, {}).items() if key[0] in by_worker and by_worker[key[0]].seen}
+        mine = {key: r for key, r in (rays or {}).get(pid, {}).items()
+                if key[0] in by_worker and by_worker[key[0]].seen}
         measured = ray_height(list(mine.values()), np.array([x, y, h if math.isfinite(h) else 1.7])) \
             if len({k for k, _ in mine}) >= 2 else None
         p = people.get(pid)

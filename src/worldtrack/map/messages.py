@@ -264,6 +264,6 @@ def time_of_id(entry_id: str) -> float:
     return int(str(entry_id).split("-", 1)[0]) / 1000.0
 
 
-__all__ = ["Estimate", "FORMAT_VERSION", "RAYS_VERSION", "MapPerson", "MapState", "Observation", "REFUTED", "bucket_index",
-           "decode_map_state", "decode_observation", "encode_map_state", "encode_observation", "stream_id_ms",
+__all__ = ["Estimate", "FORMAT_VERSION", "RAYS_VERSION", "MapPerson", "MapState", "Observation", "REFUTED",
+           "bucket_index", "decode_map_state", "decode_observation", "encode_map_state", "encode_observation", "stream_id_ms",
            "time_of_id"]
