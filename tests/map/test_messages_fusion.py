@@ -377,22 +377,3 @@ def test_a_far_views_first_estimate_merges_with_a_near_views_within_their_covari
     for k, (observations, cfg, st) in enumerate(cases):
         s = fuse_bucket(st, 5 if st is old else 0, observations, cfg)
         assert not s.aliases and sorted(p.id for p in s.people) == [1, 2], k
-
-
-def test_two_ids_a_worker_saw_together_moments_ago_are_not_merged_when_asked():
-    """A crossing on the axis two facing cameras share: both workers see 1 and 3 apart, then each
-    shows only the person in front (w1 holds 1, w2 holds 3) at one place. By default the map folds
-    3 into 1 after merge_after_s; with apart_memory_s it remembers that w1 saw both."""
-    def run(cfg):
-        state = FusionState()
-        for b in range(0, 3):                                         # both see both, 1 m apart
-            fuse_bucket(state, b, [obs("west", b / 10, "w1", [est(1, 5.0, 2.4), est(3, 6.0, 2.4)]),
-                                   obs("east", b / 10, "w2", [est(1, 5.0, 2.4), est(3, 6.0, 2.4)])], cfg)
-        merged = {}
-        for b in range(3, 8):                                         # each sees one, 0.1 m apart
-            merged.update(fuse_bucket(state, b, [obs("west", b / 10, "w1", [est(1, 5.6, 2.4)]),
-                                                 obs("east", b / 10, "w2", [est(3, 5.7, 2.4)])], cfg).aliases)
-        return merged, FusionState.from_json(state.to_json())
-    assert run(MapConfig())[0] == {3: 1}
-    kept, handed = run(MapConfig(apart_memory_s=2.0))
-    assert kept == {} and set(handed.together) == {(1, 3)}

@@ -96,10 +96,6 @@ class MapConfig(Section):
                                                       "there says so, and the first confirms them (one process "
                                                       "confirms a person two cameras show at once; "
                                                       "worldtrack.map.affirm; false: before issue 39k)")
-    apart_memory_s: float = Field(0.0, ge=0, description="two ids one worker saw at the same time less than this "
-                                                         "long ago (s) are not merged as duplicates (a crossing on "
-                                                         "the axis two facing cameras share: each shows only the "
-                                                         "person in front, each worker holds one id; 0 = off)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

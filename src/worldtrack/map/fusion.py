@@ -132,8 +132,6 @@ class FusionState:
     #: Merged ids: younger → elder, with the time of the merge (kept for ``forget_after_s``).
     aliases: dict[int, tuple[int, float]] = field(default_factory=dict)
     last_bucket: int | None = None
-    #: ``map.apart_memory_s``: pairs of ids (a < b) one worker saw at the same time, when last (s).
-    together: dict[tuple[int, int], float] = field(default_factory=dict)
 
     def to_json(self) -> str:
         # Without map.head_rays's heights (the last field) as before: an older fusion role reads it.
@@ -142,7 +140,6 @@ class FusionState:
                            "people": [list(vars(p).values())[:n] for p in self.people.values()],
                            "close_since": [[a, b, t] for (a, b), t in self.close_since.items()],
                            "aliases": [[y, e, t] for y, (e, t) in self.aliases.items()],
-                           "together": [[a, b, t] for (a, b), t in self.together.items()],
                            "last_bucket": self.last_bucket}, allow_nan=True)
 
     @classmethod
@@ -151,13 +148,12 @@ class FusionState:
         people = [FusedPerson(**dict(zip(d["fields"], p))) for p in d["people"]]
         return cls({p.id: p for p in people},
                    {(int(a), int(b)): float(t) for a, b, t in d["close_since"]},
-                   {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"],
-                   {(int(a), int(b)): float(t) for a, b, t in d.get("together", [])})
+                   {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"])
 
     def copy(self) -> "FusionState":
         """An independent copy (a bucket is fused on a copy until its write has succeeded)."""
         return FusionState({i: replace(p) for i, p in self.people.items()}, dict(self.close_since),
-                           dict(self.aliases), self.last_bucket, dict(self.together))
+                           dict(self.aliases), self.last_bucket)
 
     @classmethod
     def from_record(cls, state: MapState, bucket: int) -> "FusionState":

@@ -24,7 +24,7 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
     """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
     the elder, unless a worker sees both (then they are two people that worker tells apart: two
     people crossing in one worker's view while another worker sees only one of them are not
-    merged; with ``apart_memory_s`` also not when a worker saw both that recently). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
+    merged). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
     the same frames: no history could tell them apart) are merged at once — also farther apart than
     ``merge_distance_m`` when the workers' tracker covariances (``estimates``) put them within
     ``newborn_gate`` (a far view's first estimate through a door is off by more than 0.5 m in depth,
@@ -32,16 +32,12 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
     from scipy.spatial import cKDTree
     ids = sorted(workers_of)
     close_now = set()
-    if cfg.apart_memory_s > 0:
-        _remember_together(state, workers_of, t, cfg.apart_memory_s)
     if len(ids) >= 2:
         xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
         for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
             a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
             if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
                 continue      # a worker that sees both holds them apart: two people
-            if t - state.together.get((a, b), -math.inf) <= cfg.apart_memory_s:
-                continue      # and did so moments ago: one is behind the other in each view now
             close_now.add((a, b))
         close_now |= _newborns_within_gate(state, workers_of, t, cfg, estimates or {}, xy, ids)
     state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
@@ -61,19 +57,6 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
         merged[younger.id] = elder.id
     state.close_since = {k: v for k, v in state.close_since.items() if k[0] not in merged and k[1] not in merged}
     return merged
-
-
-def _remember_together(state: "FusionState", workers_of: dict[int, set[str]], t: float, memory_s: float) -> None:
-    """Note in ``state.together`` every pair of ids some worker sees at ``t`` (s); forget pairs
-    older than ``memory_s`` or with a person gone."""
-    by_worker: dict[str, list[int]] = {}
-    for pid in sorted(workers_of):
-        for w in workers_of[pid]:
-            by_worker.setdefault(w, []).append(pid)
-    for held in by_worker.values():
-        state.together.update({(a, b): t for k, a in enumerate(held) for b in held[k + 1:]})
-    state.together = {(a, b): s for (a, b), s in state.together.items()
-                      if t - s <= memory_s and a in state.people and b in state.people}
 
 
 def _newborns_within_gate(state: "FusionState", workers_of: dict[int, set[str]], t: float, cfg: MapConfig,
