@@ -84,15 +84,16 @@ def first_updates(messages: list[tuple[float, str]]) -> dict[tuple[str, float], 
     return first
 
 
-def one_run(server: Server, scene_dir: Path, cams: list[str], out: Path, settle_s: float) -> dict:
+def one_run(server: Server, scene_dir: Path, cams: list[str], out: Path, settle_s: float,
+            sets: list[str] = ()) -> dict:
     server.flush()
     pin = ["taskset", "-c", "1"] if shutil.which("taskset") else []
-    fuser = subprocess.Popen([*pin, *WORLDTRACK, "map", "fuse", server.url], stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
+    fuser = subprocess.Popen([*pin, *WORLDTRACK, "map", "fuse", server.url, *[a for v in sets for a in ("--set", v)]],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     listener = Listener(server.url)
     listener.start()
     try:
-        run_workers(scene_dir, server.url, cams, out, sets=["map.fusion_in_worker=false"])
+        run_workers(scene_dir, server.url, cams, out, sets=["map.fusion_in_worker=false", *sets])
         time.sleep(1.0)
     finally:
         fuser.terminate()
@@ -135,6 +136,8 @@ def main() -> None:
     ap.add_argument("--settle", type=float, default=3.0, help="seconds of start-up left out of the steady state")
     ap.add_argument("--quick", action="store_true", help="one run of 60 frames; prints only")
     ap.add_argument("--cv-threads", type=int, help="OpenCV threads per worker (OPENCV_FOR_THREADS_NUM)")
+    ap.add_argument("--set", action="append", default=[], metavar="map.NAME=VALUE",
+                    help="a map setting for the workers and the fusion (e.g. map.head_rays=true)")
     args = ap.parse_args()
     if args.cv_threads:
         os.environ["OPENCV_FOR_THREADS_NUM"] = str(args.cv_threads)     # inherited by the workers
@@ -148,7 +151,7 @@ def main() -> None:
         server = Server(tmp)
         try:
             for k in range(repeats):
-                r = one_run(server, tmp / "seq", sc.camera_ids, tmp / f"run{k}", args.settle)
+                r = one_run(server, tmp / "seq", sc.camera_ids, tmp / f"run{k}", args.settle, args.set)
                 rows.append(r)
                 print(f"run {k}: capture→live map p50 {r['total'][0] * 1000:.1f} ms p99 {r['total'][1] * 1000:.1f} ms"
                       f" (whole run p99 {r['all'][1] * 1000:.1f} ms);"
@@ -176,6 +179,7 @@ def main() -> None:
                            table_rows)
     p99, p99_all = med[("total", None)][1], med[("all", None)][1]
     threads = f"{args.cv_threads} OpenCV thread(s) per worker" if args.cv_threads else "OpenCV's default threads"
+    threads += "".join(f", --set {v}" for v in args.set)
     text = (f"{table}\n\nFour workers (one camera each, `crowd` seed 3, 4 cameras, 5 people, 320x240, "
             f"{frames} frames at 10 frames/s played as live cameras, {threads}), the fusion role in its own "
             f"process (core 1). Steady state: captures from {args.settle:g} s on. Target: capture→live map "

@@ -35,6 +35,7 @@ from worldtrack.eval.mot import evaluate_detailed  # noqa: E402
 from worldtrack.io.tracks import read_tracks  # noqa: E402
 from worldtrack.map.connection import MapKeys, connect  # noqa: E402
 from worldtrack.map.messages import Estimate, MapPerson  # noqa: E402
+from worldtrack.map.rays import ViewRay  # noqa: E402
 from worldtrack.map.replay import record_digest, replay  # noqa: E402
 from worldtrack.synth import make_scenario, write_sequence  # noqa: E402
 
@@ -48,7 +49,8 @@ def worse_frames(one, fused) -> list[int]:
 
 def dump_run(client, cameras: list[str], seq: Path, run: int, out: Path) -> None:
     """The run's evidence as CSV files in ``out``: ``estimates.csv`` (every worker's published
-    estimate of every person, per camera and frame), ``map.csv`` (the record: per bucket every
+    estimate of every person, per camera and frame), ``rays.csv`` (with ``map.head_rays``: their
+    cameras' own head and feet rays), ``map.csv`` (the record: per bucket every
     person, their lead and how many workers), ``gt.csv`` and ``one.csv`` (the one process)."""
     import shutil
 
@@ -63,6 +65,13 @@ def dump_run(client, cameras: list[str], seq: Path, run: int, out: Path) -> None
                 o = decode_observation(fields)
                 for e in o.people:
                     f.write(f"{o.t:.3f},{o.camera},{o.worker},{o.frame}," + ",".join(str(v) for v in e) + "\n")
+    with open(out / "rays.csv", "w") as f:          # map.head_rays: each camera's own head and feet rays
+        f.write("t,camera,worker,frame," + ",".join(ViewRay._fields) + "\n")
+        for cam in cameras:
+            for _, fields in client.xrange(keys.observations(cam)):
+                o = decode_observation(fields)
+                for r in o.rays:
+                    f.write(f"{o.t:.3f},{o.camera},{o.worker},{o.frame}," + ",".join(str(v) for v in r) + "\n")
     with open(out / "map.csv", "w") as f:
         f.write("t," + ",".join(MapPerson._fields) + "\n")
         for _, fields in client.xrange(keys.map_stream):

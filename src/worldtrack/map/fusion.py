@@ -79,6 +79,11 @@ from worldtrack.map.evidence import (LEAD_SHARE, floor_information, in_views, pe
                                      with_ray_error)
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
 from worldtrack.map.merges import MIN_WEIGHT, merge_duplicates
+from worldtrack.map.rays import ViewRay, ray_height
+
+#: ``map.head_rays``: the map's height of a person is the median of their last this many heights
+#: from head rays (:func:`~worldtrack.map.rays.ray_height`), once three are in.
+RAY_HEIGHTS = 15
 from worldtrack.map.refute import refute
 from worldtrack.map.same_blob import fold_same_blobs
 
@@ -106,6 +111,8 @@ class FusedPerson:
     doubt: int = 0
     #: Buckets running in which only one worker reported them, covered by other people there.
     hidden: int = 0
+    #: ``map.head_rays``: their last heights (m) from two workers' head rays, oldest first.
+    ray_heights: list = field(default_factory=list)
 
     def public(self) -> MapPerson:
         return MapPerson(self.id, self.x, self.y, self.height, self.width, self.vx, self.vy, self.score,
@@ -127,7 +134,10 @@ class FusionState:
     last_bucket: int | None = None
 
     def to_json(self) -> str:
-        return json.dumps({"fields": _PERSON_FIELDS, "people": [list(vars(p).values()) for p in self.people.values()],
+        # Without map.head_rays's heights (the last field) as before: an older fusion role reads it.
+        n = len(_PERSON_FIELDS) - (not any(p.ray_heights for p in self.people.values()))
+        return json.dumps({"fields": _PERSON_FIELDS[:n],
+                           "people": [list(vars(p).values())[:n] for p in self.people.values()],
                            "close_since": [[a, b, t] for (a, b), t in self.close_since.items()],
                            "aliases": [[y, e, t] for y, (e, t) in self.aliases.items()],
                            "last_bucket": self.last_bucket}, allow_nan=True)
@@ -266,6 +276,17 @@ def _per_worker(state: FusionState, observations: Iterable[Observation]) -> dict
     return out
 
 
+def _rays_of(state: FusionState, observations: Iterable[Observation]) -> dict[int, dict[tuple[str, str], ViewRay]]:
+    """Each person's view rays (``map.head_rays``), one per worker and camera (the latest)."""
+    out: dict[int, dict[tuple[str, str], ViewRay]] = {}
+    for o in sorted(observations, key=lambda o: (o.t, o.camera, o.frame)):
+        for r in o.rays:
+            pid = state.resolve(r.id)
+            if pid != REFUTED:
+                out.setdefault(pid, {})[o.worker, o.camera] = r._replace(id=pid)
+    return out
+
+
 def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation], cfg: MapConfig,
                 written: float = 0.0) -> MapState:
     """Merge a bucket's observations into ``state`` and return the map state of the bucket.
@@ -282,7 +303,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     observations = sorted(observations, key=lambda o: (o.t, o.camera, o.frame))
     estimates = _per_worker(state, observations)
     workers_of = _update_people(state.people, estimates, t, cfg.weigh_by, weigh_own=cfg.weigh_own,
-                                ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view)
+                                ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view,
+                                rays=_rays_of(state, observations) if cfg.head_rays else None)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -304,21 +326,34 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 
 def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
                    weigh_by: str = "geometry", copy: bool = False, weigh_own: bool = True,
-                   ray_error_m: float = 0.0, height_by_view: bool = False) -> dict[int, set[str]]:
+                   ray_error_m: float = 0.0, height_by_view: bool = False,
+                   rays: Mapping[int, Mapping[tuple[str, str], ViewRay]] | None = None) -> dict[int, set[str]]:
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
-    committed state stay as they are). Returns, per person, the workers that see them."""
+    committed state stay as they are). ``rays``: per person the view rays of each worker and camera
+    (:func:`_rays_of`); the height of a person two workers that see them publish head rays of is
+    the median of their last :data:`RAY_HEIGHTS` heights from those rays
+    (:func:`~worldtrack.map.rays.ray_height`), once three are in. Returns, per person, the workers
+    that see them."""
     workers_of: dict[int, set[str]] = {}
     for pid, by_worker in estimates.items():
         seen = [e for e in by_worker.values() if e.seen]
         use = seen or list(by_worker.values())
         x, y, h, w, vx, vy, score, support = _weighted(use, weigh_by, weigh_own, ray_error_m, height_by_view)
+        mine = {key: r for key, r in (rays or {}).get(pid, {}).items()
+                if key[0] in by_worker and by_worker[key[0]].seen}
+        measured = ray_height(list(mine.values()), np.array([x, y, h if math.isfinite(h) else 1.7])) \
+            if len({k for k, _ in mine}) >= 2 else None
         p = people.get(pid)
         if p is None:
             p = people[pid] = FusedPerson(pid, x, y, h, w, born=t)
         elif copy:
             p = people[pid] = replace(p)
         p.x, p.y, p.vx, p.vy, p.score, p.support = x, y, vx, vy, score, support
+        if measured is not None:     # a new list: a copy (copy=True) must not change the committed person's
+            p.ray_heights = [*p.ray_heights[1 - RAY_HEIGHTS:], measured]
+        if len(p.ray_heights) >= 3:
+            h = float(np.median(p.ray_heights))
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
@@ -348,7 +383,8 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     people = dict(state.people)
     for b in sorted(buckets):
         _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True,
-                       weigh_own=cfg.weigh_own, ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view)
+                       weigh_own=cfg.weigh_own, ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view,
+                       rays=_rays_of(state, buckets[b]) if cfg.head_rays else None)
     t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
     reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))

@@ -17,6 +17,10 @@ Entry ids are capture times in ms (``<ms>-<seq>``), so streams can be read and t
 ...                 candidates=((4.0, 1.0, 1.7, 0.45),), affirms=(("w2", 9.5, 2.0),), same=((4, 1),))
 >>> decode_observation(encode_observation(o)) == o
 True
+>>> r = ViewRay(3, 0.3, 2.5, 3.0, 0.9, 0.0, -0.3, 0.8, 0.0, -0.6)    # a worker's own head and feet rays
+>>> fields = encode_observation(replace(o, rays=(r,)))
+>>> fields["rays"][:3], decode_observation(fields).rays == (r,)
+('[1,', True)
 >>> bucket_index(12.34, 0.1), stream_id_ms(12.3)
 (123, 12300)
 """
@@ -25,10 +29,15 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace  # noqa: F401 (doctest)
 from typing import Mapping, NamedTuple
 
+from worldtrack.map.rays import ViewRay
+
 FORMAT_VERSION = "2"
+#: The version of an observation's optional ``rays`` field (:class:`~worldtrack.map.rays.ViewRay`
+#: rows): a field of its own, so readers of format 2 that predate it read the rest as before.
+RAYS_VERSION = 1
 
 
 class Estimate(NamedTuple):
@@ -80,7 +89,8 @@ class Observation:
     there but has not confirmed, ``(x, y, height, width)`` m; ``affirms``: other workers'
     candidates this camera shows somebody at, ``(their worker, x, y)`` (:mod:`worldtrack.map.affirm`);
     ``same``: ``(its id, another worker's id)``, two newborns its camera shows as one blob
-    (:mod:`worldtrack.map.same_blob`)."""
+    (:mod:`worldtrack.map.same_blob`). ``rays``: per person its camera's own head and feet rays
+    (``map.head_rays``, :mod:`worldtrack.map.rays`)."""
 
     camera: str
     t: float
@@ -93,6 +103,7 @@ class Observation:
     candidates: tuple[tuple[float, float, float, float], ...] = ()
     affirms: tuple[tuple[str, float, float], ...] = ()
     same: tuple[tuple[int, int], ...] = ()
+    rays: tuple[ViewRay, ...] = ()
 
 
 class MapPerson(NamedTuple):
@@ -172,7 +183,11 @@ def encode_observation(o: Observation) -> dict[str, str]:
             [int(i) for i in o.absent], [[round(float(v), 4) for v in c] for c in o.candidates],
             [[str(w), round(float(x), 4), round(float(y), 4)] for w, x, y in o.affirms],
             [[int(a), int(b)] for a, b in o.same]]
-    return {"v": FORMAT_VERSION, "t": repr(float(o.t)), "o": json.dumps(body, separators=(",", ":"))}
+    out = {"v": FORMAT_VERSION, "t": repr(float(o.t)), "o": json.dumps(body, separators=(",", ":"))}
+    if o.rays:      # ``rays``: [RAYS_VERSION, rows]; a field older readers do not look at
+        rows = [[int(r.id), *(round(float(v), 5) for v in r[1:])] for r in o.rays]
+        out["rays"] = json.dumps([RAYS_VERSION, rows], separators=(",", ":"))
+    return out
 
 
 def decode_observation(fields: Mapping[str, str]) -> Observation:
@@ -189,11 +204,22 @@ def decode_observation(fields: Mapping[str, str]) -> Observation:
                            tuple(Estimate(*p) for p in people), tuple(ended), tuple(absent),
                            tuple(tuple(float(v) for v in c[:4]) for c in candidates),
                            tuple((str(w), float(x), float(y)) for w, x, y in affirms),
-                           tuple((int(a), int(b)) for a, b in same))
+                           tuple((int(a), int(b)) for a, b in same), _rays(fields.get("rays")))
     except (KeyError, IndexError, TypeError, ValueError, json.JSONDecodeError) as e:
         if isinstance(e, ValueError) and str(e).startswith("format version"):
             raise
         raise ValueError(f"malformed observation ({type(e).__name__}: {e})") from None
+
+
+def _rays(text: str | None) -> tuple[ViewRay, ...]:
+    """The ``rays`` field of an observation; () when absent, or of a later version this reader
+    does not know (the rest of the observation is read as ever)."""
+    if not text:
+        return ()
+    version, rows = json.loads(text)
+    if version != RAYS_VERSION:
+        return ()
+    return tuple(ViewRay(int(r[0]), *(_float(v) for v in r[1:10])) for r in rows)
 
 
 def encode_map_state(s: MapState) -> dict[str, str]:
@@ -238,6 +264,6 @@ def time_of_id(entry_id: str) -> float:
     return int(str(entry_id).split("-", 1)[0]) / 1000.0
 
 
-__all__ = ["Estimate", "FORMAT_VERSION", "MapPerson", "MapState", "Observation", "REFUTED", "bucket_index",
-           "decode_map_state", "decode_observation", "encode_map_state", "encode_observation", "stream_id_ms",
+__all__ = ["Estimate", "FORMAT_VERSION", "RAYS_VERSION", "MapPerson", "MapState", "Observation", "REFUTED",
+           "bucket_index", "decode_map_state", "decode_observation", "encode_map_state", "encode_observation", "stream_id_ms",
            "time_of_id"]

@@ -33,12 +33,12 @@ from worldtrack.geometry.camera import Camera
 from worldtrack.map.affirm import CandidateExchange
 from worldtrack.map.config import MapConfig
 from worldtrack.map.connection import MapKeys
-from worldtrack.map.evidence import (NO_COVARIANCE, floor_information, in_views, looks_empty, people_boxes,
-                                     support_of, tracker_covariance, visible_share)
-from worldtrack.map.fusion import LEAD_SHARE
+from worldtrack.map.evidence import (LEAD_SHARE, NO_COVARIANCE, floor_information, in_views, looks_empty,
+                                     people_boxes, support_of, tracker_covariance, visible_share)
 from worldtrack.map.lease import FENCED_XADD, Lease
 from worldtrack.map.messages import (FORMAT_VERSION, REFUTED, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
+from worldtrack.map.rays import camera_rays
 from worldtrack.map.same_blob import same_blob_claims
 from worldtrack.map.shared_ids import SharedPositionMap
 from worldtrack.map.timings import set_epoch
@@ -186,8 +186,7 @@ class MapLink:
             self.complete_until = (int(raw[5]) + 1) * self.cfg.bucket_s
         if self.state is None or float(raw[2]) != self.state.t or float(raw[3] or 0) != self.state.written:
             fields = {"v": FORMAT_VERSION, "t": raw[2], "people": raw[0], "aliases": raw[1] or "{}",
-                      "written": raw[3] or "0",
-                      "reports": raw[4] or "[]"}
+                      "written": raw[3] or "0", "reports": raw[4] or "[]"}
             self.state = decode_map_state(fields)
         return self.state
 
@@ -346,9 +345,10 @@ class MapLink:
         cands, affirms = self.exchange.after_step(tracker, tracks, boxes, cams) if self.exchange else ({}, {})
         same = same_blob_claims({c: self.cameras[c] for c in cams}, tracks, self.state, self.born_here, t,
                                 self.cfg.same_blob_s, self.cfg.same_blob_iou)
+        rays = camera_rays(self.cameras, tracker, cams, tracks, seen_ids, self.occlusion) if self.cfg.head_rays else {}
         return [Observation(c, float(frames[c].t), self.name, int(frames[c].index), sent, tuple(per_cam[c]), ended,
                             absent.get(c, ()), tuple(cands.get(c, ())), tuple(affirms.get(c, ())),
-                            same if c == cams[0] else ()) for c in cams]
+                            same if c == cams[0] else (), rays.get(c, ())) for c in cams]
 
     def _absent(self, tracker: Tracker, tracks: Sequence[Track], t: float, cams: list[str],
                 boxes: Mapping[str, np.ndarray], seen_ids: set[int]) -> dict[str, tuple[int, ...]]:
