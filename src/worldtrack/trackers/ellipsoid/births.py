@@ -219,10 +219,12 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     ``height_range=None`` (heights not measured, as in the paper's preset), or a blob shorter
     than ``min_px`` or touching the image border: no height, and the lower end always.
 
-    ``known`` (H, W), nonzero where people already known are drawn (``births.people_occlude``): an
-    end of the blob that stops against them is hidden by them — the feet of a person behind a known
-    one, the head of one in front of a known one whose ellipse covers it — so the other end places
-    the person, no height is given, and the share is the blob's length over the person's there.
+    ``known`` (H, W), nonzero where people already known are drawn (``births.people_occlude``): a
+    blob whose top stops against them is a person whose upper body a known one's ellipse covers (in
+    front of them, or behind a farther one on the same line of sight): its lower end, the feet,
+    places the person, no height is given, and the share is the blob's length over the person's
+    there. (Its mirror — the feet hidden by a known person, the head placing them at the default
+    height — lost on crowd 10's dev seeds, and is not done.)
     """
     cam = view.camera
     down = view.down_direction(centroid)
@@ -241,16 +243,12 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, view.occ, beyond)).mean() > 0.5
     head_seen = bool(pixel_clear(cam, None, (head - 2 * down)[None]).all())
     shown, share = None, 1.0
-    if known is not None:   # an end against a known person is theirs to hide
-        above = head - 2 * down + np.linspace(-half, half, 9)[:, None] * across
-        feet_known, head_known = covered_share(known, beyond) > 0.5, covered_share(known, above) > 0.5
-        if feet_known and head_known:
-            return None
-        if (feet_known and not feet_hidden and head_seen) or (head_known and not feet_hidden):
-            p = cam.backproject((head if feet_known else foot)[None], height if feet_known else 0.0)[0]
-            if not np.isfinite(p).all():
-                return None
-            return BlobPlace(p, None, length_share(cam, p[:2], height, along_max - along_min + 1.0))
+    above = head - 2 * down + np.linspace(-half, half, 9)[:, None] * across
+    if known is not None and not feet_hidden and covered_share(known, above) > 0.5:
+        # The top stops against a known person: their ellipse hides the rest; the feet place them.
+        p = cam.backproject(foot[None], 0.0)[0]
+        return BlobPlace(p, None, length_share(cam, p[:2], height, along_max - along_min + 1.0)) \
+            if np.isfinite(p).all() else None
     if not feet_hidden:
         p = cam.backproject(foot[None], 0.0)[0]
         # Only oblique views tell the height (as in height.py): from above, the ends of the blob

@@ -100,10 +100,10 @@ class BirthConfig(Section):
         1.0, ge=0, description="a new person is placed by a grid search this far along the proposing camera's line "
         "of sight, m (0 = start at the foot point, as the paper's capture does)")
     people_occlude: bool = Field(
-        False, description="a blob that ends against somebody already known (their ellipse) is cut there, as at "
-        "an obstacle or the image border: the other end places the person, and the blob need only be "
-        "min_blob_fraction of the share of the person it shows (a person in front of or behind a tracked one "
-        "on one camera's line of sight; false: the blob's ends are the person's, as before issue 37)")
+        False, description="a blob whose top stops against somebody already known (their ellipse) is a person "
+        "whose upper body that ellipse covers: the blob's feet place them, and it need only be min_blob_fraction "
+        "of the share of the person it shows (two people on one camera's line of sight; crowd 10 dev seeds "
+        "20-39 MOTA 0.920 -> 0.924, +0.004 +- 0.007; false: the blob's top is the person's head, as before)")
 
 
 class RescueConfig(Section):
