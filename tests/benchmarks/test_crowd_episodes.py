@@ -9,7 +9,7 @@ from crowd_episodes import episodes  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 
 
-def test_a_track_slid_onto_a_neighbour_is_one_shared_miss_and_one_duplicate():
+def test_a_track_slid_onto_a_neighbour_is_one_missed_person_and_one_duplicate():
     # Person 1 at x = 0, person 2 at x = 2, frames 0-3. Track 7 holds 1 throughout; track 8 holds 2 on
     # frames 0-1, then slides onto 1 (frames 2-3): 2 is missed beside 8, which duplicates 1.
     gt = TrackTable.from_arrays([f for f in range(4) for _ in (1, 2)], [1, 2] * 4, [0.0, 2.0] * 4, [0.0] * 8)
