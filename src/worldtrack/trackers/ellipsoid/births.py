@@ -243,8 +243,8 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, view.occ, beyond)).mean() > 0.5
     head_seen = bool(pixel_clear(cam, None, (head - 2 * down)[None]).all())
     shown, share = None, 1.0
-    above = head - 2 * down + np.linspace(-half, half, 9)[:, None] * across
-    if known is not None and not feet_hidden and covered_share(known, above) > 0.5:
+    above = None if known is None else head - 2 * down + np.linspace(-half, half, 9)[:, None] * across
+    if above is not None and not feet_hidden and covered_share(known, above) > 0.5:
         # The top stops against a known person: their ellipse hides the rest; the feet place them.
         p = cam.backproject(foot[None], 0.0)[0]
         return BlobPlace(p, None, length_share(cam, p[:2], height, along_max - along_min + 1.0)) \
