@@ -103,7 +103,8 @@ class BirthConfig(Section):
         False, description="a blob whose top stops against somebody already known (their ellipse) is a person "
         "whose upper body that ellipse covers: the blob's feet place them, and it need only be min_blob_fraction "
         "of the share of the person it shows (two people on one camera's line of sight; crowd 10 MOTA dev seeds "
-        "20-39 0.920 -> 0.924, held-out 140-159 0.932 -> 0.927: off; false: the blob's top is the head, as before)")
+        "20-39 0.920 -> 0.924, held-out 140-159 0.932 -> 0.927, never-used 360-399 0.918 -> 0.921: off; false: the "
+        "blob's top is the head, as before)")
 
 
 class RescueConfig(Section):
