@@ -96,3 +96,51 @@ def test_a_blob_from_feet_to_head_gives_the_persons_height_and_one_without_legs_
     p, shown, share = torso
     assert shown is None and np.hypot(*(p[:2] - person)) < 0.2
     assert abs(share - (1.65 - 0.9) / 1.65) < 0.1   # the area test asks only for the part shown
+
+
+def _known_beside(blob, origin, below: bool, rows: int = 6) -> np.ndarray:
+    """An image reaching just past ``blob`` (a crop whose top-left pixel is ``origin``), nonzero on
+    ``rows`` rows just above its top (or below its bottom) across its columns: a known person there."""
+    crop, (u0, v0) = blob, origin
+    known = np.zeros((v0 + crop.shape[0] + rows + 2, u0 + crop.shape[1] + 2), np.uint8)
+    v = v0 + crop.shape[0] if below else max(0, v0 - rows)
+    known[v:v + rows, u0:u0 + crop.shape[1]] = 1
+    return known
+
+
+def test_a_blob_whose_top_a_known_person_covers_is_placed_by_its_feet():
+    from worldtrack.trackers.ellipsoid.births import blob_position
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    view = tracker.views[sorted(tracker.views)[0]]
+    # The legs of a person in front of a known one, whose ellipse hides their upper body: read as a
+    # whole person, the blob is too short and its top puts them far along the line of sight.
+    legs = _column_blob(view, person, 0.0, 0.8)
+    alone = blob_position(view, *legs, 1.65)
+    assert alone is not None and np.hypot(*(alone[0][:2] - person)) > 1.0
+    cut = blob_position(view, *legs, 1.65, known=_known_beside(legs[0], legs[1], below=False))
+    assert cut is not None
+    p, shown, share = cut
+    assert shown is None and np.hypot(*(p[:2] - person)) < 0.1
+    assert abs(share - 0.8 / 1.65) < 0.1          # the area test asks only for the part shown
+    # The feet against a known person are not read as hidden: the blob is placed as without one.
+    top = _column_blob(view, person, 0.6, 1.65)
+    np.testing.assert_array_equal(blob_position(view, *top, 1.65, known=_known_beside(*top[:2], below=True))[0],
+                                  blob_position(view, *top, 1.65)[0])
+    far = np.zeros_like(_known_beside(legs[0], legs[1], below=False))
+    np.testing.assert_array_equal(blob_position(view, *legs, 1.65, known=far)[0], alone[0])
+
+
+def test_births_pass_the_known_people_to_the_blobs_only_when_asked(monkeypatch):
+    from worldtrack.trackers.ellipsoid import births
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    seen = []
+    real_position = births.blob_position
+    monkeypatch.setattr(births, "blob_position", lambda *a, **k: seen.append(a[7]) or real_position(*a, **k))
+    known = People(np.array([[person[0] + 3.0, person[1]]]), np.array([1.65]), np.array([0.4]))
+    for occlude in (False, True):
+        fresh = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
+                                 EllipsoidConfig(births={"people_occlude": occlude}))
+        fresh.last_masks = tracker.last_masks
+        seen.clear()
+        assert len(_proposals(fresh, known)) == 1    # the person, 3 m from the known one, either way
+        assert seen and all((k is not None) == occlude for k in seen)

@@ -157,7 +157,8 @@ class Births:
         # Components found at ~320 px wide (each blob then read back at full resolution):
         # labelling the whole 640x480 frame was a third of the births' time.
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
-            found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px)
+            found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px,
+                                  explained if cfg.people_occlude else None)
             if found is None:
                 continue
             p, height, share = found
@@ -195,8 +196,8 @@ class Births:
 
 
 def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
-                  height: float, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: float = 0
-                  ) -> BlobPlace | None:
+                  height: float, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: float = 0,
+                  known: np.ndarray | None = None) -> BlobPlace | None:
     """Floor position (3,) of a person seen as ``blob``, the height (m) the blob shows and the share
     of the person it shows, or None.
 
@@ -217,6 +218,13 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     length of a person of that height standing there. Above the maximum, no height is given either.
     ``height_range=None`` (heights not measured, as in the paper's preset), or a blob shorter
     than ``min_px`` or touching the image border: no height, and the lower end always.
+
+    ``known`` (H, W), nonzero where people already known are drawn (``births.people_occlude``): a
+    blob whose top stops against them is a person whose upper body a known one's ellipse covers (in
+    front of them, or behind a farther one on the same line of sight): its lower end, the feet,
+    places the person, no height is given, and the share is the blob's length over the person's
+    there. (Its mirror — the feet hidden by a known person, the head placing them at the default
+    height — lost on crowd 10's dev seeds, and is not done.)
     """
     cam = view.camera
     down = view.down_direction(centroid)
@@ -235,6 +243,12 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, view.occ, beyond)).mean() > 0.5
     head_seen = bool(pixel_clear(cam, None, (head - 2 * down)[None]).all())
     shown, share = None, 1.0
+    above = None if known is None else head - 2 * down + np.linspace(-half, half, 9)[:, None] * across
+    if above is not None and not feet_hidden and covered_share(known, above) > 0.5:
+        # The top stops against a known person: their ellipse hides the rest; the feet place them.
+        p = cam.backproject(foot[None], 0.0)[0]
+        return BlobPlace(p, None, length_share(cam, p[:2], height, along_max - along_min + 1.0)) \
+            if np.isfinite(p).all() else None
     if not feet_hidden:
         p = cam.backproject(foot[None], 0.0)[0]
         # Only oblique views tell the height (as in height.py): from above, the ends of the blob
@@ -246,9 +260,7 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
         shown = head_height(cam, head, p) if readable else None
         if shown is not None and shown < height_range[0]:
             p, shown = cam.backproject(head[None], height)[0], None
-            ends = cam.project(np.array([[p[0], p[1], 0.0], [p[0], p[1], height]]))
-            length = float(np.hypot(*(ends[0] - ends[1])))
-            share = min(1.0, (along_max - along_min + 1.0) / length) if length > 0 else 1.0
+            share = length_share(cam, p[:2], height, along_max - along_min + 1.0)
         elif shown is not None and shown > height_range[1]:
             shown = None
     elif head_seen:
@@ -256,6 +268,29 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     else:
         return None
     return BlobPlace(p, shown, share) if np.isfinite(p).all() else None
+
+
+def length_share(cam, xy: np.ndarray, height: float, length_px: float) -> float:
+    """``length_px`` over the image length (px) of a person ``height`` m tall standing at floor point
+    ``xy`` (2,) m, at most 1 (1 where they have no length in the image)."""
+    ends = cam.project(np.array([[xy[0], xy[1], 0.0], [xy[0], xy[1], height]]))
+    length = float(np.hypot(*(ends[0] - ends[1])))
+    return min(1.0, length_px / length) if length > 0 else 1.0
+
+
+def covered_share(mask: np.ndarray, points: np.ndarray) -> float:
+    """Share of image points ``points`` (N, 2) px, rounded, that fall on nonzero pixels of ``mask``
+    (H, W); points outside the image count as not covered.
+
+    >>> m = np.zeros((4, 4), np.uint8); m[0, :2] = 1
+    >>> covered_share(m, np.array([[0.0, 0.0], [1.2, 0.1], [3.0, 3.0], [9.0, 0.0]]))
+    0.5
+    """
+    q = np.rint(np.asarray(points, float)).astype(int)
+    inside = (q[:, 0] >= 0) & (q[:, 0] < mask.shape[1]) & (q[:, 1] >= 0) & (q[:, 1] < mask.shape[0])
+    hit = np.zeros(len(q), dtype=bool)
+    hit[inside] = mask[q[inside, 1], q[inside, 0]] != 0
+    return float(hit.mean()) if len(q) else 0.0
 
 
 def head_height(cam, head_px: np.ndarray, foot: np.ndarray) -> float | None:
@@ -307,4 +342,5 @@ def render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: n
         out[v0:v1, u0:u1] |= ellipse_crop(forms[k], boxes[k], grid, has_dist).astype(np.uint8)
 
 
-__all__ = ["BIRTH_PLACES", "BirthPlaces", "Births", "Proposal", "blob_position", "disc_offsets"]
+__all__ = ["BIRTH_PLACES", "BirthPlaces", "Births", "Proposal", "blob_position", "covered_share", "disc_offsets",
+           "length_share"]
