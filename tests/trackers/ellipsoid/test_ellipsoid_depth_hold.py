@@ -44,27 +44,33 @@ def _hold(tracker, labels, people):
 
 def test_a_covered_person_moves_towards_the_point_under_their_clear_head(seen):
     tracker, labels, _, _ = seen
-    far, people, xy, ray = _covered(seen, 0.8, cover=True)
+    far, people, xy, ray = _covered(seen, 0.35, cover=True)   # the head's σ here: 0.22 m
     assert _hold(tracker, labels, people) == 1
     after = float((np.array([far.x, far.y]) - xy) @ ray)
-    assert 0.0 <= after < 0.5                   # from 0.8 m too far to within 0.5 m of the truth
+    assert 0.0 <= after < 0.2                   # from 0.35 m too far to within 0.2 m of the truth
+
+
+def test_a_head_farther_than_its_own_sigma_allows_moves_nobody(seen):
+    tracker, labels, _, _ = seen
+    _, people, _, _ = _covered(seen, 0.8, cover=True)        # 0.8 m: beyond 2 σ (0.44 m)
+    assert _hold(tracker, labels, people) == 0
 
 
 def test_nothing_moves_uncovered_unmeasured_or_with_the_head_not_clear(seen, monkeypatch):
     tracker, labels, _, _ = seen
-    _, alone, _, _ = _covered(seen, 0.8, cover=False)
+    _, alone, _, _ = _covered(seen, 0.35, cover=False)
     assert _hold(tracker, labels, alone) == 0          # not covered: the feet anchor's case
-    _, unmeasured, _, _ = _covered(seen, 0.8, cover=True, samples=2)
+    _, unmeasured, _, _ = _covered(seen, 0.35, cover=True, samples=2)
     assert _hold(tracker, labels, unmeasured) == 0     # a height not measured places nobody
     monkeypatch.setattr(depth_hold, "head_is_clear", lambda *a: False)
-    _, people, _, _ = _covered(seen, 0.8, cover=True)
+    _, people, _, _ = _covered(seen, 0.35, cover=True)
     assert _hold(tracker, labels, people) == 0
 
 
 def test_the_fusion_holds_covered_people_only_with_head_when_covered(seen):
     tracker, labels, _, _ = seen
     for on, expected in ((True, 1), (False, 0)):
-        _, people, _, _ = _covered(seen, 0.8, cover=True)
+        _, people, _, _ = _covered(seen, 0.35, cover=True)
         fusion = DepthFusion(DepthConfig(head_when_covered=on), FeetConfig(), HeightConfig())
         assert fusion.apply(people, tracker.views, {"cam": labels}, tracker.walkable, 0.1) == expected
 
