@@ -49,6 +49,8 @@ import numpy as np
 
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.cameras import CameraView
+from worldtrack.trackers.ellipsoid.depth_hold import hold_covered_by_head
+from worldtrack.trackers.ellipsoid.depth_step import bound_steps
 from worldtrack.trackers.ellipsoid.config import DepthConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.encounters import covered_in_some_view
 from worldtrack.trackers.ellipsoid.feet import under_head
@@ -79,20 +81,46 @@ class DepthFusion:
         self._predicted: "weakref.WeakKeyDictionary[Person, np.ndarray]" = weakref.WeakKeyDictionary()
         self._met: "weakref.WeakKeyDictionary[Person, bool]" = weakref.WeakKeyDictionary()
         self._weak: "weakref.WeakKeyDictionary[Person, int]" = weakref.WeakKeyDictionary()
+        self._velocity: "weakref.WeakKeyDictionary[Person, np.ndarray]" = weakref.WeakKeyDictionary()
 
     def remember_prediction(self, people: Sequence[Person]) -> None:
         """Keep the predicted place of each tracked person (call after the prediction, before matching)."""
-        if not self.config.fuse:
+        if not (self.config.fuse or self.config.max_along_speed_mps > 0):
             return
         for p in people:
             if p.mode == "tracking":
                 self._predicted[p] = np.array([p.x, p.y])
+                self._velocity[p] = np.array([p.vx, p.vy])
 
     def apply(self, people: Sequence[Person], views: Mapping[str, CameraView], labels: Mapping[str, np.ndarray],
               walkable, dt: float) -> int:
         """Place each of ``people`` that one camera alone shows along that camera's line of sight
         (see the module docstring), and those no camera shows by their prediction along the first
-        camera's; returns how many were moved."""
+        camera's; with ``max_along_speed_mps``, then keeps each within walking reach of their
+        last place along the line of sight (:mod:`.depth_step`); returns how many were moved."""
+        moves = self._fuse(people, views, labels, walkable, dt)
+        if self.config.head_when_covered:
+            moves += hold_covered_by_head(people, views, labels, walkable, self.feet, self.height)
+        if self.config.max_along_speed_mps > 0 and people:
+            last = {p: xy - self._velocity[p] * dt for p, xy in self._predicted.items() if p in self._velocity}
+            moves += bound_steps(people, last, self._lone_centre(people, views),
+                                 self.config.max_along_speed_mps, dt, walkable)
+        self._predicted.clear()
+        self._velocity.clear()
+        return moves
+
+    @staticmethod
+    def _lone_centre(people: Sequence[Person], views: Mapping[str, CameraView]):
+        """index -> the centre (3,) of the one camera of ``views`` that shows ``people[index]``, or None."""
+        def centre(k: int):
+            p = people[k]
+            seen = [v for v in views.values() if v.visible_pixels(np.array([p.x, p.y]), p.height, p.width) >= MIN_OWN_PIXELS]
+            return seen[0].camera.centre if len(seen) == 1 else None
+        return centre
+
+    def _fuse(self, people: Sequence[Person], views: Mapping[str, CameraView], labels: Mapping[str, np.ndarray],
+              walkable, dt: float) -> int:
+        """The fusion of :meth:`apply` (``fuse``), or without it the encounters only; returns the moves."""
         if not self.config.fuse or not people:
             if self.config.remeasure_after_encounter and people:   # the encounters, without the fusion
                 for p, covered in zip(people, covered_in_some_view(people, views, self.height.range_m[1])):
@@ -114,7 +142,6 @@ class DepthFusion:
                 if walkable(new[None])[0]:
                     people[k].x, people[k].y = float(new[0]), float(new[1])
                     moves += 1
-        self._predicted.clear()
         return moves
 
     def _cues(self, view: CameraView, labels: np.ndarray, people: Sequence[Person], xy: np.ndarray,

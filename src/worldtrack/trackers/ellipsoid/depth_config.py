@@ -62,3 +62,12 @@ class DepthConfig(Section):
         False, description="drop a person's height samples once others stop covering them: the height is measured "
         "afresh, not carried through a crossing (with or without depth.fuse; with feet.anchor and height.prior_sigma_m "
         "0.1, heights within 3 cm 67 -> 84 of 97 on held-out line-of-sight seeds, issue 37)")
+    max_along_speed_mps: float = Field(
+        0.0, ge=0, description="when > 0, a tracked person one camera alone shows stays within this speed times the "
+        "frame interval of their last place along its line of sight, m/s (depth_step.py: one frame's evidence may be "
+        "a near person's feet; 0 = off; 2 m/s did not help on line-of-sight seeds 410/415)")
+    head_when_covered: bool = Field(
+        False, description="a person one camera alone shows, covered there by others (the feet anchor silent), with a "
+        "measured height, moves towards the point under their head where it is clear of the others (depth_hold.py); "
+        "off: with the best one-camera opt-in, line of sight dev 0.759 -> 0.779, held-out 0.771 -> 0.796, new seeds "
+        "460-479 0.801 -> 0.795 (issue 37)")
