@@ -40,6 +40,10 @@ class CrowdConfig(Section):
         "the match is not read as a walk), so the prediction carries the walk measured before the cover, damped by "
         "the measured share. Off by default: PETS 2009 over 8 starts MOTA 0.922 (0.917 without it, 0.926 default), "
         "crowd 50 held-out 113-118 true places 16.3 of 49 held, MOTA 0.479 (17.5, 0.492 without it)")
+    alone_behind_obstacles: bool = Field(
+        False, description="with predict_along_ray_measured: obstacles do not hide the feet (the depth counts as "
+        "observed) of a person nobody else overlaps (own_share >= 1 - support.min_own_share): alone behind a sign, "
+        "the match has no neighbour's silhouette to slide into. Off by default")
     births_past_people: bool = Field(
         False, description="a birth blob's end on the ellipses of people already known is hidden, as one on an "
         "obstacle (a head band above a tracked person is placed by its head, not by its lower end), and the size "

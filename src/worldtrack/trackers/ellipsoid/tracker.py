@@ -128,7 +128,7 @@ class EllipsoidTracker(TrackerBase):
         #: One id per visit to the region of interest (:mod:`.region`; ``region.area``, off when empty).
         self.region = RegionVisits(cfg.region)
         #: Each person's share of velocity measured while their depth was observed (:mod:`.prediction`).
-        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing, cfg.crowd.hold_along_ray_unobserved)
+        self.measured_share = MeasuredShare.from_config(cfg)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
