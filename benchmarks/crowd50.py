@@ -21,7 +21,9 @@ Per seed it reports:
 Each seed is tracked twice: from a cold start, and given everyone's true place on frame 0. Started
 on the truth, track ids are the people's, so the script also says how each person's own track was
 first lost (:mod:`crowd_losses`: ended out of sight or in view, onto a neighbour, off along the
-camera's ray or across it).
+camera's ray or across it). For both starts it also says what is near each scored person in each
+frame (:func:`crowd_losses.coverage`): their own track, a neighbour's track (on the same line of
+sight or beside), a track between people, or no track within 1 m.
 
 Issue 37's opt-in settings for this case (``ellipsoid.crowd``): ``--set crowd.predict_along_ray=0``
 (the prediction keeps only the velocity across the lone camera's line of sight) and ``--set
@@ -50,7 +52,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result, setting_value, write_result  # noqa: E402
-from crowd_losses import LOSSES, first_losses  # noqa: E402
+from crowd_losses import COVERAGE, LOSSES, coverage, first_losses  # noqa: E402
 from crowd_seeds import GATE_M, SIZE, _seed_list, render_seed, run_seed  # noqa: E402
 
 from worldtrack.eval import CAUSES  # noqa: E402
@@ -79,14 +81,16 @@ def main(argv: list[str] | None = None) -> int:
     options = {k: setting_value(v) for k, v in (s.split("=", 1) for s in args.set)}
     t0 = time.perf_counter()
     rows, total, losses = [], {start: Counter() for start in STARTS}, Counter()
+    covered = {start: Counter() for start in STARTS}
     for seed in seeds:
         rendered = render_seed(seed, frames, PEOPLE, CAMERAS)
         for start in STARTS:
             r = run_seed(seed, frames, PEOPLE, options, cameras=CAMERAS, rendered=rendered,
                          init_from_gt=start == "true places")
             total[start] += r["causes"]
+            camera = next(iter(rendered[0].scene.cameras.values()))
+            covered[start] += coverage(*r["tables"], camera.centre[:2], GATE_M)
             if start == "true places":  # track ids are the people's: how each one's own track was lost
-                camera = next(iter(rendered[0].scene.cameras.values()))
                 losses += first_losses(*r["tables"], camera.centre[:2], GATE_M)
             held, scored = r["held"]
             rows.append([seed, start, scored, held, r["tracks"], r["mota"], r["idf1"], r["fp"], r["miss"],
@@ -101,6 +105,10 @@ def main(argv: list[str] | None = None) -> int:
                      f"(min {a[:, 1].min():.0f}; target ≥ {TARGET_HELD}), tracks per frame {a[:, 2].mean():.1f}, "
                      f"MOTA mean **{a[:, 3].mean():.3f}** (min {a[:, 3].min():.3f}), IDF1 mean {a[:, 4].mean():.3f}; "
                      "errors by cause: " + ", ".join(f"{c} {total[start][c]}" for c in CAUSES) + ".")
+    for start in STARTS:
+        n = max(sum(covered[start].values()), 1)
+        lines.append(f"- {start}, what is near each person in each frame they are scored in (crowd_losses.coverage): "
+                     + ", ".join(f"{c} {covered[start][c] / n:.0%}" for c in COVERAGE) + ".")
     lines.append("- true places, how each person's own track was first lost (crowd_losses.py): "
                  + ", ".join(f"{c} {losses[c]}" for c in LOSSES) + f"; none for {len(seeds) * PEOPLE - sum(losses.values())} "
                  f"of {len(seeds) * PEOPLE} (held to the end, or never).")

@@ -14,6 +14,17 @@ them (after having been). :func:`first_losses` sorts those first losses into:
 
 Each loss also carries the person's visible share at that frame.
 
+:func:`coverage` asks the question "held" rests on, for any run (cold start too): in each frame, is
+each scored person (at least 20 % visible) covered by a track of their own — the nearest track
+within the gate, of which they are the nearest person? If not, what is near them:
+
+* **under a neighbour's track on the same ray** — the nearest track (within 1 m) is within the gate of
+  somebody else who stands within 5° of the same line of sight: one track for two people, one
+  behind the other (one camera cannot tell them apart by the silhouette's outline);
+* **under a neighbour's track beside** — the same, the other person off that ray;
+* **a track between** — the nearest track is within 1 m of them and within the gate of nobody;
+* **no track within 1 m** — nobody proposed them, or their track ended.
+
 >>> from worldtrack.io.tracks import TrackTable
 >>> gt = TrackTable.from_arrays([0, 1, 0, 1], [1, 1, 2, 2], [2.0, 2.0, 4.0, 4.0], [0.0, 0.0, 0.0, 0.0],
 ...                             extra={"vis_c": np.ones(4)})
@@ -29,6 +40,11 @@ from collections import Counter
 import numpy as np
 
 LOSSES = ("ended out of sight", "ended in view", "onto a neighbour", "along the ray", "across the ray")
+#: What is near a scored person in a frame (:func:`coverage`).
+COVERAGE = ("own track", "under a neighbour's track on the same ray", "under a neighbour's track beside",
+            "a track between", "no track within 1 m")
+#: Two people within this angle (degrees) of one line of sight stand "on the same ray".
+SAME_RAY_DEG = 5.0
 
 
 def _visibility(gt) -> np.ndarray:
@@ -75,4 +91,47 @@ def first_losses(gt, pred, camera_xy: np.ndarray, gate: float = 0.5, min_visibil
     return out
 
 
-__all__ = ["LOSSES", "first_losses"]
+def coverage(gt, pred, camera_xy: np.ndarray, gate: float = 0.5, min_visibility: float = 0.2,
+             near: float = 1.0) -> Counter:
+    """Counter of :data:`COVERAGE` over the person-frames at least ``min_visibility`` visible.
+
+    Parameters
+    ----------
+    gt, pred : TrackTable — every ground-truth row and every reported track row
+    camera_xy : (2,) — the camera's foot point on the floor, m
+    gate : float — a track within this of a person may be theirs, m
+    min_visibility : float — less visible people are not counted
+    near : float — farther than this from every track, a person has "no track", m
+    """
+    vis = _visibility(gt)
+    out: Counter = Counter()
+    cos_same = np.cos(np.radians(SAME_RAY_DEG))
+    for f in np.unique(gt.frame):
+        g = np.flatnonzero(gt.frame == f)
+        p = np.flatnonzero(pred.frame == f)
+        shown = vis[g] >= min_visibility
+        if not len(p):
+            out["no track within 1 m"] += int(shown.sum())
+            continue
+        gxy = np.column_stack([gt.x[g], gt.y[g]])
+        d = np.hypot(gxy[:, None, 0] - pred.x[p][None], gxy[:, None, 1] - pred.y[p][None])   # (G, P), m
+        nearest_person = d.argmin(axis=0)                                                    # (P,)
+        track_gated = d[nearest_person, np.arange(len(p))] < gate
+        ray = gxy - camera_xy
+        ray /= np.maximum(np.linalg.norm(ray, axis=1, keepdims=True), 1e-9)
+        for k in np.flatnonzero(shown):
+            if np.any((nearest_person == k) & track_gated & (d[k] < gate)):
+                out["own track"] += 1
+                continue
+            j = int(d[k].argmin())
+            if d[k, j] >= near:
+                out["no track within 1 m"] += 1
+            elif not track_gated[j]:
+                out["a track between"] += 1
+            else:
+                same = ray[k] @ ray[nearest_person[j]] >= cos_same
+                out["under a neighbour's track on the same ray" if same else "under a neighbour's track beside"] += 1
+    return out
+
+
+__all__ = ["COVERAGE", "LOSSES", "coverage", "first_losses"]

@@ -34,3 +34,19 @@ def test_a_person_never_held_is_not_counted_as_lost():
     gt = TrackTable.from_arrays([0, 1], [1, 1], [2.0, 2.0], [0.0, 0.0], extra={"vis_c": np.ones(2)})
     pred = TrackTable.from_arrays([0, 1], [1, 1], [3.0, 3.0], [0.0, 0.0])
     assert not first_losses(gt, pred, np.array([0.0, 0.0]))
+
+
+def test_coverage_tells_what_is_near_each_person_without_a_track_of_their_own():
+    from crowd_losses import coverage
+    # Camera at the origin. One frame: 1 and 2 one behind the other on the x axis, so are 8 and 9
+    # (9 within the gate of 8's track, which is nearer 8), 3 beside 4, 5 alone with a track 0.8 m
+    # off, 6 with nothing near, 7 not visible enough to count.
+    xy = {1: (4.0, 0.0), 2: (4.7, 0.0), 3: (0.0, 6.0), 4: (0.7, 6.0), 5: (-6.0, 0.0), 6: (0.0, -9.0), 7: (9.0, 9.0),
+          8: (-3.0, 3.0), 9: (-3.3, 3.3)}
+    ids = list(xy)
+    vis = np.array([1.0, 0.6, 1.0, 1.0, 1.0, 1.0, 0.1, 1.0, 0.5])
+    gt = TrackTable.from_arrays([0] * 9, ids, [xy[i][0] for i in ids], [xy[i][1] for i in ids], extra={"vis_c": vis})
+    pred = TrackTable.from_arrays([0] * 4, [10, 11, 12, 13], [4.05, 0.0, -6.8, -3.0], [0.0, 6.05, 0.0, 3.05])
+    got = coverage(gt, pred, np.array([0.0, 0.0]))
+    assert got == {"own track": 3, "under a neighbour's track on the same ray": 2, "under a neighbour's track beside": 1,
+                   "a track between": 1, "no track within 1 m": 1}

@@ -135,7 +135,8 @@ def test_births_pass_the_known_people_to_the_blobs_only_when_asked(monkeypatch):
     scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
     seen = []
     real_position = births.blob_position
-    monkeypatch.setattr(births, "blob_position", lambda *a, **k: seen.append(a[7]) or real_position(*a, **k))
+    monkeypatch.setattr(births, "blob_position",
+                        lambda *a, **k: seen.append(k.get("known")) or real_position(*a, **k))
     known = People(np.array([[person[0] + 3.0, person[1]]]), np.array([1.65]), np.array([0.4]))
     for occlude in (False, True):
         fresh = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
@@ -144,3 +145,53 @@ def test_births_pass_the_known_people_to_the_blobs_only_when_asked(monkeypatch):
         seen.clear()
         assert len(_proposals(fresh, known)) == 1    # the person, 3 m from the known one, either way
         assert seen and all((k is not None) == occlude for k in seen)
+
+
+def test_a_head_band_on_top_of_a_known_person_is_placed_by_its_head_not_by_its_lower_end():
+    # Issue 37 (crowd 50): somebody behind a tracked person shows one band of head and shoulders
+    # above them. Its lower end is where the tracked person's ellipse begins, not the feet.
+    from worldtrack.trackers.ellipsoid.births import blob_position
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    for cid in sorted(tracker.views):
+        view = tracker.views[cid]
+        crop, origin, centroid = _column_blob(view, person, 1.35, 1.80)
+        # Read as a whole person, the band's lower end puts them metres along the line of sight: it is
+        # shorter than the tracker's height.min_px (60 px), so it tells no height to find that out.
+        alone = blob_position(view, crop, origin, centroid, 1.80, (1.3, 2.1), 60)
+        assert alone is not None and np.hypot(*(alone.xy[:2] - person)) > 2.0
+        explained = np.zeros((view.camera.height, view.camera.width), np.uint8)
+        explained[origin[1] + crop.shape[0]:, :] = 1     # a known person's ellipse right below the band
+        band = blob_position(view, crop, origin, centroid, 1.80, (1.3, 2.1), 60, explained=explained)
+        assert band is not None and band.height is None
+        assert np.hypot(*(band.xy[:2] - person)) < 0.15   # the head, at the default height (here 1.80 m)
+        # Legs under a known person's ellipse (somebody in front of them): still placed by the feet.
+        crop, origin, centroid = _column_blob(view, person, 0.0, 0.9)
+        explained[:] = 0
+        explained[:origin[1], :] = 1
+        legs = blob_position(view, crop, origin, centroid, 1.80, (1.3, 2.1), 60, explained=explained)
+        assert legs is not None and np.hypot(*(legs.xy[:2] - person)) < 0.1
+
+
+def test_the_size_test_past_people_expects_only_what_the_known_people_leave_unexplained():
+    from worldtrack.trackers.ellipsoid.people_edges import unexplained_pixels
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    view = tracker.views[sorted(tracker.views)[0]]
+    cam = view.camera
+    explained = np.zeros((cam.height, cam.width), np.uint8)
+    whole = view.visible_pixels(person, 1.65, 0.4)
+    assert whole > 200 and unexplained_pixels(view, person, 1.65, 0.4, explained) == whole
+    foot = cam.project(np.array([[*person, 0.0]]))[0]
+    explained[:int(round(foot[1])) - 20, :] = 1           # somebody known covers all but the legs' 20 px
+    part = unexplained_pixels(view, person, 1.65, 0.4, explained)
+    assert 0 < part < 0.5 * whole
+
+
+def test_births_past_people_is_the_crowd_setting_and_off_by_default():
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    assert tracker.births.past_people is False
+    crowd = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
+                             EllipsoidConfig(crowd={"births_past_people": True}))
+    assert crowd.births.past_people is True
+    # Nobody known: the same proposals as without it.
+    crowd.last_masks = tracker.last_masks
+    assert [tuple(np.round(q.xy, 6)) for q in _proposals(crowd)] == [tuple(np.round(q.xy, 6)) for q in _proposals(tracker)]

@@ -37,3 +37,13 @@ def test_a_table_in_front_hides_the_feet_and_a_person_out_of_the_image_has_none_
     xy = np.array([[-1.0, 2.0], [0.3, 0.5], [30.0, 0.0]])       # behind the table, beside it, far out
     assert feet_in_view(_view(), xy[:2], *_sizes(2)).tolist() == [True, True]
     assert feet_in_view(_view([table]), xy, *_sizes(3)).tolist() == [False, True, False]
+
+
+def test_without_obstacles_only_the_image_edge_and_people_hide_the_feet():
+    table = {"type": "box", "name": "table", "centre": [-1.0, 1.0, 0.4], "size": [1.2, 0.6, 0.8]}
+    view = _view([table])
+    xy = np.array([[-1.0, 2.0], [30.0, 0.0]])                  # behind the table, far out of the image
+    assert feet_in_view(view, xy, *_sizes(2), obstacles=False).tolist() == [True, False]
+    near = np.array([-1.0, 0.2])                               # somebody in front of the one behind the table
+    behind = near + 1.8 * view.camera.floor_rays(near, min_distance=0.3)[0]
+    assert feet_in_view(view, np.array([near, behind]), *_sizes(2), obstacles=False).tolist() == [True, False]

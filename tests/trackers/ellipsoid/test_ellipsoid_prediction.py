@@ -148,3 +148,33 @@ def test_lone_rays_point_from_the_lone_camera_to_the_person():
     rays = lone_rays(people, cams, ["c1", "c2"])
     np.testing.assert_allclose(rays[0], cams[1].floor_rays(np.array([-1.0, 1.5]), min_distance=0.3)[0])
     assert np.isnan(rays[1]).all()
+
+
+def test_behind_an_obstacle_depth_counts_as_observed_with_alone_share_only_for_a_person_nobody_overlaps():
+    from worldtrack.scene import scene_from_dict
+    table = {"type": "box", "name": "table", "centre": [-1.0, 1.0, 0.4], "size": [1.2, 0.6, 0.8]}
+    scene = scene_from_dict({
+        "cameras": [{"id": "cam", "image_size": [160, 120], "position": [-1.0, -1.74, 2.64],
+                     "look_at": [-1.0, 0.9, 0.68], "hfov_deg": 60}],
+        "floor": {"walkable": [{"outer": [[-4, -1.5], [2, -1.5], [2, 5], [-4, 5]]}]}, "obstacles": [table]})
+    view = EllipsoidTracker(scene, make_foregrounds(scene, noise_backgrounds(scene, np.random.default_rng(0)),
+                                                    "colour")).views["cam"]
+    alone, crowded = Person(1, -1.0, 2.0, mode="tracking"), Person(2, -1.0, 2.0, mode="tracking")
+    _seen(alone, 0.1, 0.9)          # behind the table; nobody covers 90 % of their pixels
+    _seen(crowded, 0.1, 0.5)        # the same place, half covered by others
+    assert depth_observed([alone, crowded], [], [view], 0.1).tolist() == [False, False]
+    assert depth_observed([alone, crowded], [], [view], 0.1, alone_share=0.75).tolist() == [True, False]
+    for share, kept in ((MeasuredShare(0.5), 0.5), (MeasuredShare(0.5, alone_share=0.75), 1.0)):
+        walker = Person(3, -1.0, 2.0, mode="tracking")   # counted once per time stamp: a fresh one each
+        _seen(walker, 0.1, 0.9)
+        share.observe([walker], [walker], {"cam": view}, ["cam"], 0.1)   # the share the tracker keeps
+        assert share.shares([walker]).tolist() == [kept]
+
+
+@pytest.mark.parametrize("on", [False, True])
+def test_the_tracker_reads_alone_behind_obstacles_as_one_minus_the_duplicate_share(on):
+    config = EllipsoidConfig(crowd={"predict_along_ray_measured": True, "alone_behind_obstacles": on},
+                             support={"min_own_share": 0.3})
+    share = MeasuredShare.from_config(config)
+    assert share.alone_share == (pytest.approx(0.7) if on else None)
+    assert share.smoothing == config.match.velocity_smoothing and share.hold is False

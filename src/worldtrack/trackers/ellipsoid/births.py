@@ -24,6 +24,7 @@ from worldtrack.trackers.ellipsoid.args import People
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import BirthConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop
+from worldtrack.trackers.ellipsoid.people_edges import ends_on_people, unexplained_pixels
 
 class Proposal(NamedTuple):
     """A new person: a floor place (2,) m, the camera whose foreground proposed it, and the height
@@ -102,16 +103,20 @@ class Births:
         heights are not measured (blobs then place people by their lower end, as before issue 37)
     min_px : a blob tells a height only when it is at least this long, px (``ellipsoid.height.min_px``,
         the rule the tracker's own height measurements follow: small, a pixel is centimetres)
+    past_people : a blob's end on the known people's ellipses is hidden, and the size test expects
+        only what they leave unexplained (``crowd.births_past_people``, :mod:`.people_edges`)
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
-                 config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60):
+                 config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60,
+                 past_people: bool = False):
         self.views = views
         self.scene = scene
         self.walkable = walkable
         self.config = config
         self.height_range = height_range
         self.min_px = min_px
+        self.past_people = past_people
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
@@ -158,7 +163,8 @@ class Births:
         # labelling the whole 640x480 frame was a third of the births' time.
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
             found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px,
-                                  explained if cfg.people_occlude else None)
+                                  known=explained if cfg.people_occlude else None,
+                                  explained=explained if self.past_people and len(xy) else None)
             if found is None:
                 continue
             p, height, share = found
@@ -166,7 +172,8 @@ class Births:
             if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
                 continue  # off the floor, or somebody already there
             # Is the blob big enough to be (the visible part of) a person standing there?
-            expected = view.visible_pixels(pxy, h0, w0)
+            expected = (unexplained_pixels(view, pxy, h0, w0, explained) if self.past_people and len(xy)
+                        else view.visible_pixels(pxy, h0, w0))
             if expected <= 0 or area < cfg.min_blob_fraction * expected * share:
                 continue
             out.append(Proposal(pxy, cid, height))
@@ -197,7 +204,7 @@ class Births:
 
 def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], centroid: np.ndarray,
                   height: float, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: float = 0,
-                  known: np.ndarray | None = None) -> BlobPlace | None:
+                  known: np.ndarray | None = None, explained: np.ndarray | None = None) -> BlobPlace | None:
     """Floor position (3,) of a person seen as ``blob``, the height (m) the blob shows and the share
     of the person it shows, or None.
 
@@ -225,6 +232,8 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     places the person, no height is given, and the share is the blob's length over the person's
     there. (Its mirror — the feet hidden by a known person, the head placing them at the default
     height — lost on crowd 10's dev seeds, and is not done.)
+    ``explained`` ((H, W) uint8, the known people's ellipses; None: not looked at): an end on them
+    is hidden as one on an obstacle (:func:`~.people_edges.ends_on_people`).
     """
     cam = view.camera
     down = view.down_direction(centroid)
@@ -242,6 +251,9 @@ def blob_position(view: CameraView, blob: np.ndarray, origin: tuple[int, int], c
     beyond = foot + 2 * down + np.linspace(-half, half, 9)[:, None] * across
     feet_hidden = not pixel_clear(cam, None, beyond).all() or (~pixel_clear(cam, view.occ, beyond)).mean() > 0.5
     head_seen = bool(pixel_clear(cam, None, (head - 2 * down)[None]).all())
+    if explained is not None:   # an end on somebody already known: hidden by (or hiding) them
+        feet_on, head_on = ends_on_people(explained, foot, head, down, half)
+        feet_hidden, head_seen = feet_hidden or feet_on, head_seen and not head_on
     shown, share = None, 1.0
     above = None if known is None else head - 2 * down + np.linspace(-half, half, 9)[:, None] * across
     if above is not None and not feet_hidden and covered_share(known, above) > 0.5:

@@ -36,7 +36,8 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView
 FEET_Z_M = 0.1
 
 
-def feet_in_view(view: CameraView, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray) -> np.ndarray:
+def feet_in_view(view: CameraView, xy: np.ndarray, heights: np.ndarray, widths: np.ndarray,
+                 obstacles: bool = True) -> np.ndarray:
     """Whether ``view``'s camera sees each person's feet.
 
     Parameters
@@ -44,6 +45,7 @@ def feet_in_view(view: CameraView, xy: np.ndarray, heights: np.ndarray, widths: 
     view : the camera's view (its ellipse drawing, undistortion grid and obstacle map)
     xy : (N, 2) float — everyone's floor positions, m (all the people who may cover each other)
     heights, widths : (N,) float — their body sizes, m
+    obstacles : bool — the scene's obstacles hide feet (False: only the image's edge and people do)
 
     Returns
     -------
@@ -59,7 +61,9 @@ def feet_in_view(view: CameraView, xy: np.ndarray, heights: np.ndarray, widths: 
     uv = cam.project(np.column_stack([xy, np.full(n, FEET_Z_M)]))
     u = np.clip(np.round(uv[:, 0]).astype(int), 0, cam.width - 1)
     v = np.clip(np.round(uv[:, 1]).astype(int), 0, cam.height - 1)
-    ok = valid & cam.in_image(uv) & (view.occ[v, u] >= dist)     # in the image, no obstacle in front
+    ok = valid & cam.in_image(uv)
+    if obstacles:
+        ok &= view.occ[v, u] >= dist                   # no obstacle in front
     if view.args.has_dist:                             # the ellipses are drawn in ideal coordinates
         pu, pv = view.grid[v, u, 0].astype(float), view.grid[v, u, 1].astype(float)
     else:

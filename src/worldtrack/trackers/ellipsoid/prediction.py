@@ -118,11 +118,20 @@ class MeasuredShare:
     [0.625]
     """
 
-    def __init__(self, smoothing: float, hold: bool = False) -> None:
+    def __init__(self, smoothing: float, hold: bool = False, alone_share: float | None = None) -> None:
         self.smoothing = float(np.clip(smoothing, 0.0, 1.0))
         self.hold = bool(hold)
+        self.alone_share = alone_share
         self._share: "weakref.WeakKeyDictionary[Person, float]" = weakref.WeakKeyDictionary()
         self._velocity: "weakref.WeakKeyDictionary[Person, np.ndarray]" = weakref.WeakKeyDictionary()
+
+    @classmethod
+    def from_config(cls, config) -> "MeasuredShare":
+        """The tracker's: smoothed as its velocity (``match.velocity_smoothing``), ``hold`` from
+        ``crowd.hold_along_ray_unobserved``, and with ``crowd.alone_behind_obstacles`` an
+        ``alone_share`` of 1 − ``support.min_own_share`` (see :func:`depth_observed`)."""
+        alone = 1.0 - config.support.min_own_share if config.crowd.alone_behind_obstacles else None
+        return cls(config.match.velocity_smoothing, config.crowd.hold_along_ray_unobserved, alone)
 
     def update(self, people: Sequence[Person], t: float, observed: np.ndarray, rays: np.ndarray | None = None) -> None:
         """Count this frame (time ``t`` s, once) for each tracked person of ``people``, whose depth
@@ -149,7 +158,8 @@ class MeasuredShare:
         map, and, with ``hold``, their lone camera's rays (:func:`lone_rays`)."""
         cids = list(views)
         rays = lone_rays(people, [v.camera for v in views.values()], cids) if self.hold else None
-        self.update(people, t, depth_observed(people, everyone, [views[c] for c in labelled], t), rays)
+        self.update(people, t, depth_observed(people, everyone, [views[c] for c in labelled], t, self.alone_share),
+                    rays)
 
     def shares(self, people: Sequence[Person]) -> np.ndarray:
         """(N,) float in [0, 1] — each person's measured share (1 for one not counted yet)."""
@@ -157,10 +167,15 @@ class MeasuredShare:
 
 
 def depth_observed(people: Sequence[Person], others: Sequence[Person], views: Sequence[CameraView],
-                   t: float) -> np.ndarray:
+                   t: float, alone_share: float | None = None) -> np.ndarray:
     """(N,) bool — whether a camera observed each of ``people``'s depth at time ``t`` (s): it showed
     them then and some camera of ``views`` sees their feet, in its image, in front of obstacles and
-    of everybody nearer among ``people`` and ``others`` (:func:`.ground_contact.feet_in_view`)."""
+    of everybody nearer among ``people`` and ``others`` (:func:`.ground_contact.feet_in_view`).
+
+    With ``alone_share`` (``crowd.alone_behind_obstacles``), obstacles do not hide the feet of a
+    person at least this share of whose pixels nobody else covers (``Person.own_share``): behind a
+    sign or a pillar but alone, their match has no neighbour's silhouette to slide into (PETS 2009:
+    a walker passing behind the sign lost the prediction within 3 frames and the track)."""
     seen = np.array([p.seen_now(t) for p in people], dtype=bool).reshape(-1)
     mine = {id(p) for p in people}
     everyone = list(people) + [q for q in others if id(q) not in mine]
@@ -170,6 +185,11 @@ def depth_observed(people: Sequence[Person], others: Sequence[Person], views: Se
     feet = np.zeros(len(people), dtype=bool)
     for view in views:
         feet |= feet_in_view(view, xy, hs, ws)[:len(people)]
+    if alone_share is not None:
+        own = np.array([p.own_share for p in people], dtype=float).reshape(-1)
+        alone = np.nan_to_num(own, nan=0.0) >= alone_share
+        for view in views:
+            feet |= alone & feet_in_view(view, xy, hs, ws, obstacles=False)[:len(people)]
     return seen & feet
 
 

@@ -102,7 +102,8 @@ class EllipsoidTracker(TrackerBase):
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
         self.births = Births(self.views, scene, self.walkable, cfg.births,
-                             cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px)
+                             cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px,
+                             cfg.crowd.births_past_people)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
@@ -127,7 +128,7 @@ class EllipsoidTracker(TrackerBase):
         #: One id per visit to the region of interest (:mod:`.region`; ``region.area``, off when empty).
         self.region = RegionVisits(cfg.region)
         #: Each person's share of velocity measured while their depth was observed (:mod:`.prediction`).
-        self.measured_share = MeasuredShare(cfg.match.velocity_smoothing, cfg.crowd.hold_along_ray_unobserved)
+        self.measured_share = MeasuredShare.from_config(cfg)
         self._now = 0.0
         if cfg.crowd.coast_behind_obstacles_s > 0:
             self.life.coasting = self._coasting
