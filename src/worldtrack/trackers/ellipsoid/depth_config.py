@@ -27,6 +27,8 @@ class FeetConfig(Section):
     pixel_sigma_px: float = Field(0.0, ge=0, description="with > 0, the feet's σ also holds this many pixels' floor span (feet_pixel.py)")
     centre_offset_m: float = Field(0.0, ge=0, description="with anchor: the person stands this far beyond the lowest "
                                    "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
+    footprint: bool = Field(False, description="with anchor: the person stands beyond the lowest point of their silhouette by "
+                            "where this camera sees a foot model's lowest point (anchor_footprint.py); replaces centre_offset_m")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")

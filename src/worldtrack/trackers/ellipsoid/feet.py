@@ -44,6 +44,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from worldtrack.trackers.base import Person
+from worldtrack.trackers.ellipsoid.anchor_footprint import standing_point
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
@@ -144,7 +145,9 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= config.height_match_m \
                 and not touches_other(look[1], look[2], cam.project(found[0][None])[0], k):
             sigma = feet_sigma_m(cam, found[0][:2], look[3], config.sigma_m, config.pixel_sigma_px)
-            out[k] = (beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m), sigma)
+            stands = (standing_point(found[0][:2], cam.centre, hs[k]) if config.footprint
+                      else beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m))
+            out[k] = (stands, sigma)
             continue
         if not config.head_fallback or (config.head_clear and not head_is_clear(cam, labels, look, k)):
             continue

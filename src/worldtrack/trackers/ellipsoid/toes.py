@@ -13,6 +13,7 @@ seed (issue 37): never-used seeds 260-279 MOTA 0.713 -> 0.786 (+0.073 +- 0.029 s
 4 worse), longest run > 0.5 m along the ray 6.0 -> 3.0 s; fresh 280-299 0.743 -> 0.746; held-out
 150-169 0.780 -> 0.758; the dev seeds 20-39 that three sessions tuned on 0.807 -> 0.779. Over the 60
 seeds not tuned on, +0.019: no better than neutral. Off by default (the anchor itself is).
+``feet.footprint`` (:mod:`.anchor_footprint`) replaces the constant with what the camera sees of a foot model.
 
 >>> import numpy as np
 >>> beyond_toes(np.array([0.0, 5.0]), np.zeros(2), 0.1).round(3).tolist()
