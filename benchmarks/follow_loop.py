@@ -63,17 +63,26 @@ FOLLOWERS = {
 }
 
 
-def make_follower(name: str, scene):
+def make_follower(name: str, scene, pid_settings: dict | None = None):
+    """The follower ``name`` (:data:`FOLLOWERS`) in ``scene``; ``pid_settings``: PIDFollower fields to change."""
     if name == "planner":
         return LocalPlanner(scene, distance=DISTANCE)
     return PIDFollower(distance=DISTANCE, depth_stop=name != "pid", walkers=name.startswith(("pid+walkers", "pid+scan")),
-                       search_look=None if name.endswith("nosearch") else 2.0, nav=pursuit_map(scene))
+                       search_look=None if name.endswith("nosearch") else 2.0, nav=pursuit_map(scene),
+                       **(pid_settings or {}))
+
+
+def split_settings(settings: dict) -> tuple[dict, dict]:
+    """``--set`` items as (tracker settings, follower settings): names ``pid.NAME`` go to the PIDFollower."""
+    pid = {k[4:]: v for k, v in settings.items() if k.startswith("pid.")}
+    return {k: v for k, v in settings.items() if not k.startswith("pid.")}, pid
 
 
 def run_seed(seed: int, frames: int, size, follower: str = "pid+scan", tracker_config: dict | None = None) -> dict:
     sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, distance=DISTANCE, **SCENARIO)
-    pid = make_follower(follower, sc.scene)
-    tracker = FollowTracker(FollowConfig.preset("default", **(tracker_config or {})), sc.scene)
+    tracker_config, pid_settings = split_settings(tracker_config or {})
+    pid = make_follower(follower, sc.scene, pid_settings)
+    tracker = FollowTracker(FollowConfig.preset("default", **tracker_config), sc.scene)
     blocked = []
     result = run_closed_loop(sc, tracker=tracker, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked),
                              side_scan=follower.startswith("pid+scan"))
@@ -202,12 +211,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--plot", action="store_true", help="also draw the seed with the least time within the band "
                                                         "(results/follow_loop<TAG>_worst.png)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=3; repeatable")
+                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=3, or a "
+                         "follower one (pid.NAME: PIDFollower field), e.g. pid.search_turn_rate=1; repeatable")
     args = ap.parse_args(argv)
     try:
         settings = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
-        FollowConfig.preset("default", **settings)
-    except (ValueError, InputError) as err:
+        tracker_settings, pid_settings = split_settings(settings)
+        FollowConfig.preset("default", **tracker_settings)
+        PIDFollower(**pid_settings)
+    except (ValueError, InputError, TypeError) as err:
         print(f"follow_loop: --set: {err}", file=sys.stderr)
         return 2
     setting_key = "".join(f"-{k}={v:g}" for k, v in sorted(settings.items()))
