@@ -243,8 +243,10 @@ def main(argv: list[str] | None = None) -> int:
         all_free_within.append(s["within"][s["free"]])
         for k in totals:
             totals[k] += getattr(r, k, 0)
-        for name, n_frames in out_of_band(s).items():
+        lost_by = out_of_band(s)
+        for name, n_frames in lost_by.items():
             where[name] = where.get(name, 0) + n_frames
+        largest = max(lost_by.items(), key=lambda kv: kv[1], default=("none", 0))
         totals["opening"] += opening_collisions(r.collision_causes)
         for kind, n_ep in contact_episodes(r.collision_causes).items():
             episodes[kind] += n_ep
@@ -256,7 +258,8 @@ def main(argv: list[str] | None = None) -> int:
         rows.append([seed, f"{s['within'].mean():.3f}", f"{s['within'][s['free']].mean():.3f}",
                      f"{s['blocked'].mean():.3f}", f"{np.median(err):.2f}", f"{np.percentile(err, 95):.2f}",
                      f"{err.max():.2f}", f"{r.found.mean():.3f}", r.contacts, r.collisions,
-                     getattr(r, "walked_into", 0), r.bumps, f"{r.nearest_person.min():.2f}", f"{r.clearance.min():.2f}"])
+                     getattr(r, "walked_into", 0), r.bumps, f"{r.nearest_person.min():.2f}", f"{r.clearance.min():.2f}",
+                     f"{largest[0]} {largest[1] / len(err):.3f}"])
         print(f"seed {seed}: within ±{TOLERANCE} m {s['within'].mean():.3f} (free path {s['within'][s['free']].mean():.3f}), "
               f"collisions {r.collisions}, walked into {getattr(r, 'walked_into', 0)}, contacts {r.contacts} "
               f"({time.perf_counter() - ts:.0f} s)", file=sys.stderr, flush=True)
@@ -266,7 +269,8 @@ def main(argv: list[str] | None = None) -> int:
     table = markdown_table(["seed", f"within ±{TOLERANCE} m", "same, path free", "robot held (someone in path)",
                             "median |error| m", "95th pct m", "max m", "target found", "contacts",
                             "collisions (robot's doing)", "walked into the robot", "bumper stops",
-                            "nearest person m", "nearest wall m"], rows)
+                            "nearest person m", "nearest wall m",
+                            "largest share outside the band (of all frames)"], rows)
     text = (f"Follower: {args.follower} — {FOLLOWERS[args.follower]}. Tracker settings: {settings or 'defaults'}. Seeds {', '.join(map(str, seeds))}; {frames} "
             f"frames at 10 fps, 160x120; set distance {DISTANCE} m. Every frame counts (the robot starts at the set "
             f"distance; no start-up or target-unseen window is left out).\n\n"
