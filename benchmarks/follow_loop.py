@@ -63,17 +63,26 @@ FOLLOWERS = {
 }
 
 
-def make_follower(name: str, scene):
+def make_follower(name: str, scene, pid_settings: dict | None = None):
+    """The follower ``name`` (:data:`FOLLOWERS`) in ``scene``; ``pid_settings``: PIDFollower fields to change."""
     if name == "planner":
         return LocalPlanner(scene, distance=DISTANCE)
     return PIDFollower(distance=DISTANCE, depth_stop=name != "pid", walkers=name.startswith(("pid+walkers", "pid+scan")),
-                       search_look=None if name.endswith("nosearch") else 2.0, nav=pursuit_map(scene))
+                       search_look=None if name.endswith("nosearch") else 2.0, nav=pursuit_map(scene),
+                       **(pid_settings or {}))
+
+
+def split_settings(settings: dict) -> tuple[dict, dict]:
+    """``--set`` items as (tracker settings, follower settings): names ``pid.NAME`` go to the PIDFollower."""
+    pid = {k[4:]: v for k, v in settings.items() if k.startswith("pid.")}
+    return {k: v for k, v in settings.items() if not k.startswith("pid.")}, pid
 
 
 def run_seed(seed: int, frames: int, size, follower: str = "pid+scan", tracker_config: dict | None = None) -> dict:
     sc = make_scenario("follow-target", size=size, frames=frames, seed=seed, distance=DISTANCE, **SCENARIO)
-    pid = make_follower(follower, sc.scene)
-    tracker = FollowTracker(FollowConfig.preset("default", **(tracker_config or {})), sc.scene)
+    tracker_config, pid_settings = split_settings(tracker_config or {})
+    pid = make_follower(follower, sc.scene, pid_settings)
+    tracker = FollowTracker(FollowConfig.preset("default", **tracker_config), sc.scene)
     blocked = []
     result = run_closed_loop(sc, tracker=tracker, follower=pid, on_frame=lambda b, s, c: blocked.append(pid.blocked),
                              side_scan=follower.startswith("pid+scan"))
@@ -202,12 +211,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--plot", action="store_true", help="also draw the seed with the least time within the band "
                                                         "(results/follow_loop<TAG>_worst.png)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=3; repeatable")
+                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=3, or a "
+                         "follower one (pid.NAME: PIDFollower field), e.g. pid.search_turn_rate=1; repeatable")
     args = ap.parse_args(argv)
     try:
         settings = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
-        FollowConfig.preset("default", **settings)
-    except (ValueError, InputError) as err:
+        tracker_settings, pid_settings = split_settings(settings)
+        FollowConfig.preset("default", **tracker_settings)
+        PIDFollower(**pid_settings)
+    except (ValueError, InputError, TypeError) as err:
         print(f"follow_loop: --set: {err}", file=sys.stderr)
         return 2
     setting_key = "".join(f"-{k}={v:g}" for k, v in sorted(settings.items()))
@@ -231,8 +243,10 @@ def main(argv: list[str] | None = None) -> int:
         all_free_within.append(s["within"][s["free"]])
         for k in totals:
             totals[k] += getattr(r, k, 0)
-        for name, n_frames in out_of_band(s).items():
+        lost_by = out_of_band(s)
+        for name, n_frames in lost_by.items():
             where[name] = where.get(name, 0) + n_frames
+        largest = max(lost_by.items(), key=lambda kv: kv[1], default=("none", 0))
         totals["opening"] += opening_collisions(r.collision_causes)
         for kind, n_ep in contact_episodes(r.collision_causes).items():
             episodes[kind] += n_ep
@@ -244,7 +258,8 @@ def main(argv: list[str] | None = None) -> int:
         rows.append([seed, f"{s['within'].mean():.3f}", f"{s['within'][s['free']].mean():.3f}",
                      f"{s['blocked'].mean():.3f}", f"{np.median(err):.2f}", f"{np.percentile(err, 95):.2f}",
                      f"{err.max():.2f}", f"{r.found.mean():.3f}", r.contacts, r.collisions,
-                     getattr(r, "walked_into", 0), r.bumps, f"{r.nearest_person.min():.2f}", f"{r.clearance.min():.2f}"])
+                     getattr(r, "walked_into", 0), r.bumps, f"{r.nearest_person.min():.2f}", f"{r.clearance.min():.2f}",
+                     f"{largest[0]} {largest[1] / len(err):.3f}"])
         print(f"seed {seed}: within ±{TOLERANCE} m {s['within'].mean():.3f} (free path {s['within'][s['free']].mean():.3f}), "
               f"collisions {r.collisions}, walked into {getattr(r, 'walked_into', 0)}, contacts {r.contacts} "
               f"({time.perf_counter() - ts:.0f} s)", file=sys.stderr, flush=True)
@@ -254,7 +269,8 @@ def main(argv: list[str] | None = None) -> int:
     table = markdown_table(["seed", f"within ±{TOLERANCE} m", "same, path free", "robot held (someone in path)",
                             "median |error| m", "95th pct m", "max m", "target found", "contacts",
                             "collisions (robot's doing)", "walked into the robot", "bumper stops",
-                            "nearest person m", "nearest wall m"], rows)
+                            "nearest person m", "nearest wall m",
+                            "largest share outside the band (of all frames)"], rows)
     text = (f"Follower: {args.follower} — {FOLLOWERS[args.follower]}. Tracker settings: {settings or 'defaults'}. Seeds {', '.join(map(str, seeds))}; {frames} "
             f"frames at 10 fps, 160x120; set distance {DISTANCE} m. Every frame counts (the robot starts at the set "
             f"distance; no start-up or target-unseen window is left out).\n\n"

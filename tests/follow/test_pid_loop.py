@@ -170,3 +170,26 @@ def test_with_the_map_the_pursuit_goes_round_an_obstacle():
                         0.1, clearance)
         ends[name] = np.hypot(robot.x - 8.0, robot.y - 7.0)
     assert ends["straight"] > 1.0 and ends["map"] < 0.6, ends
+
+
+@pytest.mark.parametrize("map_approach", [False, True])
+def test_a_target_seen_beyond_an_obstacle_is_approached_round_it_with_map_approach(map_approach):
+    # the target stands, seen, 2.5 m north of the courtyard's bench (8 ± 0.9, 6 ± 0.25); the robot stands south of
+    # it, facing north. The PID steers straight at it: the bumper stops the robot at the bench, 3 m off. With
+    # map_approach it drives round the bench's end and stops at the set distance.
+    from worldtrack.follow.navigation import NavigationGrid
+    from worldtrack.synth import make_scenario
+
+    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
+    field = scene.distance_field(0.05)
+    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    pid = PIDFollower(nav=NavigationGrid(scene, radius=0.5), map_approach=map_approach)
+    robot, target = Robot(8.0, 4.9, np.pi / 2), (8.0, 8.5)
+    for t in np.arange(0.0, 20.0, 0.1):
+        cam = CAM.moved(*camera_pose(robot, 1.1))
+        robot.drive(*pid.command(step(target), cam, t), 0.1, clearance)
+    d = np.hypot(*(cam.centre[:2] - target))
+    if map_approach:
+        assert abs(d - 1.8) < 0.3, d
+    else:
+        assert d > 2.5, d

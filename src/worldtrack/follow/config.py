@@ -81,8 +81,9 @@ class FollowConfig:
         long (s), the target may also be any other track whose own colour fits its templates
         (RBhat < reid_rbhat), born before the loss or far from it (:mod:`~worldtrack.follow.reid`;
         inf = never, the default; opt-in 3 s: closed loop, held-out seeds 60 0.365 -> 0.774 and 69
-        0.751 -> 0.797 within ±0.3 m, but 66 0.497 -> 0.189: the target, rightly found again 10.8 s
-        after the loss, was followed far away and lost again).
+        0.751 -> 0.797 within ±0.3 m, but 66 0.497 -> 0.189 and 74 0.760 -> 0.593: on both every
+        long-loss pick was the target (ground truth), found 6-8 m away beyond an obstacle where the
+        PID stood held; with the follower's opt-in ``map_approach`` 66 0.799 and 74 0.759, s10).
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
         height_margin : the target's height is learnt from depth (the highest point of its candidate,

@@ -26,7 +26,10 @@ lost: the robot goes to where it was last seen (``pursue`` seconds at most: it t
 place first, then drives, under the same speed limits; with the room's map, ``nav``, along the
 shortest way round its obstacles) — a target that turned a corner out of view is seen again from
 there —, and then only turns (at most ``search_turn_rate``) towards where the
-target should be, to look for it.
+target should be, to look for it. With ``map_approach`` (opt-in), a followed target whose straight way
+is blocked by the map (a bench between them: the PID would turn to it and the depth stop hold the robot
+in front of the bench) is approached the way the pursuit goes, round the obstacle, at up to the robot's
+top speed, stopping ``distance`` m short of it.
 
 >>> import numpy as np
 >>> from types import SimpleNamespace
@@ -58,6 +61,10 @@ LOOKAHEAD = 0.6
 RING = np.column_stack([np.cos(np.arange(16) * np.pi / 8), np.sin(np.arange(16) * np.pi / 8)])
 #: The pursuit's way keeps this much (m) more than the robot's radius from obstacles (the carrot cuts corners).
 NAV_MARGIN = 0.2
+#: ``map_approach``: the straight way is blocked when the robot's radius plus this (m) does not pass.
+MAP_APPROACH_MARGIN = 0.05
+#: ``map_approach``: the way round is planned again once the target has moved this far (m) from its goal.
+REPLAN = 0.3
 
 
 def pursuit_map(scene, robot: RobotLimits = RobotLimits()) -> NavigationGrid:
@@ -84,6 +91,10 @@ class PIDFollower:
     walkers : the other people's tracks (and the range scan's movers) limit the speed by where they walk
     (:func:`~worldtrack.follow.movers.moving_speed_limit`: someone walking out of the path, or ahead in
     the robot's direction, does not hold it); False: everybody is treated as standing (35e and before)
+    map_approach : with ``nav``, a followed target whose straight way is blocked on the map (the robot's
+    body, ``robot.radius`` + ``MAP_APPROACH_MARGIN`` m, does not pass from here to ``distance`` short of
+    it) is driven to along the shortest way round (:meth:`_drive_to`) at up to ``robot.max_speed``,
+    stopping ``distance`` short; False (default): the PID steers straight at it (opt-in, issue 35, s10)
     """
 
     distance: float = 1.8
@@ -105,6 +116,7 @@ class PIDFollower:
     arrive: float = 0.4
     hidden_coast: float = 3.0
     nav: NavigationGrid | None = None
+    map_approach: bool = False
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -132,6 +144,11 @@ class PIDFollower:
             if goal is not None:
                 return self._drive_to(goal, step, camera, t, frame, scan)
             return self._search(t, bearing)
+        if self.map_approach and self.nav is not None and self._blocked_by_map(pos, rel, d):
+            for k in ("t", "d_i", "d_e", "b_i", "b_e"):        # the PID starts afresh where the way is clear
+                s.pop(k, None)
+            return self._drive_to(np.asarray(step.xy, float), step, camera, t, frame, scan, stop_short=self.distance,
+                                  speed=self.robot.max_speed, with_target=True)
         e_d = d - self.distance
         dt = t - s["t"] if "t" in s else 0.0
         v_ff = w_ff = 0.0
@@ -181,18 +198,21 @@ class PIDFollower:
             return None
         return last
 
-    def _drive_to(self, goal: np.ndarray, step, camera: Camera, t: float, frame, scan) -> tuple[float, float]:
+    def _drive_to(self, goal: np.ndarray, step, camera: Camera, t: float, frame, scan, stop_short: float | None = None,
+                  speed: float | None = None, with_target: bool = False) -> tuple[float, float]:
         """Turn to face ``goal`` (m) — or the point on the way there round the obstacles (``nav``) —, then
-        drive to it, under the same speed limits as the PID."""
+        drive to it, under the same speed limits as the PID: at most ``speed`` m/s (None: ``pursue_speed``),
+        slowing to stop ``stop_short`` m short of it (None: inside ``arrive``)."""
         pos, fwd = camera.centre[:2], camera.floor_direction
         rel = self._waypoint(goal, pos - self.robot.camera_forward * fwd) - pos
         bearing = float(np.arctan2(rel @ np.array([-fwd[1], fwd[0]]), rel @ fwd))
         w = float(np.clip(self.bearing_gains[0] * bearing, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         v, limit = 0.0, np.inf
         if abs(bearing) < np.radians(20.0):      # facing it (the camera sees the way): drive
-            ahead = np.hypot(*(goal - pos)) - 0.5 * self.arrive       # slowing down to stop inside ``arrive``
-            v = float(np.clip(self.distance_gains[0] * ahead, 0.0, self.pursue_speed))
-            limit = self._forward_limit(step, camera, w, t, 0.1, frame, scan, with_target=False)
+            short = 0.5 * self.arrive if stop_short is None else stop_short
+            ahead = np.hypot(*(goal - pos)) - short                 # slowing down to stop ``short`` of it
+            v = float(np.clip(self.distance_gains[0] * ahead, 0.0, self.pursue_speed if speed is None else speed))
+            limit = self._forward_limit(step, camera, w, t, 0.1, frame, scan, with_target=with_target)
         self._state["blocked"] = bool(limit < v)
         return min(v, limit), w
 
@@ -202,7 +222,9 @@ class PIDFollower:
         if self.nav is None:
             return goal
         s = self._state
-        if s.get("way_to") is None or not np.allclose(s["way_to"], goal):
+        moved = (s.get("way_to") is None or (np.hypot(*(s["way_to"] - goal)) > REPLAN if self.map_approach
+                                              else not np.allclose(s["way_to"], goal)))
+        if moved:
             s["way"], s["way_to"] = self.nav.geodesic(goal), np.array(goal, float)
         p, here = np.array(pos, float), float(s["way"].sample(pos[None], outside=1e3)[0])
         for _ in range(int(round(LOOKAHEAD / 0.1))):
@@ -213,6 +235,14 @@ class PIDFollower:
                 break
             p, here = near[k], float(left[k])
         return p if np.hypot(*(p - pos)) > 0.05 else goal
+
+    def _blocked_by_map(self, pos: np.ndarray, rel: np.ndarray, d: float) -> bool:
+        """Whether the robot's body (``robot.radius`` + ``MAP_APPROACH_MARGIN``) cannot drive straight from
+        ``pos`` (m) along ``rel`` (m, towards the target ``d`` m away) to ``distance`` m short of it."""
+        if d <= self.distance + 0.1:
+            return False
+        way = pos + np.linspace(0.0, 1.0 - self.distance / d, int(np.ceil((d - self.distance) / 0.1)) + 1)[:, None] * rel
+        return bool(self.nav.clearance(way).min() < self.robot.radius + MAP_APPROACH_MARGIN)
 
     def _search(self, t: float, bearing: float) -> tuple[float, float]:
         """Lost: stand and turn slowly towards where the target should be; once that has been in view
