@@ -58,20 +58,16 @@ def dump_run(client, cameras: list[str], seq: Path, run: int, out: Path) -> None
 
     out.mkdir(parents=True, exist_ok=True)
     keys = MapKeys()
-    with open(out / "estimates.csv", "w") as f:
-        f.write("t,camera,worker,frame," + ",".join(Estimate._fields) + "\n")
+    # Each observation once: its people's estimates, and (map.head_rays) each camera's own head and feet rays.
+    with open(out / "estimates.csv", "w") as est, open(out / "rays.csv", "w") as rays:
+        est.write("t,camera,worker,frame," + ",".join(Estimate._fields) + "\n")
+        rays.write("t,camera,worker,frame," + ",".join(ViewRay._fields) + "\n")
         for cam in cameras:
             for _, fields in client.xrange(keys.observations(cam)):
                 o = decode_observation(fields)
-                for e in o.people:
-                    f.write(f"{o.t:.3f},{o.camera},{o.worker},{o.frame}," + ",".join(str(v) for v in e) + "\n")
-    with open(out / "rays.csv", "w") as f:          # map.head_rays: each camera's own head and feet rays
-        f.write("t,camera,worker,frame," + ",".join(ViewRay._fields) + "\n")
-        for cam in cameras:
-            for _, fields in client.xrange(keys.observations(cam)):
-                o = decode_observation(fields)
-                for r in o.rays:
-                    f.write(f"{o.t:.3f},{o.camera},{o.worker},{o.frame}," + ",".join(str(v) for v in r) + "\n")
+                head = f"{o.t:.3f},{o.camera},{o.worker},{o.frame},"
+                est.writelines(head + ",".join(str(v) for v in e) + "\n" for e in o.people)
+                rays.writelines(head + ",".join(str(v) for v in r) + "\n" for r in o.rays)
     with open(out / "map.csv", "w") as f:
         f.write("t," + ",".join(MapPerson._fields) + "\n")
         for _, fields in client.xrange(keys.map_stream):

@@ -49,7 +49,7 @@ from worldtrack.scene.floor import FloorGrid  # noqa: E402
 from worldtrack.trajectory.environment import Z_CUTOFF, Barrier, hermite_weights, sample_field  # noqa: E402
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment  # noqa: E402
 from worldtrack.trajectory.model import TimeGrid, frame_interval  # noqa: E402
-from worldtrack.trajectory.objective import Linearisation, Problem, linearise  # noqa: E402
+from worldtrack.trajectory.objective import Linearisation, Problem  # noqa: E402
 from worldtrack.trajectory.solver import LevenbergMarquardt, levenberg_marquardt  # noqa: E402
 from worldtrack.trajectory.starts import anchor_points, shortest_path_start, straight_start  # noqa: E402
 

@@ -13,7 +13,7 @@ appear is a component chosen by name (``ellipsoid.births.where``, :data:`BIRTH_P
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Callable, Mapping, NamedTuple, Protocol, Sequence
+from typing import Callable, Mapping, NamedTuple, Protocol
 
 import cv2
 import numpy as np

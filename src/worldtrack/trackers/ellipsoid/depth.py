@@ -147,7 +147,7 @@ class DepthFusion:
     def _cues(self, view: CameraView, labels: np.ndarray, people: Sequence[Person], xy: np.ndarray,
               alone: Sequence[int], dt: float) -> dict[int, tuple[np.ndarray, list[tuple[float, float]]]]:
         """{index: (the line of sight's floor direction (2,), [(offset along it m, σ m), …])}."""
-        cfg, lo, hi = self.config, *self.height.range_m
+        cfg, hi = self.config, self.height.range_m[1]
         cam = view.camera
         hs = np.array([p.height for p in people], dtype=float)
         ws = np.array([p.width for p in people], dtype=float)
