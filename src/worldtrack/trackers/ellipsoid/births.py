@@ -24,7 +24,7 @@ from worldtrack.trackers.ellipsoid.args import People
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import BirthConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop
-from worldtrack.trackers.ellipsoid.people_edges import ends_on_people, unexplained_pixels
+from worldtrack.trackers.ellipsoid.people_edges import covered_share, ends_on_people, unexplained_pixels
 
 class Proposal(NamedTuple):
     """A new person: a floor place (2,) m, the camera whose foreground proposed it, and the height
@@ -290,21 +290,6 @@ def length_share(cam, xy: np.ndarray, height: float, length_px: float) -> float:
     return min(1.0, length_px / length) if length > 0 else 1.0
 
 
-def covered_share(mask: np.ndarray, points: np.ndarray) -> float:
-    """Share of image points ``points`` (N, 2) px, rounded, that fall on nonzero pixels of ``mask``
-    (H, W); points outside the image count as not covered.
-
-    >>> m = np.zeros((4, 4), np.uint8); m[0, :2] = 1
-    >>> covered_share(m, np.array([[0.0, 0.0], [1.2, 0.1], [3.0, 3.0], [9.0, 0.0]]))
-    0.5
-    """
-    q = np.rint(np.asarray(points, float)).astype(int)
-    inside = (q[:, 0] >= 0) & (q[:, 0] < mask.shape[1]) & (q[:, 1] >= 0) & (q[:, 1] < mask.shape[0])
-    hit = np.zeros(len(q), dtype=bool)
-    hit[inside] = mask[q[inside, 1], q[inside, 0]] != 0
-    return float(hit.mean()) if len(q) else 0.0
-
-
 def head_height(cam, head_px: np.ndarray, foot: np.ndarray) -> float | None:
     """Height (m) of the viewing ray through pixel ``head_px`` (2,) where it passes over the floor
     point ``foot`` (2+,), or None for a camera not above it (the ray does not come down to it).
@@ -354,5 +339,5 @@ def render_union(out: np.ndarray, forms: np.ndarray, boxes: np.ndarray, valid: n
         out[v0:v1, u0:u1] |= ellipse_crop(forms[k], boxes[k], grid, has_dist).astype(np.uint8)
 
 
-__all__ = ["BIRTH_PLACES", "BirthPlaces", "Births", "Proposal", "blob_position", "covered_share", "disc_offsets",
+__all__ = ["BIRTH_PLACES", "BirthPlaces", "Births", "Proposal", "blob_position", "disc_offsets",
            "length_share"]

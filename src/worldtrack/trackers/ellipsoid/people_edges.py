@@ -40,15 +40,19 @@ BEYOND_PX = 3.0
 HIDDEN_SHARE = 0.5
 
 
-def _inside_share(mask: np.ndarray, points: np.ndarray) -> float:
-    """Share of ``points`` (K, 2) (u, v) px, rounded, that fall on nonzero pixels of ``mask``
-    (H, W); points outside the image count as not on it."""
-    q = np.rint(points).astype(int)
-    h, w = mask.shape
-    ok = (q[:, 0] >= 0) & (q[:, 0] < w) & (q[:, 1] >= 0) & (q[:, 1] < h)
-    on = np.zeros(len(q), dtype=bool)
-    on[ok] = mask[q[ok, 1], q[ok, 0]] != 0
-    return float(on.mean()) if len(q) else 0.0
+def covered_share(mask: np.ndarray, points: np.ndarray) -> float:
+    """Share of image points ``points`` (N, 2) px, rounded, that fall on nonzero pixels of ``mask``
+    (H, W); points outside the image count as not covered.
+
+    >>> m = np.zeros((4, 4), np.uint8); m[0, :2] = 1
+    >>> covered_share(m, np.array([[0.0, 0.0], [1.2, 0.1], [3.0, 3.0], [9.0, 0.0]]))
+    0.5
+    """
+    q = np.rint(np.asarray(points, float)).astype(int)
+    inside = (q[:, 0] >= 0) & (q[:, 0] < mask.shape[1]) & (q[:, 1] >= 0) & (q[:, 1] < mask.shape[0])
+    hit = np.zeros(len(q), dtype=bool)
+    hit[inside] = mask[q[inside, 1], q[inside, 0]] != 0
+    return float(hit.mean()) if len(q) else 0.0
 
 
 def ends_on_people(explained: np.ndarray, foot: np.ndarray, head: np.ndarray, down: np.ndarray,
@@ -72,7 +76,7 @@ def ends_on_people(explained: np.ndarray, foot: np.ndarray, head: np.ndarray, do
     spread = np.linspace(-half, half, 9)[:, None] * across
     below = np.asarray(foot, float) + BEYOND_PX * down + spread
     above = np.asarray(head, float) - BEYOND_PX * down + spread
-    return _inside_share(explained, below) >= HIDDEN_SHARE, _inside_share(explained, above) >= HIDDEN_SHARE
+    return covered_share(explained, below) >= HIDDEN_SHARE, covered_share(explained, above) >= HIDDEN_SHARE
 
 
 def unexplained_pixels(view: CameraView, xy: np.ndarray, height: float, width: float,
@@ -89,4 +93,4 @@ def unexplained_pixels(view: CameraView, xy: np.ndarray, height: float, width: f
     return int((inside & free).sum())
 
 
-__all__ = ["BEYOND_PX", "HIDDEN_SHARE", "ends_on_people", "unexplained_pixels"]
+__all__ = ["BEYOND_PX", "HIDDEN_SHARE", "covered_share", "ends_on_people", "unexplained_pixels"]
