@@ -32,3 +32,21 @@ def misplaced(tracker, truth, along_m):
     start = xy + along_m * ray
     return tracker.fresh().position_map.add(float(start[0]), float(start[1]), truth["height"], 0.45,
                                             mode="tracking", time=0.0), xy
+
+
+def anchored_shift(tracker, labels, truth, before, after) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Anchor the same person, put 0.6 m beyond the truth along the line of sight, to the feet
+    with the ``FeetConfig`` ``before`` and then ``after`` (each must move them): the shift of the
+    placed floor point from one to the other (2,) m, the line of sight's floor direction (2,) and
+    the truth's floor point (2,) m."""
+    from worldtrack.trackers.ellipsoid.config import HeightConfig
+    from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
+
+    placed = []
+    for config in (before, after):
+        p, xy = misplaced(tracker, truth, 0.6)
+        assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == 1
+        placed.append(np.array([p.x, p.y]))
+    cam = tracker.scene.cameras["cam"]
+    ray = (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
+    return placed[1] - placed[0], ray, xy

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
-from _line_of_sight import line_of_sight_frame, misplaced
+from _line_of_sight import anchored_shift, line_of_sight_frame
 
 from worldtrack.trackers.ellipsoid.anchor_footprint import (FOOT_HALF_HEIGHT_SHARE, REACH_SHARE, grazing_shortfall_m,
                                                             standing_point)
-from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
-from worldtrack.trackers.ellipsoid.feet import anchor_to_feet, feet_weight
+from worldtrack.trackers.ellipsoid.config import FeetConfig
+from worldtrack.trackers.ellipsoid.feet import feet_weight
 
 
 @pytest.fixture(scope="module")
@@ -53,15 +53,8 @@ def test_the_standing_point_lies_beyond_the_feet_along_the_line_of_sight():
 def test_the_footprint_moves_the_anchored_person_beyond_the_feet_by_its_shortfall(seen):
     tracker, labels, instance, truth = seen
     cam = tracker.scene.cameras["cam"]
-    placed = {}
-    for footprint in (False, True):
-        p, xy = misplaced(tracker, truth, 0.6)
-        moved = anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable,
-                               FeetConfig(anchor=True, footprint=footprint), HeightConfig())
-        assert moved == 1
-        placed[footprint] = np.array([p.x, p.y])
-    ray = (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
-    shift = placed[True] - placed[False]
+    shift, ray, xy = anchored_shift(tracker, labels, truth, FeetConfig(anchor=True),
+                                    FeetConfig(anchor=True, footprint=True))
     expected = grazing_shortfall_m(float(cam.centre[2]), float(np.hypot(*(xy - cam.centre[:2]))), truth["height"])
     assert 0.05 < expected < 0.12
     assert float(shift @ ray) == pytest.approx(feet_weight(0.3, 0.1) * expected, abs=0.01)

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
-from _line_of_sight import line_of_sight_frame, misplaced
+from _line_of_sight import anchored_shift, line_of_sight_frame
 
-from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
-from worldtrack.trackers.ellipsoid.feet import anchor_to_feet, feet_weight
+from worldtrack.trackers.ellipsoid.config import FeetConfig
+from worldtrack.trackers.ellipsoid.feet import feet_weight
 from worldtrack.trackers.ellipsoid.toes import beyond_toes
 
 
@@ -16,16 +16,8 @@ def seen():
 
 def test_the_feet_found_move_beyond_the_toes_along_the_line_of_sight(seen):
     tracker, labels, instance, truth = seen
-    cam = tracker.scene.cameras["cam"]
-    placed = {}
-    for offset in (0.0, 0.08):
-        p, xy = misplaced(tracker, truth, 0.6)
-        moved = anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable,
-                               FeetConfig(anchor=True, centre_offset_m=offset), HeightConfig())
-        assert moved == 1
-        placed[offset] = np.array([p.x, p.y])
-    ray = (xy - cam.centre[:2]) / np.hypot(*(xy - cam.centre[:2]))
-    shift = placed[0.08] - placed[0.0]
+    shift, ray, _ = anchored_shift(tracker, labels, truth, FeetConfig(anchor=True, centre_offset_m=0.0),
+                                   FeetConfig(anchor=True, centre_offset_m=0.08))
     # The same feet, 8 cm farther: the anchor's share of it, along the ray and not across it.
     assert float(shift @ ray) == pytest.approx(feet_weight(0.3, 0.1) * 0.08, abs=0.005)
     assert abs(float(shift[0] * ray[1] - shift[1] * ray[0])) < 0.003
