@@ -25,11 +25,18 @@ from worldtrack.trajectory.kernels import STATE, barrier_point
 
 
 class Hinge(NamedTuple):
-    """The hinge's constants: clearance c (m), softness w (m) and gain √(λ/m)/s_h (1/m)."""
+    """The hinge's constants: clearance c (m), softness w (m) and gain √(λ/m)/s_h (1/m); ``outward``: the
+    curvature factor of a sample that moved away from the obstacles since ``d_before`` (0: off, see
+    :func:`add_barrier_terms`)."""
 
     clearance: float
     softness: float
     gain: float
+    outward: float = 0.0
+
+
+#: A sample "moved away" when its distance grew by more than this (m) since the last linearisation.
+OUTWARD_MOVE = 1e-4
 
 
 class Normal(NamedTuple):
@@ -43,10 +50,16 @@ class Normal(NamedTuple):
 @njit(cache=True)
 def add_barrier_terms(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: float, values: np.ndarray,
                       origin: np.ndarray, res: float, hinge: Hinge, normal: Normal, r: np.ndarray, d: np.ndarray,
-                      inside_steps: np.ndarray) -> None:  # pragma: no cover (compiled)
+                      inside_steps: np.ndarray, d_before: np.ndarray) -> None:  # pragma: no cover (compiled)
     """In place: every sample (step t, fraction α) of the barrier added into ``normal`` as curvature·JᵀJ
     and Jᵀr; its residual into r (M,), its distance into d (M,); ``inside_steps[t]`` set where a sample
-    is within the clearance. The same numbers as ``barrier_samples`` followed by ``add_pair_terms``."""
+    is within the clearance. The same numbers as ``barrier_samples`` followed by ``add_pair_terms``.
+
+    With ``hinge.outward`` > 0 and ``d_before`` (M,) the samples' distances at the last linearisation (else
+    ``d_before`` may be empty), a sample whose distance grew by more than ``OUTWARD_MOVE`` takes the curvature
+    factor ``hinge.outward`` instead of 1 + r·r″/r′² (≈ 2 in the hinge's exponential tail): Newton's curvature
+    of e^(−2d/w) at the start of a move away from an obstacle is the largest along it, so Newton moves such a
+    sample ~w/2 per iteration (34l), Gauss–Newton (1) ~w."""
     D, B, g = normal
     row = np.empty(2 * STATE)
     for m in range(step.shape[0]):
@@ -57,6 +70,8 @@ def add_barrier_terms(X: np.ndarray, step: np.ndarray, alpha: np.ndarray, dt: fl
         if dm < hinge.clearance:
             inside_steps[t] = True
         if rm != 0.0:                  # r = 0: beyond the barrier's reach, nothing to add
+            if hinge.outward > 0.0 and dm > d_before[m] + OUTWARD_MOVE:
+                w = hinge.outward
             add_floor_row(D, B, g, t, row, rm, w)
 
 
