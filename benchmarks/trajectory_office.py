@@ -54,6 +54,7 @@ from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.synth.observations import head_pixels, head_tracks  # noqa: E402
 from worldtrack.trajectory.estimate import TrajectoryOptions, estimate_trajectory  # noqa: E402
 from worldtrack.trajectory.observation import Observations  # noqa: E402
+from worldtrack.trajectory.solver import SolverOptions  # noqa: E402
 from worldtrack.viz.trajectory import observation_points, save_height_plot, save_trajectory_plan  # noqa: E402
 
 VARIANTS = ("MAP (height known)", "MAP (height 1.70 m)", "MAP without barrier", "Kalman+RTS (height known)",
@@ -78,7 +79,9 @@ def outline_segments(scene) -> np.ndarray:
 
 
 def run_seed(seed: int, frames: int, totals: dict, starts: Counter, best: dict, race_agrees: Counter,
-             feet_seen: list, fitted: list, route_timing: str = "constant") -> list[list]:
+             feet_seen: list, fitted: list, extra: dict | None = None) -> list[list]:
+    """``extra``: more ``TrajectoryOptions`` fields of every estimate (the opt-ins)."""
+    extra = extra or {}
     sc = make_scenario("non-overlapping", frames=frames, seed=seed, people=2, layout="detours", size=(640, 480),
                        legs=40)
     tracks = head_tracks(sc)
@@ -92,16 +95,16 @@ def run_seed(seed: int, frames: int, totals: dict, starts: Counter, best: dict, 
             continue
         obs = Observations.from_rows(mine.time, mine.camera, mine.uv, sc.scene.cameras, 2.0)
         t0 = time.perf_counter()
-        default = estimate_trajectory(obs, field, TrajectoryOptions(height=track.height, route_timing=route_timing))
+        default = estimate_trajectory(obs, field, TrajectoryOptions(height=track.height, **extra))
         seconds = time.perf_counter() - t0
         # every start to convergence (no race), to tell which start wins and which tie
         known = estimate_trajectory(obs, field, TrajectoryOptions(height=track.height, race_iterations=None,
-                                                                 route_timing=route_timing))
+                                                                 **extra))
         unknown = estimate_trajectory(obs, field, TrajectoryOptions(height=sc.scene.people.height,
-                                                                    route_timing=route_timing))
+                                                                    **extra))
         with_feet = Observations.from_rows(mine.time, mine.camera, mine.uv, sc.scene.cameras, 2.0, mine.feet_uv, 2.0)
         feet = estimate_trajectory(with_feet, field, TrajectoryOptions(height=sc.scene.people.height, fit_height=True,
-                                                                          route_timing=route_timing))
+                                                                          **extra))
         feet_seen[0] += int(with_feet.has_feet.sum())
         feet_seen[1] += len(with_feet)
         fitted.append(feet.height - track.height)
@@ -159,7 +162,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
                     help="TrajectoryOptions.route_timing of every estimate (opt-in cubic, 34m): writes "
                          "results/trajectory_office_cubic.md, no pictures")
+    ap.add_argument("--outward", type=float, default=None,
+                    help="SolverOptions.outward_curvature of every estimate (opt-in, 34n): writes _outward.md, no pictures")
     args = ap.parse_args(argv)
+    extra = {"route_timing": args.route_timing}
+    if args.outward is not None:
+        extra["solver"] = SolverOptions(outward_curvature=args.outward)
     seeds = parse_seeds(args.seeds)[:2] if args.quick else parse_seeds(args.seeds)
     frames = 600 if args.quick else args.frames
     t_start = time.perf_counter()
@@ -170,7 +178,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     feet_seen, fitted = [0, 0], []
     for seed in seeds:
-        rows += run_seed(seed, frames, totals, starts, best, race_agrees, feet_seen, fitted, args.route_timing)
+        rows += run_seed(seed, frames, totals, starts, best, race_agrees, feet_seen, fitted, extra)
         print(f"seed {seed} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     per = markdown_table(["seed", "person", "steps", "seen steps", "cameras", "in view m", "z m", "between m",
                           "KF between m", "MAP/KF", "inside", "KF inside", "no-barrier inside", "crossings",
@@ -195,11 +203,12 @@ def main(argv: list[str] | None = None) -> int:
             f"people; windows won (race by gap only): {window_wins or 'none'}.\n\n"
             f"## Per person (height known)\n\n{per}\n")
     print(text)
-    cubic = args.route_timing != "constant"
-    if best and not args.quick and not cubic:
+    cubic, outward = args.route_timing != "constant", args.outward is not None
+    if best and not args.quick and not (cubic or outward):
         picture(best)
-    save_result("trajectory_office" + ("_cubic" if cubic else ""), "Seed 002: office with detours, MAP vs Kalman + RTS"
-                + (" (route_timing='cubic')" if cubic else ""), text, args.quick,
+    save_result("trajectory_office" + ("_cubic" if cubic else "") + ("_outward" if outward else ""),
+                "Seed 002: office with detours, MAP vs Kalman + RTS" + (" (route_timing='cubic')" if cubic else "")
+                + (f" (outward_curvature={args.outward})" if outward else ""), text, args.quick,
                 time.perf_counter() - t_start, script="trajectory_office")
     return 0
 

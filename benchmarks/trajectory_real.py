@@ -54,6 +54,7 @@ from worldtrack.scene.load import scene_from_dict  # noqa: E402
 from worldtrack.trajectory.environment import field_from_walkable, rasterise_segments  # noqa: E402
 from worldtrack.trajectory.estimate import TrajectoryOptions, estimate_trajectory  # noqa: E402
 from worldtrack.trajectory.observation import Observations  # noqa: E402
+from worldtrack.trajectory.solver import SolverOptions  # noqa: E402
 
 SEQUENCES = {"seq_eth": ("eth_ewap/seq_eth", 4), "seq_hotel": ("eth_ewap/seq_hotel", 3),
              "zara01": ("ucy_zara01", 4)}
@@ -141,7 +142,9 @@ class FreeSpace:
 
 
 def run_sequence(name: str, root: Path, seed: int, totals: dict, starts: Counter, quick: bool, keep: dict,
-                 route_timing: str = "constant") -> list:
+                 extra: dict | None = None) -> list:
+    """``extra``: more ``TrajectoryOptions`` fields of every estimate with the environment (the opt-ins)."""
+    extra = extra or {}
     folder, n_cams = SEQUENCES[name]
     people, walls, pillars = load(root / folder)
     rng = np.random.default_rng([seed, sum(map(ord, name))])
@@ -164,11 +167,11 @@ def run_sequence(name: str, root: Path, seed: int, totals: dict, starts: Counter
             continue
         order = np.argsort(rows, kind="stable")
         obs = Observations.from_rows(t[np.array(rows)[order]], np.array(ids)[order], np.vstack(uvs)[order], cams, 2.0)
-        opts = TrajectoryOptions(dt=0.4, height=1.70, race_iterations=None, route_timing=route_timing)  # every start
+        opts = TrajectoryOptions(dt=0.4, height=1.70, race_iterations=None, **extra)  # every start
         est = estimate_trajectory(obs, field, opts)
         learnt = estimate_trajectory(obs, free.field_without(pid), opts)
         c0 = time.process_time()
-        race = estimate_trajectory(obs, field, TrajectoryOptions(dt=0.4, height=1.70, route_timing=route_timing))
+        race = estimate_trajectory(obs, field, TrajectoryOptions(dt=0.4, height=1.70, **extra))
         c1 = time.process_time()
         estimate_trajectory(obs, None, TrajectoryOptions(dt=0.4, height=1.70, environment=False))
         starts[(name, "cpu", "walls")] += c1 - c0
@@ -202,7 +205,7 @@ def picture(keep: dict) -> None:
 
 
 def report(seed: int, root: Path, missing: list[str], quick: bool, keep: dict, t_start: float,
-           route_timing: str = "constant") -> str:
+           extra: dict | None = None) -> str:
     """Every sequence with the cameras of one seed: the table and which start won."""
     totals: dict = {}
     starts: Counter = Counter()
@@ -211,7 +214,7 @@ def report(seed: int, root: Path, missing: list[str], quick: bool, keep: dict, t
         if name in missing:
             print(f"{name}: not under {root}; skipped", file=sys.stderr)
             continue
-        seqs.append(run_sequence(name, root, seed, totals, starts, quick, keep, route_timing))
+        seqs.append(run_sequence(name, root, seed, totals, starts, quick, keep, extra))
         print(f"seed {seed}, {name} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     rows = []
     for name, n_people, used, truth_cross in seqs:
@@ -245,7 +248,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
                     help="TrajectoryOptions.route_timing (opt-in cubic, 34m): writes results/trajectory_real_cubic.md, "
                          "no picture")
+    ap.add_argument("--outward", type=float, default=None,
+                    help="SolverOptions.outward_curvature (opt-in, 34n): writes results/trajectory_real_outward.md, no picture")
     args = ap.parse_args(argv)
+    extra = {"route_timing": args.route_timing}
+    if args.outward is not None:
+        extra["solver"] = SolverOptions(outward_curvature=args.outward)
     root = data_root()
     missing = [n for n, (f, _) in SEQUENCES.items() if not (root / f / "obsmat.txt").is_file()]
     if len(missing) == len(SEQUENCES):
@@ -254,15 +262,16 @@ def main(argv: list[str] | None = None) -> int:
     t_start = time.perf_counter()
     seeds = [0] if args.quick else [int(s) for s in args.seeds.split(",")]
     keep: dict = {}
-    cubic = args.route_timing != "constant"
-    sections = [report(seed, root, missing, args.quick, keep if seed == seeds[0] and not cubic else {}, t_start,
-                       args.route_timing) for seed in seeds]
+    cubic, outward = args.route_timing != "constant", args.outward is not None
+    sections = [report(seed, root, missing, args.quick, keep if seed == seeds[0] and not (cubic or outward) else {},
+                       t_start, extra) for seed in seeds]
     text = ("Head heights U(1.6, 1.8) m, estimated with 1.70 m; 2 px noise; grid 0.4 s.\n\n" + "\n".join(sections))
     print(text)
     if keep and not args.quick:
         picture(keep)
-    save_result("trajectory_real" + ("_cubic" if cubic else ""), "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)"
-                + (" (route_timing='cubic')" if cubic else ""), text, args.quick,
+    save_result("trajectory_real" + ("_cubic" if cubic else "") + ("_outward" if outward else ""),
+                "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)" + (" (route_timing='cubic')" if cubic else "")
+                + (f" (outward_curvature={args.outward})" if outward else ""), text, args.quick,
                 time.perf_counter() - t_start, script="trajectory_real")
     return 0
 

@@ -28,8 +28,9 @@ time includes waiting for other jobs, the CPU time does not):
   banded solves, comparable across machines.
 
 Run: ``.venv/bin/python benchmarks/trajectory_speed.py [--sizes 1000,10000,100000] [--cpu 1]
-[--repeats 3] [--quick] [--settle] [--route-timing cubic]``. Writes ``benchmarks/results/trajectory_speed.md`` (with
-``--settle``: ``_settle.md``; with ``--route-timing cubic``: ``_cubic.md``). About 4 minutes
+[--repeats 3] [--quick] [--settle] [--route-timing cubic] [--outward 1.3]``. Writes
+``benchmarks/results/trajectory_speed.md`` (with ``--settle``: ``_settle.md``; with ``--route-timing cubic``:
+``_cubic.md``; with ``--outward``: ``_outward.md``). About 4 minutes
 (most of it GTSAM at T = 100 000).
 """
 
@@ -58,7 +59,7 @@ from trajectory_common import long_office_walk, pin_to_one_core, project_observa
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory  # noqa: E402
 from worldtrack.trajectory.model import TimeGrid  # noqa: E402
 from worldtrack.trajectory.objective import Problem, linearise  # noqa: E402
-from worldtrack.trajectory.solver import levenberg_marquardt, solve_blocks  # noqa: E402
+from worldtrack.trajectory.solver import SolverOptions, levenberg_marquardt, solve_blocks  # noqa: E402
 from worldtrack.trajectory.starts import shortest_path_start, straight_start  # noqa: E402
 
 
@@ -101,10 +102,11 @@ def problem_of(T: int, seed: int):
 
 
 def run_size(T: int, repeats: int, seed: int, gtsam_max: int, gtsam_barrier_max: int, settle: bool = False,
-             route_timing: str = "constant") -> dict:
+             route_timing: str = "constant", outward: float | None = None) -> dict:
     scene, obs, height = problem_of(T, seed)
     field = scene.distance_field(0.05)
-    opts = TrajectoryOptions(height=height, settle_windows=settle, route_timing=route_timing)
+    opts = TrajectoryOptions(height=height, settle_windows=settle, route_timing=route_timing,
+                             solver=SolverOptions(outward_curvature=outward))
     out = {"T": T}
     out["full"], est = timed(lambda: estimate_trajectory(obs, field, opts), repeats)
     out["full_cpu"], out["full_cpu_min"], out["full_min"] = LAST_CPU
@@ -209,6 +211,8 @@ def main(argv: list[str] | None = None) -> int:
                     "writes results/trajectory_speed_settle.md")
     ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
                     help="full with TrajectoryOptions.route_timing (opt-in cubic, 34m); writes _cubic.md")
+    ap.add_argument("--outward", type=float, default=None,
+                    help="SolverOptions.outward_curvature (opt-in, 34n; e.g. 1.3); writes _outward.md")
     args = ap.parse_args(argv)
     cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
     sizes = [1000, 3000] if args.quick else [int(s) for s in args.sizes.split(",")]
@@ -221,13 +225,15 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     for T in sizes:
         results.append(run_size(T, repeats, args.seed, args.gtsam_max, args.gtsam_barrier_max, args.settle,
-                                args.route_timing))
+                                args.route_timing, args.outward))
         print(f"T = {T}: full {results[-1]['full']:.2f} s ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     text = tables(results, cpu)
     print(text)
-    tail = ("_settle" if args.settle else "") + ("_cubic" if args.route_timing != "constant" else "")
+    tail = ("_settle" if args.settle else "") + ("_cubic" if args.route_timing != "constant" else "") + \
+        ("_outward" if args.outward is not None else "")
     save_result("trajectory_speed" + tail, "Seed 002: speed on one core, scaling, environment cost, GTSAM"
-                + (" (settle_windows)" if args.settle else "") + (" (route_timing='cubic')" if "cubic" in tail else ""),
+                + (" (settle_windows)" if args.settle else "") + (" (route_timing='cubic')" if "cubic" in tail else "")
+                + (f" (outward_curvature={args.outward})" if args.outward is not None else ""),
                 text, args.quick, time.perf_counter() - t_start, script="trajectory_speed")
     return 0
 

@@ -218,7 +218,7 @@ def test_the_one_pass_barrier_kernel_equals_the_samples_and_the_scatter(walk_wit
     one = Normal(*(a.copy() for a in start))
     r1, d1, inside = np.empty(len(step)), np.empty(len(step)), np.zeros(len(X), dtype=bool)
     add_barrier_terms(X, step, alpha, problem.grid.dt, *field, Hinge(b.clearance, b.softness, gain), one, r1, d1,
-                      inside)
+                      inside, np.empty(0))
     for x, y in zip(one, two):
         np.testing.assert_array_equal(x, y)
     np.testing.assert_array_equal(r1, r)
@@ -227,3 +227,37 @@ def test_the_one_pass_barrier_kernel_equals_the_samples_and_the_scatter(walk_wit
     lin = linearise(problem, X)                               # and the linearisation keeps them
     np.testing.assert_array_equal(lin.barrier_d, d)
     assert lin.costs.barrier == float(r @ r)
+
+
+def test_samples_that_moved_away_take_the_outward_curvature_factor(walk_with_wall):
+    """``Hinge.outward`` (``SolverOptions.outward_curvature``): the samples whose distance grew by more than
+    ``OUTWARD_MOVE`` since ``d_before`` enter D with that factor instead of Newton's; the rest, r and g unchanged."""
+    from worldtrack.trajectory.barrier_terms import OUTWARD_MOVE, Hinge, Normal, add_barrier_terms
+    problem = walk_with_wall.problem
+    env = problem.environment
+    b, f = env.barrier, env.barrier.field
+    X = straight_start(problem.observations, problem.grid, 1.7)
+    X[:, 2] += 0.3 * np.sin(np.arange(len(X)) / 9.0)
+    step, alpha = b.samples(len(X))
+    gain = np.sqrt(env.weight / b.substeps) / b.scale
+    field = (f.values, np.asarray(f.origin, dtype=float), float(f.resolution))
+    r, J, d, curvature = kernels.barrier_samples(X, step, alpha, problem.grid.dt, *field, b.clearance, b.softness, gain)
+    away = np.arange(len(d)) % 3 == 0                         # every third sample "moved away"
+    before = np.where(away, d - 2 * OUTWARD_MOVE, d - 0.5 * OUTWARD_MOVE)
+    zeros = lambda: [np.zeros((len(X), 6, 6)), np.zeros((len(X) - 1, 6, 6)), np.zeros((len(X), 6))]  # noqa: E731
+    expected = zeros()
+    kernels.add_pair_terms(*expected, step, J, r, np.where(away, 1.3, curvature))
+    got = Normal(*zeros())
+    r1, d1, inside = np.empty(len(step)), np.empty(len(step)), np.zeros(len(X), dtype=bool)
+    add_barrier_terms(X, step, alpha, problem.grid.dt, *field, Hinge(b.clearance, b.softness, gain, 1.3), got, r1, d1,
+                      inside, before)
+    assert np.sum(away & (r > 0)) > 10 and np.sum(~away & (r > 0)) > 10
+    for x, y in zip(got, expected):
+        np.testing.assert_allclose(x, y, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(r1, r)
+    newton = zeros()
+    kernels.add_pair_terms(*newton, step, J, r, curvature)
+    lin, plain = linearise(problem, X, outward=(before, 1.3)), linearise(problem, X)   # passed on by linearise
+    np.testing.assert_allclose(lin.D - plain.D, got.D - newton[0], rtol=0, atol=1e-9 * np.abs(plain.D).max())
+    np.testing.assert_array_equal(lin.g, plain.g)
+    assert lin.costs.total == plain.costs.total

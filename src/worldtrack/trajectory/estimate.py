@@ -16,7 +16,7 @@ from worldtrack.scene.floor import FloorGrid
 from worldtrack.trajectory.coarse import coarse_grid, refine, subsample
 from worldtrack.trajectory.environment import Barrier, EnvironmentModel, HeightPrior, sample_field
 from worldtrack.trajectory.model import POS, VEL, MotionPrior, TimeGrid, frame_interval
-from worldtrack.trajectory.objective import Problem
+from worldtrack.trajectory.objective import Problem, linearise
 from worldtrack.trajectory.observation import Observations
 from worldtrack.trajectory.solver import LevenbergMarquardt, SolveResult, SolverOptions, levenberg_marquardt
 from worldtrack.trajectory.starts import (ROUTE_TIMINGS, START_NAMES, anchor_points, shortest_path_start,
@@ -248,7 +248,8 @@ def estimate_trajectory(obs: Observations, field: FloorGrid | None = None,
     best = min(objectives, key=objectives.get)
     win = results[best]
     observed = np.bincount(problem.observations.step, minlength=grid.n)
-    covariance = marginal_covariances(win.linearisation.D, win.linearisation.B)
+    lin = win.linearisation if options.solver.outward_curvature is None else linearise(problem, win.X)
+    covariance = marginal_covariances(lin.D, lin.B)      # Newton's curvature, not the outward factor's
     return TrajectoryEstimate(grid.times, win.X, covariance, win.costs.as_dict(), best, objectives, observed,
                               win.linearisation.barrier_steps, without.X, results, options.height, wins)
 

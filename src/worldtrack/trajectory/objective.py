@@ -179,12 +179,18 @@ def _add_pixel_term(term: ObservationTerm, starts: np.ndarray, steps: np.ndarray
     return float(rho.sum()) if np.all(depth > 1e-3) else np.inf
 
 
+#: ``d_before`` of :func:`~.barrier_terms.add_barrier_terms` when no sample takes the outward factor.
+_NONE = np.empty(0)
+
+
 def _add_barrier(problem: Problem, X: np.ndarray, normal: Normal, barrier_steps: np.ndarray,
-                 out: Linearisation | None) -> tuple[np.ndarray, np.ndarray]:
+                 out: Linearisation | None, outward: tuple[np.ndarray, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """In place: the barrier's samples into the blocks and gradient (one compiled pass,
     :func:`~.barrier_terms.add_barrier_terms`; the steps with a sample inside the clearance marked in
     ``barrier_steps``). Returns the samples' residuals (M,), those beyond the barrier's reach 0, and their
-    distances (M,), written into ``out``'s if it has them."""
+    distances (M,), written into ``out``'s if it has them. ``outward``: (the distances (M,) at the last
+    linearisation, the curvature factor of the samples that moved away since), see
+    :func:`~.barrier_terms.add_barrier_terms`."""
     env = problem.environment
     barrier, f = env.barrier, env.barrier.field
     step, alpha = problem.barrier_sample_points
@@ -192,20 +198,24 @@ def _add_barrier(problem: Problem, X: np.ndarray, normal: Normal, barrier_steps:
         r, d = out.barrier_r, out.barrier_d
     else:
         r, d = np.empty(len(step)), np.empty(len(step))
-    hinge = Hinge(float(barrier.clearance), float(barrier.softness), barrier.gain(env.weight))
+    before, factor = outward if outward is not None else (_NONE, 0.0)
+    hinge = Hinge(float(barrier.clearance), float(barrier.softness), barrier.gain(env.weight), float(factor))
     add_barrier_terms(X, step, alpha, problem.grid.dt, f.values, np.asarray(f.origin, dtype=float), float(f.resolution),
-                      hinge, normal, r, d, barrier_steps)
+                      hinge, normal, r, d, barrier_steps, before)
     return r, d
 
 
 def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
-              step_cost: np.ndarray | None = None) -> Linearisation:
+              step_cost: np.ndarray | None = None, outward: tuple[np.ndarray, float] | None = None) -> Linearisation:
     """Costs, gradient and the block-tridiagonal Gauss–Newton matrix at X (n, 6).
 
     ``out``: a linearisation of the same problem whose arrays are overwritten (an iteration's
     tens of megabytes are then allocated once, not every time). ``step_cost`` (n,): if given, filled
     with the objective split by step (the motion and barrier terms between t and t + 1 on t, the
     first velocity's prior on 0, observations and height on their step); it sums to the total.
+    ``outward``: (barrier distances (M,) of the last linearisation, factor) — the barrier's samples that moved away
+    from the obstacles since take that curvature factor in D (``SolverOptions.outward_curvature``; the costs and g
+    are the same).
     """
     n = problem.grid.n
     D0, B0 = problem.motion_normal
@@ -233,7 +243,7 @@ def linearise(problem: Problem, X: np.ndarray, out: Linearisation | None = None,
     barrier_cost = height_cost = 0.0
     r = d = None
     if env.barrier is not None:
-        r, d = _add_barrier(problem, X, Normal(D, B, g), barrier_steps, out)
+        r, d = _add_barrier(problem, X, Normal(D, B, g), barrier_steps, out, outward)
         barrier_cost = float(r @ r)
         if step_cost is not None:
             step_cost += np.bincount(problem.barrier_sample_points[0], r * r, minlength=n)

@@ -1,0 +1,29 @@
+"""The opt-in ``SolverOptions.outward_curvature`` (34n) on the office person: the same optimum within the slides'
+tolerance, and the covariance of Newton's matrix at the estimate, not of the solver's modified one."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory
+from worldtrack.trajectory.model import TimeGrid, frame_interval
+from worldtrack.trajectory.objective import Problem, linearise
+from worldtrack.trajectory.solver import SolverOptions
+from worldtrack.trajectory.uncertainty import marginal_covariances
+
+
+def test_outward_curvature_reaches_the_default_optimum_with_newtons_covariance(office_person):
+    obs, field, height = office_person
+    options = TrajectoryOptions(height=height)
+    default = estimate_trajectory(obs, field, options)
+    opted = estimate_trajectory(obs, field, replace(options, solver=SolverOptions(outward_curvature=1.3)))
+    assert opted.start == default.start
+    assert abs(opted.costs["total"] / default.costs["total"] - 1) < 1e-5
+    assert np.hypot(*(opted.positions[:, :2] - default.positions[:, :2]).T).max() < 0.05
+    dt = frame_interval(obs.time, obs.camera)
+    problem = Problem.build(obs, TimeGrid.covering(obs.time, dt), options.motion, build_environment(options, field, dt))
+    plain = linearise(problem, opted.X)
+    np.testing.assert_allclose(opted.covariance, marginal_covariances(plain.D, plain.B), rtol=1e-9, atol=1e-15)
+    # the solver's own last linearisation has the outward factor in it: a different matrix
+    solver_lin = opted.results[opted.start].linearisation
+    assert np.abs(solver_lin.D - plain.D).max() > 1e-6 * np.abs(plain.D).max()
