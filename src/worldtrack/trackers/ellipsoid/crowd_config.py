@@ -55,6 +55,11 @@ class CrowdConfig(Section):
         "dev 110-112 cold 9.0 -> 8.3 held (MOTA 0.353 -> 0.363), true places 9.7 -> 12.7 (0.390 -> 0.410), with "
         "predict_along_ray_measured 12.7 / 0.406, 16.7 / 0.475 (without it 12.3 / 0.409, 15.3 / 0.486); PETS 2009 "
         "over 8 starts MOTA 0.926 -> 0.924, switches 2.75 -> 4.88")
+    height_max_beside: float = Field(
+        1.0, ge=0, le=1, description="a person is measured for height (:mod:`.height`) only in a frame where some "
+        "view shows at most this share of the band beside their body (the ellipse three times as wide, less theirs) "
+        "as foreground: in a crowd an untracked person behind makes the silhouette tall, and the tall ellipse then "
+        "hides them (:mod:`.height_gate`). 1 = off (the default)")
     coast_behind_obstacles_s: float = Field(
         0.0, ge=0, description="a track the scene's obstacles wholly hide from a camera that has it in its image is "
         "kept this long unseen, carried by the prediction, instead of ending after end.leave_after_s as one that "
