@@ -55,6 +55,10 @@ class CrowdConfig(Section):
         "dev 110-112 cold 9.0 -> 8.3 held (MOTA 0.353 -> 0.363), true places 9.7 -> 12.7 (0.390 -> 0.410), with "
         "predict_along_ray_measured 12.7 / 0.406, 16.7 / 0.475 (without it 12.3 / 0.409, 15.3 / 0.486); PETS 2009 "
         "over 8 starts MOTA 0.926 -> 0.924, switches 2.75 -> 4.88")
+    births_head_bands: bool = Field(
+        False, description="a birth blob too small for a person is still one where it is the top of one above "
+        "people already known: nothing above it, its lower end on their ellipses, at least half a head's square "
+        "there; placed by its top at the default height (:mod:`.head_bands`). Off by default")
     height_max_beside: float = Field(
         1.0, ge=0, le=1, description="a person is measured for height (:mod:`.height`) only in a frame where some "
         "view shows at most this share of the band beside their body (the ellipse three times as wide, less theirs) "
