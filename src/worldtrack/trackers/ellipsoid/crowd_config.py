@@ -57,7 +57,7 @@ class CrowdConfig(Section):
         "over 8 starts MOTA 0.926 -> 0.924, switches 2.75 -> 4.88")
     births_head_bands: bool = Field(
         False, description="a birth blob too small for a person is still one where it is the top of one above "
-        "people already known: nothing above it, its lower end on their ellipses, at least half a head's square "
+        "people already known: nothing above it, its lower end on their ellipses, at least a quarter of a head's square "
         "there; placed by its top at the default height (:mod:`.head_bands`). Off by default")
     height_max_beside: float = Field(
         1.0, ge=0, le=1, description="a person is measured for height (:mod:`.height`) only in a frame where some "
