@@ -65,20 +65,3 @@ def test_a_head_band_has_background_above_and_known_people_below():
     assert not is_head_band(above, explained, band, origin, down, head=8.0)
     assert not is_head_band(mask, explained, band, origin, down, head=20.0)            # too small for a head there
     assert not is_head_band(mask, explained, band, origin, None, head=8.0)
-
-
-def test_a_feet_band_has_known_people_above_and_floor_below_inside_the_image():
-    from worldtrack.trackers.ellipsoid.head_bands import is_head_band
-    mask = np.zeros((40, 30), np.uint8)
-    mask[0:30, 10:20] = 1                                                  # a silhouette down to row 29
-    explained = np.zeros_like(mask)
-    explained[:25, :] = 1                                                  # a known person down to row 24
-    legs, origin, down = mask[25:30, 10:20].astype(bool), (10, 25), np.array([0.0, 1.0])
-    assert is_head_band(mask, explained, legs, origin, down, head=8.0, feet=True)
-    assert not is_head_band(mask, explained, legs, origin, down, head=8.0)               # not a head band
-    assert not is_head_band(mask, np.zeros_like(mask), legs, origin, down, head=8.0, feet=True)
-    longer = mask.copy()
-    longer[30:35, 10:20] = 1                                               # foreground below: not the feet
-    assert not is_head_band(longer, explained, legs, origin, down, head=8.0, feet=True)
-    cut = mask[:31]                                                        # the image ends below them
-    assert not is_head_band(cut, explained[:31], legs, origin, down, head=8.0, feet=True)

@@ -108,13 +108,11 @@ class Births:
         only what they leave unexplained (``crowd.births_past_people``, :mod:`.people_edges`)
     head_bands : a blob too small for a person that is the top of one above known people is proposed
         (``crowd.births_head_bands``, :mod:`.head_bands`)
-    feet_bands : so is one that is the legs of a person in front of known people (``crowd.births_feet_bands``)
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
                  config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60,
-                 past_people: bool = False, head_bands: bool = False,
-                 feet_bands: bool = False):
+                 past_people: bool = False, head_bands: bool = False):
         self.views = views
         self.scene = scene
         self.walkable = walkable
@@ -122,7 +120,7 @@ class Births:
         self.height_range = height_range
         self.min_px = min_px
         self.past_people = past_people
-        self.head_bands, self.feet_bands = head_bands, feet_bands
+        self.head_bands = head_bands
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
@@ -167,16 +165,14 @@ class Births:
         out: list[Proposal] = []
         # Components found at ~320 px wide (each blob then read back at full resolution):
         # labelling the whole 640x480 frame was a third of the births' time.
-        bands = (self.head_bands or self.feet_bands) and len(xy) > 0   # small blobs: parts of people by known ones
+        bands = self.head_bands and len(xy) > 0   # small blobs too: the tops of people behind known ones
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, 10 if bands else min_area, max(1, cam.width // 320)):
             band = area < min_area
-            if band:
-                args = (mask, explained, blob, (x0, y0), view.down_direction(centroid), head_px(cam, centroid, h0))
-                legs = self.feet_bands and is_head_band(*args, feet=True)
-                if not legs and not (self.head_bands and is_head_band(*args)):
-                    continue
+            if band and not is_head_band(mask, explained, blob, (x0, y0), view.down_direction(centroid),
+                                         head_px(cam, centroid, h0)):
+                continue
             found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px,
-                                  known=explained if (cfg.people_occlude and not band) or (band and legs) else None,
+                                  known=explained if cfg.people_occlude and not band else None,
                                   explained=explained if (self.past_people or band) and len(xy) else None)
             if found is None:
                 continue

@@ -59,10 +59,6 @@ class CrowdConfig(Section):
         False, description="a birth blob too small for a person is still one where it is the top of one above "
         "people already known: nothing above it, its lower end on their ellipses, at least a quarter of a head's square "
         "there; placed by its top at the default height (:mod:`.head_bands`). Off by default")
-    births_feet_bands: bool = Field(
-        False, description="the mirror of births_head_bands: a birth blob too small for a person whose upper end is "
-        "on people already known and below which the image shows floor is the legs of somebody in front of them, "
-        "placed by its lower end on the floor (:mod:`.head_bands`). Off by default")
     height_max_beside: float = Field(
         1.0, ge=0, le=1, description="a person is measured for height (:mod:`.height`) only in a frame where some "
         "view shows at most this share of the band beside their body (the ellipse three times as wide, less theirs) "

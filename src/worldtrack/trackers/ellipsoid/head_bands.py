@@ -18,9 +18,7 @@ top of one (:func:`is_head_band`):
   the default height along the top's ray: :func:`head_px`).
 
 It is placed by its top at the default height (:func:`~.births.blob_position` with the known people
-given), as a head band past people is. Its mirror, with ``crowd.births_feet_bands``: a blob below
-that size whose upper end is on known people and below which the image shows floor is the legs of
-somebody in front of them, placed by its lower end on the floor.
+given), as a head band past people is.
 
 >>> import numpy as np
 >>> mask = np.zeros((30, 20), np.uint8); mask[10:30, 5:15] = 1          # a silhouette
@@ -56,9 +54,9 @@ def head_px(cam, top_px: np.ndarray, height: float) -> float:
 
 
 def is_head_band(mask: np.ndarray, explained: np.ndarray, blob: np.ndarray, origin: tuple[int, int],
-                 down: np.ndarray | None, head: float, feet: bool = False) -> bool:
+                 down: np.ndarray | None, head: float) -> bool:
     """Whether ``blob`` ((h, w) bool crop at ``origin`` (u, v) px) is the top of a person behind
-    known people (``feet``: the bottom of one in front of them, their legs below their ellipses).
+    known people.
 
     Parameters
     ----------
@@ -68,7 +66,6 @@ def is_head_band(mask: np.ndarray, explained: np.ndarray, blob: np.ndarray, orig
     origin : (u, v) — the crop's top-left pixel
     down : (2,) — unit image direction of world-down there (None: not known, not a band)
     head : float — a head's width at the band's place, px (:func:`head_px`)
-    feet : bool — a feet band: its upper end on known people, background in the image below it
     """
     if down is None or not np.isfinite(head) or blob.sum() < MIN_HEAD_SHARE * head * head:
         return False
@@ -78,13 +75,9 @@ def is_head_band(mask: np.ndarray, explained: np.ndarray, blob: np.ndarray, orig
     across = np.array([-down[1], down[0]])
     top, bottom = pts[np.argmin(along)], pts[np.argmax(along)]
     half = max(1.0, 0.4 * float(np.ptp(pts @ across)))
-    feet_on, head_on = ends_on_people(explained, bottom, top, down, half)
-    spread = np.linspace(-half, half, 9)[:, None] * across
-    if feet:    # beyond the feet: inside the image and no foreground (the silhouette ends there)
-        below = bottom + BEYOND_PX * down + spread
-        inside = ((below >= 0) & (below < np.array(mask.shape[::-1]) - 0.5)).all()
-        return bool(head_on and inside and covered_share(mask, below) == 0.0)
-    return bool(feet_on and covered_share(mask, top - BEYOND_PX * down + spread) == 0.0)
+    feet_on, _ = ends_on_people(explained, bottom, top, down, half)
+    above = top - BEYOND_PX * down + np.linspace(-half, half, 9)[:, None] * across
+    return bool(feet_on and covered_share(mask, above) == 0.0)
 
 
 __all__ = ["HEAD_WIDTH_M", "MIN_HEAD_SHARE", "head_px", "is_head_band"]

@@ -104,7 +104,7 @@ class EllipsoidTracker(TrackerBase):
         self.rounds: Rounds = ROUNDS[m.rounds]
         self.births = Births(self.views, scene, self.walkable, cfg.births,
                              cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px,
-                             cfg.crowd.births_past_people, cfg.crowd.births_head_bands, cfg.crowd.births_feet_bands)
+                             cfg.crowd.births_past_people, cfg.crowd.births_head_bands)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
