@@ -65,3 +65,4 @@ def test_a_head_band_has_background_above_and_known_people_below():
     assert not is_head_band(above, explained, band, origin, down, head=8.0)
     assert not is_head_band(mask, explained, band, origin, down, head=20.0)            # too small for a head there
     assert not is_head_band(mask, explained, band, origin, None, head=8.0)
+

@@ -3,7 +3,9 @@
 import numpy as np
 from _ellipsoid_seen import one_person_seen
 
-from worldtrack.trackers.ellipsoid import EllipsoidConfig
+from worldtrack.foreground import make_foregrounds
+
+from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.ellipsoid.height_gate import crowd_shares, heights_due_clear
 
 
@@ -40,3 +42,12 @@ def test_heights_are_not_measured_where_every_view_shows_a_crowd_only_when_asked
     assert heights_due_clear([p], [p], EllipsoidConfig(), 0, tracker.views, crowded) == [0]   # off by default
     one = dict(crowded, **{c: tracker.last_labels[c] for c in list(crowded)[:1]})              # one view clear
     assert heights_due_clear([p], [p], gated, 0, tracker.views, one) == [0]
+
+
+def test_births_read_heights_unless_the_crowd_setting_says_not_to():
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    assert tracker.births.height_range == tuple(EllipsoidConfig().height.range_m)
+    crowd = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
+                             EllipsoidConfig(crowd={"births_heights": False}))
+    assert crowd.births.height_range is None
+    assert crowd.config.height.measure                                    # the tracker still measures them

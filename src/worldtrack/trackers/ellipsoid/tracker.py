@@ -103,8 +103,8 @@ class EllipsoidTracker(TrackerBase):
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
         self.births = Births(self.views, scene, self.walkable, cfg.births,
-                             cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px,
-                             cfg.crowd.births_past_people, cfg.crowd.births_head_bands)
+                             cfg.height.range_m if cfg.height.measure and cfg.crowd.births_heights else None,
+                             cfg.height.min_px, cfg.crowd.births_past_people, cfg.crowd.births_head_bands)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
