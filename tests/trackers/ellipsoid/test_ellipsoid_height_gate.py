@@ -4,7 +4,6 @@ import numpy as np
 from _ellipsoid_seen import one_person_seen
 
 from worldtrack.foreground import make_foregrounds
-
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.trackers.ellipsoid.height_gate import crowd_shares, heights_due_clear
 
