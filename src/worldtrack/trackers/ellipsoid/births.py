@@ -24,6 +24,7 @@ from worldtrack.trackers.ellipsoid.args import People
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import BirthConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop
+from worldtrack.trackers.ellipsoid.head_bands import head_px, is_head_band
 from worldtrack.trackers.ellipsoid.people_edges import covered_share, ends_on_people, unexplained_pixels
 
 class Proposal(NamedTuple):
@@ -105,11 +106,13 @@ class Births:
         the rule the tracker's own height measurements follow: small, a pixel is centimetres)
     past_people : a blob's end on the known people's ellipses is hidden, and the size test expects
         only what they leave unexplained (``crowd.births_past_people``, :mod:`.people_edges`)
+    head_bands : a blob too small for a person that is the top of one above known people is proposed
+        (``crowd.births_head_bands``, :mod:`.head_bands`)
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
                  config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60,
-                 past_people: bool = False):
+                 past_people: bool = False, head_bands: bool = False):
         self.views = views
         self.scene = scene
         self.walkable = walkable
@@ -117,6 +120,7 @@ class Births:
         self.height_range = height_range
         self.min_px = min_px
         self.past_people = past_people
+        self.head_bands = head_bands
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
@@ -161,10 +165,15 @@ class Births:
         out: list[Proposal] = []
         # Components found at ~320 px wide (each blob then read back at full resolution):
         # labelling the whole 640x480 frame was a third of the births' time.
-        for area, (x0, y0, bw, bh), centroid, blob in blobs(un, min_area, max(1, cam.width // 320)):
+        bands = self.head_bands and len(xy) > 0   # small blobs too: the tops of people behind known ones
+        for area, (x0, y0, bw, bh), centroid, blob in blobs(un, 10 if bands else min_area, max(1, cam.width // 320)):
+            band = area < min_area
+            if band and not is_head_band(mask, explained, blob, (x0, y0), view.down_direction(centroid),
+                                         head_px(cam, centroid, h0)):
+                continue
             found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px,
-                                  known=explained if cfg.people_occlude else None,
-                                  explained=explained if self.past_people and len(xy) else None)
+                                  known=explained if cfg.people_occlude and not band else None,
+                                  explained=explained if (self.past_people or band) and len(xy) else None)
             if found is None:
                 continue
             p, height, share = found
@@ -174,7 +183,7 @@ class Births:
             # Is the blob big enough to be (the visible part of) a person standing there?
             expected = (unexplained_pixels(view, pxy, h0, w0, explained) if self.past_people and len(xy)
                         else view.visible_pixels(pxy, h0, w0))
-            if expected <= 0 or area < cfg.min_blob_fraction * expected * share:
+            if not band and (expected <= 0 or area < cfg.min_blob_fraction * expected * share):
                 continue
             out.append(Proposal(pxy, cid, height))
         return out

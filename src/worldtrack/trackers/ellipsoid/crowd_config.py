@@ -55,6 +55,30 @@ class CrowdConfig(Section):
         "dev 110-112 cold 9.0 -> 8.3 held (MOTA 0.353 -> 0.363), true places 9.7 -> 12.7 (0.390 -> 0.410), with "
         "predict_along_ray_measured 12.7 / 0.406, 16.7 / 0.475 (without it 12.3 / 0.409, 15.3 / 0.486); PETS 2009 "
         "over 8 starts MOTA 0.926 -> 0.924, switches 2.75 -> 4.88")
+    births_head_bands: bool = Field(
+        False, description="a birth blob too small for a person is still one where it is the top of one above "
+        "people already known: nothing above it, its lower end on their ellipses, at least a quarter of a head's square "
+        "there; placed by its top at the default height (:mod:`.head_bands`). Off by default: crowd 50 dev 110-112 "
+        "alone cold 9.0 -> 9.7 held but MOTA 0.353 -> 0.313 (false positives), true places 9.7 -> 14.0 / 0.390 -> "
+        "0.417; with predict_along_ray_measured, alone_behind_obstacles, births_past_people and "
+        "births.people_occlude (against the first two) dev cold 14.7 -> 13.3 / 0.420 -> 0.408, true 14.3 -> 18.0 / "
+        "0.468 -> 0.488, held-out 113-118 cold 9.5 -> 12.5 / 0.392 -> 0.424, true 18.7 -> 17.3 / 0.489 -> 0.485")
+    births_heights: bool = Field(
+        True, description="a birth blob with feet and head in view gives the new person's height and, shorter than "
+        "height.range_m's minimum, is placed by its head (:func:`.births.blob_position`), as with height.measure "
+        "on (the default). false: births read no height (blobs placed by their lower end, people born at the "
+        "default height) while the tracker still measures heights: in a crowd one camera sees, the blob left "
+        "by the known people's ellipses is rarely a whole person (crowd 50 dev 110-112 cold 9.0 -> 11.7 held, "
+        "MOTA 0.353 -> 0.385; true places 9.7 -> 10.0, 0.390 -> 0.403; with predict_along_ray_measured + "
+        "alone_behind_obstacles cold 14.7 -> 12.3 / 0.420 -> 0.409, true 14.3 -> 16.3 / 0.468 -> 0.478)")
+    height_max_beside: float = Field(
+        1.0, ge=0, le=1, description="a person is measured for height (:mod:`.height`) only in a frame where some "
+        "view shows at most this share of the band beside their body (the ellipse three times as wide, less theirs) "
+        "as foreground: in a crowd an untracked person behind makes the silhouette tall, and the tall ellipse then "
+        "hides them (:mod:`.height_gate`). 1 = off (the default): the share is ~0.31 in crowd 50, ~0.05 in "
+        "crowd 10; at 0.2 crowd 50 dev 110-112 cold 9.0 -> 10.0 held, MOTA 0.353 -> 0.346, true places 9.7 -> 11.7, "
+        "0.390 -> 0.410; with predict_along_ray_measured + alone_behind_obstacles cold 14.7 -> 10.0 (0.420 -> "
+        "0.374), true 14.3 -> 15.3 (0.468 -> 0.490)")
     coast_behind_obstacles_s: float = Field(
         0.0, ge=0, description="a track the scene's obstacles wholly hide from a camera that has it in its image is "
         "kept this long unseen, carried by the prediction, instead of ending after end.leave_after_s as one that "

@@ -41,7 +41,8 @@ from worldtrack.trackers.ellipsoid.coast import behind_obstacles
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig
 from worldtrack.trackers.ellipsoid.depth import DepthFusion
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
-from worldtrack.trackers.ellipsoid.height import heights_due, update_heights
+from worldtrack.trackers.ellipsoid.height import update_heights
+from worldtrack.trackers.ellipsoid.height_gate import heights_due_clear
 from worldtrack.trackers.ellipsoid.identity import Identities
 from worldtrack.trackers.ellipsoid.joint import JointImage
 from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
@@ -102,8 +103,8 @@ class EllipsoidTracker(TrackerBase):
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
         self.births = Births(self.views, scene, self.walkable, cfg.births,
-                             cfg.height.range_m if cfg.height.measure else None, cfg.height.min_px,
-                             cfg.crowd.births_past_people)
+                             cfg.height.range_m if cfg.height.measure and cfg.crowd.births_heights else None,
+                             cfg.height.min_px, cfg.crowd.births_past_people, cfg.crowd.births_head_bands)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
@@ -185,8 +186,7 @@ class EllipsoidTracker(TrackerBase):
         if self.config.split.enabled and real:
             split = self._split(real, judged + bystanders + born, t)
             born, scores = born + split, scores + [(0.0, 0.0)] * len(split)
-        anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet,
-                       self.config.height)
+        anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet, self.config.height)
         self.depth.apply(judged + born, self.views, self.last_labels, self.walkable, dt if dt > 0 else self.frame_interval)
         if self.config.identity.enabled:  # before the life cycle: a person confirmed now is re-identified by it
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
@@ -352,8 +352,8 @@ class EllipsoidTracker(TrackerBase):
         flag_unmeasurable(judged, [v.camera for v in self.views.values()], self.scene.occlusion, t)
         if cfg.height.measure:
             present = judged + [p for p in bystanders if self.position_map.get(p.id) is p]
-            update_heights(present, heights_due(judged, cfg.height, self.frames_stepped), self.views,
-                           self.last_labels, lambda pid: self.scene.people.size_of(pid)[0], cfg.height)
+            due = heights_due_clear(judged, present, cfg, self.frames_stepped, self.views, self.last_labels)
+            update_heights(present, due, self.views, self.last_labels, lambda pid: self.scene.people.size_of(pid)[0], cfg.height)
         self.life.merge_duplicates(t, interval)
 
     def _coasting(self, p: Person) -> bool:
