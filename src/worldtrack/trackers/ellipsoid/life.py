@@ -201,10 +201,11 @@ class LifeCycle:
                 kept.append(p)
         return kept
 
-    def _judge(self, p: Person, m: Measures, t: float, frames: tuple[int, int, int, int]) -> bool:
-        """Capture or follow ``p``; False when it ends. ``frames``: lost, leave, held and weakly held
-        (0: off), in frames."""
-        lost_after, leave_after, held_frames, weak_frames = frames
+    def _judge(self, p: Person, m: Measures, t: float, frames: tuple[int, ...]) -> bool:
+        """Capture or follow ``p``; False when it ends. ``frames``: lost, leave, held and, optionally,
+        weakly held (0 or left out: off), in frames."""
+        lost_after, leave_after, held_frames, *weak = frames
+        weak_frames = weak[0] if weak else 0
         if p.mode == "capture":
             if self._near_confirmed(p, self.config.births.min_separation_m):
                 self.end(p)  # slid onto somebody already tracked
