@@ -93,6 +93,20 @@ def test_confirmation_holds_for_confirm_held_s(fps, frames):
     assert _frames_until_confirmed(fps, support=0.1) is None           # never held: dropped after 1 s
 
 
+@pytest.mark.parametrize("fps, frames", [(10, 8), (25, 20)])
+def test_weak_evidence_in_two_views_held_for_weak_held_s_confirms(fps, frames):
+    # Issue 37, crowd 10 seed 26: a person whose shirt the foreground takes for shadow holds E ~0.23
+    # (below symmetric_threshold 0.3) with support ~0.36 in two views, and was dropped after 1 s.
+    weak = EllipsoidConfig(confirm={"weak_threshold": 0.2})
+    assert _frames_until_confirmed(fps, e=0.23, views=2, support=0.36) is None           # off: dropped
+    assert _frames_until_confirmed(fps, e=0.23, views=2, support=0.36, config=weak) == frames  # 0.8 s held
+    assert _frames_until_confirmed(fps, e=0.23, views=1, support=0.36, config=weak) is None    # one view: no
+    assert _frames_until_confirmed(fps, e=0.23, views=2, support=0.30, config=weak) is None    # support < 0.35
+    assert _frames_until_confirmed(fps, e=0.15, views=2, support=0.36, config=weak) is None    # E <= 0.2
+    paper = EllipsoidConfig.paper().model_copy(update={"confirm": weak.confirm})
+    assert _frames_until_confirmed(fps, e=0.23, views=2, support=0.36, config=paper) is None   # eq. 5 alone: no
+
+
 def test_a_person_never_confirmed_is_dropped_after_confirm_within_s():
     tracker = _tracker()
     person = tracker.position_map.add(-1.0, 1.2, mode="capture", time=0.0, tentative=True)

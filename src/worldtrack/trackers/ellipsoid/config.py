@@ -138,6 +138,12 @@ class ConfirmConfig(Section):
     views: int = Field(
         2, ge=0, description="a person passing the capture tests while at least this many cameras show their own "
         "foreground is confirmed at once (0 = never)")
+    weak_threshold: float = Field(
+        0.0, ge=0, description="when > 0, a captured person whose E stays above this (below symmetric_threshold) "
+        "for weak_held_s while two cameras show their own pixels with support >= weak_support is confirmed (a body "
+        "the foreground labels only in part; 0 = off)")
+    weak_support: float = Field(0.35, ge=0, le=1, description="... with at least this support, ...")
+    weak_held_s: float = Field(0.8, ge=0, description="... held this long in a row, s (below within_s)")
 
 
 class SupportConfig(Section):

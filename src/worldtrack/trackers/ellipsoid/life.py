@@ -65,6 +65,11 @@ class Evidence(Protocol):
         """Whether a tracked person's evidence fails this frame, and how many frames that counts."""
         ...
 
+    def weak_ok(self, m: Measures) -> bool:
+        """A captured person below the capture E passes this frame's tests for a long hold
+        (``confirm.weak_threshold``)."""
+        ...
+
 
 #: :class:`Evidence` rules by score name (``ellipsoid.score.kind``).
 EVIDENCE: Registry[type] = Registry("ellipsoid.score.kind")
@@ -89,6 +94,9 @@ class PaperEvidence:
 
     def failing(self, m: Measures, young: bool, several_cameras: bool) -> tuple[bool, int]:
         return m.e < self.keep_score, 1
+
+    def weak_ok(self, m: Measures) -> bool:
+        return False
 
 
 @EVIDENCE.register("symmetric")
@@ -126,6 +134,13 @@ class SupportEvidence:
         # Own pixels that are nearly all floor: a ghost, or a track that lost its person.
         empty = m.support < s.empty_support
         return low, (2 if empty else 1)
+
+    def weak_ok(self, m: Measures) -> bool:
+        # E held low by a body the foreground labels only in part (a shirt taken for shadow, legs
+        # behind a table) while two cameras show the person's own pixels, mostly foreground.
+        c, s = self.confirm, self.support
+        return (c.weak_threshold > 0 and m.e > c.weak_threshold and m.views >= 2 and m.support >= c.weak_support
+                and not m.own_share < s.min_own_share and m.seen_share >= s.min_seen_share)
 
 
 class LifeCycle:
@@ -168,7 +183,8 @@ class LifeCycle:
         """
         cfg = self.config
         frames = (frames_for(cfg.end.lost_after_s, interval), frames_for(cfg.end.leave_after_s, interval),
-                  frames_for(cfg.confirm.held_s, interval))
+                  frames_for(cfg.confirm.held_s, interval),
+                  frames_for(cfg.confirm.weak_held_s, interval) if cfg.confirm.weak_threshold > 0 else 0)
         kept = []
         for k, p in enumerate(people):
             m = Measures(scores[k][0], support.visible[k], support.support[k], support.own_share[k],
@@ -185,9 +201,11 @@ class LifeCycle:
                 kept.append(p)
         return kept
 
-    def _judge(self, p: Person, m: Measures, t: float, frames: tuple[int, int, int]) -> bool:
-        """Capture or follow ``p``; False when it ends. ``frames``: lost, leave and held, in frames."""
-        lost_after, leave_after, held_frames = frames
+    def _judge(self, p: Person, m: Measures, t: float, frames: tuple[int, ...]) -> bool:
+        """Capture or follow ``p``; False when it ends. ``frames``: lost, leave, held and, optionally,
+        weakly held (0 or left out: off), in frames."""
+        lost_after, leave_after, held_frames, *weak = frames
+        weak_frames = weak[0] if weak else 0
         if p.mode == "capture":
             if self._near_confirmed(p, self.config.births.min_separation_m):
                 self.end(p)  # slid onto somebody already tracked
@@ -196,7 +214,10 @@ class LifeCycle:
             if self.evidence.counts_held:
                 # Held on foreground for several frames: a person, not a flicker.
                 held = counts_for(p, "held", t, ok)
-                confirmed = held >= held_frames or (ok and self.evidence.confirms_at_once(m))
+                # Or a long hold of weaker evidence in two views (``confirm.weak_threshold``).
+                weak = counts_for(p, "weak", t, ok or self.evidence.weak_ok(m)) if weak_frames > 0 else 0
+                confirmed = held >= held_frames or (ok and self.evidence.confirms_at_once(m)) \
+                    or (weak_frames > 0 and weak >= weak_frames)
             else:
                 confirmed = ok
             if confirmed:
