@@ -29,6 +29,14 @@ class FeetConfig(Section):
                                    "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
     footprint: bool = Field(False, description="with anchor: the person stands beyond the lowest point of their silhouette by "
                             "where this camera sees a foot model's lowest point (anchor_footprint.py); replaces centre_offset_m")
+    ray_band_share: float = Field(
+        0.0, ge=0, le=1, description="with anchor, > 0: the feet are not used where another person's ellipse box reaches "
+        "their columns from this share of the person's box height above them down to them (someone just behind or "
+        "in front on the line of sight, anchor_gates.py); 0 = off")
+    height_sigmas: float = Field(
+        0.0, ge=0, description="with anchor, > 0: once the height is measured, the feet count only where the height "
+        "read above them is within this many times one measurement's scatter of the person's height (at most "
+        "height_match_m; anchor_gates.py); 0 = height_match_m alone")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")
