@@ -83,3 +83,30 @@ def test_a_measured_height_gates_the_feet_by_its_scatter(seen):
     assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == 1
     assert height_gate_m([1.7, 1.8], 0.3, 3.0) == 0.3
     assert height_gate_m([1.70, 1.73, 1.67, 1.74, 1.70], 0.1, 3.0) == 0.1
+
+
+def _with_obstacle_beside_the_feet(tracker, instance, truth, distance_m: float):
+    """The tracker's views with an obstacle ``distance_m`` m from the camera (floor distance) covering a
+    few pixels 3-5 columns beside the lowest pixel of the truth's silhouette (not the pixel below it)."""
+    import dataclasses
+
+    rows, cols = np.nonzero(instance == truth["id"])
+    v = int(rows.max())
+    u = int(round(cols[rows == v].mean()))
+    view = tracker.views["cam"]
+    occ = np.array(view.occ, copy=True)
+    occ[v - 1:v + 2, u + 3:u + 6] = distance_m
+    return {"cam": dataclasses.replace(view, args=view.args._replace(occ=occ))}
+
+
+@pytest.mark.parametrize("distance_m, moves", [(1.0, 0), (30.0, 1)])
+def test_an_obstacle_nearer_than_the_feet_beside_them_stops_the_anchor_with_obstacle_clear(seen, distance_m, moves):
+    tracker, labels, instance, truth = seen
+    views = _with_obstacle_beside_the_feet(tracker, instance, truth, distance_m)
+    p, _ = misplaced(tracker, truth, 0.6)
+    config = FeetConfig(anchor=True, head_fallback=False)
+    assert anchor_to_feet([p], views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == 1
+    p, _ = misplaced(tracker, truth, 0.6)
+    config = FeetConfig(anchor=True, head_fallback=False, obstacle_clear=True)
+    # Nearer than the feet: its edge may be where the silhouette ends. Behind them (30 m): not.
+    assert anchor_to_feet([p], views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves

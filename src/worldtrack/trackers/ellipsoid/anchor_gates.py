@@ -43,6 +43,8 @@ import numpy as np
 
 #: Least scatter of one height measurement, m (a pixel or two of the head's top at a few metres).
 SCATTER_FLOOR_M = 0.02
+#: Rows above and below the feet searched for an obstacle, share of the person's ellipse's height.
+FEET_ROWS_SHARE = 0.03
 #: Half the width of the feet's columns, share of the person's box width.
 FEET_HALF_WIDTH_SHARE = 0.25
 
@@ -95,6 +97,41 @@ def ray_shared(boxes: np.ndarray, valid: np.ndarray, k: int, feet_uv: np.ndarray
     return bool(np.any(others & meets))
 
 
+def obstacle_beside(occ: np.ndarray | None, feet_uv: np.ndarray, half_px: float, rows_px: int, distance_m: float) -> bool:
+    """Whether an obstacle nearer than ``distance_m`` (m, the person's floor distance) covers a pixel of
+    the window at the feet: columns ``feet_uv[0]`` ± ``half_px``, rows from ``rows_px`` above the feet
+    to ``rows_px`` below them (``occ`` (H, W): each pixel's nearest obstacle's floor distance, m, inf
+    where none; None: no obstacles). The bottom of a silhouette there may be the obstacle's edge."""
+    if occ is None:
+        return False
+    if not np.isfinite(feet_uv).all():
+        return True
+    h, w = occ.shape
+    u, v = int(round(feet_uv[0])), int(round(feet_uv[1]))
+    r = int(np.ceil(half_px))
+    win = occ[max(v - rows_px, 0):min(v + rows_px + 1, h), max(u - r, 0):min(u + r + 1, w)]
+    return bool(np.any(win < distance_m))
+
+
+def feet_doubted(view, current, k: int, pixel: np.ndarray, feet_distance_m: float, config) -> bool:
+    """Whether person ``k``'s feet found at real image point ``pixel`` (2,) in camera ``view``
+    (:class:`~.cameras.CameraView`; ``current``: every person's :class:`~.args.Forms` there) may be
+    another person's (``config.ray_band_share``, :func:`ray_shared`) or an obstacle's edge
+    (``config.obstacle_clear``, :func:`obstacle_beside`, the window half the person's ellipse wide
+    each side and ``FEET_ROWS_SHARE`` of its height up and down); ``config``: a FeetConfig."""
+    if config.ray_band_share <= 0 and not config.obstacle_clear:
+        return False
+    boxes = ellipse_boxes(current.inner)
+    ideal = ideal_pixel(view.grid, view.args.has_dist, pixel)
+    if ray_shared(boxes, current.valid, k, ideal, config.ray_band_share):
+        return True
+    if not config.obstacle_clear:
+        return False
+    u0, u1, v0, v1 = boxes[k]
+    rows = max(2, int(round(FEET_ROWS_SHARE * (v1 - v0))))
+    return obstacle_beside(view.occ, pixel, 0.5 * (u1 - u0), rows, feet_distance_m)
+
+
 def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float) -> float:
     """How far (m) the height read above the feet may be from the person's height: ``match_m``
     while fewer than 3 samples are in or ``sigmas`` is 0, else ``sigmas`` × the scatter of one
@@ -106,4 +143,4 @@ def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float) -> fl
     return min(match_m, sigmas * scatter)
 
 
-__all__ = ["FEET_HALF_WIDTH_SHARE", "SCATTER_FLOOR_M", "ellipse_boxes", "height_gate_m", "ideal_pixel", "ray_shared"]
+__all__ = ["FEET_HALF_WIDTH_SHARE", "FEET_ROWS_SHARE", "SCATTER_FLOOR_M", "ellipse_boxes", "feet_doubted", "height_gate_m", "ideal_pixel", "obstacle_beside", "ray_shared"]

@@ -33,6 +33,10 @@ class FeetConfig(Section):
         0.0, ge=0, le=1, description="with anchor, > 0: the feet are not used where another person's ellipse box reaches "
         "their columns from this share of the person's box height above them down to them (someone just behind or "
         "in front on the line of sight, anchor_gates.py); 0 = off")
+    obstacle_clear: bool = Field(
+        False, description="with anchor: the feet are not used where an obstacle nearer than them covers a pixel "
+        "beside or below them (the window half the person's ellipse wide each side; the silhouette's bottom may be "
+        "the obstacle's edge, anchor_gates.py); false: the one pixel below the feet is tested")
     height_sigmas: float = Field(
         0.0, ge=0, description="with anchor, > 0: once the height is measured, the feet count only where the height "
         "read above them is within this many times one measurement's scatter of the person's height (at most "

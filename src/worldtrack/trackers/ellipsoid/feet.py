@@ -45,7 +45,7 @@ import numpy as np
 
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.anchor_footprint import standing_point
-from worldtrack.trackers.ellipsoid.anchor_gates import ellipse_boxes, height_gate_m, ideal_pixel, ray_shared
+from worldtrack.trackers.ellipsoid.anchor_gates import feet_doubted, height_gate_m
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
@@ -147,7 +147,7 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
         if found is not None and lo <= found[1] <= hi \
                 and abs(found[1] - hs[k]) <= height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas) \
                 and not touches_other(look[1], look[2], pixel, k) \
-                and not ray_shared(ellipse_boxes(current.inner), current.valid, k, ideal_pixel(view.grid, view.args.has_dist, pixel), config.ray_band_share):
+                and not feet_doubted(view, current, k, pixel, float(np.hypot(*(found[0][:2] - cam.centre[:2]))), config):
             sigma = feet_sigma_m(cam, found[0][:2], look[3], config.sigma_m, config.pixel_sigma_px)
             stands = (standing_point(found[0][:2], cam.centre, hs[k]) if config.footprint
                       else beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m))
