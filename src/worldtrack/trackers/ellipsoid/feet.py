@@ -144,10 +144,10 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
                 break
             look = nearer
         pixel = cam.project(found[0][None])[0] if found is not None else None
-        if found is not None and lo <= found[1] <= hi \
-                and abs(found[1] - hs[k]) <= height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas) \
+        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas)
+        if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= gate \
                 and not touches_other(look[1], look[2], pixel, k) \
-                and not feet_doubted(view, current, k, pixel, float(np.hypot(*(found[0][:2] - cam.centre[:2]))), config):
+                and not feet_doubted(view, current, k, pixel, found[0][:2], config):
             sigma = feet_sigma_m(cam, found[0][:2], look[3], config.sigma_m, config.pixel_sigma_px)
             stands = (standing_point(found[0][:2], cam.centre, hs[k]) if config.footprint
                       else beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m))
