@@ -29,6 +29,22 @@ class FeetConfig(Section):
                                    "point of their silhouette along the line of sight, m (trackers/ellipsoid/toes.py)")
     footprint: bool = Field(False, description="with anchor: the person stands beyond the lowest point of their silhouette by "
                             "where this camera sees a foot model's lowest point (anchor_footprint.py); replaces centre_offset_m")
+    ray_band_share: float = Field(
+        0.0, ge=0, le=1, description="with anchor, > 0: the feet are not used where another person's ellipse box reaches "
+        "their columns from this share of the person's box height above them down to them (someone just behind or "
+        "in front on the line of sight, anchor_gates.py); 0 = off (0.1 with footprint and obstacle_clear: PETS 8 starts IDF1 "
+        "0.804 -> 0.842, switches 5.1 -> 4.2, with height_sigmas 3 too 0.858, 1.6 (main 0.830, 2.75); one "
+        "camera held-out 420-439 0.457 -> 0.438, -0.019 +- 0.017, issue 37)")
+    obstacle_clear: bool = Field(
+        False, description="with anchor: the feet are not used where an obstacle nearer than them covers a pixel "
+        "beside or below them (the window half the person's ellipse wide each side; the silhouette's bottom may be "
+        "the obstacle's edge, anchor_gates.py); false: the one pixel below the feet is tested (with footprint, paper_kato "
+        "T2 (a) feet hidden, through, 160 / 640: 0.260 / 0.140 -> 0.135 / 0.071 m = the anchor off, issue 37)")
+    height_sigmas: float = Field(
+        0.0, ge=0, description="with anchor, > 0: once the height is measured, the feet count only where the height "
+        "read above them is within this many times one measurement's scatter of the person's height (at most "
+        "height_match_m; anchor_gates.py); 0 = height_match_m alone (3 cost one camera held-out 420-439 0.438 -> 0.389 "
+        "with the other gates, issue 37: too strict)")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")

@@ -45,6 +45,7 @@ import numpy as np
 
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.anchor_footprint import standing_point
+from worldtrack.trackers.ellipsoid.anchor_gates import feet_doubted, height_gate_m
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
@@ -142,8 +143,11 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
                 found = None
                 break
             look = nearer
-        if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= config.height_match_m \
-                and not touches_other(look[1], look[2], cam.project(found[0][None])[0], k):
+        pixel = cam.project(found[0][None])[0] if found is not None else None
+        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas)
+        if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= gate \
+                and not touches_other(look[1], look[2], pixel, k) \
+                and not feet_doubted(view, current, k, pixel, found[0][:2], config):
             sigma = feet_sigma_m(cam, found[0][:2], look[3], config.sigma_m, config.pixel_sigma_px)
             stands = (standing_point(found[0][:2], cam.centre, hs[k]) if config.footprint
                       else beyond_toes(found[0][:2], cam.centre[:2], config.centre_offset_m))
