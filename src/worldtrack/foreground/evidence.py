@@ -61,6 +61,14 @@ class EvidenceSettings(NamedTuple):
     samples: float = 0.25     #: independent samples per window pixel (blur and smooth textures correlate them)
 
 
+#: ``foreground.shadow_test = "evidence-sure"``: the same test deciding only on pooled evidence twice as
+#: strong (±3 instead of ±1.5). On synthetic floors (texture kept exactly in a shadow) most decisions are
+#: far stronger than that; on compressed real video (PETS: plain pavement, the pattern smoothed away in
+#: dark contact shadows) the evidence is weak and about half of what ±1.5 calls cloth lies outside the
+#: people's boxes. Measured in benchmarks/results/tuning_foreground.md.
+SURE = EvidenceSettings(decide=3.0)
+
+
 def _box(x: np.ndarray, side: int) -> np.ndarray:
     return cv2.boxFilter(x, -1, (side, side), borderType=cv2.BORDER_REFLECT)
 
@@ -227,5 +235,5 @@ def judge_by_evidence_reference(labels: np.ndarray, image: np.ndarray, backgroun
     return _judge(labels, image, background, grey(background), settings, candidate, cloth, shadow, reference=True)
 
 
-__all__ = ["EvidenceSettings", "brightness_ratio", "judge_by_evidence", "judge_by_evidence_reference",
+__all__ = ["SURE", "EvidenceSettings", "brightness_ratio", "judge_by_evidence", "judge_by_evidence_reference",
            "texture_evidence", "texture_evidence_reference"]
