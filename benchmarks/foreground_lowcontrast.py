@@ -28,7 +28,7 @@ Variants (all on the colour foreground at the synthetic threshold 20 with shadow
 - ``evidence-read`` — the same, as the particle tracker reads it;
 - ``evidence-background`` — the same test, the shadows it judges labelled background (0) instead of
   unsure (``foreground.shadow_test = "evidence-background"``);
-- ``evidence-sure`` — the evidence test deciding only on pooled evidence beyond ±3 instead of ±1.5
+- ``evidence-sure`` — the evidence test deciding only on pooled evidence beyond ±4 instead of ±1.5
   (``foreground.shadow_test = "evidence-sure"``).
 
 Seeds 100–107 by default (held out: the tests and the thresholds were worked out on seeds 0–3).

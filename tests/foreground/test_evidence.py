@@ -157,7 +157,7 @@ def test_the_sure_test_leaves_weak_evidence_unsure_and_still_calls_plain_cloth_f
     weak = colour[20:60, 30:90] == UNSURE
     assert weak.mean() > 0.9
     assert (evidence[20:60, 30:90][weak] == 1).mean() > 0.7                     # 0.79 measured
-    assert (sure[20:60, 30:90][weak] == 1).mean() < 0.5                         # 0.40 measured
+    assert (sure[20:60, 30:90][weak] == 1).mean() < 0.4                         # 0.13 measured (±3: 0.40)
     plain = colour[66:74, 36:84] == UNSURE                                      # (away from the weak patch's pooling)
     assert plain.mean() > 0.9 and np.all(sure[66:74, 36:84][plain] == 1)
     assert np.array_equal(sure[colour != UNSURE], colour[colour != UNSURE])

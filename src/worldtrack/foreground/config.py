@@ -42,7 +42,7 @@ class ForegroundConfig(Section):
                           "are darker than the frame's shadows (worldtrack.foreground.evidence); "
                           "'evidence-background' also calls the ones where the floor's pattern shows "
                           "through background; 'evidence-sure' is 'evidence' deciding only on "
-                          "pooled evidence twice as strong (null: the method's own, evidence for the particle tracker, "
+                          "pooled evidence beyond ±4, not ±1.5 (null: the method's own, evidence for the particle tracker, "
                           "else colour)")
 
     def resolved_threshold(self) -> float | None:
