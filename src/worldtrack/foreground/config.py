@@ -42,8 +42,8 @@ class ForegroundConfig(Section):
                           "are darker than the frame's shadows (worldtrack.foreground.evidence); "
                           "'evidence-background' also calls the ones where the floor's pattern shows "
                           "through background; 'evidence-sure' is 'evidence' deciding only on "
-                          "pooled evidence beyond ±4, not ±1.5 (null: the method's own, evidence for the particle tracker, "
-                          "else colour)")
+                          "pooled evidence beyond ±4, not ±1.5 (null: the method's own, evidence for the "
+                          "particle tracker, else colour)")
 
     def resolved_threshold(self) -> float | None:
         """The threshold in use: :attr:`threshold`, else the default of :attr:`kind` (None for mog2/knn)."""

@@ -76,7 +76,7 @@ class EvidenceSettings(NamedTuple):
 #: of 80, MOTA 0.759 -> 0.731 (-0.028 ± 0.023, 5 better / 15 worse). As the ellipsoid tracker's own test
 #: (benchmarks/with_defaults.py) on crowd 10, seeds 140-159: MOTA 0.932 -> 0.943 (+0.011 ± 0.008, 13 better /
 #: 6 worse), switches 92 -> 87, tracked at frame 0 188 -> 193 of 197; but paper_kato at 640x480 loses up to
-#: 6 cm (lower body static 0.110 -> 0.173 m, feet hidden through 0.071 -> 0.096 m, whole body through 0.056 ->
+#: 6.3 cm (lower body static 0.110 -> 0.173 m, feet hidden through 0.071 -> 0.096 m, whole body through 0.056 ->
 #: 0.066 m; 4 rows 0.1-0.4 cm better; 160x120 identical): opt-in.
 SURE = EvidenceSettings(decide=4.0)
 
