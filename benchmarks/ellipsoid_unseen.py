@@ -227,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an ellipsoid setting by dotted path; results are then only printed")
     p.add_argument("--quick", action="store_true", help="2 seeds, 60 frames, 320x240; prints only")
-    p.add_argument("--shadow-test", choices=["colour", "evidence"], default="colour",
+    p.add_argument("--shadow-test", choices=["colour", "evidence", "evidence-sure"], default="colour",
                    help="the colour foreground's test of shadow-like pixels (foreground.shadow_test); "
                         "results are then only printed")
     args = p.parse_args(argv)

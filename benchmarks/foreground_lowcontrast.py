@@ -27,7 +27,9 @@ Variants (all on the colour foreground at the synthetic threshold 20 with shadow
   (``foreground.shadow_test = "evidence"``) as the ellipsoid tracker and the blobs read it;
 - ``evidence-read`` — the same, as the particle tracker reads it;
 - ``evidence-background`` — the same test, the shadows it judges labelled background (0) instead of
-  unsure (``foreground.shadow_test = "evidence-background"``).
+  unsure (``foreground.shadow_test = "evidence-background"``);
+- ``evidence-sure`` — the evidence test deciding only on pooled evidence beyond ±4 instead of ±1.5
+  (``foreground.shadow_test = "evidence-sure"``).
 
 Seeds 100–107 by default (held out: the tests and the thresholds were worked out on seeds 0–3).
 
@@ -136,6 +138,11 @@ def variants(background: np.ndarray, floor: np.ndarray) -> dict:
     except InputError:       # the code measured has no evidence-background test
         return out
     out["evidence-background"] = judged.labels
+    try:
+        sure = StaticBackground(background, t, "colour", shadows=True, shadow_test="evidence-sure")
+    except InputError:       # the code measured has no evidence-sure test
+        return out
+    out["evidence-sure"] = sure.labels
     return out
 
 

@@ -213,7 +213,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--methods", nargs="+", choices=METHODS, default=list(METHODS), help="the trackers to run")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="an ellipsoid setting by dotted path (e.g. identity.enabled=false); results are then only printed")
-    ap.add_argument("--shadow-test", choices=("colour", "evidence", "evidence-background"), default=None,
+    ap.add_argument("--shadow-test", choices=("colour", "evidence", "evidence-background", "evidence-sure"), default=None,
                     help="the foreground's shadow test for every method (default: each method's own, "
                          "evidence for the particle tracker); results are then only printed")
     ap.add_argument("--truth-beyond-m", type=float, default=0.0, metavar="M",

@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an ellipsoid default by dotted path (e.g. feet.anchor=true)")
-    p.add_argument("--shadow-test", choices=("colour", "evidence", "evidence-background"), default=None,
+    p.add_argument("--shadow-test", choices=("colour", "evidence", "evidence-background", "evidence-sure"), default=None,
                    help="the ellipsoid's own foreground shadow test")
     args = p.parse_args(argv[:cut])
     bench = argv[cut + 1:]

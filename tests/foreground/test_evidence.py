@@ -129,7 +129,7 @@ def test_static_background_with_the_evidence_test_and_its_setting():
     changed = background != evidence
     assert np.all(evidence[changed] == UNSURE) and np.all(background[changed] == 0)   # and nothing else
     with pytest.raises(InputError, match="shadow test: expected one of 'colour', 'evidence', "
-                                         "'evidence-background', got 'texture'"):
+                                         "'evidence-background', 'evidence-sure', got 'texture'"):
         StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test="texture")
     assert ForegroundConfig().shadow_test is None                           # the method's own (a run fills it in)
     assert ForegroundConfig().resolved_shadow_test() == "colour"
@@ -138,3 +138,27 @@ def test_static_background_with_the_evidence_test_and_its_setting():
         assert FOREGROUNDS[kind](bg, 20.0, True, None, "evidence").shadow_test == "evidence"
     with pytest.raises(InputError, match="foreground.shadow_test"):
         from_mapping(ForegroundConfig, {"shadow_test": "texture"}, root="foreground")
+
+
+def test_the_sure_test_leaves_weak_evidence_unsure_and_still_calls_plain_cloth_foreground():
+    """A shade that shows the floor's pattern at about half the shadow's contrast (pooled evidence
+    about −2.4, between the two tests' thresholds: what a compressed real shadow looks like) is
+    mostly cloth to "evidence" and mostly unsure to "evidence-sure"; plain cloth of the floor's
+    colour is foreground to both."""
+    bg = tiled_floor()
+    img = bg.astype(float)
+    patch = img[20:60, 30:90].copy()
+    img[20:60, 30:90] = 0.6 * (0.488 * patch + 0.512 * patch.mean(axis=(0, 1)))   # weak: β ≈ 0.29 for r = 0.6
+    img[62:78, 30:90] = 0.6 * img[62:78, 30:90].mean(axis=(0, 1))                 # plain cloth: β = 0
+    img = noisy(img, np.random.default_rng(1))
+    def labels(test):
+        return StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test=test).labels(img)
+    colour, evidence, sure = labels("colour"), labels("evidence"), labels("evidence-sure")
+    weak = colour[20:60, 30:90] == UNSURE
+    assert weak.mean() > 0.9
+    assert (evidence[20:60, 30:90][weak] == 1).mean() > 0.7                     # 0.79 measured
+    assert (sure[20:60, 30:90][weak] == 1).mean() < 0.4                         # 0.13 measured (±3: 0.40)
+    plain = colour[66:74, 36:84] == UNSURE                                      # (away from the weak patch's pooling)
+    assert plain.mean() > 0.9 and np.all(sure[66:74, 36:84][plain] == 1)
+    assert np.array_equal(sure[colour != UNSURE], colour[colour != UNSURE])
+    assert ForegroundConfig(shadow_test="evidence-sure").resolved_shadow_test() == "evidence-sure"

@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.foreground.evidence import judge_by_evidence
+from worldtrack.foreground.evidence import SURE, EvidenceSettings, judge_by_evidence
 from worldtrack.foreground.kernels import colour_labels, shadow_like
 from worldtrack.foreground.texture import relabel_cloth
 
@@ -26,7 +26,7 @@ from worldtrack.foreground.texture import relabel_cloth
 #: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
 UNSURE = 2
 #: The tests of shadow-like changes (``StaticBackground(shadow_test=)``, ``foreground.shadow_test``).
-SHADOW_TESTS = ("colour", "evidence", "evidence-background")
+SHADOW_TESTS = ("colour", "evidence", "evidence-background", "evidence-sure")
 
 #: MOG2/KNN output (0 background, 127 shadow, 255 foreground) → labels.
 _MOG = np.zeros(256, np.uint8)
@@ -104,6 +104,8 @@ class StaticBackground:
         foreground (cloth of the floor's colour); the rest stay unsure. ``"evidence-background"``:
         the same, and the ones whose neighbourhood shows the floor's pattern through are background
         (0, judged shadows), so that a silhouette that takes in its own shadow is penalised.
+        ``"evidence-sure"``: ``"evidence"`` deciding only on stronger pooled evidence
+        (:data:`~worldtrack.foreground.evidence.SURE`).
     """
 
     learns = False  #: a fixed background: the same frame always gives the same labels
@@ -164,7 +166,8 @@ class StaticBackground:
                                 self.shadows, self.shadow_min_ratio, self.shadow_distortion)
         if self.shadows and self.shadow_test != "colour":
             judged = 0 if self.shadow_test == "evidence-background" else UNSURE
-            out = judge_by_evidence(out, image, self.background, candidate=UNSURE, cloth=1, shadow=judged,
+            settings = SURE if self.shadow_test == "evidence-sure" else EvidenceSettings()
+            out = judge_by_evidence(out, image, self.background, settings, candidate=UNSURE, cloth=1, shadow=judged,
                                     grey_background=self.grey)
         if self.shadows and self.shadow_texture_ncc is not None:
             relabel_cloth(out, image, self.grey, self.shadow_texture_ncc, candidate=UNSURE)
