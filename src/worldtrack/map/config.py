@@ -96,6 +96,12 @@ class MapConfig(Section):
                                                       "there says so, and the first confirms them (one process "
                                                       "confirms a person two cameras show at once; "
                                                       "worldtrack.map.affirm; false: before issue 39k)")
+    crossing_s: float = Field(0.0, ge=0, description="two ids one worker held apart (saw at the same time) less "
+                                                     "than this long ago (s) are two people: the map does not fold "
+                                                     "them as duplicates, and a worker that holds one puts the other "
+                                                     "back on its own map while another worker sees them (a crossing "
+                                                     "on the axis two facing cameras share: each shows only the "
+                                                     "person in front; worldtrack.map.merges; 0 = off)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")
