@@ -85,3 +85,16 @@ def test_a_worker_puts_back_the_person_it_saw_beside_its_own_moments_ago_only_wh
     assert _sync(2.0, 0.5) == {1, 3}           # seen apart 0.55 s ago: another person, placed from the map
     assert _sync(2.0, None) == {3}             # never seen apart: the map will merge them
     assert _sync(0.3, 0.5) == {3}              # seen apart too long ago
+
+
+def test_a_worker_notes_the_pairs_it_sees_at_once_only_when_asked():
+    from worldtrack.trackers.base import Frame
+    stub = SimpleNamespace(register_script=lambda _: None)
+    for crossing_s, noted in ((2.0, {(3, 5): 1.0}), (0.0, {})):
+        link = MapLink(stub, MapKeys(), MapConfig(crossing_s=crossing_s, affirm_candidates=False), "w2", {"east": CAM})
+        tracker = _Tracker()
+        for pid, x in ((3, 5.0), (5, 6.0)):
+            tracker.position_map.add(x, 0.0, mode="tracking", track_id=pid, confirmed=True).seen_at = 1.0
+        tracks = [p.track() for p in tracker.position_map]
+        link.observations(tracker, tracks, 1.0, {"east": Frame(None, t=1.0, index=10)})
+        assert link.together == noted
