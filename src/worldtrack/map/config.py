@@ -81,7 +81,8 @@ class MapConfig(Section):
                                                "the map's height of a person two workers see is the median of "
                                                "their last heights from those rays (worldtrack.map.rays; off: "
                                                "held-out 84-113 below one process 8 -> 5 of 30, 10 seeds better, "
-                                               "6 worse, seed 84 IDF1 -0.49; never-used 118 MOTA -0.32, 119 +0.30)")
+                                               "6 worse, seed 84 IDF1 -0.49; never-used 118 MOTA -0.32, 119 +0.30; "
+                                               "held-out 124-153 MOTA +0.023, 11 better, 4 worse, 148 IDF1 -0.37)")
     weigh_own: bool = Field(False, description="weigh each worker's estimate (and choose the lead) by support x "
                                               "the share of the body no other person it holds covers in its "
                                               "views, not by support alone: a worker that sees a person behind "
@@ -96,6 +97,15 @@ class MapConfig(Section):
                                                       "there says so, and the first confirms them (one process "
                                                       "confirms a person two cameras show at once; "
                                                       "worldtrack.map.affirm; false: before issue 39k)")
+    crossing_s: float = Field(0.0, ge=0, description="two ids one worker held apart (saw at the same time) less "
+                                                     "than this long ago (s) are two people: the map does not fold "
+                                                     "them as duplicates, and a worker that holds one puts the other "
+                                                     "back on its own map while another worker sees them (a crossing "
+                                                     "on the axis two facing cameras share: each shows only the "
+                                                     "person in front; worldtrack.map.merges; 0 = off: with "
+                                                     "head_rays, 2 s lifted dev 20 MOTA 0.853 -> 0.983, but on "
+                                                     "held-out 124-153 MOTA -0.005, 2 seeds better, 4 worse, "
+                                                     "133 -0.137)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

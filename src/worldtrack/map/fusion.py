@@ -132,15 +132,18 @@ class FusionState:
     #: Merged ids: younger → elder, with the time of the merge (kept for ``forget_after_s``).
     aliases: dict[int, tuple[int, float]] = field(default_factory=dict)
     last_bucket: int | None = None
+    #: ``map.crossing_s``: pairs of ids (a < b) one worker saw at the same time, when last (s).
+    together: dict[tuple[int, int], float] = field(default_factory=dict)
 
     def to_json(self) -> str:
-        # Without map.head_rays's heights (the last field) as before: an older fusion role reads it.
+        # Without map.head_rays's heights (the last field), map.crossing_s's pairs: as before (older roles read it).
         n = len(_PERSON_FIELDS) - (not any(p.ray_heights for p in self.people.values()))
+        together = {"together": [[a, b, t] for (a, b), t in self.together.items()]} if self.together else {}
         return json.dumps({"fields": _PERSON_FIELDS[:n],
                            "people": [list(vars(p).values())[:n] for p in self.people.values()],
                            "close_since": [[a, b, t] for (a, b), t in self.close_since.items()],
                            "aliases": [[y, e, t] for y, (e, t) in self.aliases.items()],
-                           "last_bucket": self.last_bucket}, allow_nan=True)
+                           "last_bucket": self.last_bucket} | together, allow_nan=True)
 
     @classmethod
     def from_json(cls, text: str) -> "FusionState":
@@ -148,12 +151,13 @@ class FusionState:
         people = [FusedPerson(**dict(zip(d["fields"], p))) for p in d["people"]]
         return cls({p.id: p for p in people},
                    {(int(a), int(b)): float(t) for a, b, t in d["close_since"]},
-                   {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"])
+                   {int(y): (int(e), float(t)) for y, e, t in d["aliases"]}, d["last_bucket"],
+                   {(int(a), int(b)): float(t) for a, b, t in d.get("together", [])})
 
     def copy(self) -> "FusionState":
         """An independent copy (a bucket is fused on a copy until its write has succeeded)."""
         return FusionState({i: replace(p) for i, p in self.people.items()}, dict(self.close_since),
-                           dict(self.aliases), self.last_bucket)
+                           dict(self.aliases), self.last_bucket, dict(self.together))
 
     @classmethod
     def from_record(cls, state: MapState, bucket: int) -> "FusionState":

@@ -5,7 +5,7 @@ the same person, or one worker's first estimate of somebody it sees from afar. P
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
 import numpy as np
 
@@ -24,7 +24,8 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
     """Fold the younger of two ids that stay within ``merge_distance_m`` for ``merge_after_s`` into
     the elder, unless a worker sees both (then they are two people that worker tells apart: two
     people crossing in one worker's view while another worker sees only one of them are not
-    merged). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
+    merged; with ``crossing_s`` neither when a worker saw both that recently: each camera now shows
+    only the one in front). Two ids both younger than ``merge_after_s`` (two workers starting the same person in
     the same frames: no history could tell them apart) are merged at once — also farther apart than
     ``merge_distance_m`` when the workers' tracker covariances (``estimates``) put them within
     ``newborn_gate`` (a far view's first estimate through a door is off by more than 0.5 m in depth,
@@ -32,12 +33,16 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
     from scipy.spatial import cKDTree
     ids = sorted(workers_of)
     close_now = set()
+    if cfg.crossing_s > 0:
+        remember_together(state, workers_of, t, cfg.crossing_s)
     if len(ids) >= 2:
         xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
         for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
             a, b = min(ids[i], ids[j]), max(ids[i], ids[j])
             if workers_of[a] & workers_of[b] or not workers_of[a] or not workers_of[b]:
                 continue      # a worker that sees both holds them apart: two people
+            if t - state.together.get((a, b), -math.inf) <= cfg.crossing_s:
+                continue      # and did so moments ago: one is behind the other in each view now
             close_now.add((a, b))
         close_now |= _newborns_within_gate(state, workers_of, t, cfg, estimates or {}, xy, ids)
     state.close_since = {pair: state.close_since.get(pair, t) for pair in close_now}
@@ -57,6 +62,32 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
         merged[younger.id] = elder.id
     state.close_since = {k: v for k, v in state.close_since.items() if k[0] not in merged and k[1] not in merged}
     return merged
+
+
+def remember_together(state: "FusionState", workers_of: Mapping[int, set[str]], t: float, memory_s: float) -> None:
+    """Note in ``state.together`` every pair of ids ``(a, b)``, ``a < b``, some worker sees at ``t``
+    (s); forget pairs older than ``memory_s`` (s) or with a person gone from the map."""
+    by_worker: dict[str, list[int]] = {}
+    for pid in sorted(workers_of):
+        for w in sorted(workers_of[pid]):
+            by_worker.setdefault(w, []).append(pid)
+    for held in by_worker.values():
+        state.together = held_together(state.together, held, t, memory_s)
+    state.together = {k: s for k, s in state.together.items() if k[0] in state.people and k[1] in state.people}
+
+
+def held_together(together: Mapping[tuple[int, int], float], ids: Iterable[int], t: float,
+                  memory_s: float) -> dict[tuple[int, int], float]:
+    """``together`` (pairs of ids ``(a, b)``, ``a < b``: when last held at the same time, s) with
+    every pair of ``ids`` held at ``t`` (s), pairs older than ``memory_s`` (s) left out.
+
+    >>> held_together({(1, 9): 0.0}, [3, 1, 2], 5.0, 2.0)
+    {(1, 2): 5.0, (1, 3): 5.0, (2, 3): 5.0}
+    """
+    ids = sorted(set(ids))
+    out = {k: s for k, s in together.items() if t - s <= memory_s}
+    out.update({(a, b): t for k, a in enumerate(ids) for b in ids[k + 1:]})
+    return dict(sorted(out.items()))
 
 
 def _newborns_within_gate(state: "FusionState", workers_of: dict[int, set[str]], t: float, cfg: MapConfig,
@@ -102,4 +133,4 @@ def _finite(v: float) -> float:
     return v if v is not None and math.isfinite(v) else 0.0
 
 
-__all__ = ["MIN_WEIGHT", "merge_duplicates"]
+__all__ = ["MIN_WEIGHT", "held_together", "merge_duplicates", "remember_together"]

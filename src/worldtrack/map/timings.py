@@ -42,6 +42,20 @@ def set_epoch(client: Any, keys: Any, lead_s: float, bucket_s: float, clock: Cal
     return float(client.get(keys.epoch))
 
 
+def map_epoch(client: Any, keys: Any, bucket_s: float, clock: Callable[[], float] = time.time, lead_s: float = 0.5,
+              wait: bool = False, poll_s: float = 0.05) -> float:
+    """The map's epoch (s): when video files played as cameras have their frame 0. Set by the first
+    worker to ask (``lead_s`` s from ``clock()``, :func:`set_epoch`), or with ``wait`` by ``worldtrack
+    map start`` (polled every ``poll_s`` s until it is set)."""
+    if not wait:
+        set_epoch(client, keys, lead_s, bucket_s, clock, only_if_unset=True)
+    while True:
+        value = client.get(keys.epoch)
+        if value is not None:
+            return float(value)
+        time.sleep(poll_s)
+
+
 def epoch_after(now: float, lead_s: float, bucket_s: float) -> float:
     """An epoch ``lead_s`` (to 1 s more) after ``now`` (s), in the middle of a time bucket (frame
     ``i`` of every file, at ``epoch + i / fps``, then falls in bucket ``i`` when fps is ``1 / bucket_s``).
@@ -62,4 +76,4 @@ def epoch_after(now: float, lead_s: float, bucket_s: float) -> float:
     return start + round(middle * 1024) / 1024
 
 
-__all__ = ["StepTimings", "epoch_after", "set_epoch"]
+__all__ = ["StepTimings", "epoch_after", "map_epoch", "set_epoch"]

@@ -36,12 +36,13 @@ from worldtrack.map.connection import MapKeys
 from worldtrack.map.evidence import (LEAD_SHARE, NO_COVARIANCE, floor_information, in_views, looks_empty,
                                      people_boxes, support_of, tracker_covariance, visible_share)
 from worldtrack.map.lease import FENCED_XADD, Lease
+from worldtrack.map.merges import held_together
 from worldtrack.map.messages import (FORMAT_VERSION, REFUTED, Estimate, MapState, Observation, decode_map_state,
                                      encode_observation, stream_id_ms)
 from worldtrack.map.rays import camera_rays
 from worldtrack.map.same_blob import same_blob_claims
 from worldtrack.map.shared_ids import SharedPositionMap
-from worldtrack.map.timings import set_epoch
+from worldtrack.map.timings import map_epoch, set_epoch
 from worldtrack.trackers.base import Frame, PositionMap, Track, Tracker
 
 
@@ -84,6 +85,7 @@ class MapLink:
         self.handed_over = 0                  # how many times (hand-overs from a neighbour's view)
         self.claimed = 0                      # new people that took the id of a person the map had
         self.born_here: set[int] = set()      # new ids this worker gave (same_blob: its newborns)
+        self.together: dict[tuple[int, int], float] = {}     # map.crossing_s: pairs seen at once, when (s)
         self._reported: dict[int, tuple[str, ...]] = {}
         self.published = 0
         self.last_capture: float | None = None
@@ -114,13 +116,7 @@ class MapLink:
     def epoch(self, lead_s: float = 0.5, wait: bool = False, poll_s: float = 0.05) -> float:
         """The map's epoch: when video files played as cameras have their frame 0. Set by the first
         worker to ask (``lead_s`` from now), or with ``wait`` by ``worldtrack map start``."""
-        if not wait:
-            set_epoch(self.client, self.keys, lead_s, self.cfg.bucket_s, self.clock, only_if_unset=True)
-        while True:
-            value = self.client.get(self.keys.epoch)
-            if value is not None:
-                return float(value)
-            time.sleep(poll_s)
+        return map_epoch(self.client, self.keys, self.cfg.bucket_s, self.clock, lead_s, wait, poll_s)
 
     def new_id(self, x: float, y: float) -> int:
         """An id for a person the tracker confirms at (x, y): a lost person's of the map nearby, else
@@ -246,7 +242,7 @@ class MapLink:
                 # Not where this worker already holds somebody under another id: the map merges
                 # those two ids (a copy here would make one worker hold the same person twice).
                 if any(in_views(cams, np.array([x, y]), p.height, self.cfg.handover_margin_m)) and \
-                        not self._holds_near(local, x, y) and not self._born_in_view(p, x, y, t):
+                        not self._holds_near(local, x, y, p.id, t) and not self._born_in_view(p, x, y, t):
                     self._place(tracker, p, x, y, t)
             elif self._follows_map(p):
                 # Not shown by this worker's cameras, or also by another worker's: from where the
@@ -282,8 +278,11 @@ class MapLink:
         return t - p.born < self.cfg.own_births_s and any(in_views(list(self.cameras.values()), np.array([x, y]),
                                                                       p.height))
 
-    def _holds_near(self, local: PositionMap, x: float, y: float) -> bool:
-        return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m for q in local)
+    def _holds_near(self, local: PositionMap, x: float, y: float, pid: int, t: float) -> bool:
+        """Held within merge_distance_m of (x, y), and (``crossing_s``) not seen beside ``pid`` lately?"""
+        return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m and
+                   t - self.together.get((min(q.id, pid), max(q.id, pid)), -math.inf) > self.cfg.crossing_s
+                   for q in local)
 
     def _place(self, tracker: Tracker, p, x: float, y: float, t: float) -> None:
         local = tracker.position_map
@@ -341,6 +340,7 @@ class MapLink:
         self._reported = {i: () for i in now_ids}
         self.ever_seen, self.born_here = (ids & {p.id for p in local} for ids in (self.ever_seen, self.born_here))
         seen_ids = {e.id for es in per_cam.values() for e in es if e.seen}
+        self.together = held_together(self.together, seen_ids, t, self.cfg.crossing_s) if self.cfg.crossing_s else {}
         absent = self._absent(tracker, tracks, t, cams, boxes, seen_ids) if self.cfg.negative_evidence else {}
         cands, affirms = self.exchange.after_step(tracker, tracks, boxes, cams) if self.exchange else ({}, {})
         same = same_blob_claims({c: self.cameras[c] for c in cams}, tracks, self.state, self.born_here, t,
