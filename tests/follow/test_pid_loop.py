@@ -193,3 +193,29 @@ def test_a_target_seen_beyond_an_obstacle_is_approached_round_it_with_map_approa
         assert abs(d - 1.8) < 0.3, d
     else:
         assert d > 2.5, d
+
+
+@pytest.mark.parametrize("reverse_guard", [False, True])
+def test_backing_off_stops_short_of_the_obstacle_behind_with_reverse_guard(reverse_guard):
+    # the robot stands 0.6 m south of the courtyard's bench (8 ± 0.9, 6 ± 0.25; its south edge at y = 5.75), facing
+    # south, with the target 1.0 m in front: too near, the PID backs off at 0.5 m/s towards the bench. Unguarded,
+    # the bumper stops it; with the map read behind it, it backs off as far as it may and stops there.
+    from worldtrack.follow.navigation import NavigationGrid
+    from worldtrack.synth import make_scenario
+
+    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
+    field = scene.distance_field(0.05)
+    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    pid = PIDFollower(nav=NavigationGrid(scene, radius=0.5), reverse_guard=reverse_guard)
+    robot = Robot(8.0, 5.15, -np.pi / 2)
+    bumps, backs = 0, []
+    for t in np.arange(0.0, 3.0, 0.1):
+        cam = CAM.moved(*camera_pose(robot, 1.1))
+        v, w = pid.command(step((8.0, robot.y - 1.1)), cam, t)          # the target keeps 1.0 m ahead of the camera
+        backs.append(v)
+        bumps += int(not robot.drive(v, w, 0.1, clearance))
+    assert min(backs) < -0.2                                           # it did back off
+    if reverse_guard:
+        assert bumps == 0 and 0.3 < clearance(np.array([[robot.x, robot.y]]))[0] < 0.4
+    else:
+        assert bumps > 0

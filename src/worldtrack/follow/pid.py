@@ -65,6 +65,9 @@ NAV_MARGIN = 0.2
 MAP_APPROACH_MARGIN = 0.05
 #: ``map_approach``: the way round is planned again once the target has moved this far (m) from its goal.
 REPLAN = 0.3
+#: ``reverse_guard``: the map is read this far (m) behind the robot, every 0.02 m, and the body kept this much
+#: (m) more than its radius from what it shows there.
+REVERSE_LOOK, REVERSE_MARGIN = 0.5, 0.02
 
 
 def pursuit_map(scene, robot: RobotLimits = RobotLimits()) -> NavigationGrid:
@@ -95,6 +98,10 @@ class PIDFollower:
     body, ``robot.radius`` + ``MAP_APPROACH_MARGIN`` m, does not pass from here to ``distance`` short of
     it) is driven to along the shortest way round (:meth:`_drive_to`) at up to ``robot.max_speed``,
     stopping ``distance`` short; False (default): the PID steers straight at it (opt-in, issue 35, s10)
+    reverse_guard : with ``nav``, backing off (the target too near) is limited to the speed that stops before
+    the robot's body comes within ``REVERSE_MARGIN`` of a wall or an obstacle behind it on the map
+    (:meth:`_reverse_limit`; the camera and the 270° scan do not see behind it). True (default; s11: every
+    bumper stop of pid+scan on record, never-used 97's 20 / 40, was the PID backing into the bench)
     """
 
     distance: float = 1.8
@@ -117,6 +124,7 @@ class PIDFollower:
     hidden_coast: float = 3.0
     nav: NavigationGrid | None = None
     map_approach: bool = False
+    reverse_guard: bool = True
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -161,6 +169,8 @@ class PIDFollower:
         w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
         s["t"] = t
         v = float(np.clip(v, -self.robot.max_reverse, self.robot.max_speed))
+        if v < 0:
+            v = max(v, -self._reverse_limit(camera, dt if dt > 0 else 0.1))
         w = float(np.clip(w, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         limit = self._forward_limit(step, camera, w, t, dt if dt > 0 else 0.1, frame, scan)
         s["blocked"] = bool(limit < v)
@@ -176,6 +186,21 @@ class PIDFollower:
         if self.depth_stop and (frame is not None or scan is not None):
             limit = min(limit, self._depth_limit(frame, camera, w, dt, scan))
         return limit
+
+    def _reverse_limit(self, camera: Camera, dt: float) -> float:
+        """The largest backward speed (m/s, ≤ ``robot.max_reverse``): with ``reverse_guard`` and ``nav``, the one
+        that stops (braking at ``brake`` m/s² after ``dt`` s) before the robot's centre comes within
+        ``robot.radius + REVERSE_MARGIN`` m of anything the map shows behind it (read ``REVERSE_LOOK`` m back)."""
+        if not self.reverse_guard or self.nav is None:
+            return self.robot.max_reverse
+        fwd = camera.floor_direction
+        back = np.arange(0.0, REVERSE_LOOK + 1e-9, 0.02)
+        centre = camera.centre[:2] - self.robot.camera_forward * fwd
+        near = np.flatnonzero(self.nav.clearance(centre - back[:, None] * fwd) < self.robot.radius + REVERSE_MARGIN)
+        if len(near) == 0:
+            return self.robot.max_reverse
+        gap = back[near[0] - 1] if near[0] > 0 else 0.0
+        return float(np.clip(np.sqrt(2 * self.brake * gap) - self.brake * dt, 0.0, self.robot.max_reverse))
 
     def _lost_reset(self, t: float) -> None:
         """Clear the PID's state (integrals, derivatives) but what the search needs."""
