@@ -26,7 +26,7 @@ lost: the robot goes to where it was last seen (``pursue`` seconds at most: it t
 place first, then drives, under the same speed limits; with the room's map, ``nav``, along the
 shortest way round its obstacles) — a target that turned a corner out of view is seen again from
 there —, and then only turns (at most ``search_turn_rate``) towards where the
-target should be, to look for it. With ``map_approach`` (opt-in), a followed target whose straight way
+target should be, to look for it. With ``map_approach`` (default), a followed target whose straight way
 is blocked by the map (a bench between them: the PID would turn to it and the depth stop hold the robot
 in front of the bench) is approached the way the pursuit goes, round the obstacle, at up to the robot's
 top speed, stopping ``distance`` m short of it.
@@ -101,7 +101,8 @@ class PIDFollower:
     map_approach : with ``nav``, a followed target whose straight way is blocked on the map (the robot's
     body, ``robot.radius`` + ``MAP_APPROACH_MARGIN`` m, does not pass from here to ``distance`` short of
     it) is driven to along the shortest way round (:meth:`_drive_to`) at up to ``robot.max_speed``,
-    stopping ``distance`` short; False (default): the PID steers straight at it (opt-in, issue 35, s10)
+    stopping ``distance`` short (True, the default since s11, with the tracker's ``reid_any_track_after``
+    3 s; False: the PID steers straight at it, s10 and before)
     search_map : with ``nav`` (opt-in, False by default), the lost target's prediction is looked at only when
     it stands on the map and in line of sight (else the look about starts at once), and the look about turns
     towards the most open heading out of view (:meth:`_open_side`), not the way the target was going round
@@ -130,7 +131,7 @@ class PIDFollower:
     arrive: float = 0.4
     hidden_coast: float = 3.0
     nav: NavigationGrid | None = None
-    map_approach: bool = False
+    map_approach: bool = True
     reverse_guard: bool = True
     search_map: bool = False
     _state: dict = field(default_factory=dict, repr=False)
