@@ -298,6 +298,8 @@ class PIDFollower:
                 # the most open side (search_map), else the way it was last seen going round the robot (left if not at all)
                 side = self._open_side(camera) if mapped else (s.get("last_w", 0.0) or 1.0)
                 s["search_turn"] = float(np.copysign(self.search_turn_rate, side))
+                if mapped:                                     # (without the map: one more frame towards it, as before)
+                    return 0.0, s["search_turn"]
         return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
 
     def _open_side(self, camera: Camera) -> float:
