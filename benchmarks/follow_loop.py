@@ -211,8 +211,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--plot", action="store_true", help="also draw the seed with the least time within the band "
                                                         "(results/follow_loop<TAG>_worst.png)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=3, or a "
-                         "follower one (pid.NAME: PIDFollower field), e.g. pid.search_turn_rate=1; repeatable")
+                    help="a tracker setting (FollowConfig field, a number), e.g. reid_any_track_after=inf, or a "
+                         "follower one (pid.NAME: PIDFollower field), e.g. pid.search_turn_rate=1; repeatable "
+                         "(s10's defaults: reid_any_track_after=inf pid.map_approach=0 pid.reverse_guard=0)")
     args = ap.parse_args(argv)
     try:
         settings = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}

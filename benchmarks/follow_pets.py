@@ -15,8 +15,8 @@ the gains jump by exactly ``size`` steps (|ΔR| + |ΔB|, split at random, random
 B someone else, C nobody though the target was a candidate; precision A/(A+B), recall A/(A+C),
 pooled over targets and jump sequences.
 
-Run: ``.venv/bin/python benchmarks/follow_pets.py [--quick]`` (skips with one line when the data is
-absent). Writes ``benchmarks/results/follow_pets.md``. About 5 minutes.
+Run: ``.venv/bin/python benchmarks/follow_pets.py [--quick] [--set NAME=VALUE]`` (skips with one line when
+the data is absent; ``--set`` adds a row of the default with that setting). Writes ``benchmarks/results/follow_pets.md``. About 5 minutes.
 """
 
 from __future__ import annotations
@@ -32,8 +32,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table  # noqa: E402
 from follow_common import (PETS, follow_pets, gain_jumps, load_pets, pets_observations, pets_targets,  # noqa: E402
                            save_tagged)
+from follow_synth import set_variant  # noqa: E402
 
 from worldtrack.eval.follow import counts  # noqa: E402
+from worldtrack.errors import InputError  # noqa: E402
 from worldtrack.follow import FollowConfig  # noqa: E402
 
 SIZES = (0, 100, 200, 300, 400)
@@ -53,8 +55,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", default=",".join(map(str, SIZES)), help="jump sizes in gain steps (default 0-400 by 100)")
     ap.add_argument("--jump-seeds", default="0,1,2", help="seeds of the jump sequences (default 0,1,2)")
     ap.add_argument("--default-only", action="store_true", help="only the two worldtrack default rows")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="also a row of the worldtrack default with this FollowConfig setting (a number, e.g. "
+                         "reid_any_track_after=inf), on the same observations; repeatable")
     args = ap.parse_args(argv)
-    variants = {k: v for k, v in VARIANTS.items() if k.startswith("worldtrack")} if args.default_only else VARIANTS
+    try:
+        extra = set_variant(args.set)
+    except (ValueError, InputError) as err:
+        print(f"follow_pets: --set: {err}", file=sys.stderr)
+        return 2
+    variants = {k: v for k, v in VARIANTS.items() if k.startswith("worldtrack")} if args.default_only else dict(VARIANTS)
+    variants.update(extra)
     t0 = time.perf_counter()
     pets = load_pets(200 if args.quick else None)
     if pets is None:
@@ -91,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
             f"size; candidates = the visible ground-truth people. Gains jump every 1–2 s by exactly the stated "
             f"|ΔR| + |ΔB|.\n\n{table}\n")
     print(text)
-    save_tagged("follow_pets", "_default" if args.default_only else "",
+    save_tagged("follow_pets", ("_default" if args.default_only else "") + ("_set" if extra else ""),
                 "Following on PETS 2009 S2.L1 with white-balance jumps (seed 001)", text, args.quick, time.perf_counter() - t0)
     return 0
 

@@ -19,7 +19,9 @@ matched to the candidates within 0.5 m; the RMSE of the filtered position where 
 within 4 m of the camera and found.
 
 Run: ``.venv/bin/python benchmarks/follow_synth.py [--seeds 0-9] [--frames 1500] [--size 160x120]
-[--quick]``. Writes ``benchmarks/results/follow_synth.md``. About 20 minutes on one core.
+[--quick] [--set NAME=VALUE]``. Writes ``benchmarks/results/follow_synth.md``. About 20 minutes on one core.
+``--set reid_any_track_after=inf`` runs the default with that setting beside it, on the same frames (a
+default's before and after in one run).
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from common import markdown_table  # noqa: E402
 from follow_common import SCENARIO, person_candidate_d, save_tagged, seed_cached, synth_frames  # noqa: E402
 
 from worldtrack.eval.follow import counts, counts_by, follow_labels, reacquisitions, swaps  # noqa: E402
+from worldtrack.errors import InputError  # noqa: E402
 from worldtrack.follow import FollowConfig, FollowTracker, frame_from_synth  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 
@@ -51,6 +54,19 @@ VARIANTS = {
     "default without the others": ("default", {"track_others": False}),
 }
 SEGMENTS = ("front", "backlight", "shade-front", "shade-back")
+#: ``--set``'s variant: the worldtrack default with the given settings, run beside it on the same frames.
+SET_LABEL = "worldtrack default with "
+
+
+def set_variant(items: list[str]) -> dict:
+    """``--set NAME=VALUE`` items (FollowConfig fields, numbers) as {label: ("default", overrides)}, checked
+    (:class:`~worldtrack.errors.InputError` for an unknown name, ValueError for a value that is no number);
+    {} when there are none."""
+    if not items:
+        return {}
+    over = {k: float(v) for k, v in (item.split("=", 1) if "=" in item else (item, "") for item in items)}
+    FollowConfig.preset("default", **over)
+    return {SET_LABEL + ", ".join(f"{k}={v:g}" for k, v in over.items()): ("default", over)}
 
 
 def parse_seeds(text: str) -> list[int]:
@@ -132,8 +148,8 @@ def _worst(s: dict) -> tuple[float, float]:
     return min(c.precision for c in segs), min(c.recall for c in segs)
 
 
-def tables(summaries: dict, n_seeds: int) -> str:
-    d = summaries["worldtrack default"]
+def acceptance(d: dict, n_seeds: int) -> list:
+    """The issue's acceptance rows (measure, measured, target, paper, met) of one variant's summary ``d``."""
     wp, wr = _worst(d)
     reacq_ok = sum(o.delay <= 0.5 for o in d["reacq"])
     margin = min(m for m, _ in d["d_others"].values()) - d["d_target"][0]
@@ -151,8 +167,18 @@ def tables(summaries: dict, n_seeds: int) -> str:
             f"{reacq_ok} of {len(d['reacq'])} (durations {min(durations, default=0):.1f}–{max(durations, default=0):.1f} s)",
             "all", "", reacq_ok == len(d["reacq"])],
            ["position RMSE within 4 m (m)", f"{d['rmse']:.3f}", "≤ 0.10", "", d["rmse"] <= 0.10]]
-    out = ["## Acceptance (worldtrack default)\n", markdown_table(["measure", "measured", "target", "paper", "met"],
-                                                                  [r[:4] + ["yes" if r[4] else "NO"] for r in acc])]
+    return [r[:4] + ["yes" if r[4] else "NO"] for r in acc]
+
+
+def tables(summaries: dict, n_seeds: int) -> str:
+    """The acceptance table of the worldtrack default (and of every ``--set`` variant beside it), the
+    per-segment and the ablation tables."""
+    out = ["## Acceptance (worldtrack default)\n",
+           markdown_table(["measure", "measured", "target", "paper", "met"],
+                          acceptance(summaries["worldtrack default"], n_seeds))]
+    for name in [n for n in summaries if n.startswith(SET_LABEL)]:
+        out += [f"\n## Acceptance ({name})\n",
+                markdown_table(["measure", "measured", "target", "paper", "met"], acceptance(summaries[name], n_seeds))]
     seg_rows = [[name] + [f"{s['segments'][g].precision:.4f} / {s['segments'][g].recall:.4f}"
                           if g in s["segments"] else "" for g in SEGMENTS] for name, s in summaries.items()]
     out += ["\n## Precision / recall per lighting segment\n", markdown_table(["variant", *SEGMENTS], seg_rows)]
@@ -183,11 +209,20 @@ def main(argv: list[str] | None = None) -> int:
                                            "without rendering again)")
     ap.add_argument("--render-only", action="store_true", help="only render the seeds into --render-cache")
     ap.add_argument("--default-only", action="store_true", help="run only the worldtrack default (no ablations)")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="also run the worldtrack default with this FollowConfig setting (a number, e.g. "
+                         "reid_any_track_after=inf) on the same frames, with its own acceptance table; repeatable")
     args = ap.parse_args(argv)
+    try:
+        extra = set_variant(args.set)
+    except (ValueError, InputError) as err:
+        print(f"follow_synth: --set: {err}", file=sys.stderr)
+        return 2
     seeds = [100, 101] if args.quick else parse_seeds(args.seeds)       # quick: development seeds
     frames = 300 if args.quick else args.frames
     size = tuple(int(v) for v in args.size.lower().split("x"))
-    variants = {"worldtrack default": VARIANTS["worldtrack default"]} if args.default_only else VARIANTS
+    variants = {"worldtrack default": VARIANTS["worldtrack default"]} if args.default_only else dict(VARIANTS)
+    variants.update(extra)
     t0 = time.perf_counter()
     if args.render_only:
         for seed in seeds:
@@ -198,7 +233,8 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     for seed in seeds:
         ts = time.perf_counter()
-        key = f"synth-{seed}-{frames}-{size[0]}x{size[1]}" + ("-default" if args.default_only else "")
+        key = (f"synth-{seed}-{frames}-{size[0]}x{size[1]}" + ("-default" if args.default_only else "")
+               + "".join(f"-{k}={v:g}" for _, o in extra.values() for k, v in o.items()))
         results.append(seed_cached(args.cache, key,
                                    lambda: run_seed(seed, frames, size, variants, args.render_cache)))
         d = summarise(results[-1:], "worldtrack default")

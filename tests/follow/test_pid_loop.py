@@ -193,3 +193,52 @@ def test_a_target_seen_beyond_an_obstacle_is_approached_round_it_with_map_approa
         assert abs(d - 1.8) < 0.3, d
     else:
         assert d > 2.5, d
+
+
+@pytest.mark.parametrize("reverse_guard", [False, True])
+def test_backing_off_stops_short_of_the_obstacle_behind_with_reverse_guard(reverse_guard):
+    # the robot stands 0.6 m south of the courtyard's bench (8 ± 0.9, 6 ± 0.25; its south edge at y = 5.75), facing
+    # south, with the target 1.0 m in front: too near, the PID backs off at 0.5 m/s towards the bench. Unguarded,
+    # the bumper stops it; with the map read behind it, it backs off as far as it may and stops there.
+    from worldtrack.follow.navigation import NavigationGrid
+    from worldtrack.synth import make_scenario
+
+    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
+    field = scene.distance_field(0.05)
+    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    pid = PIDFollower(nav=NavigationGrid(scene, radius=0.5), reverse_guard=reverse_guard)
+    robot = Robot(8.0, 5.15, -np.pi / 2)
+    bumps, backs = 0, []
+    for t in np.arange(0.0, 3.0, 0.1):
+        cam = CAM.moved(*camera_pose(robot, 1.1))
+        v, w = pid.command(step((8.0, robot.y - 1.1)), cam, t)          # the target keeps 1.0 m ahead of the camera
+        backs.append(v)
+        bumps += int(not robot.drive(v, w, 0.1, clearance))
+    assert min(backs) < -0.2                                           # it did back off
+    if reverse_guard:
+        assert bumps == 0 and 0.3 < clearance(np.array([[robot.x, robot.y]]))[0] < 0.4
+    else:
+        assert bumps > 0
+
+
+@pytest.mark.parametrize("search_map", [False, True])
+def test_a_prediction_off_the_map_or_out_of_sight_is_not_looked_at_with_search_map(search_map):
+    # lost (no pursuit), the robot 1 m from the courtyard's south wall, facing east. (a) The prediction lies beyond
+    # the wall, to the right: the plain search turns right to look at it; with search_map it is not looked at and
+    # the look about turns left, where the courtyard is open. (b) The prediction stands north of the bench, out of
+    # line of sight: the plain search looks at it for search_look seconds; with search_map the look about starts.
+    from worldtrack.follow.navigation import NavigationGrid
+    from worldtrack.synth import make_scenario
+
+    nav = NavigationGrid(make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene)
+    pid = PIDFollower(nav=nav, pursue=None, search_map=search_map)
+    cam = CAM.moved(*camera_pose(Robot(8.0, 1.0, 0.0), 1.1))
+    pid.command(step((9.0, 1.0)), cam, 0.0)
+    _, w = pid.command(step((8.0, -2.0), found=False), cam, 1.5)
+    assert (w > 0) if search_map else (w < 0)
+    pid = PIDFollower(nav=nav, pursue=None, search_map=search_map)
+    cam = CAM.moved(*camera_pose(Robot(7.9, 4.5, np.pi / 2), 1.1))
+    pid.command(step((8.0, 7.5)), cam, 0.0)
+    for t in np.arange(1.2, 2.5, 0.1):                                 # facing it, 1.3 s of the 2 s look
+        _, w = pid.command(step((8.0, 7.5), found=False), cam, t)
+    assert abs(w) == pytest.approx(0.5) if search_map else abs(w) < 0.1

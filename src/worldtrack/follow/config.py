@@ -80,10 +80,12 @@ class FollowConfig:
         away 0.3 s after the target vanished is not the target). reid_any_track_after : unseen this
         long (s), the target may also be any other track whose own colour fits its templates
         (RBhat < reid_rbhat), born before the loss or far from it (:mod:`~worldtrack.follow.reid`;
-        inf = never, the default; opt-in 3 s: closed loop, held-out seeds 60 0.365 -> 0.774 and 69
-        0.751 -> 0.797 within ±0.3 m, but 66 0.497 -> 0.189 and 74 0.760 -> 0.593: on both every
-        long-loss pick was the target (ground truth), found 6-8 m away beyond an obstacle where the
-        PID stood held; with the follower's opt-in ``map_approach`` 66 0.799 and 74 0.759, s10).
+        3 s, the default since s11; inf = never, before). Alone it cost 66 0.497 -> 0.189 and 74
+        0.760 -> 0.593 (closed loop, within ±0.3 m): every long-loss pick was the target, found 6-8 m
+        away beyond an obstacle where the PID stood held; it is a default together with the
+        follower's ``map_approach`` (closed loop: held-out 80-89 0.764 -> 0.866, 53-58 0.892 -> 0.892,
+        never-used 90-99 0.820 -> 0.826; open loop: synth held-out 10-19 × 300 frames recall 0.901 -> 0.924,
+        precision 0.991 -> 0.991; PETS unchanged 1.000 / 1.000; s10-s11).
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
         height_margin : the target's height is learnt from depth (the highest point of its candidate,
@@ -144,7 +146,7 @@ class FollowConfig:
     reid_speed: float = 1.5
     reid_near: float = 0.5
     reid_accel: float = 3.0
-    reid_any_track_after: float = float("inf")
+    reid_any_track_after: float = 3.0
     occluders: bool = True
     height_margin: float = 0.1
     identity_margin: float = 0.4

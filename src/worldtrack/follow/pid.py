@@ -26,7 +26,7 @@ lost: the robot goes to where it was last seen (``pursue`` seconds at most: it t
 place first, then drives, under the same speed limits; with the room's map, ``nav``, along the
 shortest way round its obstacles) — a target that turned a corner out of view is seen again from
 there —, and then only turns (at most ``search_turn_rate``) towards where the
-target should be, to look for it. With ``map_approach`` (opt-in), a followed target whose straight way
+target should be, to look for it. With ``map_approach`` (default), a followed target whose straight way
 is blocked by the map (a bench between them: the PID would turn to it and the depth stop hold the robot
 in front of the bench) is approached the way the pursuit goes, round the obstacle, at up to the robot's
 top speed, stopping ``distance`` m short of it.
@@ -65,6 +65,13 @@ NAV_MARGIN = 0.2
 MAP_APPROACH_MARGIN = 0.05
 #: ``map_approach``: the way round is planned again once the target has moved this far (m) from its goal.
 REPLAN = 0.3
+#: ``reverse_guard``: the map is read this far (m) behind the robot, every 0.02 m, and the body kept this much
+#: (m) more than its radius from what it shows there.
+REVERSE_LOOK, REVERSE_MARGIN = 0.5, 0.02
+#: ``search_map``: how far (m) the camera is taken to see along each of ``RING``'s 16 headings, every 0.1 m.
+SEE_FAR = 8.0
+#: Half the robot camera's horizontal field of view (rad): a heading farther off the robot's is out of view.
+HALF_VIEW = np.radians(33.0)
 
 
 def pursuit_map(scene, robot: RobotLimits = RobotLimits()) -> NavigationGrid:
@@ -94,7 +101,15 @@ class PIDFollower:
     map_approach : with ``nav``, a followed target whose straight way is blocked on the map (the robot's
     body, ``robot.radius`` + ``MAP_APPROACH_MARGIN`` m, does not pass from here to ``distance`` short of
     it) is driven to along the shortest way round (:meth:`_drive_to`) at up to ``robot.max_speed``,
-    stopping ``distance`` short; False (default): the PID steers straight at it (opt-in, issue 35, s10)
+    stopping ``distance`` short (True, the default since s11, with the tracker's ``reid_any_track_after``
+    3 s; False: the PID steers straight at it, s10 and before)
+    search_map : with ``nav`` (opt-in, False by default), the lost target's prediction is looked at only when
+    it stands on the map and in line of sight (else the look about starts at once), and the look about turns
+    towards the most open heading out of view (:meth:`_open_side`), not the way the target was going round
+    reverse_guard : with ``nav``, backing off (the target too near) is limited to the speed that stops before
+    the robot's body comes within ``REVERSE_MARGIN`` of a wall or an obstacle behind it on the map
+    (:meth:`_reverse_limit`; the camera and the 270° scan do not see behind it). True (default; s11: every
+    bumper stop of pid+scan on record, never-used 97's 20 / 40, was the PID backing into the bench)
     """
 
     distance: float = 1.8
@@ -116,7 +131,9 @@ class PIDFollower:
     arrive: float = 0.4
     hidden_coast: float = 3.0
     nav: NavigationGrid | None = None
-    map_approach: bool = False
+    map_approach: bool = True
+    reverse_guard: bool = True
+    search_map: bool = False
     _state: dict = field(default_factory=dict, repr=False)
 
     def reset(self) -> None:
@@ -143,7 +160,7 @@ class PIDFollower:
             goal = self._pursuit_goal(step, pos, t)
             if goal is not None:
                 return self._drive_to(goal, step, camera, t, frame, scan)
-            return self._search(t, bearing)
+            return self._search(t, bearing, camera, step)
         if self.map_approach and self.nav is not None and self._blocked_by_map(pos, rel, d):
             for k in ("t", "d_i", "d_e", "b_i", "b_e"):        # the PID starts afresh where the way is clear
                 s.pop(k, None)
@@ -161,6 +178,8 @@ class PIDFollower:
         w = w_ff + self._pid("b", bearing, dt, self.bearing_gains)
         s["t"] = t
         v = float(np.clip(v, -self.robot.max_reverse, self.robot.max_speed))
+        if v < 0:
+            v = max(v, -self._reverse_limit(camera, dt if dt > 0 else 0.1))
         w = float(np.clip(w, -self.robot.max_turn_rate, self.robot.max_turn_rate))
         limit = self._forward_limit(step, camera, w, t, dt if dt > 0 else 0.1, frame, scan)
         s["blocked"] = bool(limit < v)
@@ -176,6 +195,21 @@ class PIDFollower:
         if self.depth_stop and (frame is not None or scan is not None):
             limit = min(limit, self._depth_limit(frame, camera, w, dt, scan))
         return limit
+
+    def _reverse_limit(self, camera: Camera, dt: float) -> float:
+        """The largest backward speed (m/s, ≤ ``robot.max_reverse``): with ``reverse_guard`` and ``nav``, the one
+        that stops (braking at ``brake`` m/s² after ``dt`` s) before the robot's centre comes within
+        ``robot.radius + REVERSE_MARGIN`` m of anything the map shows behind it (read ``REVERSE_LOOK`` m back)."""
+        if not self.reverse_guard or self.nav is None:
+            return self.robot.max_reverse
+        fwd = camera.floor_direction
+        back = np.arange(0.0, REVERSE_LOOK + 1e-9, 0.02)
+        centre = camera.centre[:2] - self.robot.camera_forward * fwd
+        near = np.flatnonzero(self.nav.clearance(centre - back[:, None] * fwd) < self.robot.radius + REVERSE_MARGIN)
+        if len(near) == 0:
+            return self.robot.max_reverse
+        gap = back[near[0] - 1] if near[0] > 0 else 0.0
+        return float(np.clip(np.sqrt(2 * self.brake * gap) - self.brake * dt, 0.0, self.robot.max_reverse))
 
     def _lost_reset(self, t: float) -> None:
         """Clear the PID's state (integrals, derivatives) but what the search needs."""
@@ -244,19 +278,42 @@ class PIDFollower:
         way = pos + np.linspace(0.0, 1.0 - self.distance / d, int(np.ceil((d - self.distance) / 0.1)) + 1)[:, None] * rel
         return bool(self.nav.clearance(way).min() < self.robot.radius + MAP_APPROACH_MARGIN)
 
-    def _search(self, t: float, bearing: float) -> tuple[float, float]:
+    def _search(self, t: float, bearing: float, camera: Camera | None = None, step=None) -> tuple[float, float]:
         """Lost: stand and turn slowly towards where the target should be; once that has been in view
         for ``search_look`` seconds without finding it (it turned while hidden, its prediction walked
-        on), keep turning the same way round, a full look about (worldtrack; the paper stands)."""
+        on), keep turning the same way round, a full look about (worldtrack; the paper stands). With
+        ``search_map``, a prediction off the map or out of line of sight is not looked at, and the look
+        about turns towards the most open heading (:meth:`_open_side`)."""
         s = self._state
         if s["search_turn"]:
             return 0.0, s["search_turn"]
-        if abs(bearing) < np.radians(15.0):
+        mapped = self.search_map and self.nav is not None and camera is not None and self.search_look is not None
+        if mapped:
+            pos, pred = camera.centre[:2], np.asarray(step.xy, float)
+            if not (self.nav.clearance(pred)[0] > 0 and self.nav.line_of_sight(pos, pred)[0]):
+                s["search_from"] = -np.inf                     # nothing to look at there: look about now
+        if abs(bearing) < np.radians(15.0) or s["search_from"] == -np.inf:
             s["search_from"] = min(s["search_from"], t)
             if self.search_look is not None and t - s["search_from"] > self.search_look:
-                # the way it was last seen going round the robot (left if not at all)
-                s["search_turn"] = float(np.copysign(self.search_turn_rate, s.get("last_w", 0.0) or 1.0))
+                # the most open side (search_map), else the way it was last seen going round the robot (left if not at all)
+                side = self._open_side(camera) if mapped else (s.get("last_w", 0.0) or 1.0)
+                s["search_turn"] = float(np.copysign(self.search_turn_rate, side))
+                if mapped:                                     # (without the map: one more frame towards it, as before)
+                    return 0.0, s["search_turn"]
         return 0.0, float(np.clip(self.bearing_gains[0] * bearing, -self.search_turn_rate, self.search_turn_rate))
+
+    def _open_side(self, camera: Camera) -> float:
+        """+1 (left) or −1 (right): the side of the robot's heading where the camera, turned, would see farthest
+        over the map (``nav``): the free length (≤ ``SEE_FAR`` m) along each of the 16 ``RING`` headings out of
+        view (more than ``HALF_VIEW`` off the heading); the longest's side."""
+        pos, fwd = camera.centre[:2], camera.floor_direction
+        reach = np.arange(0.1, SEE_FAR + 1e-9, 0.1)
+        pts = pos + reach[None, :, None] * RING[:, None, :]                          # (16, R, 2)
+        blocked = self.nav.clearance(pts.reshape(-1, 2)).reshape(len(RING), len(reach)) <= 0.0
+        free = np.where(blocked.any(axis=1), reach[np.argmax(blocked, axis=1)], SEE_FAR)
+        off = np.arctan2(RING @ np.array([-fwd[1], fwd[0]]), RING @ fwd)              # bearing of each heading
+        free = np.where(np.abs(off) > HALF_VIEW, free, -1.0)
+        return 1.0 if off[int(np.argmax(free))] >= 0 else -1.0
 
     @property
     def blocked(self) -> bool:
