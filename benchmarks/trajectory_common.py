@@ -61,6 +61,20 @@ def walks_of(args: argparse.Namespace, quick_size: int = 300) -> tuple[str, list
     return cpu, [int(s) for s in args.sizes.split(",")], [int(s) for s in args.seeds.split(",")], args.repeats
 
 
+def add_seed_blocks(ap: argparse.ArgumentParser, name: str) -> None:
+    """``--held-out`` and ``--never-used`` (seeds labelled in the table) and ``--tag`` (writes
+    ``results/<name>_<tag>.md`` instead)."""
+    ap.add_argument("--held-out", default="", help="seeds (comma-separated) labelled held-out in the table")
+    ap.add_argument("--never-used", default="", help="seeds labelled never-used")
+    ap.add_argument("--tag", default="", help=f"writes results/{name}_<tag>.md instead")
+
+
+def block_of(args: argparse.Namespace) -> dict[int, str]:
+    """Seed → its block's label from :func:`add_seed_blocks`' options (a seed not named is dev)."""
+    return {int(s): name for name, given in (("held-out", args.held_out), ("never-used", args.never_used))
+            for s in given.split(",") if s}
+
+
 def least_cpu(fn, repeats: int):
     """(least CPU seconds of ``repeats`` calls of ``fn``, the last call's result)."""
     best, out = float("inf"), None

@@ -29,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import least_cpu, walks_of, walks_parser  # noqa: E402
+from trajectory_common import add_seed_blocks, block_of, least_cpu, walks_of, walks_parser  # noqa: E402
 from trajectory_timing_steps import setup  # noqa: E402
 
 from worldtrack.trajectory.solver import levenberg_marquardt  # noqa: E402
@@ -50,14 +50,11 @@ def row(T: int, seed: int, block: str, factors: list[float], repeats: int) -> li
 def main(argv: list[str] | None = None) -> int:
     ap = walks_parser(__doc__, 1)
     ap.add_argument("--factors", default="1.0,1.3", help="outward curvature factors (comma-separated)")
-    ap.add_argument("--held-out", default="", help="seeds (comma-separated) labelled held-out in the table")
-    ap.add_argument("--never-used", default="", help="seeds labelled never-used")
-    ap.add_argument("--tag", default="", help="writes results/trajectory_outward_<tag>.md instead")
+    add_seed_blocks(ap, "trajectory_outward")
     args = ap.parse_args(argv)
     cpu, sizes, seeds, repeats = walks_of(args)
     factors = [float(f) for f in args.factors.split(",")]
-    labels = {int(s): name for name, given in (("held-out", args.held_out), ("never-used", args.never_used))
-              for s in given.split(",") if s}
+    labels = block_of(args)
     t0 = time.perf_counter()
     rows = []
     for T in sizes:

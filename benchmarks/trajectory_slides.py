@@ -42,7 +42,7 @@ from scipy.special import expit
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import walks_of, walks_parser  # noqa: E402
+from trajectory_common import add_seed_blocks, block_of, walks_of, walks_parser  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
 from worldtrack.scene.floor import FloorGrid  # noqa: E402
@@ -200,13 +200,10 @@ def row(T: int, seed: int, block: str) -> list:
 
 def main(argv: list[str] | None = None) -> int:
     ap = walks_parser(__doc__, 1)
-    ap.add_argument("--held-out", default="", help="seeds (comma-separated) labelled held-out in the table")
-    ap.add_argument("--never-used", default="", help="seeds labelled never-used")
-    ap.add_argument("--tag", default="", help="writes results/trajectory_slides_<tag>.md instead")
+    add_seed_blocks(ap, "trajectory_slides")
     args = ap.parse_args(argv)
     cpu, sizes, seeds, _ = walks_of(args)
-    labels = {int(s): name for name, given in (("held-out", args.held_out), ("never-used", args.never_used))
-              for s in given.split(",") if s}
+    labels = block_of(args)
     t0 = time.perf_counter()
     rows = [row(T, seed, labels.get(seed, "dev")) for T in sizes for seed in seeds]
     text = f"({cpu})\n\n" + markdown_table(
