@@ -151,16 +151,22 @@ def test_a_hidden_target_is_followed_by_its_prediction_and_the_pursuit_stops_sho
     assert v == pytest.approx(np.sqrt(2 * 1.2 * 0.2) - 1.2 * 0.1) and pid.blocked
 
 
+def _courtyard():
+    """The ``follow-target`` courtyard's scene, and its clearance (m) at floor points (n, 2), −1 outside it."""
+    from worldtrack.synth import make_scenario
+
+    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
+    field = scene.distance_field(0.05)
+    return scene, lambda xy: field.sample(xy, outside=-1.0)
+
+
 def test_with_the_map_the_pursuit_goes_round_an_obstacle():
     # the target was last seen just north of the courtyard's bench (8 ± 0.9, 6 ± 0.25); the robot stands
     # south of it, facing north. Straight at the place, the bumper stops it at the bench; with the map
     # it drives round the bench's end and gets there.
     from worldtrack.follow.navigation import NavigationGrid
-    from worldtrack.synth import make_scenario
 
-    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
-    field = scene.distance_field(0.05)
-    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    scene, clearance = _courtyard()
     ends = {}
     for name, nav in (("straight", None), ("map", NavigationGrid(scene, radius=0.5))):     # 0.2 m to spare
         pid, robot = PIDFollower(nav=nav), Robot(8.0, 4.9, np.pi / 2)
@@ -178,11 +184,8 @@ def test_a_target_seen_beyond_an_obstacle_is_approached_round_it_with_map_approa
     # it, facing north. The PID steers straight at it: the bumper stops the robot at the bench, 3 m off. With
     # map_approach it drives round the bench's end and stops at the set distance.
     from worldtrack.follow.navigation import NavigationGrid
-    from worldtrack.synth import make_scenario
 
-    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
-    field = scene.distance_field(0.05)
-    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    scene, clearance = _courtyard()
     pid = PIDFollower(nav=NavigationGrid(scene, radius=0.5), map_approach=map_approach)
     robot, target = Robot(8.0, 4.9, np.pi / 2), (8.0, 8.5)
     for t in np.arange(0.0, 20.0, 0.1):
@@ -201,11 +204,8 @@ def test_backing_off_stops_short_of_the_obstacle_behind_with_reverse_guard(rever
     # south, with the target 1.0 m in front: too near, the PID backs off at 0.5 m/s towards the bench. Unguarded,
     # the bumper stops it; with the map read behind it, it backs off as far as it may and stops there.
     from worldtrack.follow.navigation import NavigationGrid
-    from worldtrack.synth import make_scenario
 
-    scene = make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene
-    field = scene.distance_field(0.05)
-    clearance = lambda xy: field.sample(xy, outside=-1.0)            # noqa: E731
+    scene, clearance = _courtyard()
     pid = PIDFollower(nav=NavigationGrid(scene, radius=0.5), reverse_guard=reverse_guard)
     robot = Robot(8.0, 5.15, -np.pi / 2)
     bumps, backs = 0, []
@@ -228,9 +228,8 @@ def test_a_prediction_off_the_map_or_out_of_sight_is_not_looked_at_with_search_m
     # the look about turns left, where the courtyard is open. (b) The prediction stands north of the bench, out of
     # line of sight: the plain search looks at it for search_look seconds; with search_map the look about starts.
     from worldtrack.follow.navigation import NavigationGrid
-    from worldtrack.synth import make_scenario
 
-    nav = NavigationGrid(make_scenario("follow-target", size=(160, 120), frames=2, seed=0, others=0).scene)
+    nav = NavigationGrid(_courtyard()[0])
     pid = PIDFollower(nav=nav, pursue=None, search_map=search_map)
     cam = CAM.moved(*camera_pose(Robot(8.0, 1.0, 0.0), 1.1))
     pid.command(step((9.0, 1.0)), cam, 0.0)
