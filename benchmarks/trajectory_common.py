@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import ROOT  # noqa: E402,F401
+from common import ROOT, save_result  # noqa: E402,F401
 
 from worldtrack.geometry.camera import Camera  # noqa: E402
 from worldtrack.trajectory.environment import inside_obstacles, segment_crossings  # noqa: E402
@@ -73,6 +73,22 @@ def block_of(args: argparse.Namespace) -> dict[int, str]:
     """Seed → its block's label from :func:`add_seed_blocks`' options (a seed not named is dev)."""
     return {int(s): name for name, given in (("held-out", args.held_out), ("never-used", args.never_used))
             for s in given.split(",") if s}
+
+
+def rows_of_walks(sizes: list[int], seeds: list[int], labels: dict[int, str], row) -> list[list]:
+    """``row(T, seed, block)`` for every walk size and seed (``labels``: :func:`block_of`, dev when not
+    named), each row printed to stderr as it comes (long runs show their progress)."""
+    rows = []
+    for T in sizes:
+        for seed in seeds:
+            rows.append(row(T, seed, labels.get(seed, "dev")))
+            print(" | ".join(map(str, rows[-1])), file=sys.stderr, flush=True)
+    return rows
+
+
+def save_walks(name: str, title: str, text: str, args: argparse.Namespace, seconds: float) -> None:
+    """``save_result`` for a walk benchmark: ``results/<name>[_<tag>].md`` (``--tag``, :func:`add_seed_blocks`)."""
+    save_result(name + (f"_{args.tag}" if args.tag else ""), title, text, args.quick, seconds, script=name)
 
 
 def least_cpu(fn, repeats: int):

@@ -28,8 +28,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import add_seed_blocks, block_of, least_cpu, walks_of, walks_parser  # noqa: E402
+from common import markdown_table  # noqa: E402
+from trajectory_common import (add_seed_blocks, block_of, least_cpu, rows_of_walks, save_walks,  # noqa: E402
+                               walks_of, walks_parser)
 from trajectory_timing_steps import setup  # noqa: E402
 
 from worldtrack.trajectory.solver import levenberg_marquardt  # noqa: E402
@@ -54,13 +55,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     cpu, sizes, seeds, repeats = walks_of(args)
     factors = [float(f) for f in args.factors.split(",")]
-    labels = block_of(args)
     t0 = time.perf_counter()
-    rows = []
-    for T in sizes:
-        for seed in seeds:
-            rows.append(row(T, seed, labels.get(seed, "dev"), factors, repeats))
-            print(" | ".join(map(str, rows[-1])), file=sys.stderr, flush=True)
+    rows = rows_of_walks(sizes, seeds, block_of(args), lambda T, seed, block: row(T, seed, block, factors, repeats))
     totals = []
     for T in sizes:
         mine = [r for r in rows if r[0] == T]
@@ -70,9 +66,8 @@ def main(argv: list[str] | None = None) -> int:
         ["T", "walk", "default: iterations", *(f"factor {f}: iterations (F ÷ default − 1, largest gap) CPU ÷ default"
                                                for f in factors)], rows + totals)
     print(text)
-    save_result("trajectory_outward" + (f"_{args.tag}" if args.tag else ""),
-                "Seed 002: Gauss–Newton's curvature for samples moving away from obstacles", text, args.quick,
-                time.perf_counter() - t0, script="trajectory_outward")
+    save_walks("trajectory_outward", "Seed 002: Gauss–Newton's curvature for samples moving away from obstacles",
+               text, args, time.perf_counter() - t0)
     return 0
 
 

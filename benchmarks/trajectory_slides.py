@@ -41,8 +41,8 @@ from scipy import ndimage
 from scipy.special import expit
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import add_seed_blocks, block_of, walks_of, walks_parser  # noqa: E402
+from common import markdown_table  # noqa: E402
+from trajectory_common import add_seed_blocks, block_of, rows_of_walks, save_walks, walks_of, walks_parser  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
 from worldtrack.scene.floor import FloorGrid  # noqa: E402
@@ -203,18 +203,16 @@ def main(argv: list[str] | None = None) -> int:
     add_seed_blocks(ap, "trajectory_slides")
     args = ap.parse_args(argv)
     cpu, sizes, seeds, _ = walks_of(args)
-    labels = block_of(args)
     t0 = time.perf_counter()
-    rows = [row(T, seed, labels.get(seed, "dev")) for T in sizes for seed in seeds]
+    rows = rows_of_walks(sizes, seeds, block_of(args), row)
     text = f"({cpu})\n\n" + markdown_table(
         ["T", "walk", "default iterations", "default F", "start: along / across m", "after 8: along / across m",
          "tangential share of the barrier model's error at it. 12 (weighted d − linear d)",
          "(a) cubic start: iterations (F ÷ default − 1, largest gap)", "(b) curvature γ = 1 from it. 0",
          "(b) curvature γ = 0.5 from it. 6"], rows)
     print(text)
-    save_result("trajectory_slides" + (f"_{args.tag}" if args.tag else ""),
-                "Seed 002: the leader's last iterations, and two levers", text, args.quick, time.perf_counter() - t0,
-                script="trajectory_slides")
+    save_walks("trajectory_slides", "Seed 002: the leader's last iterations, and two levers", text, args,
+               time.perf_counter() - t0)
     return 0
 
 

@@ -39,8 +39,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import markdown_table, save_result  # noqa: E402
-from trajectory_common import add_seed_blocks, block_of, walks_of, walks_parser  # noqa: E402
+from common import markdown_table  # noqa: E402
+from trajectory_common import add_seed_blocks, block_of, rows_of_walks, save_walks, walks_of, walks_parser  # noqa: E402
 from trajectory_slides import along_across  # noqa: E402
 from trajectory_speed import problem_of  # noqa: E402
 
@@ -239,13 +239,8 @@ def main(argv: list[str] | None = None) -> int:
     add_seed_blocks(ap, "trajectory_timing_steps")
     args = ap.parse_args(argv)
     cpu, sizes, seeds, _ = walks_of(args)
-    labels = block_of(args)
     t0 = time.perf_counter()
-    rows = []
-    for T in sizes:
-        for seed in seeds:
-            rows.append(row(T, seed, labels.get(seed, "dev")))
-            print(" | ".join(map(str, rows[-1])), file=sys.stderr, flush=True)
+    rows = rows_of_walks(sizes, seeds, block_of(args), row)
     text = f"({cpu})\n\nFloor error along / across the path against the default's stop (m, RMS, unobserved steps).\n\n" + \
         markdown_table(["T", "walk", "default iterations", "start: along / across", "after 8 it.",
                         "+ 1 timing step", "+ 4 timing steps", "+ 1 iteration", "+ 4 iterations",
@@ -253,9 +248,8 @@ def main(argv: list[str] | None = None) -> int:
                         "[iterations + timing steps taken / tried]",
                         "line search 1.5, 2, 3: evaluations (…) [iterations]", "line search 2, 4, 8"], rows)
     print(text)
-    save_result("trajectory_timing_steps" + (f"_{args.tag}" if args.tag else ""),
-                "Seed 002: timing steps along the path, and a line search", text, args.quick,
-                time.perf_counter() - t0, script="trajectory_timing_steps")
+    save_walks("trajectory_timing_steps", "Seed 002: timing steps along the path, and a line search", text, args,
+               time.perf_counter() - t0)
     return 0
 
 
