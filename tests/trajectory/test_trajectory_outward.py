@@ -27,3 +27,22 @@ def test_outward_curvature_reaches_the_default_optimum_with_newtons_covariance(o
     # the solver's own last linearisation has the outward factor in it: a different matrix
     solver_lin = opted.results[opted.start].linearisation
     assert np.abs(solver_lin.D - plain.D).max() > 1e-6 * np.abs(plain.D).max()
+
+
+def test_finish_newton_ends_on_newtons_matrix_at_or_below_the_default_optimum(office_person):
+    """``finish_newton``: after the outward factor's run stops, the run goes on with Newton's factor, so it ends on
+    the plain linearisation, no higher than the default's stop (bar: 1e-6), and after more iterations than without."""
+    obs, field, height = office_person
+    options = TrajectoryOptions(height=height)
+    default = estimate_trajectory(obs, field, options)
+    outward = SolverOptions(outward_curvature=1.3)
+    alone = estimate_trajectory(obs, field, replace(options, solver=outward))
+    finished = estimate_trajectory(obs, field, replace(options, solver=replace(outward, finish_newton=True)))
+    assert finished.start == default.start
+    assert finished.costs["total"] <= default.costs["total"] * (1 + 1e-6)
+    assert finished.results[finished.start].iterations > alone.results[alone.start].iterations
+    dt = frame_interval(obs.time, obs.camera)
+    problem = Problem.build(obs, TimeGrid.covering(obs.time, dt), options.motion, build_environment(options, field, dt))
+    plain = linearise(problem, finished.X)
+    solver_lin = finished.results[finished.start].linearisation
+    np.testing.assert_allclose(solver_lin.D, plain.D, rtol=1e-12, atol=1e-12 * np.abs(plain.D).max())
