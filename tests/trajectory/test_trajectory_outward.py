@@ -4,11 +4,12 @@ tolerance, and the covariance of Newton's matrix at the estimate, not of the sol
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from worldtrack.trajectory.estimate import TrajectoryOptions, build_environment, estimate_trajectory
 from worldtrack.trajectory.model import TimeGrid, frame_interval
 from worldtrack.trajectory.objective import Problem, linearise
-from worldtrack.trajectory.solver import SolverOptions
+from worldtrack.trajectory.solver import LevenbergMarquardt, SolverOptions
 from worldtrack.trajectory.uncertainty import marginal_covariances
 
 
@@ -46,3 +47,25 @@ def test_finish_newton_ends_on_newtons_matrix_at_or_below_the_default_optimum(of
     plain = linearise(problem, finished.X)
     solver_lin = finished.results[finished.start].linearisation
     np.testing.assert_allclose(solver_lin.D, plain.D, rtol=1e-12, atol=1e-12 * np.abs(plain.D).max())
+
+
+def test_finish_newton_solves_its_first_step_on_newtons_matrix(office_person):
+    """The switch re-linearises at the outward run's stop: from there the matrix is Newton's, and so is the step."""
+    obs, field, height = office_person
+    options = TrajectoryOptions(height=height)
+    default = estimate_trajectory(obs, field, options)
+    dt = frame_interval(obs.time, obs.camera)
+    problem = Problem.build(obs, TimeGrid.covering(obs.time, dt), options.motion, build_environment(options, field, dt))
+    X0 = default.results[default.start].X + 0.3            # a start the solver must walk back from
+    solver = LevenbergMarquardt(problem, X0, SolverOptions(outward_curvature=1.3, finish_newton=True))
+    while not solver._finishing and not solver.converged:
+        solver.run(1)
+    assert solver._finishing and not solver.converged
+    plain = linearise(problem, solver.X)
+    np.testing.assert_allclose(solver.lin.D, plain.D, rtol=1e-12, atol=1e-12 * np.abs(plain.D).max())
+    fresh = LevenbergMarquardt(problem, solver.X, SolverOptions())
+    fresh.mu = solver.mu
+    assert solver.model_floor() == pytest.approx(fresh.model_floor(), rel=1e-12)   # the step of Newton's model
+    before = solver.iterations
+    solver.run()
+    assert solver.converged and solver.iterations > before
