@@ -76,7 +76,9 @@ class SolverOptions:
         iterations 1k 133 → 120, 10k 198 → 162, ±5 per walk (walk 3 21 → 25), F ≤ +4.5e-6 (``trajectory_outward.py``)
     finish_newton : bool — with ``outward_curvature``: once its run stops, go on from there with Newton's factor (the
         default matrix; one more linearisation) until the default rule stops, so the stop is one of the default model's
-        (34o: +1 iteration on 17 of 18 dev/held-out walks). Off by default, as the factor is
+        (34o, ``trajectory_finish.py``: 1 iteration after the switch on 34 of 36 walks, 2 on the rest). With
+        ``shrink_on_reject`` and factor 1.0, leader iterations dev + held-out 1k 194 → 161, 10k 255 → 198, never-used
+        900–902 42 → 34, 40 → 43; F ≤ default·(1 + 1e-6) on 36/36. Off by default, as the factor is
     """
 
     max_iterations: int = 100
