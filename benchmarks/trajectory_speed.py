@@ -30,7 +30,8 @@ time includes waiting for other jobs, the CPU time does not):
 Run: ``.venv/bin/python benchmarks/trajectory_speed.py [--sizes 1000,10000,100000] [--cpu 1]
 [--repeats 3] [--quick] [--settle] [--route-timing cubic] [--outward 1.3] [--shrink] [--finish]``. Writes
 ``benchmarks/results/trajectory_speed.md`` (with ``--settle``: ``_settle.md``; with ``--route-timing cubic``:
-``_cubic.md``; with ``--outward``: ``_outward.md``; ``--shrink`` and ``--finish`` add ``_shrink``, ``_finish``). About 4 minutes
+``_cubic.md``; with ``--outward``: ``_outward.md``; ``--shrink`` and ``--finish`` add ``_shrink``, ``_finish``).
+About 4 minutes
 (most of it GTSAM at T = 100 000).
 """
 

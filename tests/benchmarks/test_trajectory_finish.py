@@ -1,4 +1,5 @@
-"""benchmarks/trajectory_finish.py reads its option sets as SolverOptions fields of the right kinds, and refuses others."""
+"""benchmarks/trajectory_finish.py reads its option sets as SolverOptions fields of the right kinds, refuses
+others."""
 
 import sys
 from pathlib import Path
