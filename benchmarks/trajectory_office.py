@@ -164,10 +164,15 @@ def main(argv: list[str] | None = None) -> int:
                          "results/trajectory_office_cubic.md, no pictures")
     ap.add_argument("--outward", type=float, default=None,
                     help="SolverOptions.outward_curvature of every estimate (opt-in, 34n): writes _outward.md, no pictures")
+    ap.add_argument("--shrink", action="store_true", help="with --outward also SolverOptions.shrink_on_reject (34g); "
+                    "adds _shrink to the results file")
+    ap.add_argument("--finish", action="store_true", help="with --outward also SolverOptions.finish_newton (34o); "
+                    "adds _finish to the results file")
     args = ap.parse_args(argv)
     extra = {"route_timing": args.route_timing}
     if args.outward is not None:
-        extra["solver"] = SolverOptions(outward_curvature=args.outward)
+        extra["solver"] = SolverOptions(outward_curvature=args.outward, shrink_on_reject=args.shrink,
+                                        finish_newton=args.finish)
     seeds = parse_seeds(args.seeds)[:2] if args.quick else parse_seeds(args.seeds)
     frames = 600 if args.quick else args.frames
     t_start = time.perf_counter()
@@ -206,9 +211,10 @@ def main(argv: list[str] | None = None) -> int:
     cubic, outward = args.route_timing != "constant", args.outward is not None
     if best and not args.quick and not (cubic or outward):
         picture(best)
-    save_result("trajectory_office" + ("_cubic" if cubic else "") + ("_outward" if outward else ""),
+    tail = ("_shrink" if outward and args.shrink else "") + ("_finish" if outward and args.finish else "")
+    save_result("trajectory_office" + ("_cubic" if cubic else "") + ("_outward" if outward else "") + tail,
                 "Seed 002: office with detours, MAP vs Kalman + RTS" + (" (route_timing='cubic')" if cubic else "")
-                + (f" (outward_curvature={args.outward})" if outward else ""), text, args.quick,
+                + (f" (outward_curvature={args.outward})" if outward else "") + tail.replace("_", " "), text, args.quick,
                 time.perf_counter() - t_start, script="trajectory_office")
     return 0
 

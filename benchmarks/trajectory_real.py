@@ -250,10 +250,15 @@ def main(argv: list[str] | None = None) -> int:
                          "no picture")
     ap.add_argument("--outward", type=float, default=None,
                     help="SolverOptions.outward_curvature (opt-in, 34n): writes results/trajectory_real_outward.md, no picture")
+    ap.add_argument("--shrink", action="store_true", help="with --outward also SolverOptions.shrink_on_reject (34g); "
+                    "adds _shrink to the results file")
+    ap.add_argument("--finish", action="store_true", help="with --outward also SolverOptions.finish_newton (34o); "
+                    "adds _finish to the results file")
     args = ap.parse_args(argv)
     extra = {"route_timing": args.route_timing}
     if args.outward is not None:
-        extra["solver"] = SolverOptions(outward_curvature=args.outward)
+        extra["solver"] = SolverOptions(outward_curvature=args.outward, shrink_on_reject=args.shrink,
+                                        finish_newton=args.finish)
     root = data_root()
     missing = [n for n, (f, _) in SEQUENCES.items() if not (root / f / "obsmat.txt").is_file()]
     if len(missing) == len(SEQUENCES):
@@ -269,9 +274,10 @@ def main(argv: list[str] | None = None) -> int:
     print(text)
     if keep and not args.quick:
         picture(keep)
-    save_result("trajectory_real" + ("_cubic" if cubic else "") + ("_outward" if outward else ""),
+    tail = ("_shrink" if outward and args.shrink else "") + ("_finish" if outward and args.finish else "")
+    save_result("trajectory_real" + ("_cubic" if cubic else "") + ("_outward" if outward else "") + tail,
                 "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)" + (" (route_timing='cubic')" if cubic else "")
-                + (f" (outward_curvature={args.outward})" if outward else ""), text, args.quick,
+                + (f" (outward_curvature={args.outward})" if outward else "") + tail.replace("_", " "), text, args.quick,
                 time.perf_counter() - t_start, script="trajectory_real")
     return 0
 

@@ -28,9 +28,10 @@ time includes waiting for other jobs, the CPU time does not):
   banded solves, comparable across machines.
 
 Run: ``.venv/bin/python benchmarks/trajectory_speed.py [--sizes 1000,10000,100000] [--cpu 1]
-[--repeats 3] [--quick] [--settle] [--route-timing cubic] [--outward 1.3]``. Writes
+[--repeats 3] [--quick] [--settle] [--route-timing cubic] [--outward 1.3] [--shrink] [--finish]``. Writes
 ``benchmarks/results/trajectory_speed.md`` (with ``--settle``: ``_settle.md``; with ``--route-timing cubic``:
-``_cubic.md``; with ``--outward``: ``_outward.md``). About 4 minutes
+``_cubic.md``; with ``--outward``: ``_outward.md``; ``--shrink`` and ``--finish`` add ``_shrink``, ``_finish``).
+About 4 minutes
 (most of it GTSAM at T = 100 000).
 """
 
@@ -102,11 +103,13 @@ def problem_of(T: int, seed: int):
 
 
 def run_size(T: int, repeats: int, seed: int, gtsam_max: int, gtsam_barrier_max: int, settle: bool = False,
-             route_timing: str = "constant", outward: float | None = None) -> dict:
+             route_timing: str = "constant", outward: float | None = None, shrink: bool = False,
+             finish: bool = False) -> dict:
     scene, obs, height = problem_of(T, seed)
     field = scene.distance_field(0.05)
     opts = TrajectoryOptions(height=height, settle_windows=settle, route_timing=route_timing,
-                             solver=SolverOptions(outward_curvature=outward))
+                             solver=SolverOptions(outward_curvature=outward, shrink_on_reject=shrink,
+                                                  finish_newton=finish))
     out = {"T": T}
     out["full"], est = timed(lambda: estimate_trajectory(obs, field, opts), repeats)
     out["full_cpu"], out["full_cpu_min"], out["full_min"] = LAST_CPU
@@ -213,6 +216,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="full with TrajectoryOptions.route_timing (opt-in cubic, 34m); writes _cubic.md")
     ap.add_argument("--outward", type=float, default=None,
                     help="SolverOptions.outward_curvature (opt-in, 34n; e.g. 1.3); writes _outward.md")
+    ap.add_argument("--shrink", action="store_true", help="SolverOptions.shrink_on_reject (opt-in, 34g); adds _shrink")
+    ap.add_argument("--finish", action="store_true", help="SolverOptions.finish_newton (opt-in, 34o: with --outward, "
+                    "Newton's matrix after the outward run stops); adds _finish")
     args = ap.parse_args(argv)
     cpu = pin_to_one_core(None if args.cpu < 0 else args.cpu)
     sizes = [1000, 3000] if args.quick else [int(s) for s in args.sizes.split(",")]
@@ -225,15 +231,17 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     for T in sizes:
         results.append(run_size(T, repeats, args.seed, args.gtsam_max, args.gtsam_barrier_max, args.settle,
-                                args.route_timing, args.outward))
+                                args.route_timing, args.outward, args.shrink, args.finish))
         print(f"T = {T}: full {results[-1]['full']:.2f} s ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     text = tables(results, cpu)
     print(text)
     tail = ("_settle" if args.settle else "") + ("_cubic" if args.route_timing != "constant" else "") + \
-        ("_outward" if args.outward is not None else "")
+        ("_outward" if args.outward is not None else "") + ("_shrink" if args.shrink else "") + \
+        ("_finish" if args.finish else "")
     save_result("trajectory_speed" + tail, "Seed 002: speed on one core, scaling, environment cost, GTSAM"
                 + (" (settle_windows)" if args.settle else "") + (" (route_timing='cubic')" if "cubic" in tail else "")
-                + (f" (outward_curvature={args.outward})" if args.outward is not None else ""),
+                + (f" (outward_curvature={args.outward})" if args.outward is not None else "")
+                + (" (shrink_on_reject)" if args.shrink else "") + (" (finish_newton)" if args.finish else ""),
                 text, args.quick, time.perf_counter() - t_start, script="trajectory_speed")
     return 0
 

@@ -7,9 +7,9 @@ by block in a compiled kernel (the default), or through LAPACK (``scipy.linalg.s
 follow Nielsen (1999): μ shrinks by max(1/3, 1 − (2ρ − 1)³) on a good step and grows by ν (2,
 4, 8, …) on a rejected one, with ρ the ratio of the actual to the predicted decrease.
 
-:func:`solve_dense` is the readable reference: the same residuals stacked into one vector with a
-dense Jacobian, handed to ``scipy.optimize.least_squares``. Tests check that both reach the same
-optimum.
+:func:`solve_dense` (:mod:`.dense`, re-exported here) is the readable reference: the same residuals stacked
+into one vector with a dense Jacobian, handed to ``scipy.optimize.least_squares``. Tests check that both
+reach the same optimum.
 """
 
 from __future__ import annotations
@@ -18,14 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
-import scipy.optimize
 
-from worldtrack.trajectory.environment import barrier_residuals, height_residuals
+from worldtrack.trajectory.dense import dense_objective, jacobian_dense, residual_vector, solve_dense
 from worldtrack.trajectory.kernels import BANDWIDTH, block_cholesky_solve, fill_banded, model_decrease
 from worldtrack.trajectory.lookahead import shape_step
-from worldtrack.trajectory.model import STATE, VEL, first_velocity_residuals, motion_residuals
-from worldtrack.trajectory.objective import (Costs, Linearisation, Problem, evaluate, huber,
-                                             linearise)
+from worldtrack.trajectory.model import STATE
+from worldtrack.trajectory.objective import Costs, Linearisation, Problem, evaluate, linearise
 
 
 
@@ -76,6 +74,11 @@ class SolverOptions:
     outward_curvature : float or None — with a barrier, a sample that moved away from the obstacles in the last step takes
         this curvature factor in the next matrix instead of Newton's ≈ 2 (``barrier_terms``). Off (None): 34n, 18 walks, 1.0:
         iterations 1k 133 → 120, 10k 198 → 162, ±5 per walk (walk 3 21 → 25), F ≤ +4.5e-6 (``trajectory_outward.py``)
+    finish_newton : bool — with ``outward_curvature``: once its run stops, go on from there with Newton's factor (the
+        default matrix; one more linearisation) until the default rule stops, so the stop is one of the default model's
+        (34o, ``trajectory_finish.py``: 1 iteration after the switch on 34 of 36 walks, 2 on the rest). With
+        ``shrink_on_reject`` and factor 1.0, leader iterations dev + held-out 1k 194 → 161, 10k 255 → 198, never-used
+        900–902 42 → 34, 40 → 43; F ≤ default·(1 + 1e-6) on 36/36. Off by default, as the factor is
     """
 
     max_iterations: int = 100
@@ -89,6 +92,7 @@ class SolverOptions:
     confirm_stop: bool = True
     shrink_on_reject: bool = False
     outward_curvature: float | None = None
+    finish_newton: bool = False
 
 
 @dataclass
@@ -141,6 +145,7 @@ class LevenbergMarquardt:
         self.mu, self.nu = options.initial_damping, 2.0
         self.move_limit = options.max_move
         self._shrunk = False              # inside a trust region a rejection shrank (``shrink_on_reject``)
+        self._finishing = False           # ``finish_newton``: the outward factor's run has stopped, Newton's goes on
         # buffers reused by every iteration: the trial's linearisation and the linear solver's work
         lin = self.lin
         self._spare = lin.copy()
@@ -224,7 +229,8 @@ class LevenbergMarquardt:
             delta, predicted = self._limit(lin, delta, predicted)
         if self._still_rejected(delta):
             return self._raise_damping(lin, predicted)
-        outward = None if options.outward_curvature is None else (lin.barrier_d, float(options.outward_curvature))
+        outward = None if options.outward_curvature is None or self._finishing else \
+            (lin.barrier_d, float(options.outward_curvature))
         trial = linearise(self.problem, self.X + delta, out=self._spare, outward=outward)
         actual = lin.costs.total - trial.costs.total
         rho = actual / predicted if predicted > 0 else -1.0
@@ -242,6 +248,9 @@ class LevenbergMarquardt:
                 self.message, self.converged = "step below tolerance", True
             else:
                 self.message = "running"
+            if self.converged and options.finish_newton and options.outward_curvature is not None \
+                    and not self._finishing:
+                self._finish()
             return
         tried = float(np.hypot(delta[:, 0], delta[:, 2]).max()) if barrier else 0.0
         if barrier and options.shrink_on_reject and tried > 1e-3:
@@ -253,6 +262,11 @@ class LevenbergMarquardt:
         if np.isfinite(trial.costs.total):
             self._rejected = (delta, trial.costs.total)     # the trial's linearisation stays in self._spare
         self._raise_damping(lin, predicted)
+
+    def _finish(self) -> None:
+        """``finish_newton``: the outward factor's run stopped; the same X linearised with Newton's factor, and on."""
+        self._finishing, self.converged, self.message, self._pending = True, False, "running", None
+        self.lin, self._spare = linearise(self.problem, self.X, out=self._spare), self.lin
 
     def _raise_damping(self, lin: Linearisation, predicted: float) -> None:
         """A rejected step: μ grows by ν (2, 4, 8, …); stop where that can no longer help."""
@@ -320,80 +334,6 @@ def _limit_moves(lin: Linearisation, delta: np.ndarray, predicted: float, max_mo
         return local, pred_local
     uniform = delta * (max_move / move.max())
     return uniform, model_decrease(lin.D, lin.B, lin.g, uniform)
-
-
-# ------------------------------------------------------------------ the dense reference
-
-def residual_vector(problem: Problem, X: np.ndarray) -> np.ndarray:
-    """All whitened residuals stacked: motion, observations, every barrier sample, heights.
-
-    Huber residuals enter as r·√ρ(e)/e, whose squared norm is ρ(e): the same objective, so the same
-    optimum (not the same Jacobian as the IRLS weights the fast solver uses).
-    """
-    parts = [motion_residuals(X, problem.A, problem.W).ravel(),
-             first_velocity_residuals(X, problem.motion.first_velocity_gain)]
-    for term in problem.pixel_terms:
-        r, _, _ = term.residuals(X, with_jacobian=False)
-        e = np.hypot(r[:, 0], r[:, 1])
-        rho, _ = huber(e, problem.robust)
-        parts.append((r * (np.sqrt(rho) / np.where(e > 0, e, 1.0))[:, None]).ravel() if problem.robust else r.ravel())
-    env = problem.environment
-    if env.barrier is not None:
-        parts.append(barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False).r)
-    if env.height is not None:
-        parts.append(height_residuals(X, env.height, env.weight)[0])
-    return np.concatenate(parts)
-
-
-def jacobian_dense(problem: Problem, X: np.ndarray) -> np.ndarray:
-    """The dense Jacobian of :func:`residual_vector` (plain squares only), row by row as the terms say."""
-    n = len(X)
-    rows = []
-    minus_WA = -problem.W @ problem.A
-    for t in range(n - 1):                                    # motion: W·(x_{t+1} − A·x_t)
-        block = np.zeros((STATE, STATE * n))
-        block[:, STATE * t:STATE * t + STATE] = minus_WA
-        block[:, STATE * (t + 1):STATE * (t + 2)] = problem.W
-        rows.append(block)
-    first = np.zeros((len(VEL), STATE * n))                  # prior on the first velocity
-    first[np.arange(len(VEL)), VEL] = problem.motion.first_velocity_gain
-    rows.append(first)
-    for term in problem.pixel_terms:                          # observations: one state each
-        _, J, _ = term.residuals(X)
-        for i, k in enumerate(term.step):
-            block = np.zeros((2, STATE * n))
-            block[:, STATE * k:STATE * k + STATE] = J[i]
-            rows.append(block)
-    env = problem.environment
-    if env.barrier is not None:                               # barrier samples: two states each
-        br = barrier_residuals(X, env.barrier, env.weight, problem.grid.dt, only_active=False)
-        block = np.zeros((len(br.r), STATE * n))
-        for i, t in enumerate(br.step):
-            block[i, STATE * t:STATE * t + 2 * STATE] = br.J[i]
-        rows.append(block)
-    if env.height is not None:                                # height: ∂/∂w_t
-        _, gain = height_residuals(X, env.height, env.weight)
-        block = np.zeros((n, STATE * n))
-        block[np.arange(n), STATE * np.arange(n) + 4] = gain
-        rows.append(block)
-    return np.vstack(rows)
-
-
-def solve_dense(problem: Problem, X0: np.ndarray, xtol: float = 1e-8) -> np.ndarray:
-    """Reference optimum: ``scipy.optimize.least_squares`` (MINPACK's Levenberg–Marquardt, dense
-    Jacobian) on :func:`residual_vector` from X0. Small problems only (T of a few hundred)."""
-    shape = np.shape(X0)
-    fun = lambda x: residual_vector(problem, x.reshape(shape))  # noqa: E731
-    jac = "2-point" if problem.robust else (lambda x: jacobian_dense(problem, x.reshape(shape)))
-    sol = scipy.optimize.least_squares(fun, np.asarray(X0, float).ravel(), jac=jac, method="lm",
-                                       xtol=xtol, ftol=1e-12, gtol=1e-12)
-    return sol.x.reshape(shape)
-
-
-def dense_objective(problem: Problem, X: np.ndarray) -> float:
-    """F(X) from the stacked residuals (equals ``evaluate(problem, X).total``)."""
-    r = residual_vector(problem, X)
-    return float(r @ r)
 
 
 __all__ = ["BANDWIDTH", "LevenbergMarquardt", "SolveResult", "SolverOptions", "dense_objective", "evaluate", "jacobian_dense",
