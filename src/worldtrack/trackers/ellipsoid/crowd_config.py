@@ -63,6 +63,16 @@ class CrowdConfig(Section):
         "0.417; with predict_along_ray_measured, alone_behind_obstacles, births_past_people and "
         "births.people_occlude (against the first two) dev cold 14.7 -> 13.3 / 0.420 -> 0.408, true 14.3 -> 18.0 / "
         "0.468 -> 0.488, held-out 113-118 cold 9.5 -> 12.5 / 0.392 -> 0.424, true 18.7 -> 17.3 / 0.489 -> 0.485")
+    births_in_front: float = Field(
+        0.0, ge=0, description="a person in front of a confirmed one, whose ellipse hides them down to its feet: where "
+        "the foreground in a strip down from those feet goes on for at least this share of their length in the image "
+        "(the nearer person's legs), a person of the default size is proposed with the feet at its lowest row "
+        "(:mod:`.in_front`). 0 = off (the default)")
+    head_bands_confirmed: bool = Field(
+        False, description="with births_head_bands: a head band is one only above confirmed people (its lower end on "
+        "their ellipses, not on candidates') and its top above their ellipses drawn at height.range_m's maximum "
+        "(a person taller than their track's height shows their own head there, not somebody behind; "
+        ":func:`.head_bands.confirmed_images`). Off by default")
     births_heights: bool = Field(
         True, description="a birth blob with feet and head in view gives the new person's height and, shorter than "
         "height.range_m's minimum, is placed by its head (:func:`.births.blob_position`), as with height.measure "
