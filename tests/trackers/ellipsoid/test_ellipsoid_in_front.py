@@ -39,9 +39,17 @@ def test_the_legs_below_a_farther_confirmed_person_propose_the_person_in_front()
     assert in_front_proposals(view, mask, known, np.array([False]), explained, 1.65, 0.4, 0.1, 0.4) == []
     alone = person_mask(cam, far, 1.65, 0.4)
     assert in_front_proposals(view, alone, known, np.array([True]), explained, 1.65, 0.4, 0.1, 0.4) == []
+    # Somebody known whose ellipse reaches down to the feet explains the legs (whatever the separation).
     both = People(np.array([far, near]), np.array([1.65, 1.65]), np.array([0.4, 0.4]))
     assert in_front_proposals(view, mask, both, np.array([True, True]), _known_image(view, both),
+                              1.65, 0.4, 0.1, 0.0) == []
+    # Somebody known 0.3 m behind the feet (their ellipse ends above them) is within the separation.
+    ray = (far - near) / np.hypot(*(far - near))
+    close = People(np.array([far, near + 0.3 * ray]), np.array([1.65, 1.65]), np.array([0.4, 0.4]))
+    assert in_front_proposals(view, mask, close, np.array([True, False]), _known_image(view, close),
                               1.65, 0.4, 0.1, 0.4) == []
+    assert len(in_front_proposals(view, mask, close, np.array([True, False]), _known_image(view, close),
+                                  1.65, 0.4, 0.1, 0.2)) == 1
 
 
 def test_a_thin_streak_below_the_feet_is_not_a_person():
@@ -52,7 +60,7 @@ def test_a_thin_streak_below_the_feet_is_not_a_person():
     mask = person_mask(cam, far, 1.65, 0.4)
     foot, near_foot = cam.project(np.array([[*far, 0.0], [*near, 0.0]]))
     u, v0, v1 = int(round(foot[0])), int(round(foot[1])), int(round(near_foot[1]))
-    mask[v0:v1, u - 2:u + 3] = 1
+    mask[v0:v1, u - 8:u + 9] = 1                                           # as wide as the strip
     known = People(np.array([far]), np.array([1.65]), np.array([0.4]))
     assert in_front_proposals(view, mask, known, np.array([True]), _known_image(view, known),
                               1.65, 0.4, 0.1, 0.4) == []
@@ -118,3 +126,4 @@ def test_head_bands_confirmed_drops_a_band_a_confirmed_persons_own_head_could_be
     assert len(tracker.births._in_camera("c1", mask, known, np.array([True]))) == 1
     tracker.births.bands_confirmed = True
     assert tracker.births._in_camera("c1", mask, known, np.array([True])) == []
+    assert tracker.births._in_camera("c1", mask, known, np.array([False])) == []   # not above a candidate
