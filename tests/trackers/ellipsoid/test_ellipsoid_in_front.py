@@ -127,3 +127,21 @@ def test_head_bands_confirmed_drops_a_band_a_confirmed_persons_own_head_could_be
     tracker.births.bands_confirmed = True
     assert tracker.births._in_camera("c1", mask, known, np.array([True])) == []
     assert tracker.births._in_camera("c1", mask, known, np.array([False])) == []   # not above a candidate
+
+
+def test_births_heights_clear_reads_no_height_from_a_blob_with_foreground_beyond_an_end():
+    scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
+    cam = tracker.views["c1"].camera
+    mask = person_mask(cam, person, 1.65, 0.4)
+    nobody = People(np.zeros((0, 2)), np.zeros(0), np.zeros(0))
+    top = int(np.nonzero(mask)[0].min())
+    mask[top - 3, :] = 1                             # a 1-px line just above the head: opened away, not a gap
+    tracker.births.heights_clear = False
+    (whole,) = tracker.births._in_camera("c1", mask, nobody)
+    assert whole.height is not None and abs(whole.height - 1.65) < 0.1
+    tracker.births.heights_clear = True
+    (cut,) = tracker.births._in_camera("c1", mask, nobody)
+    assert cut.height is None and np.allclose(cut.xy, whole.xy)
+    mask[top - 3, :] = 0                             # background above and below: a height
+    (clear,) = tracker.births._in_camera("c1", mask, nobody)
+    assert clear.height is not None and abs(clear.height - 1.65) < 0.1

@@ -25,7 +25,7 @@ from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import BirthConfig
 from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop
-from worldtrack.trackers.ellipsoid.head_bands import confirmed_images, head_px, is_head_band
+from worldtrack.trackers.ellipsoid.head_bands import blob_clear, confirmed_images, head_px, is_head_band
 from worldtrack.trackers.ellipsoid.in_front import in_front_proposals
 from worldtrack.trackers.ellipsoid.people_edges import covered_share, ends_on_people, unexplained_pixels
 
@@ -111,9 +111,10 @@ class Births:
     head_bands : a blob too small for a person that is the top of one above known people is proposed
         (``crowd.births_head_bands``, :mod:`.head_bands`)
     crowd : CrowdConfig or None — also read here: ``births_in_front`` (legs below a confirmed
-        person propose one in front of them, :mod:`.in_front`) and ``head_bands_confirmed`` (head
+        person propose one in front of them, :mod:`.in_front`) ``head_bands_confirmed`` (head
         bands only above confirmed people, topping out above them at their tallest,
-        :func:`~.head_bands.confirmed_images`); None: both off
+        :func:`~.head_bands.confirmed_images`), ``births_heights_clear`` (a height only from a blob
+        with background beyond both ends, :func:`~.head_bands.blob_clear`); None: all off
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
@@ -129,6 +130,7 @@ class Births:
         self.head_bands = head_bands
         self.in_front = crowd.births_in_front if crowd is not None else 0.0
         self.bands_confirmed = crowd is not None and crowd.head_bands_confirmed
+        self.heights_clear = crowd is not None and crowd.births_heights_clear
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
@@ -191,6 +193,9 @@ class Births:
             if found is None:
                 continue
             p, height, share = found
+            if height is not None and self.heights_clear and \
+                    not blob_clear(mask, blob, (x0, y0), view.down_direction(centroid)):
+                height = None   # a blob cut by foreground at an end: its length is not a height
             pxy = self.nearest_walkable(p[:2], 0.6)
             if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
                 continue  # off the floor, or somebody already there

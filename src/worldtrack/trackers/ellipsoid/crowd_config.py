@@ -73,6 +73,10 @@ class CrowdConfig(Section):
         "their ellipses, not on candidates') and its top above their ellipses drawn at height.range_m's maximum "
         "(a person taller than their track's height shows their own head there, not somebody behind; "
         ":func:`.head_bands.confirmed_images`). Off by default")
+    births_heights_clear: bool = Field(
+        False, description="with births_heights: a birth blob gives the new person's height only where the mask "
+        "is background just beyond both its ends (:func:`.head_bands.blob_clear`, the head band's test): a blob "
+        "the known people's ellipses or a neighbour cut is not a whole person. Off by default")
     births_heights: bool = Field(
         True, description="a birth blob with feet and head in view gives the new person's height and, shorter than "
         "height.range_m's minimum, is placed by its head (:func:`.births.blob_position`), as with height.measure "

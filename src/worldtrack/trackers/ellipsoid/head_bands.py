@@ -94,6 +94,32 @@ def is_head_band(mask: np.ndarray, explained: np.ndarray, blob: np.ndarray, orig
     return bool(feet_on and clear and covered_share(mask, above) == 0.0)
 
 
+def blob_clear(mask: np.ndarray, blob: np.ndarray, origin: tuple[int, int], down: np.ndarray | None) -> bool:
+    """Whether both ends of ``blob`` ((h, w) bool crop at ``origin`` (u, v) px) along ``down`` (2,)
+    have background just beyond them in ``mask`` ((H, W), nonzero foreground), as a head band's top:
+    the blob is a whole silhouette from head to feet, whose length may be read as a height
+    (``crowd.births_heights_clear``). In a crowd a birth blob ending against foreground (that the
+    known people's ellipses explain, or a neighbour's) is cut there, and its length is not the person's.
+
+    >>> mask = np.zeros((30, 20), np.uint8); mask[5:25, 5:15] = 1
+    >>> blob_clear(mask, mask[5:25, 5:15].astype(bool), (5, 5), np.array([0.0, 1.0]))
+    True
+    >>> blob_clear(mask, mask[5:20, 5:15].astype(bool), (5, 5), np.array([0.0, 1.0]))   # the legs go on
+    False
+    """
+    if down is None:
+        return False
+    v, u = np.nonzero(blob)
+    pts = np.column_stack([u + origin[0], v + origin[1]]).astype(float)
+    along = pts @ down
+    across = np.array([-down[1], down[0]])
+    half = max(1.0, 0.4 * float(np.ptp(pts @ across)))
+    spread = np.linspace(-half, half, 9)[:, None] * across
+    top, bottom = pts[np.argmin(along)], pts[np.argmax(along)]
+    return covered_share(mask, top - BEYOND_PX * down + spread) == 0.0 and \
+        covered_share(mask, bottom + BEYOND_PX * down + spread) == 0.0
+
+
 def confirmed_images(view, people: People, confirmed: np.ndarray,
                      height_range: tuple[float, float] | None) -> tuple[np.ndarray, np.ndarray]:
     """The confirmed people's ellipses (uint8 (H, W), dilated 2 px as the births' own) and the same
@@ -123,4 +149,4 @@ def confirmed_images(view, people: People, confirmed: np.ndarray,
     return cv2.dilate(out[0], kernel), out[1]
 
 
-__all__ = ["HEAD_WIDTH_M", "MIN_HEAD_SHARE", "TALLEST_M", "confirmed_images", "head_px", "is_head_band"]
+__all__ = ["HEAD_WIDTH_M", "MIN_HEAD_SHARE", "TALLEST_M", "blob_clear", "confirmed_images", "head_px", "is_head_band"]
