@@ -14,7 +14,7 @@ from worldtrack.trackers.ellipsoid.in_front import in_front_proposals, legs_belo
 
 def _known_image(view, known: People) -> np.ndarray:
     from worldtrack.trackers.ellipsoid.head_bands import confirmed_images
-    return confirmed_images(view, known, np.ones(len(known.xy), bool), None)[0]
+    return confirmed_images(view, known, np.ones(len(known.xy), bool))[0]
 
 
 def _scene():
@@ -82,6 +82,7 @@ def test_legs_below_bridge_short_holes_and_stop_at_the_border():
 def test_births_in_front_and_head_bands_confirmed_are_crowd_settings_off_by_default():
     scene, person, bgs, tracker, images, real = one_person_seen(seed=3)
     assert tracker.births.in_front == 0.0 and tracker.births.bands_confirmed is False
+    assert tracker.births.bands_tallest == 0.0 and tracker.births.heights_clear is False
     crowd = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"),
                              EllipsoidConfig(crowd={"births_in_front": 0.15, "head_bands_confirmed": True}))
     assert crowd.births.in_front == 0.15 and crowd.births.bands_confirmed is True
@@ -107,11 +108,12 @@ def test_confirmed_images_draw_only_confirmed_people_and_at_their_tallest():
     view = tracker.views["c1"]
     other = person + np.array([1.2, 0.0])
     people = People(np.array([person, other]), np.array([1.65, 1.65]), np.array([0.4, 0.4]))
-    under, tall = confirmed_images(view, people, np.array([True, False]), (1.3, 2.1))
-    alone, alone_tall = confirmed_images(view, People(*(a[:1] for a in people)), np.array([True]), (1.3, 2.1))
+    under, tall = confirmed_images(view, people, np.array([True, False]), 2.1)
+    alone, alone_tall = confirmed_images(view, People(*(a[:1] for a in people)), np.array([True]), 2.1)
     assert under.any() and np.array_equal(under, alone) and np.array_equal(tall, alone_tall)
     assert np.nonzero(tall.any(axis=1))[0].min() < np.nonzero(under.any(axis=1))[0].min() - 5
-    assert not confirmed_images(view, people, np.array([False, False]), None)[0].any()
+    assert not confirmed_images(view, people, np.array([False, False]))[0].any()
+    assert confirmed_images(view, people, np.array([True, False]))[1] is None
 
 
 def test_head_bands_confirmed_drops_a_band_a_confirmed_persons_own_head_could_be():
@@ -124,7 +126,9 @@ def test_head_bands_confirmed_drops_a_band_a_confirmed_persons_own_head_could_be
     known = People(np.array([person]), np.array([1.9]), np.array([0.4]))
     tracker.births.head_bands = True
     assert len(tracker.births._in_camera("c1", mask, known, np.array([True]))) == 1
-    tracker.births.bands_confirmed = True
+    tracker.births.bands_confirmed = True                                  # confirmed people only: still one
+    assert len(tracker.births._in_camera("c1", mask, known, np.array([True]))) == 1
+    tracker.births.bands_tallest = 2.1                                     # and topping out above them at 2.1 m
     assert tracker.births._in_camera("c1", mask, known, np.array([True])) == []
     assert tracker.births._in_camera("c1", mask, known, np.array([False])) == []   # not above a candidate
 

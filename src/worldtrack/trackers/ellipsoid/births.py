@@ -112,8 +112,8 @@ class Births:
         (``crowd.births_head_bands``, :mod:`.head_bands`)
     crowd : CrowdConfig or None — also read here: ``births_in_front`` (legs below a confirmed
         person propose one in front of them, :mod:`.in_front`) ``head_bands_confirmed`` (head
-        bands only above confirmed people, topping out above them at their tallest,
-        :func:`~.head_bands.confirmed_images`), ``births_heights_clear`` (a height only from a blob
+        bands only above confirmed people, with ``head_bands_tallest_m`` topping out above them drawn
+        that tall, :func:`~.head_bands.confirmed_images`), ``births_heights_clear`` (a height only from a blob
         with background beyond both ends, :func:`~.head_bands.blob_clear`); None: all off
     """
 
@@ -130,6 +130,7 @@ class Births:
         self.head_bands = head_bands
         self.in_front = crowd.births_in_front if crowd is not None else 0.0
         self.bands_confirmed = crowd is not None and crowd.head_bands_confirmed
+        self.bands_tallest = crowd.head_bands_tallest_m if crowd is not None else 0.0
         self.heights_clear = crowd is not None and crowd.births_heights_clear
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
@@ -180,7 +181,7 @@ class Births:
         # labelling the whole 640x480 frame was a third of the births' time.
         bands = self.head_bands and len(xy) > 0   # small blobs too: the tops of people behind known ones
         sure = np.ones(len(xy), bool) if confirmed is None else np.asarray(confirmed, bool)
-        under, tall = confirmed_images(view, people, sure, self.height_range) if bands and self.bands_confirmed \
+        under, tall = confirmed_images(view, people, sure, self.bands_tallest) if bands and self.bands_confirmed \
             else (explained, None)
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, 10 if bands else min_area, max(1, cam.width // 320)):
             band = area < min_area

@@ -70,9 +70,11 @@ class CrowdConfig(Section):
         "(:mod:`.in_front`). 0 = off (the default)")
     head_bands_confirmed: bool = Field(
         False, description="with births_head_bands: a head band is one only above confirmed people (its lower end on "
-        "their ellipses, not on candidates') and its top above their ellipses drawn at height.range_m's maximum "
-        "(a person taller than their track's height shows their own head there, not somebody behind; "
-        ":func:`.head_bands.confirmed_images`). Off by default")
+        "their ellipses, not on candidates'; :func:`.head_bands.confirmed_images`). Off by default")
+    head_bands_tallest_m: float = Field(
+        0.0, ge=0, description="with head_bands_confirmed: a band's top must also be above those people's ellipses "
+        "drawn at least this tall, m (a person taller than their track's height shows their own head there, not "
+        "somebody behind). 0 = not tested (the default)")
     births_heights_clear: bool = Field(
         False, description="with births_heights: a birth blob gives the new person's height only where the mask "
         "is background just beyond both its ends (:func:`.head_bands.blob_clear`, the head band's test): a blob "

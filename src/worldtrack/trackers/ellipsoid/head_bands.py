@@ -49,7 +49,7 @@ from worldtrack.trackers.ellipsoid.people_edges import BEYOND_PX, covered_share,
 MIN_HEAD_SHARE = 0.25
 #: A head's width, m (with hair; as :mod:`.two_on_ray`'s 15–18 cm).
 HEAD_WIDTH_M = 0.17
-#: The tallest person (m) the confirmed people are drawn at when heights have no range.
+#: The tallest person (m): ``height.range_m``'s maximum (the default's).
 TALLEST_M = 2.1
 
 
@@ -121,32 +121,30 @@ def blob_clear(mask: np.ndarray, blob: np.ndarray, origin: tuple[int, int], down
 
 
 def confirmed_images(view, people: People, confirmed: np.ndarray,
-                     height_range: tuple[float, float] | None) -> tuple[np.ndarray, np.ndarray]:
-    """The confirmed people's ellipses (uint8 (H, W), dilated 2 px as the births' own) and the same
-    people drawn at ``height_range``'s maximum (or :data:`TALLEST_M`; never shorter than they are).
+                     tallest: float = 0.0) -> tuple[np.ndarray, np.ndarray | None]:
+    """The confirmed people's ellipses (uint8 (H, W), dilated 2 px as the births' own) and, where
+    ``tallest`` > 0, the same people drawn at least ``tallest`` m tall (else None: not looked at).
 
     Parameters
     ----------
     view : CameraView — the camera
     people : People — everybody known, (N,) each
     confirmed : (N,) bool — which of them are confirmed
-    height_range : (min, max) m or None
+    tallest : float — m (``crowd.head_bands_tallest_m``; :data:`TALLEST_M`, the height range's
+        maximum: a band no confirmed person's own head can be)
     """
-    tallest = TALLEST_M if height_range is None else float(height_range[1])
     cam = view.camera
     out = [np.zeros((cam.height, cam.width), np.uint8), np.zeros((cam.height, cam.width), np.uint8)]
     keep = np.asarray(confirmed, bool)
-    if not keep.any():
-        return out[0], out[1]
     xy, h, w = np.asarray(people.xy)[keep], np.asarray(people.heights, float)[keep], np.asarray(people.widths)[keep]
-    for image, heights in zip(out, (h, np.maximum(h, tallest))):
+    for image, heights in zip(out, (h, np.maximum(h, tallest)) if tallest > 0 else (h,)):
         inner, _, box, valid, _ = view.forms(xy, heights, w)
         for k in np.nonzero(valid)[0]:
             u0, u1, v0, v1 = box[k]
             if u0 < u1 and v0 < v1:
                 image[v0:v1, u0:u1] |= ellipse_crop(inner[k], box[k], view.grid, view.args.has_dist).astype(np.uint8)
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
-    return cv2.dilate(out[0], kernel), out[1]
+    return cv2.dilate(out[0], kernel), out[1] if tallest > 0 else None
 
 
 __all__ = ["HEAD_WIDTH_M", "MIN_HEAD_SHARE", "TALLEST_M", "blob_clear", "confirmed_images", "head_px", "is_head_band"]
