@@ -70,7 +70,9 @@ class CrowdConfig(Section):
         "(:mod:`.in_front`), unless somebody known covers that row. 0 = off (the default). At 0.15 with "
         "predict_along_ray_measured, alone_behind_obstacles, births_head_bands, births_past_people and "
         "births.people_occlude, crowd 50 dev 110-112: 16 proposals in 6 runs, cold 13.3 -> 12.3 held, MOTA 0.408 -> "
-        "0.433, true places 18.0 -> 18.0, 0.488 -> 0.495; without the cover test 177 on seed 110 alone and worse")
+        "0.433, true places 18.0 -> 18.0, 0.488 -> 0.495; without the cover test 177 on seed 110 alone and worse; "
+        "held-out 113-118 cold 12.5 -> 12.0 / 0.424 -> 0.428, true 17.3 -> 17.2 / 0.485 -> 0.488, 119-124 cold 11.8 -> "
+        "12.0, true 16.8 -> 18.2, 133-136 cold 14.8 -> 14.2, true 19.2 -> 19.2: neutral")
     head_bands_confirmed: bool = Field(
         False, description="with births_head_bands: a head band is one only above confirmed people (its lower end on "
         "their ellipses, not on candidates'; :func:`.head_bands.confirmed_images`). Off by default: with the settings "
