@@ -23,8 +23,10 @@ from worldtrack.registry import Registry
 from worldtrack.trackers.ellipsoid.args import People
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import BirthConfig
+from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop
-from worldtrack.trackers.ellipsoid.head_bands import head_px, is_head_band
+from worldtrack.trackers.ellipsoid.head_bands import blob_clear, confirmed_images, head_px, is_head_band
+from worldtrack.trackers.ellipsoid.in_front import in_front_proposals
 from worldtrack.trackers.ellipsoid.people_edges import covered_share, ends_on_people, unexplained_pixels
 
 class Proposal(NamedTuple):
@@ -108,11 +110,16 @@ class Births:
         only what they leave unexplained (``crowd.births_past_people``, :mod:`.people_edges`)
     head_bands : a blob too small for a person that is the top of one above known people is proposed
         (``crowd.births_head_bands``, :mod:`.head_bands`)
+    crowd : CrowdConfig or None — also read here: ``births_in_front`` (legs below a confirmed
+        person propose one in front of them, :mod:`.in_front`) ``head_bands_confirmed`` (head
+        bands only above confirmed people, with ``head_bands_tallest_m`` topping out above them drawn
+        that tall, :func:`~.head_bands.confirmed_images`), ``births_heights_clear`` (a height only from a blob
+        with background beyond both ends, :func:`~.head_bands.blob_clear`); None: all off
     """
 
     def __init__(self, views: Mapping[str, CameraView], scene, walkable: Callable[[np.ndarray], np.ndarray],
                  config: BirthConfig, height_range: tuple[float, float] | None = (1.3, 2.1), min_px: int = 60,
-                 past_people: bool = False, head_bands: bool = False):
+                 past_people: bool = False, head_bands: bool = False, crowd: CrowdConfig | None = None):
         self.views = views
         self.scene = scene
         self.walkable = walkable
@@ -121,17 +128,23 @@ class Births:
         self.min_px = min_px
         self.past_people = past_people
         self.head_bands = head_bands
+        self.in_front = crowd.births_in_front if crowd is not None else 0.0
+        self.bands_confirmed = crowd is not None and crowd.head_bands_confirmed
+        self.bands_tallest = crowd.head_bands_tallest_m if crowd is not None else 0.0
+        self.heights_clear = crowd is not None and crowd.births_heights_clear
         self.places: BirthPlaces = BIRTH_PLACES[config.where]()
         self._floor: np.ndarray | None = None
 
-    def propose(self, masks: Mapping[str, np.ndarray], people: People, first_frame: bool) -> list[Proposal]:
+    def propose(self, masks: Mapping[str, np.ndarray], people: People, first_frame: bool,
+                confirmed: np.ndarray | None = None) -> list[Proposal]:
         """Places of new people in this frame's foreground ``masks`` ({camera_id: (H, W) uint8}),
-        clear of ``people`` and of each other by ``min_separation_m``, in proposal order."""
+        clear of ``people`` and of each other by ``min_separation_m``, in proposal order
+        (``confirmed`` (N,) bool: which of ``people`` are; None: all)."""
         if not self.places.proposes:
             return []
         proposals: list[Proposal] = []
         for cid in masks:
-            proposals += self._in_camera(cid, masks[cid], people)
+            proposals += self._in_camera(cid, masks[cid], people, confirmed)
         if not proposals:
             return []
         proposals = self.places.keep(proposals, self.scene, first_frame)
@@ -142,7 +155,8 @@ class Births:
                 kept.append(q)
         return kept
 
-    def _in_camera(self, cid: str, mask: np.ndarray, people: People) -> list[Proposal]:
+    def _in_camera(self, cid: str, mask: np.ndarray, people: People,
+                   confirmed: np.ndarray | None = None) -> list[Proposal]:
         """Proposals from one camera's foreground that ``people`` do not explain."""
         cfg, view = self.config, self.views[cid]
         cam = view.camera
@@ -166,10 +180,13 @@ class Births:
         # Components found at ~320 px wide (each blob then read back at full resolution):
         # labelling the whole 640x480 frame was a third of the births' time.
         bands = self.head_bands and len(xy) > 0   # small blobs too: the tops of people behind known ones
+        sure = np.ones(len(xy), bool) if confirmed is None else np.asarray(confirmed, bool)
+        under, tall = confirmed_images(view, people, sure, self.bands_tallest) if bands and self.bands_confirmed \
+            else (explained, None)
         for area, (x0, y0, bw, bh), centroid, blob in blobs(un, 10 if bands else min_area, max(1, cam.width // 320)):
             band = area < min_area
-            if band and not is_head_band(mask, explained, blob, (x0, y0), view.down_direction(centroid),
-                                         head_px(cam, centroid, h0)):
+            if band and not is_head_band(mask, under, blob, (x0, y0), view.down_direction(centroid),
+                                         head_px(cam, centroid, h0), tall):
                 continue
             found = blob_position(view, blob, (x0, y0), centroid, h0, self.height_range, self.min_px,
                                   known=explained if cfg.people_occlude and not band else None,
@@ -177,6 +194,9 @@ class Births:
             if found is None:
                 continue
             p, height, share = found
+            if height is not None and self.heights_clear and \
+                    not blob_clear(mask, blob, (x0, y0), view.down_direction(centroid)):
+                height = None   # a blob cut by foreground at an end: its length is not a height
             pxy = self.nearest_walkable(p[:2], 0.6)
             if pxy is None or (len(xy) and np.min(np.hypot(*(xy - pxy).T)) < cfg.min_separation_m):
                 continue  # off the floor, or somebody already there
@@ -186,6 +206,9 @@ class Births:
             if not band and (expected <= 0 or area < cfg.min_blob_fraction * expected * share):
                 continue
             out.append(Proposal(pxy, cid, height))
+        if self.in_front > 0 and len(xy):   # people in front of confirmed ones, shown by their legs below
+            out += [Proposal(q, cid, None) for q in in_front_proposals(
+                view, mask, people, sure, explained, h0, w0, self.in_front, cfg.min_separation_m)]
         return out
 
     def walkable_floor(self) -> np.ndarray:

@@ -63,6 +63,31 @@ class CrowdConfig(Section):
         "0.417; with predict_along_ray_measured, alone_behind_obstacles, births_past_people and "
         "births.people_occlude (against the first two) dev cold 14.7 -> 13.3 / 0.420 -> 0.408, true 14.3 -> 18.0 / "
         "0.468 -> 0.488, held-out 113-118 cold 9.5 -> 12.5 / 0.392 -> 0.424, true 18.7 -> 17.3 / 0.489 -> 0.485")
+    births_in_front: float = Field(
+        0.0, ge=0, description="a person in front of a confirmed one, whose ellipse hides them down to its feet: where "
+        "the foreground in a strip down from those feet goes on for at least this share of their length in the image "
+        "(the nearer person's legs), a person of the default size is proposed with the feet at its lowest row "
+        "(:mod:`.in_front`), unless somebody known covers that row. 0 = off (the default). At 0.15 with "
+        "predict_along_ray_measured, alone_behind_obstacles, births_head_bands, births_past_people and "
+        "births.people_occlude, crowd 50 dev 110-112: 16 proposals in 6 runs, cold 13.3 -> 12.3 held, MOTA 0.408 -> "
+        "0.433, true places 18.0 -> 18.0, 0.488 -> 0.495; without the cover test 177 on seed 110 alone and worse; "
+        "held-out 113-118 cold 12.5 -> 12.0 / 0.424 -> 0.428, true 17.3 -> 17.2 / 0.485 -> 0.488, 119-124 cold 11.8 -> "
+        "12.0, true 16.8 -> 18.2, 133-136 cold 14.8 -> 14.2, true 19.2 -> 19.2: neutral")
+    head_bands_confirmed: bool = Field(
+        False, description="with births_head_bands: a head band is one only above confirmed people (its lower end on "
+        "their ellipses, not on candidates'; :func:`.head_bands.confirmed_images`). Off by default: with the settings "
+        "above crowd 50 dev 110-112 kept 718 of 771 bands, cold 13.3 -> 13.7 held (MOTA 0.408 -> 0.412), true "
+        "places 18.0 -> 17.7 (0.488 -> 0.477)")
+    head_bands_tallest_m: float = Field(
+        0.0, ge=0, description="with head_bands_confirmed: a band's top must also be above those people's ellipses "
+        "drawn at least this tall, m (a person taller than their track's height shows their own head there, not "
+        "somebody behind). 0 = not tested (the default); at 2.1 (height.range_m's maximum) crowd 50 dev 110-112 kept "
+        "143 of 771 bands, cold 13.3 -> 13.3 held (0.408 -> 0.404), true places 18.0 -> 14.7 (0.488 -> 0.490)")
+    births_heights_clear: bool = Field(
+        False, description="with births_heights: a birth blob gives the new person's height only where the mask "
+        "is background just beyond both its ends (:func:`.head_bands.blob_clear`, the head band's test): a blob "
+        "the known people's ellipses or a neighbour cut is not a whole person. Off by default: with the settings "
+        "above crowd 50 dev 110-112 cold 13.3 -> 13.0 held (0.408 -> 0.405), true places 18.0 -> 17.3 (0.488 -> 0.494)")
     births_heights: bool = Field(
         True, description="a birth blob with feet and head in view gives the new person's height and, shorter than "
         "height.range_m's minimum, is placed by its head (:func:`.births.blob_position`), as with height.measure "

@@ -98,13 +98,13 @@ class EllipsoidTracker(TrackerBase):
         self._walk = Walkable(raster.inside, np.asarray(raster.origin, float), float(raster.resolution))
         self.scoring = Scoring(self._draw, int(cfg.score.target_pixels), cfg.score.kind == "symmetric",
                                cfg.score.camera_weights == "current")
-        m = cfg.match
+        m, crowd = cfg.match, cfg.crowd
         self.steps = StepArgs(float(m.step_m), float(m.min_step_m), float(m.max_step_m), int(m.iterations),
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
         self.rounds: Rounds = ROUNDS[m.rounds]
         self.births = Births(self.views, scene, self.walkable, cfg.births,
-                             cfg.height.range_m if cfg.height.measure and cfg.crowd.births_heights else None,
-                             cfg.height.min_px, cfg.crowd.births_past_people, cfg.crowd.births_head_bands)
+                             cfg.height.range_m if cfg.height.measure and crowd.births_heights else None,
+                             cfg.height.min_px, crowd.births_past_people, crowd.births_head_bands, crowd)
         self.life = LifeCycle(cfg, self.position_map, len(self.views) >= 2, self._promote)
         self.frames_stepped = 0
         self.frame_interval = 0.0
@@ -315,8 +315,8 @@ class EllipsoidTracker(TrackerBase):
         """New people (tentative, in capture mode) from foreground the simulation does not explain."""
         if not self.births.places.proposes:
             return []
-        masks = {cid: self.last_masks[cid] for cid in real}
-        proposals = self.births.propose(masks, _people(list(self.position_map)), self.frames_stepped == 0)
+        masks, known = {cid: self.last_masks[cid] for cid in real}, list(self.position_map)
+        proposals = self.births.propose(masks, _people(known), self.frames_stepped == 0, [p.id > 0 for p in known])
         h0, w0 = self.scene.people.height, self.scene.people.width
         born = []
         for xy, cid, shown in proposals:
