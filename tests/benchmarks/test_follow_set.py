@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+import follow_holder  # noqa: E402
 import follow_pets  # noqa: E402
 import follow_synth  # noqa: E402
 
@@ -29,7 +30,7 @@ def test_an_unknown_setting_or_a_bad_value_is_refused():
         follow_synth.set_variant(["reid_any_track_after=soon"])
 
 
-@pytest.mark.parametrize("script", [follow_synth, follow_pets])
+@pytest.mark.parametrize("script", [follow_synth, follow_pets, follow_holder])
 def test_bad_set_is_one_line_and_exit_2(script, capsys):
     assert script.main(["--set", "no_such_field=1"]) == 2
     err = capsys.readouterr().err.strip()

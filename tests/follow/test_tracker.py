@@ -322,3 +322,59 @@ def test_a_target_back_far_from_its_prediction_is_found_again_after_a_long_loss(
         assert labels[56:] == ["T"] * 24, text             # unseen 3 s at k = 55: its track may be it
     else:
         assert "T" not in labels[25:], text
+
+
+@pytest.mark.parametrize("case", ["clearly", "not clearly", "off"])
+def test_a_lost_target_held_by_another_track_is_taken_back_only_when_it_fits_clearly_better(case):
+    """The red target walks for 2.5 s and is lost; a stranger in red and blue stands 3.8 m from where
+    it is predicted (beyond the target's gate). At 4 s the stranger has gone and the target stands in
+    their place, its lower half in another red (RBhat 0.23 against its templates, over ``reid_rbhat``
+    0.1 here: painted colours give RBhat 0, 0.23 or 0.57): the stranger's track takes its candidate
+    (position fits, half the colours too), and no default rule hands it back within 3 s. With
+    ``reid_holder_margin`` 0.1 the templates fit it clearly better than the holder's own histogram
+    does (0.23 + 0.1 < 0.52): it is the target again once within reach (2.2 s unseen). Not when it
+    comes back in red and orange (0.57 against the templates, 0.56 against the holder)."""
+    from worldtrack.geometry.camera import Camera
+
+    cam = Camera.look_at("c", 320, 240, position=(0, -6, 3), target=(0, 0, 0.8), hfov_deg=60)
+    cfg = FollowConfig(reid_rbhat=0.1, reid_holder_margin=np.inf if case == "off" else 0.1)
+    tracker = FollowTracker(cfg)
+    rng = np.random.default_rng(4)
+    red, blue = (50, 70, 160), (160, 70, 50)
+    back = (50, 100, 160) if case == "not clearly" else (60, 60, 210)
+    there = np.array([3.0, 2.0])
+    labels = []
+    for k in range(54):
+        t = k / 10
+        if k < 25:
+            people, colours, names = [[-2.0 + 0.4 * t, 0.0], there], [(red, red), (red, blue)], ["T", "B"]
+        elif k < 40:
+            people, colours, names = [there], [(red, blue)], ["B"]
+        else:
+            people, colours, names = [there + [0.05, 0.0]], [(red, back)], ["T"]
+        obs = _seen(cam, cfg, people, colours, [np.nan] * len(people), rng)
+        step = tracker.start_with(obs, t, people[0]) if k == 0 else tracker.step_with(obs, t)
+        labels.append(names[step.chosen] if step.found else ".")
+    assert labels[:25] == ["T"] * 25 and "B" not in labels, "".join(labels)
+    if case == "clearly":
+        assert labels[40:46] == ["."] * 6 and labels[47:] == ["T"] * 7, "".join(labels)
+    else:
+        assert labels[40:] == ["."] * 14, "".join(labels)
+
+
+def test_a_held_candidate_counts_as_clearly_the_targets_only_against_its_holders_own_colours():
+    """Histograms over 4 bins. The templates are bin 0. Track 2's own colour is bins 2-3, track 3's is
+    bin 0. A bin-0 candidate held by track 2 fits the templates (RBhat 0) clearly better than its
+    holder (1); the same held by track 3 fits its holder as well (0): not clearly. A candidate
+    nobody holds is never counted, nor anything with the margin inf."""
+    from worldtrack.follow.others import Others
+    from worldtrack.follow.reid import held_by_another_clearly
+    from worldtrack.follow.templates import Templates
+
+    others = Others(4, 2.0, 0.08, 1.5)
+    others.add(np.zeros((2, 2)), np.array([[0, 0, 0.5, 0.5], [1.0, 0, 0, 0]]), 0.0)
+    templates = Templates(np.array([1.0, 0, 0, 0]), (1.0, 1.0))
+    hists = np.array([[0.9, 0.1, 0, 0], [0.9, 0.1, 0, 0], [0.9, 0.1, 0, 0], [0, 0, 0.5, 0.5]])
+    owner = np.array([2, 3, 0, 2])
+    assert held_by_another_clearly(hists, owner, others, templates, 0.3).tolist() == [True, False, False, False]
+    assert not held_by_another_clearly(hists, owner, others, templates, np.inf).any()

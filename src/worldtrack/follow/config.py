@@ -85,7 +85,10 @@ class FollowConfig:
         away beyond an obstacle where the PID stood held; it is a default together with the
         follower's ``map_approach`` (closed loop: held-out 80-89 0.764 -> 0.866, 53-58 0.892 -> 0.892,
         never-used 90-99 0.820 -> 0.826; open loop: synth held-out 10-19 × 300 frames recall 0.901 -> 0.924,
-        precision 0.991 -> 0.991; PETS unchanged 1.000 / 1.000; s10-s11).
+        precision 0.991 -> 0.991; PETS unchanged 1.000 / 1.000; s10-s11). reid_holder_margin : unseen
+        longer than the coast, the target may also be a candidate another track holds now if the
+        templates fit it better by more than this than the holder's own histogram does (RBhat; no
+        absolute RBhat needed; inf = never, the default; opt-in since s12).
         occluders : a person nearer the camera who covers the image box where the target should
         stand may be hiding it, and is never taken for it (True; False in the paper).
         height_margin : the target's height is learnt from depth (the highest point of its candidate,
@@ -147,6 +150,7 @@ class FollowConfig:
     reid_near: float = 0.5
     reid_accel: float = 3.0
     reid_any_track_after: float = 3.0
+    reid_holder_margin: float = float("inf")
     occluders: bool = True
     height_margin: float = 0.1
     identity_margin: float = 0.4
@@ -166,6 +170,8 @@ class FollowConfig:
         for name in ("alpha_th", "alpha_floor"):
             if not 0 <= getattr(self, name) <= 1:
                 raise InputError(f"{name}: expected a value in [0, 1], got {getattr(self, name)!r}")
+        if not self.reid_holder_margin >= 0:
+            raise InputError(f"reid_holder_margin: expected RBhat ≥ 0 (inf: never), got {self.reid_holder_margin!r}")
         if not self.reid_any_track_after >= 0:
             raise InputError(f"reid_any_track_after: expected seconds ≥ 0 (inf: never), got {self.reid_any_track_after!r}")
         if self.p < 0:

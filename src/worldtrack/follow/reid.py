@@ -12,6 +12,12 @@ must be recognised as it. Who qualifies (:func:`reidentify`):
   round, or walked out of view and in again elsewhere) is first tracked as a stranger, and the
   first rule never hands it back, even while it walks past in full view. After that long the
   prediction says little, and a track carrying the target's colours is the best evidence left;
+* opt-in (``reid_holder_margin`` finite, off by default): a candidate another track holds now, when
+  the target's templates fit it clearly better than that track's own colour does (its RBhat against
+  the templates, plus the margin, under its RBhat against the holder's own histogram). A track that
+  took over the target's candidate from somebody else (a swap as they passed) carries the other
+  person's colours, and its own candidate stops fitting them; such a candidate needs no absolute
+  RBhat (the target's own, under other light, is often over ``reid_rbhat``);
 * never one who may be hiding the target or is of another height (``hiding``), nor a piece of
   somebody another track holds now (:mod:`~worldtrack.follow.vetoes`), nor anybody farther from the
   target's prediction than a walker could have gone (:func:`within_reach`).
@@ -31,6 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from worldtrack.follow.colour import bhattacharyya
 from worldtrack.follow.config import FollowConfig
 from worldtrack.follow.dissimilarity import dissimilarity
 from worldtrack.follow.observation import Observation
@@ -56,6 +63,21 @@ def long_lost_tracks(others: Others, templates: Templates, unseen: float, cfg: F
     return others.ids[templates.rbhat(others.hist) < cfg.reid_rbhat]
 
 
+def held_by_another_clearly(hists: np.ndarray, owner: np.ndarray, others: Others, templates: Templates,
+                            margin: float) -> np.ndarray:
+    """(N,) bool: candidates (histograms (N, B)) held by another track (``owner`` (N,) ≥ 2) that fit
+    the target's templates better, by more than ``margin``, than the holder's own histogram:
+    ``RBhat(templates) + margin < RBhat(holder)``. None when ``margin`` is inf."""
+    out = np.zeros(len(owner), dtype=bool)
+    held = np.flatnonzero(np.isin(owner, others.ids))
+    if not np.isfinite(margin) or len(held) == 0:
+        return out
+    rows = np.searchsorted(others.ids, owner[held])
+    rb_holder = np.diagonal(bhattacharyya(hists[held], others.hist[rows]))     # ids are kept sorted
+    out[held] = templates.rbhat(hists[held]) + margin < rb_holder
+    return out
+
+
 def reidentify(obs: Observation, owner: np.ndarray, hiding: np.ndarray, t: float, *, others: Others,
                templates: Templates, predicted: np.ndarray, last_seen: float, alpha: float, coast_s: float,
                cfg: FollowConfig) -> int:
@@ -77,8 +99,10 @@ def reidentify(obs: Observation, owner: np.ndarray, hiding: np.ndarray, t: float
     unseen = t - last_seen
     young_ids = others.ids[(others.born > last_seen) & others.maybe_target]
     may_be = np.concatenate([young_ids, long_lost_tracks(others, templates, unseen, cfg)])
-    eligible = ((owner == 0) | np.isin(owner, may_be)) & ~hiding
-    eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, may_be))
+    clearly = held_by_another_clearly(obs.hists, owner, others, templates, cfg.reid_holder_margin)
+    clearly &= unseen > coast_s
+    eligible = ((owner == 0) | np.isin(owner, may_be) | clearly) & ~hiding
+    eligible &= ~pieces_of_others(obs.candidates.xy, (owner > 1) & ~np.isin(owner, may_be) & ~clearly)
     eligible = np.flatnonzero(eligible)
     if len(eligible) == 0:
         return -1
@@ -89,7 +113,7 @@ def reidentify(obs: Observation, owner: np.ndarray, hiding: np.ndarray, t: float
     d = dissimilarity(rb, e, alpha, cfg.alpha_th)
     # Position speaks while the prediction is trusted (coasting: a change of light may have changed
     # every colour meanwhile); after that, with E discounted, colour must agree.
-    looks = (rb < cfg.reid_rbhat) | ((d < cfg.threshold) & (unseen <= coast_s))
+    looks = (rb < cfg.reid_rbhat) | ((d < cfg.threshold) & (unseen <= coast_s)) | clearly[eligible]
     ok = looks & within_reach(c.xy[eligible], predicted, unseen, cfg)
     if not ok.any():
         return -1
