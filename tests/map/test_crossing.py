@@ -98,3 +98,39 @@ def test_a_worker_notes_the_pairs_it_sees_at_once_only_when_asked():
         tracks = [p.track() for p in tracker.position_map]
         link.observations(tracker, tracks, 1.0, {"east": Frame(None, t=1.0, index=10)})
         assert link.together == noted
+
+
+def _twins(cfg: MapConfig) -> dict[int, int]:
+    """w1 holds 1 and its tracker's duplicate 3 0.1 m apart (buckets 0-2), then only 1 while w2
+    holds 3 there (buckets 3-7). Returns the merges."""
+    state, merged = FusionState(), {}
+    for b in range(3):
+        fuse_bucket(state, b, [_obs("west", b, "w1", [_est(1, 5.6), _est(3, 5.7)]),
+                               _obs("east", b, "w2", [_est(3, 5.7)])], cfg)
+    for b in range(3, 8):
+        s = fuse_bucket(state, b, [_obs("west", b, "w1", [_est(1, 5.6)]), _obs("east", b, "w2", [_est(3, 5.7)])], cfg)
+        merged.update(s.aliases)
+    return merged
+
+
+def test_the_map_folds_a_duplicate_born_on_top_of_its_twin_despite_crossing_s():
+    assert _twins(MapConfig(crossing_s=2.0)) == {3: 1}                          # never held apart: folded
+    assert _twins(MapConfig(crossing_s=2.0, crossing_apart_m=0.0)) == {}        # issue 39o: kept for 2 s
+    merged, _ = _cross(MapConfig(crossing_s=2.0, crossing_apart_m=0.9))
+    assert merged == {}                                                         # 1 m apart: a crossing, kept
+    merged, _ = _cross(MapConfig(crossing_s=2.0, crossing_apart_m=1.1))
+    assert merged == {3: 1}
+
+
+def test_a_worker_notes_only_the_pairs_it_holds_apart():
+    from worldtrack.trackers.base import Frame
+    stub = SimpleNamespace(register_script=lambda _: None)
+    for apart_m, noted in ((0.5, {(3, 7): 1.0, (5, 7): 1.0}), (0.0, {(3, 5): 1.0, (3, 7): 1.0, (5, 7): 1.0})):
+        cfg = MapConfig(crossing_s=2.0, crossing_apart_m=apart_m, affirm_candidates=False)
+        link = MapLink(stub, MapKeys(), cfg, "w2", {"east": CAM})
+        tracker = _Tracker()
+        for pid, x in ((3, 5.0), (5, 5.2), (7, 6.0)):
+            tracker.position_map.add(x, 0.0, mode="tracking", track_id=pid, confirmed=True).seen_at = 1.0
+        tracks = [p.track() for p in tracker.position_map]
+        link.observations(tracker, tracks, 1.0, {"east": Frame(None, t=1.0, index=10)})
+        assert link.together == noted

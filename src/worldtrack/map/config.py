@@ -106,6 +106,11 @@ class MapConfig(Section):
                                                      "head_rays, 2 s lifted dev 20 MOTA 0.853 -> 0.983, but on "
                                                      "held-out 124-153 MOTA -0.005, 2 seeds better, 4 worse, "
                                                      "133 -0.137)")
+    crossing_apart_m: float = Field(0.5, ge=0, description="with crossing_s: only a pair a worker held at least "
+                                                          "this far apart (m) at once is remembered (people that "
+                                                          "cross were apart before one hid the other; a tracker's "
+                                                          "duplicate is born on top of its twin and is folded as "
+                                                          "before); 0 = every pair held at once (issue 39o)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")
