@@ -83,6 +83,10 @@ class MapConfig(Section):
                                                "held-out 84-113 below one process 8 -> 5 of 30, 10 seeds better, "
                                                "6 worse, seed 84 IDF1 -0.49; never-used 118 MOTA -0.32, 119 +0.30; "
                                                "held-out 124-153 MOTA +0.023, 11 better, 4 worse, 148 IDF1 -0.37)")
+    ray_height_deadband_m: float = Field(0.0, ge=0, description="with head_rays: the map's height stays while the "
+                                                               "median of the ray heights is within this (m) of "
+                                                               "it, the first change from the workers' height "
+                                                               "included (worldtrack.map.rays.map_height; 0 = off)")
     weigh_own: bool = Field(False, description="weigh each worker's estimate (and choose the lead) by support x "
                                               "the share of the body no other person it holds covers in its "
                                               "views, not by support alone: a worker that sees a person behind "
