@@ -63,11 +63,12 @@ class _Tracker:
         self.position_map.add(x, y, mode="tracking", time=t, track_id=track_id, confirmed=True)
 
 
-def _sync(crossing_s: float, seen_apart_at: float | None) -> set[int]:
+def _sync(crossing_s: float, seen_apart_at: float | None, gap_m: float = 0.0) -> set[int]:
     """Worker w2 (one camera) holds 3 as its own; the map has 1 (w1's) 0.2 m from it. Which ids does
     w2 hold after its sync at t = 1.05 s, having seen 1 and 3 apart at ``seen_apart_at`` (s)?"""
     stub = SimpleNamespace(register_script=lambda _: None)
-    link = MapLink(stub, MapKeys(), MapConfig(crossing_s=crossing_s, affirm_candidates=False), "w2", {"east": CAM})
+    cfg = MapConfig(crossing_s=crossing_s, crossing_gap_m=gap_m, affirm_candidates=False)
+    link = MapLink(stub, MapKeys(), cfg, "w2", {"east": CAM})
     tracker = _Tracker()
     tracker.position_map.add(5.0, 0.0, mode="tracking", track_id=3, confirmed=True)
     link.mine_seen = link.ever_seen = {3}
@@ -85,6 +86,11 @@ def test_a_worker_puts_back_the_person_it_saw_beside_its_own_moments_ago_only_wh
     assert _sync(2.0, 0.5) == {1, 3}           # seen apart 0.55 s ago: another person, placed from the map
     assert _sync(2.0, None) == {3}             # never seen apart: the map will merge them
     assert _sync(0.3, 0.5) == {3}              # seen apart too long ago
+
+
+def test_a_worker_does_not_put_back_the_other_on_top_of_its_own():
+    assert _sync(2.0, 0.5, gap_m=0.1) == {1, 3}    # 0.2 m from its own: placed
+    assert _sync(2.0, 0.5, gap_m=0.25) == {3}      # within the gap its tracker would end it again: not placed
 
 
 def test_a_worker_notes_the_pairs_it_sees_at_once_only_when_asked():

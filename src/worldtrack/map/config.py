@@ -115,6 +115,10 @@ class MapConfig(Section):
                                                           "cross were apart before one hid the other; a tracker's "
                                                           "duplicate is born on top of its twin and is folded as "
                                                           "before); 0 = every pair held at once (issue 39o)")
+    crossing_gap_m: float = Field(0.0, ge=0, description="with crossing_s: a worker puts the other of a pair back "
+                                                        "only at least this far (m) from the one it holds (nearer, "
+                                                        "its tracker ends it again as a duplicate and both ids ride "
+                                                        "one person: held-out 133); 0 = anywhere (issue 39o)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

@@ -277,10 +277,11 @@ class MapLink:
                                                                       p.height))
 
     def _holds_near(self, local: PositionMap, x: float, y: float, pid: int, t: float) -> bool:
-        """Held within merge_distance_m of (x, y), and (``crossing_s``) not seen beside ``pid`` lately?"""
-        return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m and
-                   t - self.together.get((min(q.id, pid), max(q.id, pid)), -math.inf) > self.cfg.crossing_s
-                   for q in local)
+        """Held within merge_distance_m of (x, y), and (``crossing_s``) not seen beside ``pid`` lately
+        or within ``crossing_gap_m`` (there its tracker would end ``pid`` again as a duplicate)?"""
+        return any(q.id > 0 and (d := math.hypot(q.x - x, q.y - y)) < self.cfg.merge_distance_m and
+                   (t - self.together.get((min(q.id, pid), max(q.id, pid)), -math.inf) > self.cfg.crossing_s or
+                    d < self.cfg.crossing_gap_m) for q in local)
 
     def _place(self, tracker: Tracker, p, x: float, y: float, t: float) -> None:
         local = tracker.position_map
