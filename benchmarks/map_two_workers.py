@@ -20,6 +20,7 @@ Writes ``benchmarks/results/map_two_workers.md``.
 from __future__ import annotations
 
 import argparse
+import re
 import statistics
 import subprocess
 import sys
@@ -139,7 +140,7 @@ def main() -> None:
     ap.add_argument("--only-if-same", action="store_true",
                     help="run the --also variants only for seeds whose default run published a same-blob claim "
                          "(Observation.same; without one the variant map.same_blob_iou=0 writes the same map)")
-    ap.add_argument("--dump", type=Path, help="write per run the workers' published estimates, the map and the "
+    ap.add_argument("--dump", type=Path, help="write per run and variant (seedS_runK/VARIANT) the workers' published estimates, the map and the "
                                              "one process's tracks as CSV files in this folder (to find out why)")
     args = ap.parse_args()
     seeds, repeats = ([2], 1) if args.quick else ([int(s) for s in args.seeds.split(",")], args.repeats)
@@ -172,7 +173,8 @@ def main() -> None:
                     fused = evaluate_detailed(gt, read_tracks(replay(connect(server.url), MapKeys(),
                                                                      seq / f"replay{k}").tracks_csv))
                     if args.dump:
-                        dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}")
+                        dump_run(connect(server.url), sc.camera_ids, seq, k, args.dump / f"seed{seed}_run{k}" /
+                                 re.sub(r"[^\w.=-]+", "_", variant))
                     if variant == "default":
                         affirmed_run = any_affirms(connect(server.url), sc.camera_ids)
                     folds = same_blob_folds(connect(server.url), sc.camera_ids, gt)

@@ -63,11 +63,12 @@ class _Tracker:
         self.position_map.add(x, y, mode="tracking", time=t, track_id=track_id, confirmed=True)
 
 
-def _sync(crossing_s: float, seen_apart_at: float | None) -> set[int]:
+def _sync(crossing_s: float, seen_apart_at: float | None, gap_m: float = 0.0) -> set[int]:
     """Worker w2 (one camera) holds 3 as its own; the map has 1 (w1's) 0.2 m from it. Which ids does
     w2 hold after its sync at t = 1.05 s, having seen 1 and 3 apart at ``seen_apart_at`` (s)?"""
     stub = SimpleNamespace(register_script=lambda _: None)
-    link = MapLink(stub, MapKeys(), MapConfig(crossing_s=crossing_s, affirm_candidates=False), "w2", {"east": CAM})
+    cfg = MapConfig(crossing_s=crossing_s, crossing_gap_m=gap_m, affirm_candidates=False)
+    link = MapLink(stub, MapKeys(), cfg, "w2", {"east": CAM})
     tracker = _Tracker()
     tracker.position_map.add(5.0, 0.0, mode="tracking", track_id=3, confirmed=True)
     link.mine_seen = link.ever_seen = {3}
@@ -87,6 +88,11 @@ def test_a_worker_puts_back_the_person_it_saw_beside_its_own_moments_ago_only_wh
     assert _sync(0.3, 0.5) == {3}              # seen apart too long ago
 
 
+def test_a_worker_does_not_put_back_the_other_on_top_of_its_own():
+    assert _sync(2.0, 0.5, gap_m=0.1) == {1, 3}    # 0.2 m from its own: placed
+    assert _sync(2.0, 0.5, gap_m=0.25) == {3}      # within the gap its tracker would end it again: not placed
+
+
 def test_a_worker_notes_the_pairs_it_sees_at_once_only_when_asked():
     from worldtrack.trackers.base import Frame
     stub = SimpleNamespace(register_script=lambda _: None)
@@ -94,6 +100,42 @@ def test_a_worker_notes_the_pairs_it_sees_at_once_only_when_asked():
         link = MapLink(stub, MapKeys(), MapConfig(crossing_s=crossing_s, affirm_candidates=False), "w2", {"east": CAM})
         tracker = _Tracker()
         for pid, x in ((3, 5.0), (5, 6.0)):
+            tracker.position_map.add(x, 0.0, mode="tracking", track_id=pid, confirmed=True).seen_at = 1.0
+        tracks = [p.track() for p in tracker.position_map]
+        link.observations(tracker, tracks, 1.0, {"east": Frame(None, t=1.0, index=10)})
+        assert link.together == noted
+
+
+def _twins(cfg: MapConfig) -> dict[int, int]:
+    """w1 holds 1 and its tracker's duplicate 3 0.1 m apart (buckets 0-2), then only 1 while w2
+    holds 3 there (buckets 3-7). Returns the merges."""
+    state, merged = FusionState(), {}
+    for b in range(3):
+        fuse_bucket(state, b, [_obs("west", b, "w1", [_est(1, 5.6), _est(3, 5.7)]),
+                               _obs("east", b, "w2", [_est(3, 5.7)])], cfg)
+    for b in range(3, 8):
+        s = fuse_bucket(state, b, [_obs("west", b, "w1", [_est(1, 5.6)]), _obs("east", b, "w2", [_est(3, 5.7)])], cfg)
+        merged.update(s.aliases)
+    return merged
+
+
+def test_the_map_folds_a_duplicate_born_on_top_of_its_twin_despite_crossing_s():
+    assert _twins(MapConfig(crossing_s=2.0)) == {3: 1}                          # never held apart: folded
+    assert _twins(MapConfig(crossing_s=2.0, crossing_apart_m=0.0)) == {}        # issue 39o: kept for 2 s
+    merged, _ = _cross(MapConfig(crossing_s=2.0, crossing_apart_m=0.9))
+    assert merged == {}                                                         # 1 m apart: a crossing, kept
+    merged, _ = _cross(MapConfig(crossing_s=2.0, crossing_apart_m=1.1))
+    assert merged == {3: 1}
+
+
+def test_a_worker_notes_only_the_pairs_it_holds_apart():
+    from worldtrack.trackers.base import Frame
+    stub = SimpleNamespace(register_script=lambda _: None)
+    for apart_m, noted in ((0.5, {(3, 7): 1.0, (5, 7): 1.0}), (0.0, {(3, 5): 1.0, (3, 7): 1.0, (5, 7): 1.0})):
+        cfg = MapConfig(crossing_s=2.0, crossing_apart_m=apart_m, affirm_candidates=False)
+        link = MapLink(stub, MapKeys(), cfg, "w2", {"east": CAM})
+        tracker = _Tracker()
+        for pid, x in ((3, 5.0), (5, 5.2), (7, 6.0)):
             tracker.position_map.add(x, 0.0, mode="tracking", track_id=pid, confirmed=True).seen_at = 1.0
         tracks = [p.track() for p in tracker.position_map]
         link.observations(tracker, tracks, 1.0, {"east": Frame(None, t=1.0, index=10)})

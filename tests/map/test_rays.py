@@ -152,3 +152,21 @@ def test_the_ray_heights_are_handed_over_and_without_them_the_hand_over_is_as_be
     plain = FusionState()
     fuse_bucket(plain, 50, _opposite_workers([5.3, 2.5, 1.85, 0.45], 6.0, 4.9), MapConfig())
     assert "ray_heights" not in plain.to_json() and FusionState.from_json(plain.to_json()).people[7].ray_heights == []
+
+
+def test_the_map_height_holds_while_the_ray_heights_stay_within_the_deadband():
+    from worldtrack.map.fusion import provisional_state
+    from worldtrack.map.rays import map_height
+    truth = [5.3, 2.5, 1.85, 0.45]                      # the rays tell ~1.85 m, the estimates 1.7 m
+    for deadband, expect in ((0.25, 1.7), (0.05, 1.85)):
+        cfg = MapConfig(head_rays=True, ray_height_deadband_m=deadband)
+        state = FusionState()
+        for b in range(50, 54):
+            p, = fuse_bucket(state, b, _opposite_workers(truth, 6.0, 4.9, b / 10), cfg).people
+        assert abs(p.height - expect) < 0.04
+        p, = provisional_state(state, {54: _opposite_workers(truth, 6.0, 4.9, 5.4)}, cfg).people
+        assert abs(p.height - expect) < 0.04           # the live map holds it too
+    assert map_height([1.80, 1.84, 1.90], 1.82, 0.03) == 1.82        # within: held
+    assert map_height([1.80, 1.86, 1.90], 1.82, 0.03) == 1.86        # beyond: the median
+    assert map_height([1.80, 1.84, 1.90], 1.82, 0.0) == 1.84         # off: always the median
+    assert map_height([1.80, 1.84, 1.90], math.nan, 0.03) == 1.84    # no height yet

@@ -83,6 +83,13 @@ class MapConfig(Section):
                                                "held-out 84-113 below one process 8 -> 5 of 30, 10 seeds better, "
                                                "6 worse, seed 84 IDF1 -0.49; never-used 118 MOTA -0.32, 119 +0.30; "
                                                "held-out 124-153 MOTA +0.023, 11 better, 4 worse, 148 IDF1 -0.37)")
+    ray_height_deadband_m: float = Field(0.0, ge=0, description="with head_rays: the map's height stays while the "
+                                                               "median of the ray heights is within this (m) of "
+                                                               "it, the first change from the workers' height "
+                                                               "included (worldtrack.map.rays.map_height; 0 = off: "
+                                                               "0.03 on 8 seen seeds vs head_rays MOTA +0.026, 4 "
+                                                               "better, 2 worse; IDF1 84 +0.49, 148 +0.37, but 20 "
+                                                               "-0.17, 137 -0.09)")
     weigh_own: bool = Field(False, description="weigh each worker's estimate (and choose the lead) by support x "
                                               "the share of the body no other person it holds covers in its "
                                               "views, not by support alone: a worker that sees a person behind "
@@ -105,7 +112,18 @@ class MapConfig(Section):
                                                      "person in front; worldtrack.map.merges; 0 = off: with "
                                                      "head_rays, 2 s lifted dev 20 MOTA 0.853 -> 0.983, but on "
                                                      "held-out 124-153 MOTA -0.005, 2 seeds better, 4 worse, "
-                                                     "133 -0.137)")
+                                                     "133 -0.137; with crossing_gap_m 133 -0.023, IDF1 still -0.45)")
+    crossing_apart_m: float = Field(0.5, ge=0, description="with crossing_s: only a pair a worker held at least "
+                                                          "this far apart (m) at once is remembered (people that "
+                                                          "cross were apart before one hid the other; a tracker's "
+                                                          "duplicate is born on top of its twin and is folded as "
+                                                          "before; no digest changed on dev 0-8, 20, held-out 133, "
+                                                          "148); 0 = every pair held at once (issue 39o)")
+    crossing_gap_m: float = Field(0.25, ge=0, description="with crossing_s: a worker puts the other of a pair back "
+                                                         "only at least this far (m) from the one it holds (nearer, "
+                                                         "its tracker ends it again as a duplicate and both ids ride "
+                                                         "one person: held-out 133 MOTA 0.852 -> 0.965, 4 of 13 "
+                                                         "seen seeds better, 0 worse); 0 = anywhere (issue 39o)")
     merge_distance_m: float = Field(0.5, gt=0, description="two ids from different workers closer than this "
                                                            "for merge_after_s are one person (the younger id "
                                                            "is folded into the elder)")

@@ -79,11 +79,7 @@ from worldtrack.map.evidence import (LEAD_SHARE, floor_information, in_views, pe
                                      with_ray_error)
 from worldtrack.map.messages import REFUTED, Estimate, MapPerson, MapState, Observation
 from worldtrack.map.merges import MIN_WEIGHT, merge_duplicates
-from worldtrack.map.rays import ViewRay, ray_height
-
-#: ``map.head_rays``: the map's height of a person is the median of their last this many heights
-#: from head rays (:func:`~worldtrack.map.rays.ray_height`), once three are in.
-RAY_HEIGHTS = 15
+from worldtrack.map.rays import RAY_HEIGHTS, ViewRay, map_height, ray_height
 from worldtrack.map.refute import refute
 from worldtrack.map.same_blob import fold_same_blobs
 
@@ -308,7 +304,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
     estimates = _per_worker(state, observations)
     workers_of = _update_people(state.people, estimates, t, cfg.weigh_by, weigh_own=cfg.weigh_own,
                                 ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view,
-                                rays=_rays_of(state, observations) if cfg.head_rays else None)
+                                rays=_rays_of(state, observations) if cfg.head_rays else None,
+                                height_deadband_m=cfg.ray_height_deadband_m)
     ended = {state.resolve(i) for o in observations for i in o.ended}
     for pid in list(state.people):
         p = state.people[pid]
@@ -331,7 +328,8 @@ def fuse_bucket(state: FusionState, bucket: int, observations: list[Observation]
 def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str, Estimate]], t: float,
                    weigh_by: str = "geometry", copy: bool = False, weigh_own: bool = True,
                    ray_error_m: float = 0.0, height_by_view: bool = False,
-                   rays: Mapping[int, Mapping[tuple[str, str], ViewRay]] | None = None) -> dict[int, set[str]]:
+                   rays: Mapping[int, Mapping[tuple[str, str], ViewRay]] | None = None,
+                   height_deadband_m: float = 0.0) -> dict[int, set[str]]:
     """Set each reported person of ``people`` to the weighted estimate of the workers that report
     them at bucket time ``t`` (s); ``copy``: replace the person by an updated copy (the people of a
     committed state stay as they are). ``rays``: per person the view rays of each worker and camera
@@ -356,8 +354,8 @@ def _update_people(people: dict[int, FusedPerson], estimates: dict[int, dict[str
         p.x, p.y, p.vx, p.vy, p.score, p.support = x, y, vx, vy, score, support
         if measured is not None:     # a new list: a copy (copy=True) must not change the committed person's
             p.ray_heights = [*p.ray_heights[1 - RAY_HEIGHTS:], measured]
-        if len(p.ray_heights) >= 3:
-            h = float(np.median(p.ray_heights))
+        if len(p.ray_heights) >= 3:       # held while within height_deadband_m (map_height)
+            h = map_height(p.ray_heights, p.height, height_deadband_m)
         p.height = h if math.isfinite(h) else p.height
         p.width = w if math.isfinite(w) else p.width
         p.mode, p.last_seen, p.workers = "tracking", t, len(use)
@@ -388,7 +386,8 @@ def provisional_state(state: FusionState, buckets: Mapping[int, list[Observation
     for b in sorted(buckets):
         _update_people(people, _per_worker(state, buckets[b]), b * cfg.bucket_s, cfg.weigh_by, copy=True,
                        weigh_own=cfg.weigh_own, ray_error_m=cfg.ray_error_m, height_by_view=cfg.height_by_view,
-                       rays=_rays_of(state, buckets[b]) if cfg.head_rays else None)
+                       rays=_rays_of(state, buckets[b]) if cfg.head_rays else None,
+                       height_deadband_m=cfg.ray_height_deadband_m)
     t = max(buckets, default=state.last_bucket or 0) * cfg.bucket_s
     reports = tuple((o.camera, o.t, o.sent) for b in sorted(buckets) for o in buckets[b])
     public = tuple(p.public() for p in sorted(people.values(), key=lambda p: p.id))

@@ -34,7 +34,7 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
     ids = sorted(workers_of)
     close_now = set()
     if cfg.crossing_s > 0:
-        remember_together(state, workers_of, t, cfg.crossing_s)
+        remember_together(state, workers_of, t, cfg.crossing_s, _held_xy(estimates or {}), cfg.crossing_apart_m)
     if len(ids) >= 2:
         xy = np.array([[state.people[i].x, state.people[i].y] for i in ids])
         for i, j in cKDTree(xy).query_pairs(cfg.merge_distance_m):
@@ -64,30 +64,57 @@ def merge_duplicates(state: "FusionState", workers_of: dict[int, set[str]], t: f
     return merged
 
 
-def remember_together(state: "FusionState", workers_of: Mapping[int, set[str]], t: float, memory_s: float) -> None:
+def remember_together(state: "FusionState", workers_of: Mapping[int, set[str]], t: float, memory_s: float,
+                      held_xy: Mapping[str, Mapping[int, tuple[float, float]]] | None = None,
+                      apart_m: float = 0.0) -> None:
     """Note in ``state.together`` every pair of ids ``(a, b)``, ``a < b``, some worker sees at ``t``
-    (s); forget pairs older than ``memory_s`` (s) or with a person gone from the map."""
+    (s) at least ``apart_m`` (m) apart where that worker holds them (``held_xy``: per worker, id →
+    (x, y) m; an id missing there counts as apart); forget pairs older than ``memory_s`` (s) or with
+    a person gone from the map."""
     by_worker: dict[str, list[int]] = {}
     for pid in sorted(workers_of):
         for w in sorted(workers_of[pid]):
             by_worker.setdefault(w, []).append(pid)
-    for held in by_worker.values():
-        state.together = held_together(state.together, held, t, memory_s)
+    for w, held in by_worker.items():
+        state.together = held_together(state.together, held, t, memory_s, (held_xy or {}).get(w), apart_m)
     state.together = {k: s for k, s in state.together.items() if k[0] in state.people and k[1] in state.people}
 
 
-def held_together(together: Mapping[tuple[int, int], float], ids: Iterable[int], t: float,
-                  memory_s: float) -> dict[tuple[int, int], float]:
+def held_together(together: Mapping[tuple[int, int], float], ids: Iterable[int], t: float, memory_s: float,
+                  xy: Mapping[int, tuple[float, float]] | None = None,
+                  apart_m: float = 0.0) -> dict[tuple[int, int], float]:
     """``together`` (pairs of ids ``(a, b)``, ``a < b``: when last held at the same time, s) with
-    every pair of ``ids`` held at ``t`` (s), pairs older than ``memory_s`` (s) left out.
+    every pair of ``ids`` held at ``t`` (s), pairs older than ``memory_s`` (s) left out (``memory_s``
+    0: none noted, ``{}``).
+
+    With ``apart_m`` > 0 only pairs held at least that far apart (``xy``: id → (x, y), m; an id
+    without a position counts as apart) are noted: two people crossing were apart before one hid
+    the other, while a tracker's duplicate is born on top of its twin and is no second person.
 
     >>> held_together({(1, 9): 0.0}, [3, 1, 2], 5.0, 2.0)
     {(1, 2): 5.0, (1, 3): 5.0, (2, 3): 5.0}
+    >>> held_together({}, [1, 2, 3], 5.0, 2.0, {1: (0.0, 0.0), 2: (0.1, 0.0), 3: (2.0, 0.0)}, 0.5)
+    {(1, 3): 5.0, (2, 3): 5.0}
     """
+    if memory_s <= 0:
+        return {}
     ids = sorted(set(ids))
     out = {k: s for k, s in together.items() if t - s <= memory_s}
-    out.update({(a, b): t for k, a in enumerate(ids) for b in ids[k + 1:]})
+    pairs = [(a, b) for k, a in enumerate(ids) for b in ids[k + 1:]]
+    if apart_m > 0 and xy:
+        pairs = [(a, b) for a, b in pairs if a not in xy or b not in xy or
+                 math.hypot(xy[a][0] - xy[b][0], xy[a][1] - xy[b][1]) >= apart_m]
+    out.update({pair: t for pair in pairs})
     return dict(sorted(out.items()))
+
+
+def _held_xy(estimates: Mapping[int, Mapping[str, Estimate]]) -> dict[str, dict[int, tuple[float, float]]]:
+    """Per worker, where it holds each id it reports: id → (x, y), m."""
+    out: dict[str, dict[int, tuple[float, float]]] = {}
+    for pid, by_worker in estimates.items():
+        for w, e in by_worker.items():
+            out.setdefault(w, {})[pid] = (e.x, e.y)
+    return out
 
 
 def _newborns_within_gate(state: "FusionState", workers_of: dict[int, set[str]], t: float, cfg: MapConfig,

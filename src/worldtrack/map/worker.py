@@ -68,9 +68,7 @@ class MapLink:
                  fps: float = 10.0, clock: Callable[[], float] = time.time,
                  occlusion: Mapping[str, np.ndarray] | None = None, scene_cameras: Sequence[str] = ()):
         self.client, self.keys, self.cfg, self.name, self.clock = client, keys, cfg, name, clock
-        self.cameras = dict(cameras)
-        self.occlusion = dict(occlusion or {})
-        self.fps = fps
+        self.cameras, self.occlusion, self.fps = dict(cameras), dict(occlusion or {}), fps
         self.leases = {c: Lease(client, keys.camera_lease(c), name, cfg.lease_s) for c in self.cameras}
         order = [c for c in scene_cameras if c in self.cameras]
         #: Ids this worker gives out: ``slot + 1 + k * stride`` (k = 0, 1, ...), slot = the scene
@@ -279,10 +277,11 @@ class MapLink:
                                                                       p.height))
 
     def _holds_near(self, local: PositionMap, x: float, y: float, pid: int, t: float) -> bool:
-        """Held within merge_distance_m of (x, y), and (``crossing_s``) not seen beside ``pid`` lately?"""
-        return any(q.id > 0 and math.hypot(q.x - x, q.y - y) < self.cfg.merge_distance_m and
-                   t - self.together.get((min(q.id, pid), max(q.id, pid)), -math.inf) > self.cfg.crossing_s
-                   for q in local)
+        """Held within merge_distance_m of (x, y), and (``crossing_s``) not seen beside ``pid`` lately
+        or within ``crossing_gap_m`` (there its tracker would end ``pid`` again as a duplicate)?"""
+        return any(q.id > 0 and (d := math.hypot(q.x - x, q.y - y)) < self.cfg.merge_distance_m and
+                   (t - self.together.get((min(q.id, pid), max(q.id, pid)), -math.inf) > self.cfg.crossing_s or
+                    d < self.cfg.crossing_gap_m) for q in local)
 
     def _place(self, tracker: Tracker, p, x: float, y: float, t: float) -> None:
         local = tracker.position_map
@@ -339,8 +338,9 @@ class MapLink:
         ended = tuple(sorted(i for i in self._reported if i not in local))
         self._reported = {i: () for i in now_ids}
         self.ever_seen, self.born_here = (ids & {p.id for p in local} for ids in (self.ever_seen, self.born_here))
-        seen_ids = {e.id for es in per_cam.values() for e in es if e.seen}
-        self.together = held_together(self.together, seen_ids, t, self.cfg.crossing_s) if self.cfg.crossing_s else {}
+        held = {e.id: (e.x, e.y) for es in per_cam.values() for e in es if e.seen}   # seen now: where (m)
+        seen_ids, self.together = set(held), held_together(self.together, held, t, self.cfg.crossing_s, held,
+                                                           self.cfg.crossing_apart_m)
         absent = self._absent(tracker, tracks, t, cams, boxes, seen_ids) if self.cfg.negative_evidence else {}
         cands, affirms = self.exchange.after_step(tracker, tracks, boxes, cams) if self.exchange else ({}, {})
         same = same_blob_claims({c: self.cameras[c] for c in cams}, tracks, self.state, self.born_here, t,
