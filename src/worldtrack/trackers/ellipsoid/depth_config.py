@@ -45,6 +45,9 @@ class FeetConfig(Section):
         "read above them is within this many times one measurement's scatter of the person's height (at most "
         "height_match_m; anchor_gates.py); 0 = height_match_m alone (3 cost one camera held-out 420-439 0.438 -> 0.389 "
         "with the other gates, issue 37: too strict)")
+    height_scatter_floor_m: float = Field(
+        0.02, gt=0, description="with height_sigmas: the least scatter of one height measurement the gate assumes, m "
+        "(anchor_gates.py; 0.02 m with 3 sigmas is a 0.06 m gate)")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")

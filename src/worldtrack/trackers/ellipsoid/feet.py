@@ -144,7 +144,8 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
                 break
             look = nearer
         pixel = cam.project(found[0][None])[0] if found is not None else None
-        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas)
+        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas,
+                             config.height_scatter_floor_m)
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= gate \
                 and not touches_other(look[1], look[2], pixel, k) \
                 and not feet_doubted(view, current, k, pixel, found[0][:2], config):
