@@ -85,6 +85,18 @@ def test_a_measured_height_gates_the_feet_by_its_scatter(seen):
     assert height_gate_m([1.70, 1.73, 1.67, 1.74, 1.70], 0.1, 3.0) == 0.1
 
 
+@pytest.mark.parametrize("floor_m, moves", [(0.02, 0), (0.04, 1)])
+def test_the_scatter_floor_loosens_the_height_gate(seen, floor_m, moves):
+    tracker, labels, _, truth = seen
+    # Five equal samples (no scatter): the gate is 3 x the floor, 0.06 m or 0.12 m; the height is 0.1 m off.
+    p, _ = misplaced(tracker, truth, 0.6)
+    p.height = truth["height"] + 0.1
+    p.height_samples.extend([p.height] * 5)
+    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0, height_scatter_floor_m=floor_m)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
+    assert height_gate_m([1.7] * 5, 0.3, 3.0, floor_m) == pytest.approx(3 * floor_m)
+
+
 def _with_obstacle_beside_the_feet(tracker, instance, truth, distance_m: float):
     """The tracker's views with an obstacle ``distance_m`` m from the camera (floor distance) covering a
     few pixels 3-5 columns beside the lowest pixel of the truth's silhouette (not the pixel below it)."""
