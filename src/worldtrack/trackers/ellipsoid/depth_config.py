@@ -48,6 +48,9 @@ class FeetConfig(Section):
     height_scatter_floor_m: float = Field(
         0.02, gt=0, description="with height_sigmas: the least scatter of one height measurement the gate assumes, m "
         "(anchor_gates.py; 0.02 m with 3 sigmas is a 0.06 m gate)")
+    height_gate_near_only: bool = Field(
+        False, description="with height_sigmas: that gate only while another person's ellipse box meets the "
+        "person's (a merged silhouette); alone, height_match_m (anchor_gates.py)")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")

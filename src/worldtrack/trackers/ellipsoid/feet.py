@@ -45,7 +45,7 @@ import numpy as np
 
 from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.anchor_footprint import standing_point
-from worldtrack.trackers.ellipsoid.anchor_gates import feet_doubted, height_gate_m
+from worldtrack.trackers.ellipsoid.anchor_gates import ellipse_boxes, feet_doubted, height_gate_m, overlaps_other
 from worldtrack.trackers.ellipsoid.cameras import CameraView
 from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
@@ -144,7 +144,8 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
                 break
             look = nearer
         pixel = cam.project(found[0][None])[0] if found is not None else None
-        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas,
+        alone = config.height_gate_near_only and not overlaps_other(ellipse_boxes(current.inner), current.valid, k)
+        gate = height_gate_m(p.height_samples, config.height_match_m, 0.0 if alone else config.height_sigmas,
                              config.height_scatter_floor_m)
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= gate \
                 and not touches_other(look[1], look[2], pixel, k) \
