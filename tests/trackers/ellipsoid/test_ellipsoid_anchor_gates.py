@@ -122,3 +122,25 @@ def test_an_obstacle_nearer_than_the_feet_beside_them_stops_the_anchor_with_obst
     config = FeetConfig(anchor=True, head_fallback=False, obstacle_clear=True)
     # Nearer than the feet: its edge may be where the silhouette ends. Behind them (30 m): not.
     assert anchor_to_feet([p], views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
+
+
+def test_with_near_only_the_height_gate_holds_only_beside_another_person(seen):
+    tracker, labels, _, truth = seen
+
+    def moves(near_only: bool, beside_m: float | None, sigmas: float = 3.0) -> int:
+        # The track's height 0.1 m over what the silhouette shows, 5 equal samples: the tight gate is 0.06 m.
+        p, _ = misplaced(tracker, truth, 0.6)
+        p.height = truth["height"] + 0.1
+        p.height_samples.extend([p.height] * 5)
+        people = [p]
+        if beside_m is not None:   # another track across the line of sight, its ellipse beside the person's
+            xy = _near_on_ray(tracker, truth, 0.6, beside_m)
+            people.append(tracker.position_map.add(float(xy[0]), float(xy[1]), truth["height"], 0.45, mode="lost", time=0.0))
+        config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=sigmas, height_gate_near_only=near_only)
+        return anchor_to_feet(people, tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig())
+
+    assert moves(False, None) == 0      # the tight gate everywhere
+    assert moves(True, None) == 1       # alone: height_match_m (0.3 m)
+    assert moves(True, 0.5) == 0        # another ellipse beside: the tight gate again
+    assert moves(True, 0.5, 0.0) == 1   # (no gate: the other track alone does not stop it)
+    assert moves(True, 3.0) == 1        # far aside: alone
