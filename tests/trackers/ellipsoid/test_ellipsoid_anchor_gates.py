@@ -144,3 +144,16 @@ def test_with_near_only_the_height_gate_holds_only_beside_another_person(seen):
     assert moves(True, 0.5) == 0        # another ellipse beside: the tight gate again
     assert moves(True, 0.5, 0.0) == 1   # (no gate: the other track alone does not stop it)
     assert moves(True, 3.0) == 1        # far aside: alone
+
+
+@pytest.mark.parametrize("samples, moves", [(5, 1), (10, 0)])
+def test_with_min_samples_the_height_gate_waits_for_a_settled_height(seen, samples, moves):
+    tracker, labels, _, truth = seen
+    # The track's height 0.1 m over what the silhouette shows: the tight gate (0.06 m) only from 10 samples.
+    p, _ = misplaced(tracker, truth, 0.6)
+    p.height = truth["height"] + 0.1
+    p.height_samples.extend([p.height] * samples)
+    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0, height_gate_min_samples=10)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
+    assert height_gate_m([1.7] * 9, 0.3, 3.0, 0.02, 10) == 0.3
+    assert height_gate_m([1.7] * 10, 0.3, 3.0, 0.02, 10) == pytest.approx(0.06)

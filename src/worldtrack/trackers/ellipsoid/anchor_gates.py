@@ -152,11 +152,13 @@ def overlaps_other(boxes: np.ndarray, valid: np.ndarray, k: int) -> bool:
     return bool(np.any(others & (b[:, 0] < u1) & (b[:, 1] > u0) & (b[:, 2] < v1) & (b[:, 3] > v0)))
 
 
-def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float, floor_m: float = SCATTER_FLOOR_M) -> float:
+def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float, floor_m: float = SCATTER_FLOOR_M,
+                  min_samples: int = 3) -> float:
     """How far (m) the height read above the feet may be from the person's height: ``match_m``
-    while fewer than 3 samples are in or ``sigmas`` is 0, else ``sigmas`` × the scatter of one
-    measurement (1.4826 × MAD of ``samples``, m, at least ``floor_m``, m), at most ``match_m``."""
-    if sigmas <= 0 or len(samples) < 3:
+    while fewer than ``min_samples`` (at least 3) samples are in or ``sigmas`` is 0, else ``sigmas`` ×
+    the scatter of one measurement (1.4826 × MAD of ``samples``, m, at least ``floor_m``, m), at most
+    ``match_m``."""
+    if sigmas <= 0 or len(samples) < max(3, min_samples):
         return match_m
     s = np.asarray(samples, dtype=float)
     scatter = max(1.4826 * float(np.median(np.abs(s - np.median(s)))), floor_m)

@@ -51,6 +51,9 @@ class FeetConfig(Section):
     height_gate_near_only: bool = Field(
         False, description="with height_sigmas: that gate only while another person's ellipse box meets the "
         "person's (a merged silhouette); alone, height_match_m (anchor_gates.py)")
+    height_gate_min_samples: int = Field(
+        3, ge=3, description="with height_sigmas: that gate only once this many height samples are in (a settled "
+        "height); before, height_match_m (anchor_gates.py)")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")

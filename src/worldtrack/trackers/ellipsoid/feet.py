@@ -146,7 +146,7 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
         pixel = cam.project(found[0][None])[0] if found is not None else None
         alone = config.height_gate_near_only and not overlaps_other(ellipse_boxes(current.inner), current.valid, k)
         gate = height_gate_m(p.height_samples, config.height_match_m, 0.0 if alone else config.height_sigmas,
-                             config.height_scatter_floor_m)
+                             config.height_scatter_floor_m, config.height_gate_min_samples)
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= gate \
                 and not touches_other(look[1], look[2], pixel, k) \
                 and not feet_doubted(view, current, k, pixel, found[0][:2], config):
