@@ -6,7 +6,7 @@ import pytest
 from _line_of_sight import line_of_sight_frame, misplaced
 
 from worldtrack.trackers.ellipsoid.anchor_gates import height_gate_m, ray_shared
-from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
+from worldtrack.trackers.ellipsoid.config import AnchorHeightConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 
 
@@ -92,8 +92,9 @@ def test_the_scatter_floor_loosens_the_height_gate(seen, floor_m, moves):
     p, _ = misplaced(tracker, truth, 0.6)
     p.height = truth["height"] + 0.1
     p.height_samples.extend([p.height] * 5)
-    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0, height_scatter_floor_m=floor_m)
-    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
+    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0)
+    gate = AnchorHeightConfig(scatter_floor_m=floor_m)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig(), gate) == moves
     assert height_gate_m([1.7] * 5, 0.3, 3.0, floor_m) == pytest.approx(3 * floor_m)
 
 
@@ -124,28 +125,6 @@ def test_an_obstacle_nearer_than_the_feet_beside_them_stops_the_anchor_with_obst
     assert anchor_to_feet([p], views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
 
 
-def test_with_near_only_the_height_gate_holds_only_beside_another_person(seen):
-    tracker, labels, _, truth = seen
-
-    def moves(near_only: bool, beside_m: float | None, sigmas: float = 3.0) -> int:
-        # The track's height 0.1 m over what the silhouette shows, 5 equal samples: the tight gate is 0.06 m.
-        p, _ = misplaced(tracker, truth, 0.6)
-        p.height = truth["height"] + 0.1
-        p.height_samples.extend([p.height] * 5)
-        people = [p]
-        if beside_m is not None:   # another track across the line of sight, its ellipse beside the person's
-            xy = _near_on_ray(tracker, truth, 0.6, beside_m)
-            people.append(tracker.position_map.add(float(xy[0]), float(xy[1]), truth["height"], 0.45, mode="lost", time=0.0))
-        config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=sigmas, height_gate_near_only=near_only)
-        return anchor_to_feet(people, tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig())
-
-    assert moves(False, None) == 0      # the tight gate everywhere
-    assert moves(True, None) == 1       # alone: height_match_m (0.3 m)
-    assert moves(True, 0.5) == 0        # another ellipse beside: the tight gate again
-    assert moves(True, 0.5, 0.0) == 1   # (no gate: the other track alone does not stop it)
-    assert moves(True, 3.0) == 1        # far aside: alone
-
-
 @pytest.mark.parametrize("samples, moves", [(5, 1), (10, 0)])
 def test_with_min_samples_the_height_gate_waits_for_a_settled_height(seen, samples, moves):
     tracker, labels, _, truth = seen
@@ -153,7 +132,8 @@ def test_with_min_samples_the_height_gate_waits_for_a_settled_height(seen, sampl
     p, _ = misplaced(tracker, truth, 0.6)
     p.height = truth["height"] + 0.1
     p.height_samples.extend([p.height] * samples)
-    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0, height_gate_min_samples=10)
-    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
+    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0)
+    gate = AnchorHeightConfig(min_samples=10)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig(), gate) == moves
     assert height_gate_m([1.7] * 9, 0.3, 3.0, 0.02, 10) == 0.3
     assert height_gate_m([1.7] * 10, 0.3, 3.0, 0.02, 10) == pytest.approx(0.06)

@@ -33,8 +33,6 @@ floor point under the lowest point of their silhouette. Three ways that point is
 False
 >>> ray_shared(boxes, np.ones(3, bool), 0, np.array([100.0, 99.0]), 0.3)
 True
->>> overlaps_other(boxes, np.ones(3, bool), 0), overlaps_other(boxes, np.ones(3, bool), 2)
-(True, False)
 >>> ellipse_boxes(np.array([[100.0, 50.0, 1 / 10 ** 2, 0.0, 1 / 40 ** 2]])).tolist()
 [[90.0, 110.0, 10.0, 90.0]]
 >>> round(height_gate_m([1.70, 1.71, 1.69, 1.72, 1.70], 0.3, 3.0), 3)     # MAD 0.01 m: the floor
@@ -143,15 +141,6 @@ def feet_doubted(view, current, k: int, pixel: np.ndarray, feet_xy: np.ndarray, 
     return obstacle_beside(view.occ, pixel, 0.5 * (u1 - u0), rows, distance)
 
 
-def overlaps_other(boxes: np.ndarray, valid: np.ndarray, k: int) -> bool:
-    """Whether another drawn person's ellipse box meets person ``k``'s (``boxes`` (N, 4) ``u0, u1, v0, v1``
-    px from :func:`ellipse_boxes`, ``valid`` (N,) bool): their silhouettes may have merged."""
-    b = np.asarray(boxes, dtype=float)
-    u0, u1, v0, v1 = b[k]
-    others = np.asarray(valid, bool) & (np.arange(len(b)) != k)
-    return bool(np.any(others & (b[:, 0] < u1) & (b[:, 1] > u0) & (b[:, 2] < v1) & (b[:, 3] > v0)))
-
-
 def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float, floor_m: float = SCATTER_FLOOR_M,
                   min_samples: int = 3) -> float:
     """How far (m) the height read above the feet may be from the person's height: ``match_m``
@@ -166,4 +155,4 @@ def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float, floor
 
 
 __all__ = ["FEET_HALF_WIDTH_SHARE", "FEET_ROWS_SHARE", "SCATTER_FLOOR_M", "ellipse_boxes", "feet_doubted",
-           "height_gate_m", "ideal_pixel", "obstacle_beside", "overlaps_other", "ray_shared"]
+           "height_gate_m", "ideal_pixel", "obstacle_beside", "ray_shared"]

@@ -45,15 +45,6 @@ class FeetConfig(Section):
         "read above them is within this many times one measurement's scatter of the person's height (at most "
         "height_match_m; anchor_gates.py); 0 = height_match_m alone (3 cost one camera held-out 420-439 0.438 -> 0.389 "
         "with the other gates, issue 37: too strict)")
-    height_scatter_floor_m: float = Field(
-        0.02, gt=0, description="with height_sigmas: the least scatter of one height measurement the gate assumes, m "
-        "(anchor_gates.py; 0.02 m with 3 sigmas is a 0.06 m gate)")
-    height_gate_near_only: bool = Field(
-        False, description="with height_sigmas: that gate only while another person's ellipse box meets the "
-        "person's (a merged silhouette); alone, height_match_m (anchor_gates.py)")
-    height_gate_min_samples: int = Field(
-        3, ge=3, description="with height_sigmas: that gate only once this many height samples are in (a settled "
-        "height); before, height_match_m (anchor_gates.py)")
     ellipse_sigma_m: float = Field(0.3, ge=0, description="uncertainty of the matched ellipse's place along the line of sight, m")
     height_match_m: float = Field(0.3, ge=0, description="the feet count only where the head's ray above them is "
                                   "this close to the person's height, m (floor-coloured legs end silhouettes at the waist)")
@@ -64,6 +55,20 @@ class FeetConfig(Section):
         0.03, gt=0, description="the same once 3 height measurements are in, m (their scatter; with depth.fuse, the "
         "least σ of a measured height)")
     min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
+
+
+class AnchorHeightConfig(Section):
+    """How tight ``feet.height_sigmas``'s gate is: the height read above the feet against the person's
+    height (:func:`worldtrack.trackers.ellipsoid.anchor_gates.height_gate_m`)."""
+
+    path: ClassVar[str] = "ellipsoid.anchor_height"
+
+    scatter_floor_m: float = Field(
+        0.02, gt=0, description="the least scatter of one height measurement the gate assumes, m (0.02 m with 3 "
+        "sigmas is a 0.06 m gate; 0.04 lost PETS start 1 IDF1 0.884 -> 0.810, issue 37)")
+    min_samples: int = Field(
+        3, ge=3, description="the gate only once this many height samples are in (a settled height); before, "
+        "feet.height_match_m")
 
 
 class DepthConfig(Section):
