@@ -6,7 +6,7 @@ import pytest
 from _line_of_sight import line_of_sight_frame, misplaced
 
 from worldtrack.trackers.ellipsoid.anchor_gates import height_gate_m, ray_shared
-from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
+from worldtrack.trackers.ellipsoid.config import AnchorHeightConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet import anchor_to_feet
 
 
@@ -85,6 +85,19 @@ def test_a_measured_height_gates_the_feet_by_its_scatter(seen):
     assert height_gate_m([1.70, 1.73, 1.67, 1.74, 1.70], 0.1, 3.0) == 0.1
 
 
+@pytest.mark.parametrize("floor_m, moves", [(0.02, 0), (0.04, 1)])
+def test_the_scatter_floor_loosens_the_height_gate(seen, floor_m, moves):
+    tracker, labels, _, truth = seen
+    # Five equal samples (no scatter): the gate is 3 x the floor, 0.06 m or 0.12 m; the height is 0.1 m off.
+    p, _ = misplaced(tracker, truth, 0.6)
+    p.height = truth["height"] + 0.1
+    p.height_samples.extend([p.height] * 5)
+    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0)
+    gate = AnchorHeightConfig(scatter_floor_m=floor_m)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig(), gate) == moves
+    assert height_gate_m([1.7] * 5, 0.3, 3.0, floor_m) == pytest.approx(3 * floor_m)
+
+
 def _with_obstacle_beside_the_feet(tracker, instance, truth, distance_m: float):
     """The tracker's views with an obstacle ``distance_m`` m from the camera (floor distance) covering a
     few pixels 3-5 columns beside the lowest pixel of the truth's silhouette (not the pixel below it)."""
@@ -110,3 +123,17 @@ def test_an_obstacle_nearer_than_the_feet_beside_them_stops_the_anchor_with_obst
     config = FeetConfig(anchor=True, head_fallback=False, obstacle_clear=True)
     # Nearer than the feet: its edge may be where the silhouette ends. Behind them (30 m): not.
     assert anchor_to_feet([p], views, {"cam": labels}, tracker.walkable, config, HeightConfig()) == moves
+
+
+@pytest.mark.parametrize("samples, moves", [(5, 1), (10, 0)])
+def test_with_min_samples_the_height_gate_waits_for_a_settled_height(seen, samples, moves):
+    tracker, labels, _, truth = seen
+    # The track's height 0.1 m over what the silhouette shows: the tight gate (0.06 m) only from 10 samples.
+    p, _ = misplaced(tracker, truth, 0.6)
+    p.height = truth["height"] + 0.1
+    p.height_samples.extend([p.height] * samples)
+    config = FeetConfig(anchor=True, head_fallback=False, height_sigmas=3.0)
+    gate = AnchorHeightConfig(min_samples=10)
+    assert anchor_to_feet([p], tracker.views, {"cam": labels}, tracker.walkable, config, HeightConfig(), gate) == moves
+    assert height_gate_m([1.7] * 9, 0.3, 3.0, 0.02, 10) == 0.3
+    assert height_gate_m([1.7] * 10, 0.3, 3.0, 0.02, 10) == pytest.approx(0.06)

@@ -39,6 +39,8 @@ True
 0.06
 >>> round(height_gate_m([1.70, 1.73, 1.67, 1.74, 1.70], 0.3, 3.0), 3)     # MAD 0.03 m
 0.133
+>>> round(height_gate_m([1.70, 1.71, 1.69, 1.72, 1.70], 0.3, 3.0, floor_m=0.04), 3)
+0.12
 """
 
 from __future__ import annotations
@@ -139,14 +141,16 @@ def feet_doubted(view, current, k: int, pixel: np.ndarray, feet_xy: np.ndarray, 
     return obstacle_beside(view.occ, pixel, 0.5 * (u1 - u0), rows, distance)
 
 
-def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float) -> float:
+def height_gate_m(samples: Sequence[float], match_m: float, sigmas: float, floor_m: float = SCATTER_FLOOR_M,
+                  min_samples: int = 3) -> float:
     """How far (m) the height read above the feet may be from the person's height: ``match_m``
-    while fewer than 3 samples are in or ``sigmas`` is 0, else ``sigmas`` × the scatter of one
-    measurement (1.4826 × MAD of ``samples``, m, at least ``SCATTER_FLOOR_M``), at most ``match_m``."""
-    if sigmas <= 0 or len(samples) < 3:
+    while fewer than ``min_samples`` (at least 3) samples are in or ``sigmas`` is 0, else ``sigmas`` ×
+    the scatter of one measurement (1.4826 × MAD of ``samples``, m, at least ``floor_m``, m), at most
+    ``match_m``."""
+    if sigmas <= 0 or len(samples) < max(3, min_samples):
         return match_m
     s = np.asarray(samples, dtype=float)
-    scatter = max(1.4826 * float(np.median(np.abs(s - np.median(s)))), SCATTER_FLOOR_M)
+    scatter = max(1.4826 * float(np.median(np.abs(s - np.median(s)))), floor_m)
     return min(match_m, sigmas * scatter)
 
 

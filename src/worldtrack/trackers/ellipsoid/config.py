@@ -27,7 +27,7 @@ from pydantic import Field, model_validator
 from worldtrack.config import Section, with_overrides
 from worldtrack.trackers.ellipsoid.cross_view_config import CrossViewConfig
 from worldtrack.trackers.ellipsoid.crowd_config import CrowdConfig
-from worldtrack.trackers.ellipsoid.depth_config import DepthConfig, FeetConfig
+from worldtrack.trackers.ellipsoid.depth_config import AnchorHeightConfig, DepthConfig, FeetConfig
 from worldtrack.trackers.ellipsoid.region_config import RegionConfig
 
 
@@ -339,6 +339,7 @@ class EllipsoidConfig(Section):
     height: HeightConfig = Field(HeightConfig(), description="measuring people's heights")
     warm_start: WarmStartConfig = Field(WarmStartConfig(), description="starting with the people in view")
     feet: FeetConfig = Field(FeetConfig(), description="depth from the feet along the line of sight")
+    anchor_height: AnchorHeightConfig = Field(AnchorHeightConfig(), description="how tight feet.height_sigmas's gate is")
     depth: DepthConfig = Field(DepthConfig(), description="depth along one camera's line of sight from every cue")
     identity: IdentityConfig = Field(IdentityConfig(), description="identity by colour")
     lost: LostConfig = Field(LostConfig(), description="tracks that ended, kept a moment to give their ids back")
@@ -359,4 +360,4 @@ class EllipsoidConfig(Section):
         }, root="ellipsoid")
 
 
-__all__ = ["BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig", "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]
+__all__ = ["AnchorHeightConfig", "BirthConfig", "ConfirmConfig", "DepthConfig", "EllipsoidConfig", "EndConfig", "FeetConfig", "HeightConfig", "IdentityConfig", "LostConfig", "MatchConfig", "RescueConfig", "ScoreConfig", "SplitConfig", "SupportConfig", "WarmStartConfig"]

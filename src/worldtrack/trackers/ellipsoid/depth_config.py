@@ -57,6 +57,20 @@ class FeetConfig(Section):
     min_px: int = Field(40, ge=0, description="only people at least this tall in the image, px")
 
 
+class AnchorHeightConfig(Section):
+    """How tight ``feet.height_sigmas``'s gate is: the height read above the feet against the person's
+    height (:func:`worldtrack.trackers.ellipsoid.anchor_gates.height_gate_m`)."""
+
+    path: ClassVar[str] = "ellipsoid.anchor_height"
+
+    scatter_floor_m: float = Field(
+        0.02, gt=0, description="the least scatter of one height measurement the gate assumes, m (0.02 m with 3 "
+        "sigmas is a 0.06 m gate; 0.04 lost PETS start 1 IDF1 0.884 -> 0.810, issue 37)")
+    min_samples: int = Field(
+        3, ge=3, description="the gate only once this many height samples are in (a settled height); before, "
+        "feet.height_match_m (10 lost PETS start 0 IDF1 0.849 -> 0.815, 1 -> 9 switches, issue 37)")
+
+
 class DepthConfig(Section):
     """Depth along one camera's line of sight from every cue, each weighed by its σ
     (:mod:`worldtrack.trackers.ellipsoid.depth`); the feet's and the head's σ are ``ellipsoid.feet``'s."""

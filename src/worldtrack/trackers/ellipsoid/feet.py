@@ -47,7 +47,7 @@ from worldtrack.trackers.base import Person
 from worldtrack.trackers.ellipsoid.anchor_footprint import standing_point
 from worldtrack.trackers.ellipsoid.anchor_gates import feet_doubted, height_gate_m
 from worldtrack.trackers.ellipsoid.cameras import CameraView
-from worldtrack.trackers.ellipsoid.config import FeetConfig, HeightConfig
+from worldtrack.trackers.ellipsoid.config import AnchorHeightConfig, FeetConfig, HeightConfig
 from worldtrack.trackers.ellipsoid.feet_pixel import feet_sigma_m
 from worldtrack.trackers.ellipsoid.head_clear import head_is_clear
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
@@ -63,7 +63,7 @@ def feet_weight(ellipse_sigma_m: float, feet_sigma_m: float) -> float:
 
 
 def anchor_to_feet(people: Sequence[Person], views: Mapping[str, CameraView], labels: Mapping[str, np.ndarray],
-                   walkable, config: FeetConfig, height: HeightConfig) -> int:
+                   walkable, config: FeetConfig, height: HeightConfig, gate: AnchorHeightConfig | None = None) -> int:
     """Move each of ``people`` along the line of sight of every camera that shows their feet
     (see the module docstring); returns how many moves were made.
 
@@ -73,6 +73,7 @@ def anchor_to_feet(people: Sequence[Person], views: Mapping[str, CameraView], la
     views, labels : the tracker's cameras and their foreground labels, by camera id
     walkable : callable — (M, 2) floor points → (M,) bool; a move off the floor is not made
     config : FeetConfig; height : HeightConfig (plausible range, the depth offset allowed)
+    gate : AnchorHeightConfig — how tight ``config.height_sigmas``'s gate is (default: its defaults)
     """
     if not config.anchor or not people:
         return 0
@@ -86,7 +87,7 @@ def anchor_to_feet(people: Sequence[Person], views: Mapping[str, CameraView], la
     moves = 0
     for cid, image_labels in labels.items():
         view = views[cid]
-        found = _feet_in_view(view, image_labels, (xy, hs, ws), people, height, config)
+        found = _feet_in_view(view, image_labels, (xy, hs, ws), people, height, config, gate or AnchorHeightConfig())
         for k, (place, sigma) in found.items():
             if seen_by[k] != 1:
                 continue
@@ -101,7 +102,7 @@ def anchor_to_feet(people: Sequence[Person], views: Mapping[str, CameraView], la
 
 
 def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray, np.ndarray, np.ndarray],
-                  persons: Sequence[Person], height: HeightConfig, config: FeetConfig
+                  persons: Sequence[Person], height: HeightConfig, config: FeetConfig, gate_config: AnchorHeightConfig
                   ) -> dict[int, tuple[np.ndarray, float]]:
     """{index: (floor point (2,), its σ along the line of sight, m)} of the people this camera shows
     clear of others: their feet, or where feet are not to be trusted, the point under the top of
@@ -144,7 +145,8 @@ def _feet_in_view(view: CameraView, labels: np.ndarray, people: tuple[np.ndarray
                 break
             look = nearer
         pixel = cam.project(found[0][None])[0] if found is not None else None
-        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas)
+        gate = height_gate_m(p.height_samples, config.height_match_m, config.height_sigmas, gate_config.scatter_floor_m,
+                             gate_config.min_samples)
         if found is not None and lo <= found[1] <= hi and abs(found[1] - hs[k]) <= gate \
                 and not touches_other(look[1], look[2], pixel, k) \
                 and not feet_doubted(view, current, k, pixel, found[0][:2], config):

@@ -186,7 +186,7 @@ class EllipsoidTracker(TrackerBase):
         if self.config.split.enabled and real:
             split = self._split(real, judged + bystanders + born, t)
             born, scores = born + split, scores + [(0.0, 0.0)] * len(split)
-        anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet, self.config.height)
+        anchor_to_feet(judged + born, self.views, self.last_labels, self.walkable, self.config.feet, self.config.height, self.config.anchor_height)
         self.depth.apply(judged + born, self.views, self.last_labels, self.walkable, dt if dt > 0 else self.frame_interval)
         if self.config.identity.enabled:  # before the life cycle: a person confirmed now is re-identified by it
             self.identity.update(judged + born, self.views, self.last_images, self.last_labels, t,
