@@ -83,9 +83,10 @@ SURE = EvidenceSettings(decide=4.0)
 
 #: ``foreground.shadow_test = "evidence-above-feet"``: :data:`SURE` calling no cloth in the lowest
 #: tenth of a changed region's object rows or below them (:func:`low_band`), where a person's contact
-#: shadow lies. On paper 000's static grid (640x480, camera 1, every 5th frame) this keeps 91 % of
-#: the body pixels that SURE turns foreground and drops 79 % of the non-body ones (a band of 0.05:
-#: 98 % / 66 %).
+#: shadow lies. On paper 000's static grid (640x480, camera 1, every 5th frame) SURE turns 18290 body
+#: and 7445 other pixels (6429 in the cast shadow) from unsure to foreground; this 16507 and 1176 (360).
+#: The tenth was chosen there, without the opening (a band of 0.05 kept 98 % of the body pixels and
+#: 34 % of the others; 0.1: 91 % / 21 %).
 ABOVE_FEET = EvidenceSettings(decide=4.0, low_band=0.1)
 
 
