@@ -64,3 +64,12 @@ def test_the_limit_is_reset_sigmas_times_the_spread_at_least_its_floor():
     wide = Person(id=2, x=0.0, y=0.0, height_samples=[1.60, 1.70, 1.80, 1.65, 1.75], height_px=[80.0] * 5)
     _feed(wide, [1.84, 1.84, 1.84], HeightConfig(samples=5, reset_sigmas=3.0, reset_after=3))
     assert wide.height_samples[:5] == [1.60, 1.70, 1.80, 1.65, 1.75]   # MAD 5 cm: 14 cm is within 3σ
+
+
+def test_doubts_that_scatter_do_not_start_the_height_over():
+    config = HeightConfig(samples=8, reset_sigmas=3.0, reset_after=3)
+    p = _person()
+    _feed(p, [1.83, 1.90, 1.78], config)                           # all off, but 12 cm apart: no one person
+    assert p.height_samples == FIRST
+    _feed(p, [1.79, 1.80], config)                                 # now three alike (1.78-1.80)
+    assert p.height_samples == [1.78, 1.79, 1.80]
