@@ -230,7 +230,9 @@ class HeightConfig(Section):
     reset_sigmas: float = Field(
         0.0, ge=0, description="when > 0, keep measuring and start a person's height samples over when reset_after "
         "measurements in a row are more than this many sigma (robust spread, >= 1.5 cm) from their median: a track "
-        "handed over to somebody else keeps the first person's height otherwise (the height_reset module)")
+        "handed over to somebody else keeps the first person's height otherwise (the height_reset module; dev "
+        "400-419, best one-camera recipe: 3 sigma x 3 / x 6: heights within 3 cm 83 -> 82 / 84 of 98, MOTA 0.759 -> "
+        "0.742 / 0.743: off)")
     reset_after: int = Field(3, ge=1, description="with reset_sigmas: disagreeing measurements in a row that start "
                                                    "the height over")
 
