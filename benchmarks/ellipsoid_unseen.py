@@ -48,6 +48,7 @@ from worldtrack.eval import drop_ignored, evaluate, evaluate_detailed  # noqa: E
 from worldtrack.experiment import (bundle_frames, gt_table, predictions_table, step_tracker,  # noqa: E402
                                    synthetic_threshold, synthetic_tracker, visibility)
 from worldtrack.foreground import make_foregrounds  # noqa: E402
+from worldtrack.foreground.background import SHADOW_TESTS  # noqa: E402
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.trackers import make_tracker  # noqa: E402
 from worldtrack.synth.unseen import FLOOR  # noqa: E402
@@ -227,7 +228,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an ellipsoid setting by dotted path; results are then only printed")
     p.add_argument("--quick", action="store_true", help="2 seeds, 60 frames, 320x240; prints only")
-    p.add_argument("--shadow-test", choices=["colour", "evidence", "evidence-sure"], default="colour",
+    p.add_argument("--shadow-test", choices=SHADOW_TESTS, default="colour",
                    help="the colour foreground's test of shadow-like pixels (foreground.shadow_test); "
                         "results are then only printed")
     args = p.parse_args(argv)

@@ -29,7 +29,10 @@ Variants (all on the colour foreground at the synthetic threshold 20 with shadow
 - ``evidence-background`` — the same test, the shadows it judges labelled background (0) instead of
   unsure (``foreground.shadow_test = "evidence-background"``);
 - ``evidence-sure`` — the evidence test deciding only on pooled evidence beyond ±4 instead of ±1.5
-  (``foreground.shadow_test = "evidence-sure"``).
+  (``foreground.shadow_test = "evidence-sure"``);
+- ``evidence-above-feet`` — ``evidence-sure`` calling no cloth in the lowest tenth of a changed
+  region's object rows or below them, where contact shadows lie
+  (``foreground.shadow_test = "evidence-above-feet"``).
 
 Seeds 100–107 by default (held out: the tests and the thresholds were worked out on seeds 0–3).
 
@@ -143,6 +146,11 @@ def variants(background: np.ndarray, floor: np.ndarray) -> dict:
     except InputError:       # the code measured has no evidence-sure test
         return out
     out["evidence-sure"] = sure.labels
+    try:
+        above = StaticBackground(background, t, "colour", shadows=True, shadow_test="evidence-above-feet")
+    except InputError:       # the code measured has no evidence-above-feet test
+        return out
+    out["evidence-above-feet"] = above.labels
     return out
 
 

@@ -63,6 +63,7 @@ from worldtrack.io.gt_import import boxes_to_world, read_boxes  # noqa: E402
 from worldtrack.trackers.base import Frame  # noqa: E402
 from worldtrack.io.tracks import TrackTable  # noqa: E402
 from worldtrack.foreground import make_foregrounds  # noqa: E402
+from worldtrack.foreground.background import SHADOW_TESTS  # noqa: E402
 from worldtrack.scene.load import load_scene  # noqa: E402
 from worldtrack.trackers import METHODS, make_tracker, method_shadow_test, method_threshold  # noqa: E402
 
@@ -213,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--methods", nargs="+", choices=METHODS, default=list(METHODS), help="the trackers to run")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="an ellipsoid setting by dotted path (e.g. identity.enabled=false); results are then only printed")
-    ap.add_argument("--shadow-test", choices=("colour", "evidence", "evidence-background", "evidence-sure"), default=None,
+    ap.add_argument("--shadow-test", choices=SHADOW_TESTS, default=None,
                     help="the foreground's shadow test for every method (default: each method's own, "
                          "evidence for the particle tracker); results are then only printed")
     ap.add_argument("--truth-beyond-m", type=float, default=0.0, metavar="M",

@@ -29,6 +29,7 @@ from common import setting_value  # noqa: E402
 
 import worldtrack.trackers as trackers  # noqa: E402
 from worldtrack.trackers.ellipsoid.config import EllipsoidConfig  # noqa: E402
+from worldtrack.foreground.background import SHADOW_TESTS  # noqa: E402
 
 
 def changed_defaults(overrides: dict, shadow_test: str | None) -> None:
@@ -55,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an ellipsoid default by dotted path (e.g. feet.anchor=true)")
-    p.add_argument("--shadow-test", choices=("colour", "evidence", "evidence-background", "evidence-sure"), default=None,
+    p.add_argument("--shadow-test", choices=SHADOW_TESTS, default=None,
                    help="the ellipsoid's own foreground shadow test")
     args = p.parse_args(argv[:cut])
     bench = argv[cut + 1:]

@@ -8,7 +8,7 @@ from worldtrack.config import from_mapping
 from worldtrack.errors import InputError
 from worldtrack.foreground import FOREGROUNDS, ForegroundConfig, StaticBackground
 from worldtrack.foreground.background import UNSURE
-from worldtrack.foreground.evidence import (EvidenceSettings, brightness_ratio, judge_by_evidence,
+from worldtrack.foreground.evidence import (ABOVE_FEET, EvidenceSettings, brightness_ratio, judge_by_evidence,
                                             judge_by_evidence_reference, texture_evidence, texture_evidence_reference)
 
 SHADOW = 3
@@ -129,7 +129,8 @@ def test_static_background_with_the_evidence_test_and_its_setting():
     changed = background != evidence
     assert np.all(evidence[changed] == UNSURE) and np.all(background[changed] == 0)   # and nothing else
     with pytest.raises(InputError, match="shadow test: expected one of 'colour', 'evidence', "
-                                         "'evidence-background', 'evidence-sure', got 'texture'"):
+                                         "'evidence-background', 'evidence-sure', 'evidence-above-feet', "
+                                         "got 'texture'"):
         StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test="texture")
     assert ForegroundConfig().shadow_test is None                           # the method's own (a run fills it in)
     assert ForegroundConfig().resolved_shadow_test() == "colour"
@@ -162,3 +163,35 @@ def test_the_sure_test_leaves_weak_evidence_unsure_and_still_calls_plain_cloth_f
     assert plain.mean() > 0.9 and np.all(sure[66:74, 36:84][plain] == 1)
     assert np.array_equal(sure[colour != UNSURE], colour[colour != UNSURE])
     assert ForegroundConfig(shadow_test="evidence-sure").resolved_shadow_test() == "evidence-sure"
+
+
+def test_above_the_feet_no_contact_shadow_becomes_cloth_and_the_trousers_above_still_do():
+    """A person: a red top (rows 10-40), trousers of the floor's grey in shade (40-70), dark shoes
+    (70-74), and under them a contact shadow that lost the floor's pattern (74-86: plain, as on
+    compressed video). "evidence-sure" calls trousers and shadow cloth; "evidence-above-feet" the
+    trousers only (the lowest tenth of the silhouette and below it stay unsure), and a plain shade
+    with no body at all stays unsure too."""
+    bg = tiled_floor(h=100)
+    img = bg.astype(float)
+    grey_shade = 0.6 * img.mean(axis=(0, 1))
+    img[10:40, 40:60] = (40, 40, 200)                                   # red top (BGR)
+    img[40:70, 42:58] = grey_shade                                      # floor-coloured trousers
+    img[70:74, 40:60] = 20                                              # shoes
+    img[74:86, 30:70] = grey_shade                                      # contact shadow, pattern lost
+    img[60:90, 95:115] = grey_shade                                     # a plain shade, nobody above
+    img = noisy(img, np.random.default_rng(2))
+    def labels(test):
+        return StaticBackground(bg, 20.0, "colour", shadows=True, shadow_test=test).labels(img)
+    colour, sure, above = labels("colour"), labels("evidence-sure"), labels("evidence-above-feet")
+    trousers, shadow, lone = (slice(42, 64), slice(44, 56)), (slice(76, 86), slice(32, 68)), \
+        (slice(62, 88), slice(97, 113))
+    for part in (trousers, shadow, lone):
+        assert (colour[part] == UNSURE).mean() > 0.9
+        assert (sure[part] == 1).mean() > 0.9
+    assert (above[trousers] == 1).mean() > 0.9
+    for part in (shadow, lone):                                         # no shade turned cloth
+        assert not np.any((above[part] == 1) & (colour[part] == UNSURE))
+    assert np.array_equal(above[colour != UNSURE], colour[colour != UNSURE])
+    same = judge_by_evidence(colour, img, bg, ABOVE_FEET)
+    assert np.array_equal(same, judge_by_evidence_reference(colour, img, bg, ABOVE_FEET))
+    assert ForegroundConfig(shadow_test="evidence-above-feet").resolved_shadow_test() == "evidence-above-feet"

@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 
 from worldtrack.errors import InputError
-from worldtrack.foreground.evidence import SURE, EvidenceSettings, judge_by_evidence
+from worldtrack.foreground.evidence import ABOVE_FEET, SURE, EvidenceSettings, judge_by_evidence
 from worldtrack.foreground.kernels import colour_labels, shadow_like
 from worldtrack.foreground.texture import relabel_cloth
 
@@ -26,7 +26,10 @@ from worldtrack.foreground.texture import relabel_cloth
 #: Label of a pixel that changed but may be a shadow: neither foreground nor background evidence.
 UNSURE = 2
 #: The tests of shadow-like changes (``StaticBackground(shadow_test=)``, ``foreground.shadow_test``).
-SHADOW_TESTS = ("colour", "evidence", "evidence-background", "evidence-sure")
+SHADOW_TESTS = ("colour", "evidence", "evidence-background", "evidence-sure", "evidence-above-feet")
+#: The evidence settings of each evidence test.
+_SETTINGS = {"evidence": EvidenceSettings(), "evidence-background": EvidenceSettings(), "evidence-sure": SURE,
+             "evidence-above-feet": ABOVE_FEET}
 
 #: MOG2/KNN output (0 background, 127 shadow, 255 foreground) → labels.
 _MOG = np.zeros(256, np.uint8)
@@ -105,7 +108,9 @@ class StaticBackground:
         the same, and the ones whose neighbourhood shows the floor's pattern through are background
         (0, judged shadows), so that a silhouette that takes in its own shadow is penalised.
         ``"evidence-sure"``: ``"evidence"`` deciding only on stronger pooled evidence
-        (:data:`~worldtrack.foreground.evidence.SURE`).
+        (:data:`~worldtrack.foreground.evidence.SURE`); ``"evidence-above-feet"``: ``"evidence-sure"``
+        calling no cloth in the lowest band of a silhouette or below it, where contact shadows lie
+        (:data:`~worldtrack.foreground.evidence.ABOVE_FEET`).
     """
 
     learns = False  #: a fixed background: the same frame always gives the same labels
@@ -166,9 +171,8 @@ class StaticBackground:
                                 self.shadows, self.shadow_min_ratio, self.shadow_distortion)
         if self.shadows and self.shadow_test != "colour":
             judged = 0 if self.shadow_test == "evidence-background" else UNSURE
-            settings = SURE if self.shadow_test == "evidence-sure" else EvidenceSettings()
-            out = judge_by_evidence(out, image, self.background, settings, candidate=UNSURE, cloth=1, shadow=judged,
-                                    grey_background=self.grey)
+            out = judge_by_evidence(out, image, self.background, _SETTINGS[self.shadow_test], candidate=UNSURE,
+                                    cloth=1, shadow=judged, grey_background=self.grey)
         if self.shadows and self.shadow_texture_ncc is not None:
             relabel_cloth(out, image, self.grey, self.shadow_texture_ncc, candidate=UNSURE)
         return _open_foreground(out, self.kernel)

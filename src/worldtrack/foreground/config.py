@@ -36,13 +36,16 @@ class ForegroundConfig(Section):
     shadow_texture_ncc: float | None = Field(
         None, ge=-1, le=1, description="with shadows: shadow-like pixels whose texture correlates with the "
                                        "background's at most this much are cloth (null: off; hurt on PETS)")
-    shadow_test: Literal["colour", "evidence", "evidence-background", "evidence-sure"] | None = Field(
+    shadow_test: Literal["colour", "evidence", "evidence-background", "evidence-sure",
+                         "evidence-above-feet"] | None = Field(
         None, description="with shadows, for grey/colour: 'colour' leaves shadow-like changes unsure; "
                           "'evidence' calls them foreground where the floor's pattern is gone or they "
                           "are darker than the frame's shadows (worldtrack.foreground.evidence); "
                           "'evidence-background' also calls the ones where the floor's pattern shows "
                           "through background; 'evidence-sure' is 'evidence' deciding only on "
-                          "pooled evidence beyond ±4, not ±1.5 (null: the method's own, evidence for the "
+                          "pooled evidence beyond ±4, not ±1.5; 'evidence-above-feet' is 'evidence-sure' "
+                          "calling no cloth in a silhouette's lowest tenth or below (contact shadows) "
+                          "(null: the method's own, evidence for the "
                           "particle tracker, else colour)")
 
     def resolved_threshold(self) -> float | None:

@@ -100,6 +100,8 @@ class Person:
     height_tries : int — frames in which a height measurement was attempted
     height_px : list of float — how large (px) the view of each height sample showed the person
         (inf: several views); the ellipsoid tracker's ``height.prefer_large`` keeps the largest
+    height_doubts : list of (float, float) — height measurements (m, view px) that disagree with the
+        samples, held back (the ellipsoid tracker's ``height.reset_sigmas``)
     support, own_share : float — the share of the person's own pixels that are foreground, and
         of their visible pixels that nobody else covers (ellipsoid tracker; NaN unknown)
     rescue_after : float — no rescue search before this time (s)
@@ -132,6 +134,7 @@ class Person:
     height_samples: list[float] = field(default_factory=list)
     height_tries: int = 0
     height_px: list[float] = field(default_factory=list)
+    height_doubts: list[tuple[float, float]] = field(default_factory=list)
     support: float = float("nan")
     own_share: float = float("nan")
     rescue_after: float = -np.inf

@@ -32,6 +32,7 @@ from worldtrack.trackers.ellipsoid.border import cut_by_border
 from worldtrack.trackers.ellipsoid.cameras import CameraView, pixel_clear
 from worldtrack.trackers.ellipsoid.config import HeightConfig
 from worldtrack.trackers.ellipsoid.forms import ellipse_crop, owner_crop
+from worldtrack.trackers.ellipsoid.height_reset import watch_samples
 from worldtrack.trackers.ellipsoid.height_sigma import height_estimate
 from worldtrack.trackers.ellipsoid.height_views import add_samples
 
@@ -284,10 +285,10 @@ def heights_due(people: Sequence[Person], config: HeightConfig, frame: int) -> l
     group rarely gives one), then one frame in five until ``config.samples`` are in: a person's
     height does not change, and the median of that many is final — unless ``config.prefer_large``:
     then one frame in five for as long as they are tracked, so that nearer views can replace far
-    ones (:mod:`.height_views`).
+    ones (:mod:`.height_views`), or ``config.reset_sigmas`` > 0: to see a new height (:mod:`.height_reset`).
     """
     return [k for k, p in enumerate(people) if p.mode == "tracking"
-            and (len(p.height_samples) < config.samples or config.prefer_large)
+            and (len(p.height_samples) < config.samples or config.prefer_large or config.reset_sigmas > 0)
             and ((len(p.height_samples) < 10 and p.height_tries < 20) or (frame + p.id) % 5 == 0)]
 
 
@@ -338,7 +339,7 @@ def update_heights(people: Sequence[Person], due: Sequence[int], views: Mapping[
             new = samples_now.get(k, [])
         if not new:
             continue
-        add_samples(p, new, config)
+        add_samples(p, watch_samples(p, new, config), config)
         if len(p.height_samples) >= 3:
             p.height = height_estimate(p.height_samples, default_height(p.id), config)
 
