@@ -42,6 +42,10 @@ class ScoreConfig(Section):
     camera_weights: Literal["current", "candidate"] = Field(
         "current", description="several cameras: weigh each camera as at the person's current place ('current'), so "
         "a candidate cannot gain by sliding out of a camera that fits badly, or at the candidate")
+    fixed_pixels: bool = Field(
+        False, description="with camera_weights 'current': a candidate's denominator in each camera also counts the "
+        "pixels its current place counts and it does not, so a camera that sees a sliver of the person past a "
+        "nearer one cannot push them away by shrinking the sliver (issue 37; off: as before)")
     target_pixels: int = Field(
         1500, ge=0, description="pixels visited per candidate set, on a stride (0 = every pixel, as published); "
         "keeps the cost independent of the image size")

@@ -97,7 +97,7 @@ class EllipsoidTracker(TrackerBase):
         self.walkable = raster.contains
         self._walk = Walkable(raster.inside, np.asarray(raster.origin, float), float(raster.resolution))
         self.scoring = Scoring(self._draw, int(cfg.score.target_pixels), cfg.score.kind == "symmetric",
-                               cfg.score.camera_weights == "current")
+                               cfg.score.camera_weights == "current", bool(cfg.score.fixed_pixels))
         m = cfg.match
         self.steps = StepArgs(float(m.step_m), float(m.min_step_m), float(m.max_step_m), int(m.iterations),
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
