@@ -10,7 +10,9 @@ work on it.
 
 With several cameras a candidate's E is Σ num / Σ den over the cameras; for a tracked person each
 camera is weighed as at the person's current place (``held``, :func:`.match.held_scores`), so a
-candidate cannot gain by sliding out of the view of a camera that fits the person badly.
+candidate cannot gain by sliding out of the view of a camera that fits the person badly. With
+``score.fixed_pixels`` each camera's denominator also counts the pixels counted at the current
+place (:mod:`.fixed_pixels`), so neither can it gain by shrinking its sliver past a nearer person.
 """
 
 from __future__ import annotations
