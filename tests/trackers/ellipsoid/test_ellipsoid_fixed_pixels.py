@@ -10,9 +10,9 @@ from worldtrack.scene import scene_from_dict
 from worldtrack.trackers.ellipsoid import EllipsoidConfig, EllipsoidTracker
 from worldtrack.geometry.camera import Camera
 from worldtrack.trackers.ellipsoid.args import Forms, People, ScoreArgs, camera_args
-from worldtrack.trackers.ellipsoid.fixed_pixels import dropped_pixels
+from worldtrack.trackers.ellipsoid.fixed_pixels import dropped_pixels, dropped_pixels_reference
 from worldtrack.trackers.ellipsoid.real import ternary_real
-from worldtrack.trackers.ellipsoid.score import _reference_masks, sample_region, score_candidates
+from worldtrack.trackers.ellipsoid.score import score_candidates
 
 C1, C2 = np.array([0.3, 0.3]), np.array([9.7, 7.7])
 AWAY = (C2 - C1) / np.linalg.norm(C2 - C1)      # c1's line of sight, away from c1 (and towards c2)
@@ -94,19 +94,12 @@ def test_dropped_pixels_equal_a_whole_frame_count():
     _, den, forms = joint.camera_sums(0, cand, True)
     dropped = joint._dropped(0, forms, 0, True)
     neighbour = People(joint.xy[1:], joint.people.heights[1:], joint.people.widths[1:])
+    n = len(cand)
+    people = People(cand, np.full(n, joint.people.heights[0]), np.full(n, joint.people.widths[0]))
     for c, cid in enumerate(joint.cids):
         view = tracker.views[cid]
-        cam, real = view.camera, joint.real[cid]
-        n = len(cand)
-        c_in, c_rg = _reference_masks(cam, np.full(real.shape, np.inf), People(cand, np.full(n, joint.people.heights[0]),
-                                      np.full(n, joint.people.widths[0])), view.args.ring_px, tracker.scoring.draw)
-        o_in, o_rg = _reference_masks(cam, np.full(real.shape, np.inf), neighbour, view.args.ring_px, tracker.scoring.draw)
-        u0, u1, v0, v1, _ = sample_region(forms[cid], real.shape, 0)
-        region = np.zeros(real.shape, bool)
-        region[v0:v1, u0:u1] = True
-        base = o_in[0] | o_rg[0] | (real > 0)
-        counted = [region & (base | c_in[j] | c_rg[j]) for j in range(n)]
-        expected = np.array([(counted[0] & ~counted[j]).sum() for j in range(n)])
+        expected = dropped_pixels_reference(view.camera, joint.real[cid], people, forms[cid], neighbour,
+                                            view.args.ring_px, tracker.scoring.draw, 0)
         np.testing.assert_allclose(dropped[c], expected, atol=2)
         assert expected[-1] > 10 or cid == "c2"
 

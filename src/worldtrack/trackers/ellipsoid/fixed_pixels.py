@@ -24,8 +24,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from worldtrack.trackers.ellipsoid.args import DrawArgs, Forms, People
 from worldtrack.trackers.ellipsoid.forms import ideal_position, inside
-from worldtrack.trackers.ellipsoid.score import sample_region
+from worldtrack.trackers.ellipsoid.score import _reference_masks, sample_region
 
 
 @njit(cache=True)
@@ -87,4 +88,33 @@ def dropped_pixels(cam, real, cand, others, ref, opts):
     return out
 
 
-__all__ = ["dropped_pixels"]
+def dropped_pixels_reference(camera, real: np.ndarray, cand: People, forms: Forms, others: People, ring_px: float,
+                             draw: DrawArgs, ref: int, count_unexplained: bool = True) -> np.ndarray:
+    """:func:`dropped_pixels` from whole-frame masks, every pixel visited (``target_pixels`` 0), no
+    obstacles: ``|D_ref \\ D_c|`` over the sampled region, ``D`` the pixels eq. 5's denominator counts.
+
+    Parameters
+    ----------
+    camera : Camera; real : (H, W) int8
+    cand : People — the candidates (C); forms : Forms — their forms (for the sampled region)
+    others : People — everybody else (M)
+    ring_px : float; draw : DrawArgs; ref : int; count_unexplained : bool
+
+    Returns
+    -------
+    (C,) float64
+    """
+    occ = np.full(real.shape, np.inf)
+    c_in, c_rg = _reference_masks(camera, occ, cand, ring_px, draw)
+    o_in, o_rg = _reference_masks(camera, occ, others, ring_px, draw)
+    u0, u1, v0, v1, _ = sample_region(forms, real.shape, 0)
+    region = np.zeros(real.shape, bool)
+    region[v0:v1, u0:u1] = True
+    base = np.zeros(real.shape, bool) | (real > 0 if count_unexplained else False)
+    for a, b in zip(o_in, o_rg):
+        base |= a | b
+    counted = [region & (base | a | b) for a, b in zip(c_in, c_rg)]
+    return np.array([(counted[ref] & ~d).sum() for d in counted], dtype=float)
+
+
+__all__ = ["dropped_pixels", "dropped_pixels_reference"]
