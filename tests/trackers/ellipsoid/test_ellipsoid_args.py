@@ -72,7 +72,8 @@ def test_every_compiled_kernel_has_a_reference_or_a_test_of_its_caller():
                        "run_rounds": "rounds_python", "walkable_lookup": "rounds_python",
                        "owner_crop": "owner_map", "inside": "ellipse_crop_reference",
                        "ideal_position": "ellipse_crop_reference", "pixels_by_rows": "score_candidates_reference",
-                       "pixels_distorted": "score_candidates_reference"}
+                       "pixels_distorted": "score_candidates_reference",
+                       "sample_region": "score_candidates_reference"}
     import importlib
     for path in PACKAGE.glob("*.py"):
         module = importlib.import_module(f"worldtrack.trackers.ellipsoid.{path.stem}")

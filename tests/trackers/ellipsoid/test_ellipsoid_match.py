@@ -80,7 +80,7 @@ def test_the_rounds_are_chosen_by_name():
 
 
 def _facing_cameras_match(camera_weights: str, python_rounds: bool = False, seed: int = 1,
-                          mode: str = "tracking") -> tuple:
+                          mode: str = "tracking", fixed_pixels: bool = False) -> tuple:
     """Two cameras facing each other across a 10 x 8 m room, a 1.7 m person at (8.0, 6.2): far from
     c1, near c2. Only c1's foreground shows them (c2's missed them). A track started on the person
     (in ``mode``) makes 5 matching calls; returns its place and E."""
@@ -91,7 +91,7 @@ def _facing_cameras_match(camera_weights: str, python_rounds: bool = False, seed
     rng = np.random.default_rng(seed)
     bgs = noise_backgrounds(scene, rng)
     cen, rad = q.person_ellipsoid([[8.0, 6.2]], 1.7, 0.45)
-    config = EllipsoidConfig(score={"camera_weights": camera_weights},
+    config = EllipsoidConfig(score={"camera_weights": camera_weights, "fixed_pixels": fixed_pixels},
                              match={"rounds": "python" if python_rounds else "compiled"})
     tracker = EllipsoidTracker(scene, make_foregrounds(scene, bgs, "colour"), config)
     real = {cid: ternary_real(tracker.views[cid].foreground.labels(frame.image), tracker.views[cid].ring_px)
@@ -128,10 +128,12 @@ def test_a_camera_that_fits_the_person_badly_does_not_push_the_track_out_of_its_
         np.testing.assert_array_equal(captured[0][0], captured[1][0])
 
 
-@pytest.mark.parametrize("camera_weights", ["current", "candidate"])
-def test_compiled_rounds_equal_the_python_rounds_with_two_cameras(camera_weights):
-    compiled = _facing_cameras_match(camera_weights, python_rounds=False)
-    python = _facing_cameras_match(camera_weights, python_rounds=True)
+@pytest.mark.parametrize("camera_weights, fixed_pixels", [("current", False), ("candidate", False), ("current", True)])
+def test_compiled_rounds_equal_the_python_rounds_with_two_cameras(camera_weights, fixed_pixels):
+    compiled = _facing_cameras_match(camera_weights, python_rounds=False, fixed_pixels=fixed_pixels)
+    python = _facing_cameras_match(camera_weights, python_rounds=True, fixed_pixels=fixed_pixels)
+    if fixed_pixels:  # and the fixed pixels change the scores (the person's pixels in c2 are background)
+        assert not np.allclose(np.array(compiled[1]), np.array(_facing_cameras_match(camera_weights)[1]))
     np.testing.assert_allclose(compiled[0], python[0], atol=1e-12)
     np.testing.assert_allclose(np.array(compiled[1]), np.array(python[1]), atol=1e-12)
 

@@ -177,12 +177,15 @@ class Scoring(NamedTuple):
     target_pixels : int — pixels visited per candidate set (0: all)
     symmetric : bool — count the foreground no ellipse explains, for tracked people
     held : bool — with several cameras, weigh each camera as at a tracked person's current place
+    fixed_pixels : bool — with ``held``, also score each camera on the pixels counted at the current
+        place (:mod:`.fixed_pixels`)
     """
 
     draw: DrawArgs
     target_pixels: int
     symmetric: bool
     held: bool
+    fixed_pixels: bool = False
 
 
 class StepArgs(NamedTuple):

@@ -42,6 +42,10 @@ class ScoreConfig(Section):
     camera_weights: Literal["current", "candidate"] = Field(
         "current", description="several cameras: weigh each camera as at the person's current place ('current'), so "
         "a candidate cannot gain by sliding out of a camera that fits badly, or at the candidate")
+    fixed_pixels: bool = Field(
+        False, description="with camera_weights 'current': a candidate's denominator in each camera also counts the "
+        "pixels its current place counts and it does not, so a camera that sees a sliver of the person past a "
+        "nearer one cannot push them away by shrinking the sliver (issue 37; off: as before)")
     target_pixels: int = Field(
         1500, ge=0, description="pixels visited per candidate set, on a stride (0 = every pixel, as published); "
         "keeps the cost independent of the image size")
@@ -73,6 +77,8 @@ class MatchConfig(Section):
     max_speed_mps: float = Field(3.0, gt=0, description="velocities are clipped to this speed (a running person), m/s")
     velocity_along_ray: float = Field(1.0, ge=0, le=1, description="velocity_smoothing's share along the line of sight "
         "of the one camera that showed a person (1 = all, the default; PETS 2009 at 0.4: 0.251 -> 0.238 m, MOTA 0.926 -> 0.912)")
+    velocity_sure_sigma_m: float = Field(0.0, ge=0, description="velocity_smoothing's share along the line of sight "
+        "follows how well E places the person there: (this / the along-ray sigma)^2, at most 1; 0 = off (issue 37)")
     rounds: Literal["compiled", "python"] = Field("compiled", description="the compiled rounds, or their readable Python reference (same tracks, slower)")
 
     @model_validator(mode="after")

@@ -10,7 +10,9 @@ work on it.
 
 With several cameras a candidate's E is Σ num / Σ den over the cameras; for a tracked person each
 camera is weighed as at the person's current place (``held``, :func:`.match.held_scores`), so a
-candidate cannot gain by sliding out of the view of a camera that fits the person badly.
+candidate cannot gain by sliding out of the view of a camera that fits the person badly. With
+``score.fixed_pixels`` each camera's denominator also counts the pixels counted at the current
+place (:mod:`.fixed_pixels`), so neither can it gain by shrinking its sliver past a nearer person.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 
 from worldtrack.trackers.ellipsoid.args import Forms, People, ScoreArgs, Scoring, Walkable
 from worldtrack.trackers.ellipsoid.cameras import CameraView, ray_direction
+from worldtrack.trackers.ellipsoid.fixed_pixels import dropped_pixels
 from worldtrack.trackers.ellipsoid.match import held_scores
 from worldtrack.trackers.ellipsoid.score import score_camera
 
@@ -70,7 +73,10 @@ class JointImage:
         s = self.settings
         num, den, forms = self.camera_sums(k, cand, use_ring)
         if current is not None and s.held and len(self.cids) > 1:
-            return held_scores(num, den, current), den.sum(axis=0), forms  # (one camera: the same)
+            total = den.sum(axis=0)
+            if s.fixed_pixels:
+                den = den + self._dropped(k, forms, current, use_ring)
+            return held_scores(num, den, current), total, forms  # (one camera: the same)
         num, den = num.sum(axis=0), den.sum(axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):
             e = np.where(den > 0, num / np.maximum(den, 1e-12), -np.inf)
@@ -91,6 +97,20 @@ class JointImage:
                                                               widths, s.draw, self.state[cid], k, opts)
             forms[cid] = Forms(ci, cr, cb, cv, cd)
         return num, den, forms
+
+    def _dropped(self, k: int, forms: Mapping[str, Forms], current: int, use_ring: bool) -> np.ndarray:
+        """(C, J): per camera, the pixels candidate ``current`` of ``forms`` counts and each
+        candidate does not (:func:`.fixed_pixels.dropped_pixels`), everybody else fixed."""
+        s = self.settings
+        opts = ScoreArgs(use_ring, int(s.target_pixels), use_ring and s.symmetric)
+        out = []
+        for cid in self.cids:
+            st = self.state[cid]
+            valid = st.valid.copy()
+            valid[k] = False
+            out.append(dropped_pixels(self.views[cid].args, self.real[cid], forms[cid], st._replace(valid=valid),
+                                      current, opts))
+        return np.array(out)
 
     def move(self, k: int, place: np.ndarray, forms: Mapping[str, Forms], b: int) -> None:
         """Person ``k`` moves to ``place`` (2,), candidate ``b`` of ``forms`` (from :meth:`score`)."""

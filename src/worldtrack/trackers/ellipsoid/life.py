@@ -166,6 +166,9 @@ class LifeCycle:
         #: The floor ray (2,) of the one camera that showed a person, whose velocity gain along it is
         #: ``match.velocity_along_ray`` of the rest (:mod:`.ray_velocity`); None: the same gain.
         self.velocity_ray: Callable[[Person], np.ndarray | None] = lambda p: None
+        #: (A line of sight (2,), the velocity gain's share along it) from how well E places a person
+        #: there (``match.velocity_sure_sigma_m``, :func:`.ray_velocity.flat_ray`); None: no damping.
+        self.velocity_flat: Callable[[Person], tuple[np.ndarray, float] | None] = lambda p: None
 
     def end(self, p: Person) -> None:
         """Take person ``p`` off the map (if still there)."""
@@ -251,10 +254,13 @@ class LifeCycle:
         a = self.config.match.velocity_smoothing
         vx = (1 - a) * p.vx + a * (p.x - p.prev_x) / dt
         vy = (1 - a) * p.vy + a * (p.y - p.prev_y) / dt
-        ray = self.velocity_ray(p)
+        ray, share = self.velocity_ray(p), self.config.match.velocity_along_ray
+        flat = self.velocity_flat(p)
+        if flat is not None and (ray is None or flat[1] < share):
+            ray, share = flat  # the smaller share of the two
         if ray is not None:
             moved = np.array([p.x - p.prev_x, p.y - p.prev_y]) / dt
-            v = damped_velocity(np.array([p.vx, p.vy]), moved, a, self.config.match.velocity_along_ray, ray)
+            v = damped_velocity(np.array([p.vx, p.vy]), moved, a, share, ray)
             vx, vy = float(v[0]), float(v[1])
         speed = math.hypot(vx, vy)
         scale = min(1.0, self.config.match.max_speed_mps / speed) if speed > 0 else 1.0

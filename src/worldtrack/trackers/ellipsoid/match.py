@@ -24,6 +24,7 @@ from numba import njit
 
 from worldtrack.registry import Registry
 from worldtrack.trackers.ellipsoid.args import Forms, ScoreArgs, StepArgs
+from worldtrack.trackers.ellipsoid.fixed_pixels import dropped_pixels
 from worldtrack.trackers.ellipsoid.score import score_camera
 
 if TYPE_CHECKING:
@@ -136,7 +137,9 @@ def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scor
     steps : StepArgs
     scoring : Scoring — how candidates are drawn and scored; ``held``: score the candidates
         of tracked people (not those in capture mode, still sliding into their blob) with
-        :func:`held_scores`, cameras weighed as at the current place, instead of Σ num / Σ den
+        :func:`held_scores`, cameras weighed as at the current place, instead of Σ num / Σ den;
+        with ``fixed_pixels`` too, each camera's denominators also count the pixels counted at the
+        current place (:func:`~.fixed_pixels.dropped_pixels`)
 
     Returns
     -------
@@ -203,6 +206,13 @@ def run_rounds(people, n_moving, use_ring, cams, reals, state, walk, steps, scor
                 best_den[k] = den_all[STAY]
                 continue
             if scoring.held and C > 1 and use_ring[k]:  # tracked people; one camera: the same either way
+                if scoring.fixed_pixels:
+                    for c in range(C):
+                        ov = s_valid[c].copy()
+                        ov[k] = False
+                        den[c] += dropped_pixels(cams[c], reals[c], Forms(f_inner[c], f_ring[c], f_box[c], f_valid[c],
+                                                                          f_dist[c]),
+                                                 Forms(s_inner[c], s_ring[c], s_box[c], ov, s_dist[c]), STAY, opts)
                 e = held_scores(num, den, STAY)
             else:
                 num_all = num.sum(axis=0)

@@ -57,6 +57,26 @@ from worldtrack.trackers.ellipsoid.pixels import pixels_by_rows, pixels_distorte
 
 
 @njit(cache=True)
+def sample_region(cand, shape, target_pixels):
+    """The region :func:`score_candidates` samples for candidates ``cand`` (Forms, C) in an image of
+    ``shape`` (H, W): the union of their boxes ``u0, u1, v0, v1`` (empty: u0 ≥ u1 or v0 ≥ v1) and
+    the stride that visits about ``target_pixels`` pixels of it (1 when ``target_pixels`` is 0)."""
+    c_box, c_valid = cand.box, cand.valid
+    H, W = shape
+    u0, u1, v0, v1 = W, 0, H, 0
+    for c in range(cand.inner.shape[0]):
+        if c_valid[c] and c_box[c, 0] < c_box[c, 1] and c_box[c, 2] < c_box[c, 3]:
+            u0 = min(u0, c_box[c, 0])
+            u1 = max(u1, c_box[c, 1])
+            v0 = min(v0, c_box[c, 2])
+            v1 = max(v1, c_box[c, 3])
+    stride = 1
+    if target_pixels > 0 and u0 < u1 and v0 < v1:
+        stride = max(1, int(math.sqrt((u1 - u0) * (v1 - v0) / target_pixels)))
+    return u0, u1, v0, v1, stride
+
+
+@njit(cache=True)
 def score_candidates(cam, real, cand, others, opts):
     """Numerators and denominators of E for C candidates of one person in one camera.
 
@@ -76,23 +96,13 @@ def score_candidates(cam, real, cand, others, opts):
     num, den : (C,) float64 — E = num / den where den > 0
     n_in : (C,) int64 — visited pixels inside the candidate's own visible ellipse
     """
-    c_box, c_valid, o_box, o_valid = cand.box, cand.valid, others.box, others.valid
+    o_box, o_valid = others.box, others.valid
     C = cand.inner.shape[0]
     M = others.inner.shape[0]
     sums = Sums(np.zeros(C), np.zeros(C), np.zeros(C, dtype=np.int64))
-    H, W = real.shape
-    u0, u1, v0, v1 = W, 0, H, 0
-    for c in range(C):
-        if c_valid[c] and c_box[c, 0] < c_box[c, 1] and c_box[c, 2] < c_box[c, 3]:
-            u0 = min(u0, c_box[c, 0])
-            u1 = max(u1, c_box[c, 1])
-            v0 = min(v0, c_box[c, 2])
-            v1 = max(v1, c_box[c, 3])
+    u0, u1, v0, v1, stride = sample_region(cand, real.shape, opts.target_pixels)
     if u0 >= u1 or v0 >= v1:
         return sums.num, sums.den, sums.n_in
-    stride = 1
-    if opts.target_pixels > 0:
-        stride = max(1, int(math.sqrt((u1 - u0) * (v1 - v0) / opts.target_pixels)))
     # Others whose ring box overlaps the region.
     near = np.empty(M, dtype=np.int64)
     n_near = 0
@@ -241,4 +251,4 @@ def _reference_masks(camera, occ: np.ndarray, people: People, ring_px: float,
     return ins, rng
 
 
-__all__ = ["score_camera", "score_candidates", "score_candidates_reference"]
+__all__ = ["sample_region", "score_camera", "score_candidates", "score_candidates_reference"]

@@ -14,14 +14,12 @@ One :meth:`EllipsoidTracker.step`:
    cue (:mod:`.depth`);
 5. measure each person's support (:mod:`.support`), then confirm, follow or end them
    (:mod:`.life`), flag the unmeasurable, measure heights (:mod:`.height`), end duplicates;
-6. measure each person's position uncertainty σ, filter their velocity and say their state
-   (:mod:`.uncertainty`).
+6. measure each person's position uncertainty σ, filter their velocity and say their state (:mod:`.uncertainty`).
 
-Everything needed to continue a person is on the :class:`~worldtrack.trackers.base.Person` in the
-map, so several trackers, each with its own cameras, can share one map: each moves and judges the
-people its cameras show and the people no camera on the map shows, and leaves the others (whom
-another tracker's cameras show) to that tracker; per-frame counters and the prediction advance
-once per time stamp whichever tracker steps first.
+Everything needed to continue a person is on the :class:`~worldtrack.trackers.base.Person` in the map, so
+several trackers, each with its own cameras, can share one map: each moves and judges the people its cameras
+show and the people no camera on the map shows, and leaves the others (whom another tracker's cameras show)
+to that tracker; per-frame counters and the prediction advance once per time stamp whichever tracker steps first.
 """
 
 from __future__ import annotations
@@ -49,6 +47,7 @@ from worldtrack.trackers.ellipsoid.kept_heights import KeptHeights
 from worldtrack.trackers.ellipsoid.life import LifeCycle
 from worldtrack.trackers.ellipsoid.match import ROUNDS, Rounds
 from worldtrack.trackers.ellipsoid.prediction import MeasuredShare, lone_camera, predicted_places
+from worldtrack.trackers.ellipsoid.ray_velocity import flat_rays
 from worldtrack.trackers.ellipsoid.real import ternary_real
 from worldtrack.trackers.ellipsoid.exits import left_the_view
 from worldtrack.trackers.ellipsoid.reentry import LostTracks
@@ -97,7 +96,7 @@ class EllipsoidTracker(TrackerBase):
         self.walkable = raster.contains
         self._walk = Walkable(raster.inside, np.asarray(raster.origin, float), float(raster.resolution))
         self.scoring = Scoring(self._draw, int(cfg.score.target_pixels), cfg.score.kind == "symmetric",
-                               cfg.score.camera_weights == "current")
+                               cfg.score.camera_weights == "current", bool(cfg.score.fixed_pixels))
         m, crowd = cfg.match, cfg.crowd
         self.steps = StepArgs(float(m.step_m), float(m.min_step_m), float(m.max_step_m), int(m.iterations),
                               int(m.max_iterations), bool(m.adaptive_step), float(m.min_gain))
@@ -135,6 +134,8 @@ class EllipsoidTracker(TrackerBase):
             self.life.coasting = self._coasting
         if cfg.match.velocity_along_ray != 1.0:
             self.life.velocity_ray = self._lone_ray
+        if cfg.match.velocity_sure_sigma_m > 0:
+            self.life.velocity_flat = flat_rays(self.uncertainty.components, cfg.match.velocity_sure_sigma_m)
 
     # ------------------------------------------------------------------ the Tracker protocol
     def init_track(self, x: float, y: float, track_id: int | None = None, t: float = 0.0,
@@ -392,9 +393,7 @@ class EllipsoidTracker(TrackerBase):
 def _people(people: Sequence[Person]) -> People:
     """Floor positions (N, 2), heights (N,) and widths (N,) of ``people``."""
     xy = np.array([[p.x, p.y] for p in people], dtype=float).reshape(-1, 2)
-    hs = np.array([p.height for p in people], dtype=float)
-    ws = np.array([p.width for p in people], dtype=float)
-    return People(xy, hs, ws)
+    return People(xy, np.array([p.height for p in people], dtype=float), np.array([p.width for p in people], dtype=float))
 
 
 __all__ = ["EllipsoidTracker"]
