@@ -91,6 +91,42 @@ def save_walks(name: str, title: str, text: str, args: argparse.Namespace, secon
     save_result(name + (f"_{args.tag}" if args.tag else ""), title, text, args.quick, seconds, script=name)
 
 
+def add_estimate_flags(ap: argparse.ArgumentParser, name: str) -> None:
+    """Issue 34's opt-in estimate options as flags: ``--route-timing`` (``TrajectoryOptions.route_timing``),
+    ``--outward`` (``SolverOptions.outward_curvature``) and, with it, ``--shrink`` (``shrink_on_reject``) and
+    ``--finish`` (``finish_newton``). Any of them writes ``results/<name>`` with :func:`estimate_tail`'s suffix and
+    no picture."""
+    ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
+                    help=f"TrajectoryOptions.route_timing (opt-in cubic, 34m): writes results/{name}_cubic.md, "
+                         "no picture")
+    ap.add_argument("--outward", type=float, default=None,
+                    help=f"SolverOptions.outward_curvature (opt-in, 34n): writes results/{name}_outward.md, no picture")
+    ap.add_argument("--shrink", action="store_true", help="with --outward also SolverOptions.shrink_on_reject (34g); "
+                    "adds _shrink to the results file")
+    ap.add_argument("--finish", action="store_true", help="with --outward also SolverOptions.finish_newton (34o); "
+                    "adds _finish to the results file")
+
+
+def estimate_options(args: argparse.Namespace) -> dict:
+    """Keyword options of ``estimate_trajectory`` from :func:`add_estimate_flags`' flags."""
+    from worldtrack.trajectory.solver import SolverOptions
+
+    extra: dict = {"route_timing": args.route_timing}
+    if args.outward is not None:
+        extra["solver"] = SolverOptions(outward_curvature=args.outward, shrink_on_reject=args.shrink,
+                                        finish_newton=args.finish)
+    return extra
+
+
+def estimate_tail(args: argparse.Namespace) -> tuple[str, str]:
+    """(results file suffix, title suffix) of :func:`add_estimate_flags`' flags; ("", "") for the defaults."""
+    cubic, outward = args.route_timing != "constant", args.outward is not None
+    tail = ("_shrink" if outward and args.shrink else "") + ("_finish" if outward and args.finish else "")
+    return (("_cubic" if cubic else "") + ("_outward" if outward else "") + tail,
+            (" (route_timing='cubic')" if cubic else "") + (f" (outward_curvature={args.outward})" if outward else "")
+            + tail.replace("_", " "))
+
+
 def least_cpu(fn, repeats: int):
     """(least CPU seconds of ``repeats`` calls of ``fn``, the last call's result)."""
     best, out = float("inf"), None

@@ -48,13 +48,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import RESULTS, markdown_table, save_result  # noqa: E402
-from trajectory_common import Score, baseline, score, winners  # noqa: E402
+from trajectory_common import (Score, add_estimate_flags, baseline, estimate_options, estimate_tail,  # noqa: E402
+                               score, winners)
 
 from worldtrack.synth import make_scenario  # noqa: E402
 from worldtrack.synth.observations import head_pixels, head_tracks  # noqa: E402
 from worldtrack.trajectory.estimate import TrajectoryOptions, estimate_trajectory  # noqa: E402
 from worldtrack.trajectory.observation import Observations  # noqa: E402
-from worldtrack.trajectory.solver import SolverOptions  # noqa: E402
 from worldtrack.viz.trajectory import observation_points, save_height_plot, save_trajectory_plan  # noqa: E402
 
 VARIANTS = ("MAP (height known)", "MAP (height 1.70 m)", "MAP without barrier", "Kalman+RTS (height known)",
@@ -159,20 +159,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", default="20-29", help="scenario seeds, e.g. 20-29 or 20,22")
     ap.add_argument("--frames", type=int, default=1200)
     ap.add_argument("--quick", action="store_true", help="two seeds of 600 frames; prints only")
-    ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
-                    help="TrajectoryOptions.route_timing of every estimate (opt-in cubic, 34m): writes "
-                         "results/trajectory_office_cubic.md, no pictures")
-    ap.add_argument("--outward", type=float, default=None,
-                    help="SolverOptions.outward_curvature of every estimate (opt-in, 34n): writes _outward.md, no pictures")
-    ap.add_argument("--shrink", action="store_true", help="with --outward also SolverOptions.shrink_on_reject (34g); "
-                    "adds _shrink to the results file")
-    ap.add_argument("--finish", action="store_true", help="with --outward also SolverOptions.finish_newton (34o); "
-                    "adds _finish to the results file")
+    add_estimate_flags(ap, "trajectory_office")
     args = ap.parse_args(argv)
-    extra = {"route_timing": args.route_timing}
-    if args.outward is not None:
-        extra["solver"] = SolverOptions(outward_curvature=args.outward, shrink_on_reject=args.shrink,
-                                        finish_newton=args.finish)
+    extra = estimate_options(args)
     seeds = parse_seeds(args.seeds)[:2] if args.quick else parse_seeds(args.seeds)
     frames = 600 if args.quick else args.frames
     t_start = time.perf_counter()
@@ -208,13 +197,11 @@ def main(argv: list[str] | None = None) -> int:
             f"people; windows won (race by gap only): {window_wins or 'none'}.\n\n"
             f"## Per person (height known)\n\n{per}\n")
     print(text)
-    cubic, outward = args.route_timing != "constant", args.outward is not None
-    if best and not args.quick and not (cubic or outward):
+    suffix, title_suffix = estimate_tail(args)
+    if best and not args.quick and not suffix:
         picture(best)
-    tail = ("_shrink" if outward and args.shrink else "") + ("_finish" if outward and args.finish else "")
-    save_result("trajectory_office" + ("_cubic" if cubic else "") + ("_outward" if outward else "") + tail,
-                "Seed 002: office with detours, MAP vs Kalman + RTS" + (" (route_timing='cubic')" if cubic else "")
-                + (f" (outward_curvature={args.outward})" if outward else "") + tail.replace("_", " "), text, args.quick,
+    save_result("trajectory_office" + suffix, "Seed 002: office with detours, MAP vs Kalman + RTS"
+                + title_suffix, text, args.quick,
                 time.perf_counter() - t_start, script="trajectory_office")
     return 0
 

@@ -48,13 +48,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import RESULTS, ROOT, markdown_table, save_result  # noqa: E402
-from trajectory_common import Score, baseline, score, winners  # noqa: E402
+from trajectory_common import (Score, add_estimate_flags, baseline, estimate_options, estimate_tail,  # noqa: E402
+                               score, winners)
 
 from worldtrack.scene.load import scene_from_dict  # noqa: E402
 from worldtrack.trajectory.environment import field_from_walkable, rasterise_segments  # noqa: E402
 from worldtrack.trajectory.estimate import TrajectoryOptions, estimate_trajectory  # noqa: E402
 from worldtrack.trajectory.observation import Observations  # noqa: E402
-from worldtrack.trajectory.solver import SolverOptions  # noqa: E402
 
 SEQUENCES = {"seq_eth": ("eth_ewap/seq_eth", 4), "seq_hotel": ("eth_ewap/seq_hotel", 3),
              "zara01": ("ucy_zara01", 4)}
@@ -245,20 +245,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", default="0,1,2", help="camera placements (with heights and noise), e.g. 0,1,2")
     ap.add_argument("--quick", action="store_true", help="seed 0, 8 people per sequence; prints only")
-    ap.add_argument("--route-timing", default="constant", choices=["constant", "cubic"],
-                    help="TrajectoryOptions.route_timing (opt-in cubic, 34m): writes results/trajectory_real_cubic.md, "
-                         "no picture")
-    ap.add_argument("--outward", type=float, default=None,
-                    help="SolverOptions.outward_curvature (opt-in, 34n): writes results/trajectory_real_outward.md, no picture")
-    ap.add_argument("--shrink", action="store_true", help="with --outward also SolverOptions.shrink_on_reject (34g); "
-                    "adds _shrink to the results file")
-    ap.add_argument("--finish", action="store_true", help="with --outward also SolverOptions.finish_newton (34o); "
-                    "adds _finish to the results file")
+    add_estimate_flags(ap, "trajectory_real")
     args = ap.parse_args(argv)
-    extra = {"route_timing": args.route_timing}
-    if args.outward is not None:
-        extra["solver"] = SolverOptions(outward_curvature=args.outward, shrink_on_reject=args.shrink,
-                                        finish_newton=args.finish)
+    extra = estimate_options(args)
     root = data_root()
     missing = [n for n, (f, _) in SEQUENCES.items() if not (root / f / "obsmat.txt").is_file()]
     if len(missing) == len(SEQUENCES):
@@ -267,17 +256,15 @@ def main(argv: list[str] | None = None) -> int:
     t_start = time.perf_counter()
     seeds = [0] if args.quick else [int(s) for s in args.seeds.split(",")]
     keep: dict = {}
-    cubic, outward = args.route_timing != "constant", args.outward is not None
-    sections = [report(seed, root, missing, args.quick, keep if seed == seeds[0] and not (cubic or outward) else {},
+    suffix, title_suffix = estimate_tail(args)
+    sections = [report(seed, root, missing, args.quick, keep if seed == seeds[0] and not suffix else {},
                        t_start, extra) for seed in seeds]
     text = ("Head heights U(1.6, 1.8) m, estimated with 1.70 m; 2 px noise; grid 0.4 s.\n\n" + "\n".join(sections))
     print(text)
     if keep and not args.quick:
         picture(keep)
-    tail = ("_shrink" if outward and args.shrink else "") + ("_finish" if outward and args.finish else "")
-    save_result("trajectory_real" + ("_cubic" if cubic else "") + ("_outward" if outward else "") + tail,
-                "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)" + (" (route_timing='cubic')" if cubic else "")
-                + (f" (outward_curvature={args.outward})" if outward else "") + tail.replace("_", " "), text, args.quick,
+    save_result("trajectory_real" + suffix, "Seed 002 on ETH EWAP and UCY zara01 (virtual cameras)"
+                + title_suffix, text, args.quick,
                 time.perf_counter() - t_start, script="trajectory_real")
     return 0
 
