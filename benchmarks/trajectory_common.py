@@ -86,6 +86,20 @@ def rows_of_walks(sizes: list[int], seeds: list[int], labels: dict[int, str], ro
     return rows
 
 
+def iteration_totals(rows: list[list], sizes: list[int], variants: int, note=None) -> list[list]:
+    """Per walk size a row "all" summing the iterations (each cell's leading integer) of the default (column 2)
+    and of each of ``variants`` columns after it; ``note(cells)`` (optional) adds a text after a variant's sum."""
+    totals = []
+    for T in sizes:
+        mine = [r for r in rows if r[0] == T]
+
+        def its(i: int) -> int:
+            return sum(int(str(r[i]).split()[0]) for r in mine)
+        totals.append([T, "all", its(2), *(its(3 + k) if note is None else
+                                           f"{its(3 + k)}, {note([r[3 + k] for r in mine])}" for k in range(variants))])
+    return totals
+
+
 def save_walks(name: str, title: str, text: str, args: argparse.Namespace, seconds: float) -> None:
     """``save_result`` for a walk benchmark: ``results/<name>[_<tag>].md`` (``--tag``, :func:`add_seed_blocks`)."""
     save_result(name + (f"_{args.tag}" if args.tag else ""), title, text, args.quick, seconds, script=name)

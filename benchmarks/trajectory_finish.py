@@ -27,8 +27,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table  # noqa: E402
-from trajectory_common import (add_seed_blocks, block_of, rows_of_walks, save_walks, walks_of,  # noqa: E402
-                               walks_parser)
+from trajectory_common import (add_seed_blocks, block_of, iteration_totals, rows_of_walks, save_walks,  # noqa: E402
+                               walks_of, walks_parser)
 from trajectory_timing_steps import setup  # noqa: E402
 
 from worldtrack.errors import InputError  # noqa: E402
@@ -96,12 +96,8 @@ def main(argv: list[str] | None = None) -> int:
     cpu, sizes, seeds, _ = walks_of(args)
     t0 = time.perf_counter()
     rows = rows_of_walks(sizes, seeds, block_of(args), lambda T, seed, block: row(T, seed, block, sets))
-    totals = []
-    for T in sizes:
-        mine = [r for r in rows if r[0] == T]
-        its = lambda i: sum(int(str(r[i]).split()[0]) for r in mine)  # noqa: E731
-        above = lambda i: sum(float(str(r[i]).split()[-3]) > BAR for r in mine)  # noqa: E731
-        totals.append([T, "all", its(2), *(f"{its(3 + k)}, {above(3 + k)} above {BAR:g}" for k in range(len(sets)))])
+    totals = iteration_totals(rows, sizes, len(sets),
+                              lambda cells: f"{sum(float(str(c).split()[-3]) > BAR for c in cells)} above {BAR:g}")
     text = f"({cpu})\n\n" + markdown_table(
         ["T", "walk", "default: iterations", *(f"{s}: iterations, F ÷ default − 1, largest gap" for s in args.sets)],
         rows + totals)

@@ -29,8 +29,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import markdown_table  # noqa: E402
-from trajectory_common import (add_seed_blocks, block_of, least_cpu, rows_of_walks, save_walks,  # noqa: E402
-                               walks_of, walks_parser)
+from trajectory_common import (add_seed_blocks, block_of, iteration_totals, least_cpu, rows_of_walks,  # noqa: E402
+                               save_walks, walks_of, walks_parser)
 from trajectory_timing_steps import setup  # noqa: E402
 
 from worldtrack.trajectory.solver import levenberg_marquardt  # noqa: E402
@@ -57,11 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     factors = [float(f) for f in args.factors.split(",")]
     t0 = time.perf_counter()
     rows = rows_of_walks(sizes, seeds, block_of(args), lambda T, seed, block: row(T, seed, block, factors, repeats))
-    totals = []
-    for T in sizes:
-        mine = [r for r in rows if r[0] == T]
-        its = lambda i: sum(int(str(r[i]).split()[0]) for r in mine)  # noqa: E731
-        totals.append([T, "all", its(2), *(its(3 + k) for k in range(len(factors)))])
+    totals = iteration_totals(rows, sizes, len(factors))
     text = f"({cpu})\n\n" + markdown_table(
         ["T", "walk", "default: iterations", *(f"factor {f}: iterations (F ÷ default − 1, largest gap) CPU ÷ default"
                                                for f in factors)], rows + totals)
